@@ -1,0 +1,84 @@
+//! The output helpers: atomic writes, SHA-256, hexadecimal.
+
+use asset::{hex, sha256, sha256_file, sha256_from_hex, write_atomic};
+
+/// FIPS 180-2, appendix B.1.
+const ABC_SHA256: &str = "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad";
+
+fn entries(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn sha256_matches_the_standard_test_vector() {
+    assert_eq!(hex(&sha256(b"abc")), ABC_SHA256);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("abc");
+    std::fs::write(&path, b"abc").unwrap();
+    assert_eq!(hex(&sha256_file(&path).unwrap()), ABC_SHA256);
+}
+
+#[test]
+fn sha256_file_streams_files_larger_than_its_buffer() {
+    let bytes: Vec<u8> = (0..1_000_003u32).map(|i| (i * 7 + i / 251) as u8).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big");
+    std::fs::write(&path, &bytes).unwrap();
+    assert_eq!(sha256_file(&path).unwrap(), sha256(&bytes));
+}
+
+#[test]
+fn hex_parses_back_and_rejects_what_the_schema_rejects() {
+    let hash = sha256(b"abc");
+    assert_eq!(sha256_from_hex(&hex(&hash)), Some(hash));
+    assert_eq!(hex(&[0x00, 0x0f, 0xf0, 0xff]), "000ff0ff");
+    let upper = ABC_SHA256.to_uppercase();
+    let plus = format!("+{}", &ABC_SHA256[1..]);
+    for bad in [&ABC_SHA256[..62], &upper, &plus, "", &format!("{ABC_SHA256}00")] {
+        assert_eq!(sha256_from_hex(bad), None, "{bad}");
+    }
+}
+
+#[test]
+fn write_atomic_replaces_the_file_and_leaves_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.bin");
+    write_atomic(&path, b"first").unwrap();
+    write_atomic(&path, b"second").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"second");
+    assert_eq!(entries(dir.path()), ["out.bin"]);
+}
+
+/// The result must be as readable as a file written by `File::create`, not owner-only like the
+/// temporary file it started as.
+#[cfg(unix)]
+#[test]
+fn write_atomic_gives_ordinary_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let atomic = dir.path().join("atomic");
+    let plain = dir.path().join("plain");
+    write_atomic(&atomic, b"x").unwrap();
+    std::fs::write(&plain, b"x").unwrap();
+    let mode = |p: &std::path::Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&atomic), mode(&plain));
+}
+
+#[test]
+fn a_failed_write_leaves_the_target_and_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    // Renaming a file over a non-empty folder fails on every platform.
+    let target = dir.path().join("occupied");
+    std::fs::create_dir(&target).unwrap();
+    std::fs::write(target.join("keep"), b"keep").unwrap();
+    assert!(write_atomic(&target, b"new").is_err());
+    assert_eq!(entries(dir.path()), ["occupied"]);
+    assert_eq!(std::fs::read(target.join("keep")).unwrap(), b"keep");
+
+    let missing = dir.path().join("missing/out.bin");
+    assert!(write_atomic(&missing, b"new").is_err());
+    assert!(!dir.path().join("missing").exists());
+}

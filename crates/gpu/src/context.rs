@@ -1,0 +1,123 @@
+//! A headless wgpu device for compute and offscreen work, on whatever adapter the machine has:
+//! a real GPU, or lavapipe (Mesa's software Vulkan driver) in CI.
+
+use crate::error::GpuError;
+use crate::merl_lookup::table_bytes;
+
+/// An adapter, its device and its queue. Created once per process (a device on lavapipe takes
+/// tens of milliseconds, a MERL table upload more); share it by reference.
+#[derive(Debug)]
+pub struct Gpu {
+    info: wgpu::AdapterInfo,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+}
+
+impl Gpu {
+    /// Opens the preferred adapter: Vulkan first (the backend CI runs on, through lavapipe), then
+    /// a real GPU before a software one. `WGPU_BACKEND` and the other wgpu variables are honoured.
+    ///
+    /// The device gets the adapter's own limits rather than the WebGPU defaults, and fails with
+    /// [`GpuError::AdapterLimit`] if the adapter cannot bind a whole MERL table of the largest
+    /// size (360 cells in `phi_d`, 35 MB as f32).
+    pub fn new() -> Result<Gpu, GpuError> {
+        pollster::block_on(Gpu::new_async())
+    }
+
+    async fn new_async() -> Result<Gpu, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let need = table_bytes(merl::Dims::MERL_FULL_PHI);
+        let adapter = adapters
+            .into_iter()
+            .max_by_key(|a| {
+                let fits = check_buffer_fits(&a.limits(), &a.get_info(), need, "").is_ok();
+                (fits, preference(&a.get_info()))
+            })
+            .ok_or(GpuError::NoAdapter)?;
+        let info = adapter.get_info();
+        // Asking for everything the adapter has costs nothing here and lets batch sizes follow
+        // the hardware; the WebGPU defaults are a floor for portability we do not need.
+        let limits = adapter.limits();
+        check_buffer_fits(&limits, &info, need, "a MERL table of 90 x 90 x 360 cells")?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("gpu"),
+                required_limits: limits,
+                ..Default::default()
+            })
+            .await
+            .map_err(|error| GpuError::RequestDevice { adapter: describe(&info), error })?;
+        Ok(Gpu { info, device, queue })
+    }
+
+    /// Name, backend and driver of the adapter, for tools and CI logs to say what ran.
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// One line naming the adapter, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu, Mesa
+    /// 22.3.6)`.
+    pub fn adapter_summary(&self) -> String {
+        describe(&self.info)
+    }
+
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
+    /// The limits the device was created with (the adapter's own).
+    pub fn limits(&self) -> wgpu::Limits {
+        self.device.limits()
+    }
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    let driver = [info.driver.as_str(), info.driver_info.as_str()]
+        .into_iter()
+        .filter(|s| !s.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let mut s = format!("{} ({:?}, {:?}", info.name, info.backend, info.device_type);
+    if !driver.is_empty() {
+        s.push_str(", ");
+        s.push_str(&driver);
+    }
+    s.push(')');
+    s
+}
+
+/// Larger is better.
+fn preference(info: &wgpu::AdapterInfo) -> (bool, u8) {
+    let kind = match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 4,
+        wgpu::DeviceType::IntegratedGpu => 3,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 1,
+        wgpu::DeviceType::Other => 0,
+    };
+    (info.backend == wgpu::Backend::Vulkan, kind)
+}
+
+/// Whether one buffer of `bytes` can be created and bound whole as a storage buffer.
+pub(crate) fn check_buffer_fits(
+    limits: &wgpu::Limits,
+    info: &wgpu::AdapterInfo,
+    bytes: u64,
+    what: &'static str,
+) -> Result<(), GpuError> {
+    let checks = [
+        ("max_storage_buffer_binding_size", limits.max_storage_buffer_binding_size),
+        ("max_buffer_size", limits.max_buffer_size),
+    ];
+    for (limit, have) in checks {
+        if have < bytes {
+            return Err(GpuError::AdapterLimit { adapter: describe(info), limit, have, need: bytes, what });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,63 @@
+//! Every damaged input gives exit 2 and a one-line error naming the file and the problem, never
+//! a panic. Small damaged files are committed in fixtures/invalid/; those that must be full size
+//! (NaN in the payload, trailing bytes) are made here.
+
+use std::path::Path;
+
+use crate::support::{root, run, temp_dir, tool};
+
+/// Runs `tool FILE`, expects exit `code` and a single `error: reading FILE: ...` line holding
+/// `problem`.
+fn check(tool_name: &str, path: &Path, code: i32, problem: &str) {
+    let mut cmd = tool(tool_name);
+    cmd.arg(path);
+    let r = run(cmd, "").expect_code(code);
+    let name = path.display().to_string();
+    let lines: Vec<&str> = r.stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "expected a one-line error\n{r}");
+    assert!(lines[0].starts_with(&format!("error: reading {name}: ")), "the error must name the file\n{r}");
+    assert!(lines[0].contains(problem), "expected the error to say {problem:?}\n{r}");
+    assert!(!r.stderr.contains("panicked"), "{r}");
+}
+
+#[test]
+fn damaged_merl_files_are_rejected() {
+    let dir = root().join("fixtures").join("invalid");
+    let cases = [
+        ("merl-empty.binary", "truncated header: expected 12 bytes, found 0"),
+        ("merl-truncated-header.binary", "truncated header: expected 12 bytes, found 8"),
+        ("merl-truncated-payload.binary", "truncated payload: a 90 x 90 x 180 table is 34992012 bytes, found 1212"),
+        ("merl-wrong-dims.binary", "unsupported dimensions 90 x 90 x 90"),
+        ("merl-negative-dims.binary", "unsupported dimensions -90 x 90 x 180"),
+        ("merl-huge-header.binary", "unsupported dimensions 2048 x 1024 x 1024"),
+        ("merl-size-mismatch.binary", "truncated payload: a 90 x 90 x 360 table is 69984012 bytes, found 1212"),
+    ];
+    for (file, problem) in cases {
+        check("merl-info", &dir.join(file), 2, problem);
+    }
+    check("merl-info", &dir.join("does-not-exist.binary"), 2, "o such file or directory");
+}
+
+#[test]
+fn full_size_damaged_merl_files_are_rejected() {
+    let tmp = temp_dir();
+    let table = merl::analytic::Analytic::Lambertian { albedo: [0.5; 3] }.table(merl::Dims::MERL);
+    let mut bytes = table.to_bytes();
+
+    let trailing = tmp.path().join("trailing.binary");
+    let mut longer = bytes.clone();
+    longer.extend_from_slice(&[0; 8]);
+    std::fs::write(&trailing, &longer).unwrap();
+    check("merl-info", &trailing, 2, "trailing bytes: a 90 x 90 x 180 table is 34992012 bytes, found 34992020");
+
+    // A NaN in the blue channel at cell (2, 3, 4).
+    let at = 12 + 8 * (2 * 1_458_000 + (2 * 90 + 3) * 180 + 4);
+    bytes[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    let nan = tmp.path().join("nan.binary");
+    std::fs::write(&nan, &bytes).unwrap();
+    check("merl-info", &nan, 2, "NaN value in the blue channel at cell (theta_h 2, theta_d 3, phi_d 4)");
+
+    bytes[at..at + 8].copy_from_slice(&f64::NEG_INFINITY.to_le_bytes());
+    std::fs::write(&nan, &bytes).unwrap();
+    check("merl-info", &nan, 2, "infinite value in the blue channel");
+}

@@ -1,0 +1,7 @@
+//! End-to-end tests: they build the tools once, run them on fixtures and generated inputs, and
+//! print the command, its stdout and stderr when a check fails.
+
+mod support;
+
+mod invalid_inputs;
+mod merl_info;

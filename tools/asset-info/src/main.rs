@@ -1,0 +1,182 @@
+//! `asset-info`: shows what a baked asset file holds (header, provenance, checksum status and a
+//! summary of the payload) as text or JSON. The exit status tells a script whether the file is
+//! valid (0), readable but damaged (1: the checksum does not match), or unreadable (2).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use asset::{Asset, Error, Header, MaterialInfo, Payload, Provenance, hex};
+use clap::Parser;
+use serde_json::{Value, json};
+
+/// Show what a baked asset file holds: its header, where it came from, whether its checksum
+/// matches, and a summary of its payload.
+///
+/// Exit status: 0 the asset is valid; 1 its checksum does not match its contents (the header is
+/// still shown); 2 the file cannot be read, is not an asset, or is of a version or kind this
+/// build does not know.
+#[derive(Debug, Parser)]
+#[command(version)]
+struct Args {
+    /// The asset file to inspect
+    file: PathBuf,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    json: bool,
+}
+
+/// What was found in a file whose header is valid.
+#[derive(Debug)]
+struct Report {
+    header: Header,
+    /// What the contents hash to.
+    computed: [u8; 32],
+    /// `None` when `computed` differs from the header's checksum: damaged contents are not
+    /// decoded.
+    asset: Option<Asset>,
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run() -> anyhow::Result<ExitCode> {
+    let args = Args::parse();
+    let context = || format!("reading {}", args.file.display());
+    let report = match asset::read_file_with_header(&args.file) {
+        Ok((header, asset)) => Report { header, computed: header.checksum, asset: Some(asset) },
+        Err(Error::ChecksumMismatch { header, computed }) => Report { header, computed, asset: None },
+        Err(e) => return Err(e).with_context(context),
+    };
+    if args.json {
+        println!("{:#}", to_json(&report));
+    } else {
+        print_text(&report);
+    }
+    if report.asset.is_some() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mismatch = Error::ChecksumMismatch { header: report.header, computed: report.computed };
+    eprintln!("error: {:#}", anyhow::Error::new(mismatch).context(context()));
+    Ok(ExitCode::from(1))
+}
+
+fn print_text(report: &Report) {
+    let header = &report.header;
+    println!("header");
+    println!("  magic            {} (ok)", asset::MAGIC.escape_ascii());
+    println!("  format version   {}", header.version);
+    println!("  kind             {} ({})", header.kind, header.kind.code());
+    println!("  provenance       {} bytes", header.provenance_len);
+    println!("  payload          {} bytes", header.payload_len);
+    match &report.asset {
+        None => {
+            println!("checksum           MISMATCH");
+            println!("  stored sha256    {}", hex(&header.checksum));
+            println!("  computed sha256  {}", hex(&report.computed));
+            println!("(contents not decoded: they are damaged)");
+        }
+        Some(asset) => {
+            println!("checksum           ok (sha256 {})", hex(&header.checksum));
+            print_provenance(&asset.provenance);
+            match &asset.payload {
+                Payload::MaterialInfo(info) => print_material_info(info),
+            }
+        }
+    }
+}
+
+fn print_provenance(p: &Provenance) {
+    println!("provenance");
+    println!("  source           {}", p.source_name);
+    println!("  source sha256    {}", hex(&p.source_sha256));
+    println!("  tool             {} {}", p.tool, p.tool_version);
+    if p.parameters.is_empty() {
+        println!("  parameters       (none)");
+    }
+    for (i, (name, value)) in p.parameters.iter().enumerate() {
+        let label = if i == 0 { "parameters" } else { "" };
+        println!("  {label:<16} {name} = {value}");
+    }
+}
+
+fn print_material_info(info: &MaterialInfo) {
+    let [theta_h, theta_d, phi_d] = info.dims;
+    let cells = u64::from(theta_h) * u64::from(theta_d) * u64::from(phi_d);
+    let rgb = |v: [f64; 3]| format!("{:.6} {:.6} {:.6}", v[0], v[1], v[2]);
+    println!("payload: material info");
+    println!("  dims             {theta_h} x {theta_d} x {phi_d} (theta_h x theta_d x phi_d)");
+    println!("  no-data cells    {} of {cells}", info.no_data_cells);
+    println!("  min (1/sr)       {}", rgb(info.channel_min));
+    println!("  max (1/sr)       {}", rgb(info.channel_max));
+    println!("  mean (1/sr)      {}", rgb(info.channel_mean));
+    let [h, d, p] = info.peak_cell;
+    println!("  peak (1/sr)      {} at cell ({h}, {d}, {p})", rgb(info.peak_rgb));
+    println!("  directional albedo");
+    println!("    theta_o_deg        red      green       blue   no data");
+    let rows = info.albedo_theta_o.iter().zip(&info.albedo_rgb).zip(&info.albedo_no_data_fraction);
+    for ((theta_o, albedo), no_data) in rows {
+        println!(
+            "    {:>11.2} {:>10.6} {:>10.6} {:>10.6} {:>8.2}%",
+            theta_o.to_degrees(),
+            albedo[0],
+            albedo[1],
+            albedo[2],
+            100.0 * no_data
+        );
+    }
+}
+
+fn to_json(report: &Report) -> Value {
+    let header = &report.header;
+    let header_json = json!({
+        "magic": asset::MAGIC.escape_ascii().to_string(),
+        "format_version": header.version,
+        "kind": header.kind.name(),
+        "kind_code": header.kind.code(),
+        "provenance_bytes": header.provenance_len,
+        "payload_bytes": header.payload_len,
+    });
+    let checksum = json!({
+        "ok": report.asset.is_some(),
+        "stored_sha256": hex(&header.checksum),
+        "computed_sha256": hex(&report.computed),
+    });
+    match &report.asset {
+        None => json!({
+            "header": header_json,
+            "checksum": checksum,
+            "provenance": null,
+            "payload": null,
+        }),
+        Some(asset) => {
+            let p = &asset.provenance;
+            // Pairs rather than an object: the order is the tool's and names may repeat.
+            let parameters: Vec<[&str; 2]> =
+                p.parameters.iter().map(|(name, value)| [name.as_str(), value.as_str()]).collect();
+            let payload = match &asset.payload {
+                // The payload's own serde form: the field names of the type, angles in radians.
+                Payload::MaterialInfo(info) => serde_json::to_value(info).expect("material info serializes to json"),
+            };
+            json!({
+                "header": header_json,
+                "checksum": checksum,
+                "provenance": {
+                    "source_name": p.source_name,
+                    "source_sha256": hex(&p.source_sha256),
+                    "tool": p.tool,
+                    "tool_version": p.tool_version,
+                    "parameters": parameters,
+                },
+                "payload": payload,
+            })
+        }
+    }
+}
