@@ -3,5 +3,6 @@
 
 mod support;
 
+mod asset_info;
 mod invalid_inputs;
 mod merl_info;

@@ -54,6 +54,29 @@ impl Run {
         assert!(self.code == Some(code), "expected exit {code}\n{self}");
         self
     }
+
+    pub fn expect_stdout(self, needle: &str) -> Run {
+        assert!(self.stdout.contains(needle), "stdout lacks {needle:?}\n{self}");
+        self
+    }
+
+    /// stdout parsed as JSON.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::from_str(&self.stdout).unwrap_or_else(|e| panic!("stdout is not JSON: {e}\n{self}"))
+    }
+
+    /// stderr is exactly one line `error: reading FILE: problem`, the problem in lower case,
+    /// without a trailing period, and containing `needle`; and nothing panicked.
+    pub fn expect_error(self, file: &Path, needle: &str) -> Run {
+        let prefix = format!("error: reading {}: ", file.display());
+        let problem = self.stderr.strip_suffix('\n').and_then(|s| s.strip_prefix(&prefix));
+        let Some(problem) = problem else { panic!("stderr is not one line starting with {prefix:?}\n{self}") };
+        assert!(!problem.contains('\n'), "expected a one-line error\n{self}");
+        assert!(problem.contains(needle), "expected the error to say {needle:?}\n{self}");
+        assert!(!problem.ends_with('.'), "no trailing period\n{self}");
+        assert!(!problem.starts_with(|c: char| c.is_uppercase()) || problem.starts_with("NaN"), "lower case\n{self}");
+        self
+    }
 }
 
 impl std::fmt::Display for Run {

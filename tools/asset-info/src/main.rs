@@ -38,13 +38,7 @@ struct Report {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
+    cli::main(run)
 }
 
 fn run() -> anyhow::Result<ExitCode> {
@@ -56,7 +50,7 @@ fn run() -> anyhow::Result<ExitCode> {
         Err(e) => return Err(e).with_context(context),
     };
     if args.json {
-        println!("{:#}", to_json(&report));
+        cli::outln!("{:#}", to_json(&report));
     } else {
         print_text(&report);
     }
@@ -70,21 +64,21 @@ fn run() -> anyhow::Result<ExitCode> {
 
 fn print_text(report: &Report) {
     let header = &report.header;
-    println!("header");
-    println!("  magic            {} (ok)", asset::MAGIC.escape_ascii());
-    println!("  format version   {}", header.version);
-    println!("  kind             {} ({})", header.kind, header.kind.code());
-    println!("  provenance       {} bytes", header.provenance_len);
-    println!("  payload          {} bytes", header.payload_len);
+    cli::outln!("header");
+    cli::outln!("  magic            {} (ok)", asset::MAGIC.escape_ascii());
+    cli::outln!("  format version   {}", header.version);
+    cli::outln!("  kind             {} ({})", header.kind, header.kind.code());
+    cli::outln!("  provenance       {} bytes", header.provenance_len);
+    cli::outln!("  payload          {} bytes", header.payload_len);
     match &report.asset {
         None => {
-            println!("checksum           MISMATCH");
-            println!("  stored sha256    {}", hex(&header.checksum));
-            println!("  computed sha256  {}", hex(&report.computed));
-            println!("(contents not decoded: they are damaged)");
+            cli::outln!("checksum           MISMATCH");
+            cli::outln!("  stored sha256    {}", hex(&header.checksum));
+            cli::outln!("  computed sha256  {}", hex(&report.computed));
+            cli::outln!("(contents not decoded: they are damaged)");
         }
         Some(asset) => {
-            println!("checksum           ok (sha256 {})", hex(&header.checksum));
+            cli::outln!("checksum           ok (sha256 {})", hex(&header.checksum));
             print_provenance(&asset.provenance);
             match &asset.payload {
                 Payload::MaterialInfo(info) => print_material_info(info),
@@ -94,16 +88,16 @@ fn print_text(report: &Report) {
 }
 
 fn print_provenance(p: &Provenance) {
-    println!("provenance");
-    println!("  source           {}", p.source_name);
-    println!("  source sha256    {}", hex(&p.source_sha256));
-    println!("  tool             {} {}", p.tool, p.tool_version);
+    cli::outln!("provenance");
+    cli::outln!("  source           {}", p.source_name);
+    cli::outln!("  source sha256    {}", hex(&p.source_sha256));
+    cli::outln!("  tool             {} {}", p.tool, p.tool_version);
     if p.parameters.is_empty() {
-        println!("  parameters       (none)");
+        cli::outln!("  parameters       (none)");
     }
     for (i, (name, value)) in p.parameters.iter().enumerate() {
         let label = if i == 0 { "parameters" } else { "" };
-        println!("  {label:<16} {name} = {value}");
+        cli::outln!("  {label:<16} {name} = {value}");
     }
 }
 
@@ -111,19 +105,19 @@ fn print_material_info(info: &MaterialInfo) {
     let [theta_h, theta_d, phi_d] = info.dims;
     let cells = u64::from(theta_h) * u64::from(theta_d) * u64::from(phi_d);
     let rgb = |v: [f64; 3]| format!("{:.6} {:.6} {:.6}", v[0], v[1], v[2]);
-    println!("payload: material info");
-    println!("  dims             {theta_h} x {theta_d} x {phi_d} (theta_h x theta_d x phi_d)");
-    println!("  no-data cells    {} of {cells}", info.no_data_cells);
-    println!("  min (1/sr)       {}", rgb(info.channel_min));
-    println!("  max (1/sr)       {}", rgb(info.channel_max));
-    println!("  mean (1/sr)      {}", rgb(info.channel_mean));
+    cli::outln!("payload: material info");
+    cli::outln!("  dims             {theta_h} x {theta_d} x {phi_d} (theta_h x theta_d x phi_d)");
+    cli::outln!("  no-data cells    {} of {cells}", info.no_data_cells);
+    cli::outln!("  min (1/sr)       {}", rgb(info.channel_min));
+    cli::outln!("  max (1/sr)       {}", rgb(info.channel_max));
+    cli::outln!("  mean (1/sr)      {}", rgb(info.channel_mean));
     let [h, d, p] = info.peak_cell;
-    println!("  peak (1/sr)      {} at cell ({h}, {d}, {p})", rgb(info.peak_rgb));
-    println!("  directional albedo");
-    println!("    theta_o_deg        red      green       blue   no data");
+    cli::outln!("  peak (1/sr)      {} at cell ({h}, {d}, {p})", rgb(info.peak_rgb));
+    cli::outln!("  directional albedo");
+    cli::outln!("    theta_o_deg        red      green       blue   no data");
     let rows = info.albedo_theta_o.iter().zip(&info.albedo_rgb).zip(&info.albedo_no_data_fraction);
     for ((theta_o, albedo), no_data) in rows {
-        println!(
+        cli::outln!(
             "    {:>11.2} {:>10.6} {:>10.6} {:>10.6} {:>8.2}%",
             theta_o.to_degrees(),
             albedo[0],

@@ -80,13 +80,7 @@ const ALBEDO_LIMIT: f64 = 1.01;
 const NO_DATA_LIMIT: f64 = 0.01;
 
 fn main() -> ExitCode {
-    match run(Args::parse()) {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
+    cli::main(|| run(Args::parse()))
 }
 
 fn run(args: Args) -> Result<ExitCode> {
@@ -99,11 +93,11 @@ fn run(args: Args) -> Result<ExitCode> {
     let summary = summarize(&table, albedo_interp, Quadrature::default());
     let problems = problems(&summary);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary_json(&args.file, &summary, &args, &problems))?);
+        cli::outln!("{}", serde_json::to_string_pretty(&summary_json(&args.file, &summary, &args, &problems))?);
     } else {
         print_summary(&args.file, &summary, &args);
         for p in &problems {
-            println!("problem: {p}");
+            cli::outln!("problem: {p}");
         }
     }
     if let Some(out) = &args.asset {
@@ -186,24 +180,24 @@ fn interp_name(i: InterpArg) -> &'static str {
 
 fn print_summary(path: &Path, s: &Summary, args: &Args) {
     let d = s.dims;
-    println!("file       {}", path.display());
-    println!("dims       {} x {} x {} (theta_h x theta_d x phi_d)", d.n_theta_h, d.n_theta_d, d.n_phi_d);
-    println!(
+    cli::outln!("file       {}", path.display());
+    cli::outln!("dims       {} x {} x {} (theta_h x theta_d x phi_d)", d.n_theta_h, d.n_theta_d, d.n_phi_d);
+    cli::outln!(
         "no data    {} of {} cells per channel ({:.1}%)",
         s.no_data_cells,
         s.cells,
         100.0 * s.no_data_cells as f64 / s.cells as f64
     );
     if let Some(ch) = &s.channels {
-        println!("BRDF (1/sr)        red        green       blue");
+        cli::outln!("BRDF (1/sr)        red        green       blue");
         for (name, pick) in [("min", 0), ("max", 1), ("mean", 2)] {
             let v = ch.map(|c| [c.min, c.max, c.mean][pick]);
-            println!("  {name:<10} {:>11.5e} {:>11.5e} {:>11.5e}", v[0], v[1], v[2]);
+            cli::outln!("  {name:<10} {:>11.5e} {:>11.5e} {:>11.5e}", v[0], v[1], v[2]);
         }
     }
-    println!("directional albedo ({} lookup, half-vector quadrature)", interp_name(args.albedo_interp));
+    cli::outln!("directional albedo ({} lookup, half-vector quadrature)", interp_name(args.albedo_interp));
     for (deg, a) in &s.albedo {
-        println!(
+        cli::outln!(
             "  theta_o {deg:>2} deg  {:.4} {:.4} {:.4}   no data {:.2}%",
             a.rgb[0],
             a.rgb[1],
@@ -212,7 +206,7 @@ fn print_summary(path: &Path, s: &Summary, args: &Args) {
         );
     }
     if let Some(p) = &s.peak {
-        println!(
+        cli::outln!(
             "peak       {:.5e} {:.5e} {:.5e} (luminance {:.5e}) at cell ({}, {}, {}): theta_h {:.3} deg, theta_d {:.3} deg, phi_d {:.3} deg",
             p.rgb[0],
             p.rgb[1],

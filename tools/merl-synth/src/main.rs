@@ -80,13 +80,7 @@ fn positive(name: &str, v: f64) -> Result<f64> {
 }
 
 fn main() -> ExitCode {
-    match run(Args::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
+    cli::main(|| run(Args::parse()).map(|()| ExitCode::SUCCESS))
 }
 
 fn run(args: Args) -> Result<()> {
