@@ -30,7 +30,8 @@ lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
 ## demo: make a synthetic material, validate and summarize it, write its info asset and check it.
-demo: setup build
+demo: setup
+	$(CARGO) build --release -p merl-synth -p merl-info -p asset-info
 	@mkdir -p $(DEMO)
 	$(BIN)/merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out $(DEMO)/ggx-copper.binary
 	$(BIN)/merl-info $(DEMO)/ggx-copper.binary --asset $(DEMO)/ggx-copper.info.asset

@@ -36,23 +36,6 @@ fn lower_case_start(message: &str) -> String {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::lower_case_start;
-
-    #[test]
-    fn only_plain_capitalized_first_words_are_lowered() {
-        assert_eq!(
-            lower_case_start("No such file or directory (os error 2)"),
-            "no such file or directory (os error 2)"
-        );
-        assert_eq!(lower_case_start("NaN value in the red channel"), "NaN value in the red channel");
-        assert_eq!(lower_case_start("EXR: bad header"), "EXR: bad header");
-        assert_eq!(lower_case_start("truncated header"), "truncated header");
-        assert_eq!(lower_case_start(""), "");
-    }
-}
-
 /// A write to stdout failed because its reader went away: not an error of the tool.
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == ErrorKind::BrokenPipe))
@@ -76,4 +59,21 @@ pub fn write_line(args: fmt::Arguments<'_>) {
 macro_rules! outln {
     () => { $crate::write_line(format_args!("")) };
     ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lower_case_start;
+
+    #[test]
+    fn only_plain_capitalized_first_words_are_lowered() {
+        assert_eq!(
+            lower_case_start("No such file or directory (os error 2)"),
+            "no such file or directory (os error 2)"
+        );
+        assert_eq!(lower_case_start("NaN value in the red channel"), "NaN value in the red channel");
+        assert_eq!(lower_case_start("EXR: bad header"), "EXR: bad header");
+        assert_eq!(lower_case_start("truncated header"), "truncated header");
+        assert_eq!(lower_case_start(""), "");
+    }
 }

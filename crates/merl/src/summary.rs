@@ -71,3 +71,38 @@ pub fn summarize(table: &MerlTable, interp: Interp, q: Quadrature) -> Summary {
         albedo,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analytic::Analytic;
+
+    #[test]
+    fn normalized_phong_tables_stay_at_or_below_one() {
+        // Exact albedo: 1 at normal incidence, less elsewhere. The table adds its discretization
+        // error (trilinear between lower-edge samples, measured +0.06% at n = 10, +0.8% at
+        // n = 1000); 1% covers that and nothing else: a wrong Jacobian is off by far more.
+        for n in [1.0, 10.0, 100.0, 1000.0] {
+            let table = Analytic::Phong { n, ks: [1.0; 3] }.table(Dims::MERL);
+            let s = summarize(&table, Interp::Trilinear, Quadrature::default());
+            for (deg, a) in &s.albedo {
+                assert!(a.rgb[0] <= 1.01, "n {n}, theta_o {deg}: {:?}", a.rgb);
+            }
+            assert!(s.albedo[0].1.rgb[0] > 0.99, "n {n}: normal incidence {:?}", s.albedo[0].1.rgb);
+        }
+    }
+
+    #[test]
+    fn statistics_skip_cells_without_data() {
+        let table = Analytic::Lambertian { albedo: [0.5; 3] }.table(Dims::MERL);
+        let s = summarize(&table, Interp::Nearest, Quadrature::default());
+        let ch = s.channels.expect("cells with data");
+        for c in ch {
+            // Every cell with data holds 0.5/pi; a no-data -1 leaking in would lower min and mean.
+            assert!((c.min - 0.5 / std::f64::consts::PI).abs() < 1e-12, "{c:?}");
+            // The mean sums 1.1e6 values: allow their rounding (1e-9 relative), not a -1.
+            assert!((c.mean - 0.5 / std::f64::consts::PI).abs() < 1e-9, "{c:?}");
+        }
+        assert_eq!(s.no_data_cells, 346_570);
+    }
+}

@@ -269,7 +269,10 @@ fn write_asset(out: &Path, args: &Args, s: &Summary) -> Result<()> {
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
         parameters: vec![
             ("albedo_interp".to_string(), interp_name(args.albedo_interp).to_string()),
-            ("quadrature".to_string(), format!("{:?}", Quadrature::default())),
+            ("quadrature".to_string(), {
+                let q = Quadrature::default();
+                format!("{} u nodes per theta_h cell x {} phi_h nodes", q.nodes_per_cell, q.n_phi_h)
+            }),
         ],
     };
     let d = s.dims;
