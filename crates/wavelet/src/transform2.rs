@@ -1,0 +1,215 @@
+use rayon::prelude::*;
+
+use crate::kernels::{analysis_rows, analyze, analyze_across, synthesize, synthesize_across};
+use crate::wavelet::{Bank, D4, HAAR};
+use crate::{Error, Image, Wavelet, check_finite, check_levels, with_bank};
+
+/// The three detail orientations of a 2D level, in PyWavelets' order `(cH, cV, cD)`; the value is
+/// the index into a `[Image; 3]`.
+///
+/// Axis 0 runs down the rows (`y`), axis 1 along a row (`x`), as in numpy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Orientation {
+    /// `cH`: high-pass along axis 0 (`y`), low-pass along axis 1 (`x`). Responds to horizontal
+    /// edges and lines: intensity that changes from row to row.
+    Horizontal = 0,
+    /// `cV`: low-pass along axis 0 (`y`), high-pass along axis 1 (`x`). Responds to vertical
+    /// edges: intensity that changes along a row.
+    Vertical = 1,
+    /// `cD`: high-pass along both axes.
+    Diagonal = 2,
+}
+
+impl Orientation {
+    /// The three orientations in storage order.
+    pub const ALL: [Orientation; 3] = [Orientation::Horizontal, Orientation::Vertical, Orientation::Diagonal];
+
+    /// The index into a `[Image; 3]` of details.
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Lower-case name for messages: `"horizontal"`, `"vertical"`, `"diagonal"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Orientation::Horizontal => "horizontal",
+            Orientation::Vertical => "vertical",
+            Orientation::Diagonal => "diagonal",
+        }
+    }
+}
+
+/// A multi-level 2D decomposition: the approximation after `levels()` steps and, per level, the
+/// three detail images, finest level first.
+///
+/// `details[j - 1][o.index()]` is level `j` (1 = finest, `width / 2` x `height / 2`; `levels()` =
+/// coarsest, the size of `approx`), orientation `o`. PyWavelets' `wavedec2` lists the same images
+/// coarsest first: `[approx, tuple(details[J-1]), ..., tuple(details[0])]`. Coefficient `(kx, ky)`
+/// of level `j` describes the pixels around `(coefficient_center(j, kx), coefficient_center(j, ky))`
+/// ([`crate::coefficient_center`], [`Wavelet::support`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decomposition2 {
+    pub wavelet: Wavelet,
+    pub approx: Image,
+    pub details: Vec<[Image; 3]>,
+}
+
+impl Decomposition2 {
+    /// Number of levels `J`.
+    pub fn levels(&self) -> usize {
+        self.details.len()
+    }
+
+    /// The detail image of level `level` (1 = finest) and `orientation`. Panics unless
+    /// `1 <= level <= J`.
+    pub fn detail(&self, level: usize, orientation: Orientation) -> &Image {
+        assert!((1..=self.levels()).contains(&level), "level {level} is not in 1..={}", self.levels());
+        &self.details[level - 1][orientation.index()]
+    }
+
+    /// Mutable access to one detail image, e.g. to threshold it before [`waverec2`].
+    pub fn detail_mut(&mut self, level: usize, orientation: Orientation) -> &mut Image {
+        assert!((1..=self.levels()).contains(&level), "level {level} is not in 1..={}", self.levels());
+        &mut self.details[level - 1][orientation.index()]
+    }
+
+    /// Sum of squares of all coefficients; equals the image's energy.
+    pub fn energy(&self) -> f64 {
+        self.approx.energy() + self.details.iter().flatten().map(Image::energy).sum::<f64>()
+    }
+}
+
+/// One level of the forward transform: `cA, (cH, cV, cD)` of
+/// `pywt.dwt2(x, w, mode="periodization")`. Width and height must be even.
+pub fn dwt2(image: &Image, wavelet: Wavelet) -> Result<(Image, [Image; 3]), Error> {
+    check_image(image, 1)?;
+    Ok(with_bank!(wavelet, bank => forward_level(bank, image)))
+}
+
+/// One level of the inverse transform: `pywt.idwt2((approx, details), w, mode="periodization")`,
+/// an image twice as wide and high as the four (equally sized) coefficient images.
+pub fn idwt2(approx: &Image, details: &[Image; 3], wavelet: Wavelet) -> Result<Image, Error> {
+    check_coefficients(approx, std::slice::from_ref(details))?;
+    Ok(with_bank!(wavelet, bank => inverse_level(bank, approx, details)))
+}
+
+/// The forward transform over `levels` levels: `pywt.wavedec2(x, w, mode="periodization",
+/// level=levels)`. Width and height must both be divisible by `2^levels`
+/// ([`crate::max_levels2`]).
+pub fn wavedec2(image: &Image, wavelet: Wavelet, levels: usize) -> Result<Decomposition2, Error> {
+    check_image(image, levels)?;
+    let mut details = Vec::with_capacity(levels);
+    let (mut approx, first) = with_bank!(wavelet, bank => forward_level(bank, image));
+    details.push(first);
+    for _ in 1..levels {
+        let (a, d) = with_bank!(wavelet, bank => forward_level(bank, &approx));
+        approx = a;
+        details.push(d);
+    }
+    Ok(Decomposition2 { wavelet, approx, details })
+}
+
+/// The inverse of [`wavedec2`]: `pywt.waverec2(coeffs, w, mode="periodization")` with `coeffs` in
+/// PyWavelets' order. Fails unless the three details of level `j` are `2^(J-j)` times as wide and
+/// high as `approx` and every value is finite.
+pub fn waverec2(decomposition: &Decomposition2) -> Result<Image, Error> {
+    let Decomposition2 { wavelet, approx, details } = decomposition;
+    check_coefficients(approx, details)?;
+    let (coarsest, finer) = details.split_last().expect("checked: at least one level");
+    let mut image = with_bank!(*wavelet, bank => inverse_level(bank, approx, coarsest));
+    for level in finer.iter().rev() {
+        image = with_bank!(*wavelet, bank => inverse_level(bank, &image, level));
+    }
+    Ok(image)
+}
+
+fn check_image(image: &Image, levels: usize) -> Result<(), Error> {
+    if image.data().is_empty() {
+        return Err(Error::Empty { what: "image" });
+    }
+    check_levels("width", image.width(), levels)?;
+    check_levels("height", image.height(), levels)?;
+    check_finite(|| "image".to_owned(), image.data())
+}
+
+fn check_coefficients(approx: &Image, details: &[[Image; 3]]) -> Result<(), Error> {
+    if details.is_empty() {
+        return Err(Error::ZeroLevels);
+    }
+    if approx.data().is_empty() {
+        return Err(Error::Empty { what: "approximation" });
+    }
+    check_finite(|| "approximation".to_owned(), approx.data())?;
+    let (mut width, mut height) = (approx.width(), approx.height());
+    for (j, level) in details.iter().enumerate().rev() {
+        for (o, image) in Orientation::ALL.into_iter().zip(level) {
+            let what = || format!("level {} {} detail", j + 1, o.name());
+            if (image.width(), image.height()) != (width, height) {
+                return Err(Error::ShapeMismatch(format!(
+                    "{} is {}x{}, expected {width}x{height}",
+                    what(),
+                    image.width(),
+                    image.height()
+                )));
+            }
+            check_finite(what, image.data())?;
+        }
+        (width, height) = (2 * width, 2 * height);
+    }
+    Ok(())
+}
+
+/// Rows per rayon task: enough that a task is worth its scheduling (~16k samples).
+fn min_rows(width: usize) -> usize {
+    (1 << 14) / width.max(1) + 1
+}
+
+/// One forward level of a checked image (even width and height), one output row `k` at a time:
+/// the column filters combine the `F` input rows that row `k` depends on (contiguous rows, so
+/// the loops vectorize), then the row filter splits each of the two results. Columns first is
+/// also PyWavelets' order (axis 0, then axis 1), and no intermediate image is ever allocated.
+fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> (Image, [Image; 3]) {
+    let (w, h) = (image.width(), image.height());
+    let (w2, h2) = (w / 2, h / 2);
+    let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
+    let [ca, ch, cv, cd] = &mut out;
+    ca.par_chunks_mut(w2)
+        .zip(ch.par_chunks_mut(w2))
+        .zip(cv.par_chunks_mut(w2))
+        .zip(cd.par_chunks_mut(w2))
+        .enumerate()
+        .with_min_len(min_rows(w))
+        .for_each_init(
+            || vec![0.0; 2 * w],
+            |scratch, (k, (((a, hh), v), dd))| {
+                let src = analysis_rows::<F>(k, h).map(|r| image.row(r));
+                let (lo, hi) = scratch.split_at_mut(w);
+                analyze_across(bank, &src, lo, hi);
+                // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
+                analyze(bank, lo, a, v);
+                analyze(bank, hi, hh, dd);
+            },
+        );
+    let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
+    (ca, [ch, cv, cd])
+}
+
+/// One inverse level of checked coefficients: the transpose of [`forward_level`], one output
+/// row at a time: the column synthesis of row `n` of the two half-width images (low-pass and
+/// high-pass along axis 1), then the row synthesis of the two into the output row.
+fn inverse_level<const F: usize>(bank: &Bank<F>, approx: &Image, details: &[Image; 3]) -> Image {
+    let (w2, h2) = (approx.width(), approx.height());
+    let (w, h) = (2 * w2, 2 * h2);
+    let [ch, cv, cd] = details;
+    let mut out = vec![0.0; w * h];
+    out.par_chunks_mut(w).enumerate().with_min_len(min_rows(w)).for_each_init(
+        || vec![0.0; w],
+        |scratch, (n, row)| {
+            let (lo, hi) = scratch.split_at_mut(w2);
+            synthesize_across(bank, n, approx.data(), ch.data(), w2, lo);
+            synthesize_across(bank, n, cv.data(), cd.data(), w2, hi);
+            synthesize(bank, lo, hi, row);
+        },
+    );
+    Image::new(w, h, out).expect("sizes match")
+}
