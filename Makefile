@@ -7,7 +7,7 @@ BIN := target/release
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup build test demo lint clean-demo
+.PHONY: setup build test demo lint bench clean-demo
 
 ## setup: install what the tests need and the machine lacks (numpy for the shared data tool,
 ## the software Vulkan driver lavapipe for the GPU tests). Idempotent.
@@ -25,6 +25,11 @@ build:
 ## test: every unit, property, GPU (lavapipe) and end-to-end test.
 test: setup
 	$(CARGO) test --workspace
+
+## bench: timings against baselines measured in the same run (benchmarks, not tests).
+bench:
+	$(CARGO) bench -p importance --bench build
+	$(CARGO) bench -p envmap --bench load
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

@@ -4,5 +4,6 @@
 mod support;
 
 mod asset_info;
+mod importance;
 mod invalid_inputs;
 mod merl_info;

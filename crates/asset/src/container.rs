@@ -13,7 +13,7 @@ use sha2::{Digest, Sha256};
 
 use crate::error::Error;
 use crate::files::write_atomic;
-use crate::types::{Asset, AssetKind, MaterialInfo, Payload, Provenance};
+use crate::types::{Asset, AssetKind, ImportanceSamples, MaterialInfo, Payload, Provenance};
 
 /// The first eight bytes of every asset file.
 pub const MAGIC: [u8; 8] = *b"BRDFASET";
@@ -116,6 +116,7 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
     let provenance = encode_section(&asset.provenance);
     let payload = match &asset.payload {
         Payload::MaterialInfo(info) => encode_section(info),
+        Payload::ImportanceSamples(samples) => encode_section(samples),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -157,6 +158,9 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
     let provenance: Provenance = decode_section("provenance", provenance)?;
     let payload = match header.kind {
         AssetKind::MaterialInfo => Payload::MaterialInfo(decode_section::<MaterialInfo>("payload", payload)?),
+        AssetKind::ImportanceSamples => {
+            Payload::ImportanceSamples(decode_section::<ImportanceSamples>("payload", payload)?)
+        }
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;
     Ok((header, Asset { provenance, payload }))

@@ -15,11 +15,14 @@ use sha2::{Digest, Sha256};
 /// temporary file is removed and `path` is untouched. (On Unix the folder is synced after the
 /// rename; if only that fails, `path` already holds the new bytes and the error says the rename
 /// may not survive a power loss.) A symbolic link at `path` is replaced, not followed.
+///
+/// A missing parent folder is created first: a bake writes into folders of its own choosing.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let folder = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
+    std::fs::create_dir_all(folder)?;
     let mut prefix = std::ffi::OsString::from(".");
     prefix.push(path.file_name().unwrap_or_default());
     prefix.push(".");

@@ -29,11 +29,13 @@ pub struct Provenance {
 pub enum AssetKind {
     /// [`MaterialInfo`]: the validation summary of a MERL table.
     MaterialInfo = 1,
+    /// [`ImportanceSamples`]: importance-sampling tables and precomputed samples of a material.
+    ImportanceSamples = 2,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 1] = [AssetKind::MaterialInfo];
+    pub const ALL: [AssetKind; 2] = [AssetKind::MaterialInfo, AssetKind::ImportanceSamples];
 
     /// The number stored in the header.
     pub fn code(self) -> u32 {
@@ -49,6 +51,7 @@ impl AssetKind {
     pub fn name(self) -> &'static str {
         match self {
             AssetKind::MaterialInfo => "material-info",
+            AssetKind::ImportanceSamples => "importance-samples",
         }
     }
 }
@@ -101,18 +104,75 @@ impl MaterialInfo {
     }
 }
 
+/// Importance-sampling tables of a MERL material and precomputed samples (payload of
+/// [`AssetKind::ImportanceSamples`], written by `merl-importance`). `data-schema/README.md`
+/// describes the parameterization and how a renderer reads it.
+///
+/// With `n_slices = theta_o.len()`, `rows = theta_h_edges.len() - 1`, `cols = n_phi_h`:
+/// - `samples`: `n_slices * n_vectors * n_samples` texels `(wi.x, wi.y, wi.z, pdf)`, slice-major,
+///   then vector, then sample (a texture `n_samples` wide and `n_slices * n_vectors` tall);
+///   `wi` for `phi_o = 0`, `pdf` per unit solid angle, 0 for a sample that reflects nowhere.
+/// - `marginal_cdf`: per slice, `rows + 1` values from 0 to 1 over the `theta_h` rows.
+/// - `conditional_cdf`: per slice and row, `cols + 1` values from 0 to 1 over the `phi_h` sectors.
+/// - `h_density`: per slice and row, `cols` densities per unit solid angle of the half vector;
+///   the density of a direction `wi` is `h_density[cell of h] / (4 wo . h)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImportanceSamples {
+    /// Outgoing elevation of each slice, radians.
+    pub theta_o: Vec<f64>,
+    pub n_vectors: u32,
+    pub n_samples: u32,
+    /// `theta_h` at the row edges, radians, from 0 to pi/2.
+    pub theta_h_edges: Vec<f64>,
+    /// Sectors of `phi_h` over `[0, 2 pi)`.
+    pub n_phi_h: u32,
+    pub samples: Vec<[f32; 4]>,
+    pub marginal_cdf: Vec<f32>,
+    pub conditional_cdf: Vec<f32>,
+    pub h_density: Vec<f32>,
+}
+
+impl ImportanceSamples {
+    fn check(&self) -> Result<(), String> {
+        let slices = self.theta_o.len();
+        let rows = self.theta_h_edges.len().saturating_sub(1);
+        let cols = self.n_phi_h as usize;
+        if slices == 0 || rows == 0 || cols == 0 || self.n_vectors == 0 || self.n_samples == 0 {
+            return Err(format!(
+                "importance samples need at least one slice, row, sector, vector and sample, found {slices}, {rows}, \
+                 {cols}, {}, {}",
+                self.n_vectors, self.n_samples
+            ));
+        }
+        let expect = [
+            ("samples", self.samples.len(), slices * self.n_vectors as usize * self.n_samples as usize),
+            ("marginal cdf", self.marginal_cdf.len(), slices * (rows + 1)),
+            ("conditional cdf", self.conditional_cdf.len(), slices * rows * (cols + 1)),
+            ("h density", self.h_density.len(), slices * rows * cols),
+        ];
+        for (what, found, expected) in expect {
+            if found != expected {
+                return Err(format!("importance samples: {what} has {found} values, expected {expected}"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The payload of an asset, one variant per [`AssetKind`].
 ///
 /// Only the variant's content is serialized; the header's kind code says which type follows.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Payload {
     MaterialInfo(MaterialInfo),
+    ImportanceSamples(ImportanceSamples),
 }
 
 impl Payload {
     pub fn kind(&self) -> AssetKind {
         match self {
             Payload::MaterialInfo(_) => AssetKind::MaterialInfo,
+            Payload::ImportanceSamples(_) => AssetKind::ImportanceSamples,
         }
     }
 
@@ -120,6 +180,7 @@ impl Payload {
     pub(crate) fn check(&self) -> Result<(), String> {
         match self {
             Payload::MaterialInfo(info) => info.check(),
+            Payload::ImportanceSamples(samples) => samples.check(),
         }
     }
 }
@@ -127,6 +188,12 @@ impl Payload {
 impl From<MaterialInfo> for Payload {
     fn from(info: MaterialInfo) -> Payload {
         Payload::MaterialInfo(info)
+    }
+}
+
+impl From<ImportanceSamples> for Payload {
+    fn from(samples: ImportanceSamples) -> Payload {
+        Payload::ImportanceSamples(samples)
     }
 }
 

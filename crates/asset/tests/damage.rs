@@ -112,7 +112,10 @@ fn the_unsupported_version_message_names_both_versions() {
 fn the_unknown_kind_message_names_the_number() {
     let mut bytes = encode(&small_asset());
     bytes[12..16].copy_from_slice(&9u32.to_le_bytes());
-    assert_eq!(decode(&bytes).unwrap_err().to_string(), "unknown asset kind 9: this build knows 1 (material-info)");
+    assert_eq!(
+        decode(&bytes).unwrap_err().to_string(),
+        "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples)"
+    );
 }
 
 #[test]
@@ -170,7 +173,7 @@ fn bytes_left_over_in_a_section_are_invalid() {
 #[test]
 fn albedo_vectors_of_different_lengths_are_refused_on_write_and_read() {
     let mut asset = small_asset();
-    let Payload::MaterialInfo(info) = &mut asset.payload;
+    let Payload::MaterialInfo(info) = &mut asset.payload else { unreachable!("small_asset is material info") };
     info.albedo_rgb.pop();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.asset");

@@ -78,7 +78,17 @@ fn a_failed_write_leaves_the_target_and_no_temporary_file() {
     assert_eq!(entries(dir.path()), ["occupied"]);
     assert_eq!(std::fs::read(target.join("keep")).unwrap(), b"keep");
 
-    let missing = dir.path().join("missing/out.bin");
-    assert!(write_atomic(&missing, b"new").is_err());
-    assert!(!dir.path().join("missing").exists());
+    // A file where the parent folder should be: the folder cannot be made.
+    std::fs::write(dir.path().join("plain"), b"plain").unwrap();
+    assert!(write_atomic(&dir.path().join("plain/out.bin"), b"new").is_err());
+    assert_eq!(std::fs::read(dir.path().join("plain")).unwrap(), b"plain");
+}
+
+#[test]
+fn missing_parent_folders_are_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let nested = dir.path().join("a/b/out.bin");
+    write_atomic(&nested, b"new").unwrap();
+    assert_eq!(std::fs::read(&nested).unwrap(), b"new");
+    assert_eq!(entries(&dir.path().join("a/b")), ["out.bin"]);
 }

@@ -79,7 +79,7 @@ pub fn hand_built_v1(asset: &Asset) -> Vec<u8> {
         provenance.string(value);
     }
 
-    let Payload::MaterialInfo(info) = &asset.payload;
+    let Payload::MaterialInfo(info) = &asset.payload else { unreachable!("the golden asset is material info") };
     let mut payload = V1Writer::default();
     info.dims.iter().for_each(|&v| payload.u32(v));
     payload.u64(info.no_data_cells);

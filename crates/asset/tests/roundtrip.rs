@@ -1,6 +1,6 @@
 //! read(write(a)) = a for random assets, in memory and through files.
 
-use asset::{Asset, MaterialInfo, Payload, Provenance, decode, encode, read_file, write_file};
+use asset::{Asset, ImportanceSamples, MaterialInfo, Payload, Provenance, decode, encode, read_file, write_file};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -46,15 +46,8 @@ fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
 
 fn random_asset(rng: &mut StdRng) -> Asset {
     let angles = random_len(rng);
-    Asset {
-        provenance: Provenance {
-            source_name: random_string(rng),
-            source_sha256: rng.random(),
-            tool: random_string(rng),
-            tool_version: random_string(rng),
-            parameters: (0..random_len(rng)).map(|_| (random_string(rng), random_string(rng))).collect(),
-        },
-        payload: Payload::MaterialInfo(MaterialInfo {
+    let payload = if rng.random_bool(0.5) {
+        Payload::MaterialInfo(MaterialInfo {
             dims: rng.random(),
             no_data_cells: rng.random(),
             channel_min: random_rgb(rng),
@@ -65,8 +58,43 @@ fn random_asset(rng: &mut StdRng) -> Asset {
             albedo_theta_o: (0..angles).map(|_| random_f64(rng)).collect(),
             albedo_rgb: (0..angles).map(|_| random_rgb(rng)).collect(),
             albedo_no_data_fraction: (0..angles).map(|_| random_f64(rng)).collect(),
-        }),
+        })
+    } else {
+        random_importance_samples(rng)
+    };
+    Asset {
+        provenance: Provenance {
+            source_name: random_string(rng),
+            source_sha256: rng.random(),
+            tool: random_string(rng),
+            tool_version: random_string(rng),
+            parameters: (0..random_len(rng)).map(|_| (random_string(rng), random_string(rng))).collect(),
+        },
+        payload,
     }
+}
+
+/// Consistent sizes (the payload's invariant), random contents.
+fn random_importance_samples(rng: &mut StdRng) -> Payload {
+    let (slices, rows, cols) = (rng.random_range(1..4), rng.random_range(1..5), rng.random_range(1..6));
+    let (vectors, samples) = (rng.random_range(1..3u32), rng.random_range(1..5u32));
+    let mut f32s = |n: usize| -> Vec<f32> { (0..n).map(|_| random_f64(rng) as f32).collect() };
+    let samples_data =
+        f32s(4 * slices * (vectors * samples) as usize).chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    let marginal_cdf = f32s(slices * (rows + 1));
+    let conditional_cdf = f32s(slices * rows * (cols + 1));
+    let h_density = f32s(slices * rows * cols);
+    Payload::ImportanceSamples(ImportanceSamples {
+        theta_o: (0..slices).map(|_| random_f64(rng)).collect(),
+        n_vectors: vectors,
+        n_samples: samples,
+        theta_h_edges: (0..=rows).map(|_| random_f64(rng)).collect(),
+        n_phi_h: cols as u32,
+        samples: samples_data,
+        marginal_cdf,
+        conditional_cdf,
+        h_density,
+    })
 }
 
 /// Decoding gives the value back, and encoding that again gives the same bytes (which also
@@ -96,7 +124,19 @@ fn empty_strings_and_vectors_round_trip() {
         tool_version: String::new(),
         parameters: Vec::new(),
     };
-    let Payload::MaterialInfo(info) = &mut asset.payload;
+    asset.payload = Payload::MaterialInfo(MaterialInfo {
+        dims: [0; 3],
+        no_data_cells: 0,
+        channel_min: [0.0; 3],
+        channel_max: [0.0; 3],
+        channel_mean: [0.0; 3],
+        peak_rgb: [0.0; 3],
+        peak_cell: [0; 3],
+        albedo_theta_o: vec![1.0],
+        albedo_rgb: vec![[1.0; 3]],
+        albedo_no_data_fraction: vec![0.0],
+    });
+    let Payload::MaterialInfo(info) = &mut asset.payload else { unreachable!() };
     info.albedo_theta_o.clear();
     info.albedo_rgb.clear();
     info.albedo_no_data_fraction.clear();

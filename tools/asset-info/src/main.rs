@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use asset::{Asset, Error, Header, MaterialInfo, Payload, Provenance, hex};
+use asset::{Asset, Error, Header, ImportanceSamples, MaterialInfo, Payload, Provenance, hex};
 use clap::Parser;
 use serde_json::{Value, json};
 
@@ -82,6 +82,7 @@ fn print_text(report: &Report) {
             print_provenance(&asset.provenance);
             match &asset.payload {
                 Payload::MaterialInfo(info) => print_material_info(info),
+                Payload::ImportanceSamples(samples) => print_importance_samples(samples),
             }
         }
     }
@@ -128,6 +129,39 @@ fn print_material_info(info: &MaterialInfo) {
     }
 }
 
+fn print_importance_samples(s: &ImportanceSamples) {
+    let summary = importance_summary(s);
+    cli::outln!("payload: importance samples");
+    cli::outln!(
+        "  slices           {} (theta_o {:.1} to {:.1} deg)",
+        summary.slices,
+        summary.theta_o_deg.0,
+        summary.theta_o_deg.1
+    );
+    cli::outln!("  samples          {} vectors x {} samples per slice", s.n_vectors, s.n_samples);
+    cli::outln!("  cells            {} theta_h rows x {} phi_h sectors", summary.rows, s.n_phi_h);
+    cli::outln!("  samples with pdf 0  {}", summary.zero_pdf_samples);
+}
+
+/// What asset-info says about an importance-samples payload (the arrays themselves are too
+/// large to print).
+struct ImportanceSummary {
+    slices: usize,
+    rows: usize,
+    theta_o_deg: (f64, f64),
+    zero_pdf_samples: usize,
+}
+
+fn importance_summary(s: &ImportanceSamples) -> ImportanceSummary {
+    let degrees = |v: Option<&f64>| v.map_or(0.0, |t| t.to_degrees());
+    ImportanceSummary {
+        slices: s.theta_o.len(),
+        rows: s.theta_h_edges.len().saturating_sub(1),
+        theta_o_deg: (degrees(s.theta_o.first()), degrees(s.theta_o.last())),
+        zero_pdf_samples: s.samples.iter().filter(|t| t[3] == 0.0).count(),
+    }
+}
+
 fn to_json(report: &Report) -> Value {
     let header = &report.header;
     let header_json = json!({
@@ -158,6 +192,17 @@ fn to_json(report: &Report) -> Value {
             let payload = match &asset.payload {
                 // The payload's own serde form: the field names of the type, angles in radians.
                 Payload::MaterialInfo(info) => serde_json::to_value(info).expect("material info serializes to json"),
+                Payload::ImportanceSamples(samples) => {
+                    let summary = importance_summary(samples);
+                    json!({
+                        "theta_o": samples.theta_o,
+                        "n_vectors": samples.n_vectors,
+                        "n_samples": samples.n_samples,
+                        "theta_h_rows": summary.rows,
+                        "n_phi_h": samples.n_phi_h,
+                        "zero_pdf_samples": summary.zero_pdf_samples,
+                    })
+                }
             };
             json!({
                 "header": header_json,
