@@ -1,0 +1,334 @@
+//! The wavelet estimator: per level, the largest detail coefficient whose support covers a pixel
+//! (a separable sliding maximum over the coefficient grid), then the finest significant level
+//! of eq. 7 per pixel.
+
+use rayon::prelude::*;
+use wavelet::{Image, Wavelet, max_levels2, wavedec2};
+
+use crate::Error;
+
+/// `c` in `f = c 2^-j*` (cycles per pixel), calibrated on pure sinusoids (crate docs,
+/// "Calibration"): `2^-2.5`.
+pub const DEFAULT_C: f64 = 0.176_776_695_296_636_9;
+
+/// How the estimator reads an image. [`Config::default`] is the paper's setting with the
+/// calibrated constant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    /// The relative threshold of eq. 7: level `j*` is the first (finest first) at which the sum
+    /// of `lambda_1 .. lambda_j*` reaches `eps` times the largest `lambda_j` of the pixel. 0.01
+    /// as in both papers.
+    pub eps: f64,
+    /// Amplitude, in the units of the image, below which a detail counts as zero: a level-`j`
+    /// coefficient is dropped when its magnitude is below `noise_floor * 2^j`, the magnitude a
+    /// pattern of that amplitude produces at level `j`. 1e-6 by default, for images of O(1)
+    /// values such as [`crate::log1p_luminance`]; scale it with the data.
+    pub noise_floor: f64,
+    /// The mother wavelet's bandwidth constant: `f = c 2^-j*` cycles per pixel.
+    pub c: f64,
+    /// The wavelet; D4 (PyWavelets' `db2`) as in the papers.
+    pub wavelet: Wavelet,
+    /// Number of levels `J`; `None` for as many as the (padded or extended) image allows (crate
+    /// docs, "Sizes").
+    pub levels: Option<usize>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self { eps: 0.01, noise_floor: 1e-6, c: DEFAULT_C, wavelet: Wavelet::D4, levels: None }
+    }
+}
+
+impl Config {
+    fn check(&self) -> Result<(), Error> {
+        if !(self.eps > 0.0 && self.eps <= 1.0) {
+            return Err(Error::Config(format!("eps {} is not in (0, 1]", self.eps)));
+        }
+        if !(self.noise_floor >= 0.0 && self.noise_floor.is_finite()) {
+            return Err(Error::Config(format!("noise floor {} is negative or not finite", self.noise_floor)));
+        }
+        if !(self.c > 0.0 && self.c.is_finite()) {
+            return Err(Error::Config(format!("c {} is not positive and finite", self.c)));
+        }
+        match self.levels {
+            Some(0) => Err(Error::Config("zero levels requested: at least one level is needed".to_owned())),
+            Some(l) if l > 30 => Err(Error::Config(format!("{l} levels requested: at most 30 are supported"))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Per-pixel local bandwidth of an image: the finest significant level `j*` and the frequency
+/// `c 2^-j*` in cycles per pixel, row-major like the image it was computed from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BandwidthMap {
+    width: usize,
+    height: usize,
+    levels: usize,
+    c: f64,
+    level: Vec<u8>,
+    frequency: Vec<f64>,
+}
+
+impl BandwidthMap {
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The number of levels `J` the estimate used.
+    pub fn levels(&self) -> usize {
+        self.levels
+    }
+
+    /// Frequencies in cycles per pixel, row-major; 0 where no level is significant.
+    pub fn frequency(&self) -> &[f64] {
+        &self.frequency
+    }
+
+    /// The frequency at column `x`, row `y`, in cycles per pixel. Panics outside the map.
+    pub fn frequency_at(&self, x: usize, y: usize) -> f64 {
+        self.frequency[self.index(x, y)]
+    }
+
+    /// The finest significant level `j*` of every pixel, row-major; 0 where none is.
+    pub fn level(&self) -> &[u8] {
+        &self.level
+    }
+
+    /// `j*` at column `x`, row `y`: `None` where no level is significant (a flat neighbourhood).
+    pub fn level_at(&self, x: usize, y: usize) -> Option<usize> {
+        match self.level[self.index(x, y)] {
+            0 => None,
+            j => Some(j as usize),
+        }
+    }
+
+    /// Whether the finest level is significant at `(x, y)`: the content may reach the grid's
+    /// Nyquist limit, so the true bandwidth can be anything from [`Self::max_frequency`] up.
+    pub fn at_nyquist(&self, x: usize, y: usize) -> bool {
+        self.level[self.index(x, y)] == 1
+    }
+
+    /// Number of pixels at the Nyquist limit ([`Self::at_nyquist`]).
+    pub fn nyquist_count(&self) -> usize {
+        self.level.iter().filter(|&&j| j == 1).count()
+    }
+
+    /// The highest frequency the map can hold, `c / 2` cycles per pixel (level 1).
+    pub fn max_frequency(&self) -> f64 {
+        self.c / 2.0
+    }
+
+    /// The frequencies as an image, e.g. to analyse them further.
+    pub fn to_image(&self) -> Image {
+        Image::new(self.width, self.height, self.frequency.clone()).expect("sizes match")
+    }
+
+    fn index(&self, x: usize, y: usize) -> usize {
+        assert!(x < self.width && y < self.height, "({x}, {y}) is outside a {}x{} map", self.width, self.height);
+        y * self.width + x
+    }
+}
+
+/// The local bandwidth of `image` taken as one period of a periodic image (the transform's
+/// periodization): its right edge meets its left edge and its bottom its top. Both sides must
+/// divide by `2^J` (crate docs, "Sizes").
+pub fn local_bandwidth(image: &Image, config: &Config) -> Result<BandwidthMap, Error> {
+    config.check()?;
+    let (w, h) = (image.width(), image.height());
+    let levels = periodic_levels("image", w, h, config)?;
+    estimate(image, levels, w, h, config)
+}
+
+/// The local bandwidth of an image of finite extent, zero outside (001 section 2.3, an area light
+/// or a texture): zero padding to at least twice the size, the estimate, then the crop back to
+/// the image. Any size works (crate docs, "Sizes").
+pub fn local_bandwidth_zero_padded(image: &Image, config: &Config) -> Result<BandwidthMap, Error> {
+    config.check()?;
+    let (w, h) = (image.width(), image.height());
+    if w == 0 || h == 0 {
+        return Err(Error::Size(format!("image is empty ({w}x{h})")));
+    }
+    check_finite("image", image.data())?;
+    // By default the deepest level whose grid is at most 2 coefficients on the shorter padded side.
+    let levels = config.levels.unwrap_or_else(|| (usize::BITS - 1 - (2 * w.min(h)).leading_zeros()) as usize);
+    // Deeper levels would only analyse more zeros (and allocate them).
+    if 1usize << levels > (2 * w.max(h)).next_power_of_two() {
+        return Err(Error::Config(format!(
+            "{levels} levels requested for a {w}x{h} image: at most {} fit its padded size",
+            (2 * w.max(h)).next_power_of_two().trailing_zeros()
+        )));
+    }
+    let pad = |n: usize| (2 * n).div_ceil(1 << levels) << levels;
+    let (pw, ph) = (pad(w), pad(h));
+    let mut padded = vec![0.0; pw * ph];
+    for (dst, src) in padded.chunks_exact_mut(pw).zip(image.rows()) {
+        dst[..w].copy_from_slice(src);
+    }
+    let padded = Image::new(pw, ph, padded).expect("sizes match");
+    estimate(&padded, levels, w, h, config)
+}
+
+/// The number of levels for a periodic image: the requested number, or the most the size allows
+/// provided the coarsest grid is at most 3 coefficients on the shorter side (a level-`J` D4
+/// support, `3 2^J - 2` pixels, then spans the side).
+pub(crate) fn periodic_levels(what: &str, w: usize, h: usize, config: &Config) -> Result<usize, Error> {
+    if w < 2 || h < 2 {
+        return Err(Error::Size(format!("{what} is {w}x{h}: both sides need at least 2 pixels")));
+    }
+    if let Some(levels) = config.levels {
+        return Ok(levels);
+    }
+    let levels = max_levels2(w, h);
+    let coarsest = w.min(h) >> levels;
+    if coarsest > 3 {
+        let limiting = if w.trailing_zeros() <= h.trailing_zeros() { ("width", w) } else { ("height", h) };
+        return Err(Error::Size(format!(
+            "{what} is {w}x{h}: the {} {} allows {levels} level(s) only, which leave {coarsest} coefficients on \
+             the shorter side at the coarsest level (at most 3 allowed); pad or resample it, or set the levels",
+            limiting.0, limiting.1
+        )));
+    }
+    Ok(levels)
+}
+
+pub(crate) fn check_finite(what: &'static str, data: &[f64]) -> Result<(), Error> {
+    match data.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(Error::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}
+
+/// The coefficients of one level that cover each pixel of one axis: pixel `x` is covered by the
+/// `count[x]` coefficients `first[x], first[x] + 1, ...` (modulo the grid size `m`).
+#[derive(Debug)]
+struct Cover {
+    first: Vec<u32>,
+    count: Vec<u32>,
+}
+
+impl Cover {
+    /// Pixels `0..out` of an axis of `n` pixels (`n` divisible by `2^level`). Coefficient `k`
+    /// covers the pixels of `Wavelet::support(level, k)`, wrapped into `0..n`: pixel `x` is
+    /// covered by the `k` with `start_k <= x + t n < start_k + len` for some integer `t`, and
+    /// `t` only shifts `k` by multiples of `m = n / 2^level`.
+    fn new(wavelet: Wavelet, level: usize, n: usize, out: usize) -> Self {
+        let m = (n >> level) as i64;
+        let support = wavelet.support(level, 0);
+        let (start, len, step) = (support.start, support.end - support.start, 1i64 << level);
+        let (mut first, mut count) = (Vec::with_capacity(out), Vec::with_capacity(out));
+        for x in 0..out as i64 {
+            let hi = (x - start).div_euclid(step);
+            let lo = (x - start - len).div_euclid(step) + 1;
+            let c = (hi - lo + 1).min(m);
+            first.push(if c == m { 0 } else { lo.rem_euclid(m) as u32 });
+            count.push(c as u32);
+        }
+        Self { first, count }
+    }
+}
+
+/// One level ready for the per-row pass: for every coefficient row `ky`, the maximum over the
+/// coefficients covering each output column (`rows[ky * out_w + x]`), and the row cover.
+#[derive(Debug)]
+struct LevelRows {
+    rows: Vec<f64>,
+    m_y: usize,
+    cover_y: Cover,
+}
+
+/// The estimate for the top-left `out_w` x `out_h` pixels of a (padded or extended) image.
+pub(crate) fn estimate(
+    image: &Image,
+    levels: usize,
+    out_w: usize,
+    out_h: usize,
+    config: &Config,
+) -> Result<BandwidthMap, Error> {
+    let (w, h) = (image.width(), image.height());
+    let decomposition = wavedec2(image, config.wavelet, levels)?;
+    let prepared: Vec<LevelRows> = decomposition
+        .details
+        .par_iter()
+        .enumerate()
+        .map(|(i, details)| {
+            let level = i + 1;
+            let (m_x, m_y) = (w >> level, h >> level);
+            let floor = config.noise_floor * (1u64 << level) as f64;
+            let [ch, cv, cd] = details;
+            // The largest magnitude of the three orientations, zero below the noise floor.
+            let grid: Vec<f64> = ch
+                .data()
+                .iter()
+                .zip(cv.data())
+                .zip(cd.data())
+                .map(|((a, b), c)| {
+                    let v = a.abs().max(b.abs()).max(c.abs());
+                    if v < floor { 0.0 } else { v }
+                })
+                .collect();
+            let cover_x = Cover::new(config.wavelet, level, w, out_w);
+            let mut rows = vec![0.0; m_y * out_w];
+            for (row, src) in rows.chunks_exact_mut(out_w).zip(grid.chunks_exact(m_x)) {
+                for ((out, &first), &count) in row.iter_mut().zip(&cover_x.first).zip(&cover_x.count) {
+                    let mut best = 0.0f64;
+                    let mut k = first as usize;
+                    for _ in 0..count {
+                        best = best.max(src[k]);
+                        k = if k + 1 == m_x { 0 } else { k + 1 };
+                    }
+                    *out = best;
+                }
+            }
+            LevelRows { rows, m_y, cover_y: Cover::new(config.wavelet, level, h, out_h) }
+        })
+        .collect();
+
+    let mut level = vec![0u8; out_w * out_h];
+    let mut frequency = vec![0.0; out_w * out_h];
+    let eps = config.eps;
+    level.par_chunks_mut(out_w).zip(frequency.par_chunks_mut(out_w)).enumerate().with_min_len(4).for_each_init(
+        || vec![0.0f64; (levels + 2) * out_w],
+        |scratch, (y, (level_row, frequency_row))| {
+            let (lambdas, rest) = scratch.split_at_mut(levels * out_w);
+            let (max, sum) = rest.split_at_mut(out_w);
+            max.fill(0.0);
+            for (lambda, prepared) in lambdas.chunks_exact_mut(out_w).zip(&prepared) {
+                // lambda_j of this row: the maximum over the covering coefficient rows.
+                let (first, count) = (prepared.cover_y.first[y] as usize, prepared.cover_y.count[y]);
+                lambda.fill(0.0);
+                let mut ky = first;
+                for _ in 0..count {
+                    let src = &prepared.rows[ky * out_w..(ky + 1) * out_w];
+                    for (l, s) in lambda.iter_mut().zip(src) {
+                        *l = l.max(*s);
+                    }
+                    ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
+                }
+                for (m, l) in max.iter_mut().zip(lambda.iter()) {
+                    *m = m.max(*l);
+                }
+            }
+            // Eq. 7, finest level first: j* is the first level at which the sum of the finer or
+            // equal levels reaches eps times the pixel's largest lambda.
+            sum.fill(0.0);
+            level_row.fill(0);
+            for (j, lambda) in lambdas.chunks_exact(out_w).enumerate() {
+                for (((s, l), m), out) in sum.iter_mut().zip(lambda).zip(max.iter()).zip(level_row.iter_mut()) {
+                    *s += l;
+                    if *out == 0 && *m > 0.0 && *s >= eps * m {
+                        *out = (j + 1) as u8;
+                    }
+                }
+            }
+            for (f, &j) in frequency_row.iter_mut().zip(level_row.iter()) {
+                *f = if j == 0 { 0.0 } else { config.c * 0.5f64.powi(j as i32) };
+            }
+        },
+    );
+    Ok(BandwidthMap { width: out_w, height: out_h, levels, c: config.c, level, frequency })
+}
