@@ -34,13 +34,15 @@ bench:
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
-## demo: make a synthetic material, validate and summarize it, write its info asset and check it.
+## demo: make a synthetic material, validate and summarize it, write its info asset and check it,
+## bake its importance-sampling tables (and a PNG of the samples over the lobe).
 demo: setup
-	$(CARGO) build --release -p merl-synth -p merl-info -p asset-info
+	$(CARGO) build --release -p merl-synth -p merl-info -p asset-info -p merl-importance
 	@mkdir -p $(DEMO)
 	$(BIN)/merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out $(DEMO)/ggx-copper.binary
 	$(BIN)/merl-info $(DEMO)/ggx-copper.binary --asset $(DEMO)/ggx-copper.info.asset
 	$(BIN)/asset-info $(DEMO)/ggx-copper.info.asset
+	$(BIN)/merl-importance $(DEMO)/ggx-copper.binary --out $(DEMO)/ggx-copper.importance.asset --report
 	@echo "demo outputs are in $(DEMO)/"
 
 clean-demo:

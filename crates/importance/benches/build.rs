@@ -32,9 +32,10 @@ fn main() {
     let chrome = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/merl/chrome.binary");
     let (name, table): (&str, MerlTable) = match merl::read_file(&chrome) {
         Ok(t) => ("chrome (real-derived)", t),
-        Err(_) => {
-            ("ggx alpha 0.05 (synthetic)", merl::analytic::Analytic::Ggx { alpha: 0.05, f0: [0.9; 3] }.table(merl::Dims::MERL))
-        }
+        Err(_) => (
+            "ggx alpha 0.05 (synthetic)",
+            merl::analytic::Analytic::Ggx { alpha: 0.05, f0: [0.9; 3] }.table(merl::Dims::MERL),
+        ),
     };
     let pairs: Vec<_> = (0..1_000_000u32)
         .map(|i| {
@@ -53,7 +54,12 @@ fn main() {
     let threads = rayon::current_num_threads();
     println!("material: {name}; {threads} threads");
     println!("{:<44} {:>10} {:>12}", "operation", "median", "x baseline");
-    println!("{:<44} {:>8.1}ms {:>12.2}", "baseline: 1e6 nearest lookups, one thread", baseline.as_secs_f64() * 1e3, 1.0);
+    println!(
+        "{:<44} {:>8.1}ms {:>12.2}",
+        "baseline: 1e6 nearest lookups, one thread",
+        baseline.as_secs_f64() * 1e3,
+        1.0
+    );
     println!(
         "{:<44} {:>8.1}ms {:>12.2}",
         "build tables (90 slices, 8 x 256 samples)",
