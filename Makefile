@@ -30,6 +30,7 @@ test: setup
 bench:
 	$(CARGO) bench -p importance --bench build
 	$(CARGO) bench -p envmap --bench load
+	$(CARGO) bench -p bandwidth --bench bandwidth
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

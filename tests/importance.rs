@@ -6,7 +6,7 @@ use importance::quality::{albedo_estimate, chi2_against_density, slice_quality};
 use importance::{Config, build};
 use merl::albedo::Quadrature;
 
-use crate::support::{nbrdf_table, run, temp_dir, tool};
+use crate::support::{nbrdf_table, png_size, run, temp_dir, tool};
 
 /// The 20 materials of `../shared/data/nbrdf/merl-dev.json`.
 const MATERIALS: [&str; 20] = [
@@ -185,7 +185,7 @@ fn merl_importance_writes_an_asset_and_a_picture() {
     }
 
     let png = out.with_extension("png");
-    let decoded = image_size(&png);
+    let decoded = png_size(&png);
     assert_eq!(decoded, (4 * 256 + 3 * 4, 256), "{}", png.display());
 }
 
@@ -201,12 +201,4 @@ fn merl_importance_refuses_bad_settings() {
     let r = run(cmd, "").expect_code(2);
     assert!(r.stderr.contains("invalid setting: samples per vector must be at least 1"), "{r}");
     assert!(!dir.path().join("x.asset").exists());
-}
-
-/// Width and height of a PNG, from its IHDR chunk.
-fn image_size(path: &std::path::Path) -> (usize, usize) {
-    let bytes = std::fs::read(path).unwrap();
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
-    let be = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-    (be(16), be(20))
 }

@@ -4,6 +4,7 @@
 mod support;
 
 mod asset_info;
+mod envmap_bandwidth;
 mod importance;
 mod invalid_inputs;
 mod merl_info;

@@ -156,3 +156,12 @@ pub fn temp_dir() -> tempfile::TempDir {
     std::fs::create_dir_all(&base).expect("creating target/test-tmp");
     tempfile::tempdir_in(base).expect("creating a temporary folder")
 }
+
+/// Width and height from a PNG's IHDR chunk (right after the 8-byte signature).
+pub fn png_size(path: &Path) -> (usize, usize) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
+    assert_eq!(&bytes[12..16], b"IHDR");
+    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    (be(16), be(20))
+}

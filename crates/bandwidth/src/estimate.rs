@@ -40,7 +40,8 @@ impl Default for Config {
 }
 
 impl Config {
-    fn check(&self) -> Result<(), Error> {
+    /// Every public entry point calls this first.
+    pub(crate) fn check(&self) -> Result<(), Error> {
         if !(self.eps > 0.0 && self.eps <= 1.0) {
             return Err(Error::Config(format!("eps {} is not in (0, 1]", self.eps)));
         }

@@ -72,6 +72,7 @@ impl AngularBandwidthMap {
 /// row 0 is row 0 turned by half a turn (`x + width / 2`), and likewise below the last row, so
 /// the estimate sees the sphere, not the seams of the image (crate docs, "Lat-long maps").
 pub fn latlong_bandwidth(image: &Image, config: &Config) -> Result<AngularBandwidthMap, Error> {
+    config.check()?;
     let (w, h) = (image.width(), image.height());
     if w < 2 || h < 1 || w % 2 != 0 {
         return Err(Error::Size(format!("lat-long map is {w}x{h}: the width must be even and at least 2")));

@@ -56,7 +56,11 @@ fn bad_configurations_are_refused() {
         Config { c: 0.0, ..Config::default() },
         Config { levels: Some(0), ..Config::default() },
     ] {
+        // Every entry point refuses it, not just the plain one.
         assert!(matches!(local_bandwidth(&image, &config), Err(Error::Config(_))), "{config:?}");
+        assert!(matches!(local_bandwidth_zero_padded(&image, &config), Err(Error::Config(_))), "{config:?}");
+        let latlong = Image::zeros(32, 16);
+        assert!(matches!(latlong_bandwidth(&latlong, &config), Err(Error::Config(_))), "{config:?}");
     }
     let image = Image::zeros(64, 64);
     for config in [
