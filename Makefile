@@ -31,6 +31,7 @@ bench:
 	$(CARGO) bench -p importance --bench build
 	$(CARGO) bench -p envmap --bench load
 	$(CARGO) bench -p bandwidth --bench bandwidth
+	$(CARGO) bench -p prefilter --bench prefilter
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

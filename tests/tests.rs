@@ -5,6 +5,7 @@ mod support;
 
 mod asset_info;
 mod envmap_bandwidth;
+mod envmap_prefilter;
 mod importance;
 mod invalid_inputs;
 mod merl_info;

@@ -13,7 +13,7 @@ use sha2::{Digest, Sha256};
 
 use crate::error::Error;
 use crate::files::write_atomic;
-use crate::types::{Asset, AssetKind, ImportanceSamples, MaterialInfo, Payload, Provenance};
+use crate::types::{Asset, AssetKind, ImportanceSamples, MaterialInfo, Payload, PrefilteredEnvmap, Provenance};
 
 /// The first eight bytes of every asset file.
 pub const MAGIC: [u8; 8] = *b"BRDFASET";
@@ -117,6 +117,7 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
     let payload = match &asset.payload {
         Payload::MaterialInfo(info) => encode_section(info),
         Payload::ImportanceSamples(samples) => encode_section(samples),
+        Payload::PrefilteredEnvmap(prefiltered) => encode_section(prefiltered),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -160,6 +161,9 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
         AssetKind::MaterialInfo => Payload::MaterialInfo(decode_section::<MaterialInfo>("payload", payload)?),
         AssetKind::ImportanceSamples => {
             Payload::ImportanceSamples(decode_section::<ImportanceSamples>("payload", payload)?)
+        }
+        AssetKind::PrefilteredEnvmap => {
+            Payload::PrefilteredEnvmap(decode_section::<PrefilteredEnvmap>("payload", payload)?)
         }
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;

@@ -60,4 +60,6 @@ pub use container::{
 pub use error::Error;
 pub use files::{hex, sha256, sha256_file, sha256_from_hex, write_atomic};
 pub use manifest::{BakeManifest, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool};
-pub use types::{Asset, AssetKind, ImportanceSamples, MaterialInfo, Payload, Provenance};
+pub use types::{
+    Asset, AssetKind, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
+};

@@ -31,11 +31,14 @@ pub enum AssetKind {
     MaterialInfo = 1,
     /// [`ImportanceSamples`]: importance-sampling tables and precomputed samples of a material.
     ImportanceSamples = 2,
+    /// [`PrefilteredEnvmap`]: an environment map convolved with Phong lobes, and its mip chain.
+    PrefilteredEnvmap = 3,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 2] = [AssetKind::MaterialInfo, AssetKind::ImportanceSamples];
+    pub const ALL: [AssetKind; 3] =
+        [AssetKind::MaterialInfo, AssetKind::ImportanceSamples, AssetKind::PrefilteredEnvmap];
 
     /// The number stored in the header.
     pub fn code(self) -> u32 {
@@ -52,6 +55,7 @@ impl AssetKind {
         match self {
             AssetKind::MaterialInfo => "material-info",
             AssetKind::ImportanceSamples => "importance-samples",
+            AssetKind::PrefilteredEnvmap => "prefiltered-envmap",
         }
     }
 }
@@ -159,6 +163,126 @@ impl ImportanceSamples {
     }
 }
 
+/// A file written next to an asset: its name in the asset's folder and its SHA-256, so that a
+/// reader can find it and check that it is the file the asset describes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinkedFile {
+    /// A plain file name: not empty, no `/` or `\`, not `.` or `..`.
+    pub name: String,
+    pub sha256: [u8; 32],
+}
+
+impl LinkedFile {
+    fn check(&self) -> Result<(), String> {
+        let name = &self.name;
+        if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\\', '\0']) {
+            return Err(format!("linked file name {name:?} is not a plain file name"));
+        }
+        Ok(())
+    }
+}
+
+/// An environment map convolved with normalized Phong lobes `(n + 1) / (2 pi) max(0, w . r)^n`,
+/// one layer per exponent, and the source's mip chain (payload of [`AssetKind::PrefilteredEnvmap`],
+/// written by `envmap-prefilter`). The texels are in the linked files; `data-schema/README.md`
+/// describes them and how a renderer picks a layer from a BRDF's bandwidth.
+///
+/// With `K = exponents.len()`: `lobe_bandwidth`, `layer_mean_radiance` and `layer_exrs` have `K`
+/// entries (entry `k` is layer `k`), `bandwidth_thresholds` has `K - 1`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PrefilteredEnvmap {
+    /// Width and height of the source map (lat-long, `width = 2 height`).
+    pub source_size: [u32; 2],
+    /// The source's solid-angle-weighted mean radiance, red, green, blue.
+    pub source_mean_radiance: [f64; 3],
+    /// Width and height of every layer (lat-long, `width = 2 height`).
+    pub layer_size: [u32; 2],
+    /// Levels of the mip chain in `mips_ktx2`, level 0 being the source.
+    pub mip_levels: u32,
+    /// Texels of `layers_ktx2` are radiance times this (a power of two, at most 1).
+    pub layers_radiance_scale: f64,
+    /// Texels of `mips_ktx2` are radiance times this (a power of two, at most 1).
+    pub mips_radiance_scale: f64,
+    /// The Phong exponent of each layer, strictly increasing.
+    pub exponents: Vec<u32>,
+    /// The angular bandwidth of each layer's lobe, cycles per radian: `sqrt(n) / (2 pi)`.
+    pub lobe_bandwidth: Vec<f64>,
+    /// Between layers `k` and `k + 1`: `sqrt(lobe_bandwidth[k] lobe_bandwidth[k + 1])`. A BRDF
+    /// of bandwidth `nu` uses the layer whose index is the number of thresholds below `nu`.
+    pub bandwidth_thresholds: Vec<f64>,
+    /// Each layer's solid-angle-weighted mean radiance (equal to the source's up to rounding and
+    /// sampling: the lobes integrate to 1).
+    pub layer_mean_radiance: Vec<[f64; 3]>,
+    /// The layers as a KTX2 2D array texture, RGBA16F, one layer per exponent.
+    pub layers_ktx2: LinkedFile,
+    /// The layers as OpenEXR files (RGB, 32-bit float), one per exponent.
+    pub layer_exrs: Vec<LinkedFile>,
+    /// The source's mip chain as a KTX2 2D texture, RGBA16F.
+    pub mips_ktx2: LinkedFile,
+    /// The source and the layers side by side, tone mapped (PNG, for people).
+    pub contact_sheet_png: LinkedFile,
+}
+
+impl PrefilteredEnvmap {
+    fn check(&self) -> Result<(), String> {
+        let k = self.exponents.len();
+        if k == 0 {
+            return Err("prefiltered envmap has no layers".into());
+        }
+        if let Some(w) = self.exponents.windows(2).find(|w| w[0] >= w[1]) {
+            return Err(format!("prefiltered envmap exponents must increase strictly, found {} then {}", w[0], w[1]));
+        }
+        if self.exponents[0] == 0 {
+            return Err("prefiltered envmap exponent 0: exponents start at 1".into());
+        }
+        for (what, [w, h]) in [("source", self.source_size), ("layer", self.layer_size)] {
+            if h == 0 || u64::from(w) != 2 * u64::from(h) {
+                return Err(format!("prefiltered envmap {what} size {w} x {h} is not a 2:1 lat-long map"));
+            }
+        }
+        if self.mip_levels == 0 {
+            return Err("prefiltered envmap has no mip levels".into());
+        }
+        let expect = [
+            ("lobe bandwidths", self.lobe_bandwidth.len(), k),
+            ("bandwidth thresholds", self.bandwidth_thresholds.len(), k - 1),
+            ("layer means", self.layer_mean_radiance.len(), k),
+            ("layer exr files", self.layer_exrs.len(), k),
+        ];
+        for (what, found, expected) in expect {
+            if found != expected {
+                return Err(format!("prefiltered envmap: {what} has {found} entries, expected {expected}"));
+            }
+        }
+        if !self.lobe_bandwidth.iter().all(|b| b.is_finite() && *b > 0.0) {
+            return Err("prefiltered envmap lobe bandwidths must be positive and finite".into());
+        }
+        for (i, t) in self.bandwidth_thresholds.iter().enumerate() {
+            let (lower, upper) = (self.lobe_bandwidth[i], self.lobe_bandwidth[i + 1]);
+            if !(lower < *t && *t < upper) {
+                return Err(format!(
+                    "prefiltered envmap threshold {i} ({t}) does not lie between the bandwidths of its layers ({lower}, \
+                     {upper})"
+                ));
+            }
+        }
+        for (what, scale) in [("layers", self.layers_radiance_scale), ("mips", self.mips_radiance_scale)] {
+            if !(scale > 0.0 && scale <= 1.0) {
+                return Err(format!("prefiltered envmap {what} radiance scale {scale} outside (0, 1]"));
+            }
+        }
+        let files: Vec<&LinkedFile> =
+            [&self.layers_ktx2, &self.mips_ktx2, &self.contact_sheet_png].into_iter().chain(&self.layer_exrs).collect();
+        for (i, file) in files.iter().enumerate() {
+            file.check().map_err(|problem| format!("prefiltered envmap: {problem}"))?;
+            if files[..i].iter().any(|other| other.name == file.name) {
+                return Err(format!("prefiltered envmap names the file {:?} twice", file.name));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The payload of an asset, one variant per [`AssetKind`].
 ///
 /// Only the variant's content is serialized; the header's kind code says which type follows.
@@ -166,6 +290,7 @@ impl ImportanceSamples {
 pub enum Payload {
     MaterialInfo(MaterialInfo),
     ImportanceSamples(ImportanceSamples),
+    PrefilteredEnvmap(PrefilteredEnvmap),
 }
 
 impl Payload {
@@ -173,6 +298,7 @@ impl Payload {
         match self {
             Payload::MaterialInfo(_) => AssetKind::MaterialInfo,
             Payload::ImportanceSamples(_) => AssetKind::ImportanceSamples,
+            Payload::PrefilteredEnvmap(_) => AssetKind::PrefilteredEnvmap,
         }
     }
 
@@ -181,6 +307,7 @@ impl Payload {
         match self {
             Payload::MaterialInfo(info) => info.check(),
             Payload::ImportanceSamples(samples) => samples.check(),
+            Payload::PrefilteredEnvmap(prefiltered) => prefiltered.check(),
         }
     }
 }
@@ -194,6 +321,12 @@ impl From<MaterialInfo> for Payload {
 impl From<ImportanceSamples> for Payload {
     fn from(samples: ImportanceSamples) -> Payload {
         Payload::ImportanceSamples(samples)
+    }
+}
+
+impl From<PrefilteredEnvmap> for Payload {
+    fn from(prefiltered: PrefilteredEnvmap) -> Payload {
+        Payload::PrefilteredEnvmap(prefiltered)
     }
 }
 

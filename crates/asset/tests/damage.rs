@@ -1,7 +1,9 @@
 //! Damaged bytes: every flipped byte, every truncation and every lying length is an error that
 //! names the problem, never a panic and never an allocation sized by the lie.
 
-use asset::{Error, HEADER_BYTES, Payload, decode, encode, read_file, write_file};
+use asset::{
+    Asset, Error, HEADER_BYTES, LinkedFile, Payload, PrefilteredEnvmap, decode, encode, read_file, write_file,
+};
 
 use crate::{reseal, small_asset};
 
@@ -114,7 +116,7 @@ fn the_unknown_kind_message_names_the_number() {
     bytes[12..16].copy_from_slice(&9u32.to_le_bytes());
     assert_eq!(
         decode(&bytes).unwrap_err().to_string(),
-        "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples)"
+        "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples), 3 (prefiltered-envmap)"
     );
 }
 
@@ -185,4 +187,65 @@ fn albedo_vectors_of_different_lengths_are_refused_on_write_and_read() {
         message,
         "invalid payload: material info has 2 albedo angles but 1 albedo values and 2 no-data fractions"
     );
+}
+
+/// A valid prefiltered-envmap asset: three layers, exponents 1, 4, 16.
+fn prefiltered_asset() -> Asset {
+    let file = |name: &str| LinkedFile { name: name.into(), sha256: [7; 32] };
+    let bandwidth = |n: f64| n.sqrt() / (2.0 * std::f64::consts::PI);
+    Asset {
+        provenance: small_asset().provenance,
+        payload: PrefilteredEnvmap {
+            source_size: [1024, 512],
+            source_mean_radiance: [0.5, 0.4, 0.3],
+            layer_size: [256, 128],
+            mip_levels: 10,
+            layers_radiance_scale: 1.0,
+            mips_radiance_scale: 0.5,
+            exponents: vec![1, 4, 16],
+            lobe_bandwidth: vec![bandwidth(1.0), bandwidth(4.0), bandwidth(16.0)],
+            bandwidth_thresholds: vec![bandwidth(2.0), bandwidth(8.0)],
+            layer_mean_radiance: vec![[0.5, 0.4, 0.3]; 3],
+            layers_ktx2: file("layers.ktx2"),
+            layer_exrs: vec![file("layer-n1.exr"), file("layer-n4.exr"), file("layer-n16.exr")],
+            mips_ktx2: file("mips.ktx2"),
+            contact_sheet_png: file("contact-sheet.png"),
+        }
+        .into(),
+    }
+}
+
+#[test]
+fn prefiltered_envmap_invariants_are_refused_on_write_and_read() {
+    type Edit = fn(&mut PrefilteredEnvmap);
+    let cases: [(Edit, &str); 10] = [
+        (|p| p.exponents = vec![1, 16, 4], "exponents must increase strictly, found 16 then 4"),
+        (|p| p.exponents[0] = 0, "exponent 0: exponents start at 1"),
+        (|p| p.layer_size = [256, 256], "layer size 256 x 256 is not a 2:1 lat-long map"),
+        (|p| p.source_size = [0, 0], "source size 0 x 0 is not a 2:1 lat-long map"),
+        (|p| p.mip_levels = 0, "has no mip levels"),
+        (|p| p.bandwidth_thresholds.truncate(1), "bandwidth thresholds has 1 entries, expected 2"),
+        (|p| p.bandwidth_thresholds[1] = 10.0, "threshold 1 (10) does not lie between the bandwidths of its layers"),
+        (|p| p.mips_radiance_scale = 2.0, "mips radiance scale 2 outside (0, 1]"),
+        (
+            |p| p.layer_exrs[1].name = "../layer-n4.exr".into(),
+            "linked file name \"../layer-n4.exr\" is not a plain file name",
+        ),
+        (|p| p.mips_ktx2.name = "layers.ktx2".into(), "names the file \"layers.ktx2\" twice"),
+    ];
+    let valid = prefiltered_asset();
+    assert_eq!(decode(&encode(&valid)).unwrap(), valid);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.asset");
+    for (edit, expected) in cases {
+        let mut asset = valid.clone();
+        let Payload::PrefilteredEnvmap(p) = &mut asset.payload else { unreachable!("a prefiltered envmap") };
+        edit(p);
+        let message = write_file(&path, &asset).unwrap_err().to_string();
+        assert!(message.contains(expected), "{expected}: {message}");
+        assert!(!path.exists());
+        let message = decode(&encode(&asset)).unwrap_err().to_string();
+        assert!(message.starts_with("invalid payload: prefiltered envmap"), "{message}");
+        assert!(message.contains(expected), "{expected}: {message}");
+    }
 }

@@ -1,6 +1,9 @@
 //! read(write(a)) = a for random assets, in memory and through files.
 
-use asset::{Asset, ImportanceSamples, MaterialInfo, Payload, Provenance, decode, encode, read_file, write_file};
+use asset::{
+    Asset, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance, decode, encode,
+    read_file, write_file,
+};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -46,8 +49,8 @@ fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
 
 fn random_asset(rng: &mut StdRng) -> Asset {
     let angles = random_len(rng);
-    let payload = if rng.random_bool(0.5) {
-        Payload::MaterialInfo(MaterialInfo {
+    let payload = match rng.random_range(0..3) {
+        0 => Payload::MaterialInfo(MaterialInfo {
             dims: rng.random(),
             no_data_cells: rng.random(),
             channel_min: random_rgb(rng),
@@ -58,9 +61,9 @@ fn random_asset(rng: &mut StdRng) -> Asset {
             albedo_theta_o: (0..angles).map(|_| random_f64(rng)).collect(),
             albedo_rgb: (0..angles).map(|_| random_rgb(rng)).collect(),
             albedo_no_data_fraction: (0..angles).map(|_| random_f64(rng)).collect(),
-        })
-    } else {
-        random_importance_samples(rng)
+        }),
+        1 => random_importance_samples(rng),
+        _ => random_prefiltered_envmap(rng),
     };
     Asset {
         provenance: Provenance {
@@ -94,6 +97,52 @@ fn random_importance_samples(rng: &mut StdRng) -> Payload {
         marginal_cdf,
         conditional_cdf,
         h_density,
+    })
+}
+
+/// Consistent sizes and orders (the payload's invariants), random contents: bandwidths and
+/// thresholds interleaved, distinct plain file names.
+fn random_prefiltered_envmap(rng: &mut StdRng) -> Payload {
+    let layers = rng.random_range(1..8);
+    let mut exponents: Vec<u32> = Vec::new();
+    for _ in 0..layers {
+        let previous = exponents.last().copied().unwrap_or(0);
+        exponents.push(previous + rng.random_range(1..5000));
+    }
+    // Increasing bandwidths, thresholds strictly between their neighbours.
+    let mut lobe_bandwidth = Vec::new();
+    let mut bandwidth_thresholds = Vec::new();
+    let mut at = rng.random::<f64>() + 1e-3;
+    for k in 0..layers {
+        if k > 0 {
+            at += rng.random::<f64>() + 1e-3;
+            bandwidth_thresholds.push(at);
+            at += rng.random::<f64>() + 1e-3;
+        }
+        lobe_bandwidth.push(at);
+    }
+    let mut file = |i: usize| LinkedFile {
+        name: format!("{}-{i}", random_string(rng).replace(['/', '\\', '\0'], "_")),
+        sha256: rng.random(),
+    };
+    let (layers_ktx2, mips_ktx2, contact_sheet_png) = (file(0), file(1), file(2));
+    let layer_exrs = (3..3 + layers).map(file).collect();
+    let height = rng.random_range(1..u32::MAX / 2);
+    Payload::PrefilteredEnvmap(PrefilteredEnvmap {
+        source_size: [2 * height, height],
+        source_mean_radiance: random_rgb(rng),
+        layer_size: [2 * (height / 3 + 1), height / 3 + 1],
+        mip_levels: rng.random_range(1..20),
+        layers_radiance_scale: 0.5f64.powi(rng.random_range(0..20)),
+        mips_radiance_scale: 0.5f64.powi(rng.random_range(0..20)),
+        exponents,
+        lobe_bandwidth,
+        bandwidth_thresholds,
+        layer_mean_radiance: (0..layers).map(|_| random_rgb(rng)).collect(),
+        layers_ktx2,
+        layer_exrs,
+        mips_ktx2,
+        contact_sheet_png,
     })
 }
 

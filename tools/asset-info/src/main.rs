@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use asset::{Asset, Error, Header, ImportanceSamples, MaterialInfo, Payload, Provenance, hex};
+use asset::{
+    Asset, Error, Header, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance, hex,
+};
 use clap::Parser;
 use serde_json::{Value, json};
 
@@ -83,6 +85,7 @@ fn print_text(report: &Report) {
             match &asset.payload {
                 Payload::MaterialInfo(info) => print_material_info(info),
                 Payload::ImportanceSamples(samples) => print_importance_samples(samples),
+                Payload::PrefilteredEnvmap(prefiltered) => print_prefiltered_envmap(prefiltered),
             }
         }
     }
@@ -141,6 +144,53 @@ fn print_importance_samples(s: &ImportanceSamples) {
     cli::outln!("  samples          {} vectors x {} samples per slice", s.n_vectors, s.n_samples);
     cli::outln!("  cells            {} theta_h rows x {} phi_h sectors", summary.rows, s.n_phi_h);
     cli::outln!("  samples with pdf 0  {}", summary.zero_pdf_samples);
+}
+
+fn print_prefiltered_envmap(p: &PrefilteredEnvmap) {
+    let rgb = |v: [f64; 3]| format!("{:.6} {:.6} {:.6}", v[0], v[1], v[2]);
+    let [sw, sh] = p.source_size;
+    let [lw, lh] = p.layer_size;
+    cli::outln!("payload: prefiltered envmap");
+    cli::outln!("  source           {sw} x {sh}, mean radiance {}", rgb(p.source_mean_radiance));
+    cli::outln!("  layers           {} of {lw} x {lh}", p.exponents.len());
+    cli::outln!("    exponent  bandwidth (cycles/rad)  up to (cycles/rad)   mean radiance");
+    for (k, (n, nu)) in p.exponents.iter().zip(&p.lobe_bandwidth).enumerate() {
+        let up_to = p.bandwidth_thresholds.get(k).map_or_else(|| "-".to_string(), |t| format!("{t:.4}"));
+        cli::outln!("    {n:>8} {nu:>22.4} {up_to:>19}   {}", rgb(p.layer_mean_radiance[k]));
+    }
+    let file = |f: &LinkedFile| format!("{} (sha256 {})", f.name, hex(&f.sha256));
+    cli::outln!("  layers ktx2      {}, radiance scale {}", file(&p.layers_ktx2), p.layers_radiance_scale);
+    for (n, exr) in p.exponents.iter().zip(&p.layer_exrs) {
+        cli::outln!("  layer exr        n = {n}: {}", file(exr));
+    }
+    cli::outln!(
+        "  mips ktx2        {}, {} levels, radiance scale {}",
+        file(&p.mips_ktx2),
+        p.mip_levels,
+        p.mips_radiance_scale
+    );
+    cli::outln!("  contact sheet    {}", file(&p.contact_sheet_png));
+}
+
+/// A prefiltered envmap's payload in JSON: its own fields, hashes as hexadecimal.
+fn prefiltered_envmap_json(p: &PrefilteredEnvmap) -> Value {
+    let file = |f: &LinkedFile| json!({ "name": f.name, "sha256": hex(&f.sha256) });
+    json!({
+        "source_size": p.source_size,
+        "source_mean_radiance": p.source_mean_radiance,
+        "layer_size": p.layer_size,
+        "mip_levels": p.mip_levels,
+        "layers_radiance_scale": p.layers_radiance_scale,
+        "mips_radiance_scale": p.mips_radiance_scale,
+        "exponents": p.exponents,
+        "lobe_bandwidth": p.lobe_bandwidth,
+        "bandwidth_thresholds": p.bandwidth_thresholds,
+        "layer_mean_radiance": p.layer_mean_radiance,
+        "layers_ktx2": file(&p.layers_ktx2),
+        "layer_exrs": p.layer_exrs.iter().map(file).collect::<Vec<_>>(),
+        "mips_ktx2": file(&p.mips_ktx2),
+        "contact_sheet_png": file(&p.contact_sheet_png),
+    })
 }
 
 /// What asset-info says about an importance-samples payload (the arrays themselves are too
@@ -203,6 +253,7 @@ fn to_json(report: &Report) -> Value {
                         "zero_pdf_samples": summary.zero_pdf_samples,
                     })
                 }
+                Payload::PrefilteredEnvmap(prefiltered) => prefiltered_envmap_json(prefiltered),
             };
             json!({
                 "header": header_json,

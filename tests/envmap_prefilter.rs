@@ -1,0 +1,202 @@
+//! `envmap-prefilter` end to end on the shared real maps: every output is written, the asset
+//! names them with their true hashes, the KTX2 files read back with the maintained `ktx2` reader
+//! and hold the EXR layers and the mip chain to half-float rounding (`--verify`), and damaged or
+//! awkward inputs give exit 2 and one line naming the file.
+
+use std::path::{Path, PathBuf};
+
+use asset::Payload;
+
+use crate::support::{run, shared, temp_dir, tool};
+
+fn env_dir() -> PathBuf {
+    shared().join("data").join("env")
+}
+
+fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap())
+}
+
+/// `(vkFormat, width, height, layerCount, levelCount)` from a KTX2 header, by hand.
+fn ktx2_header(path: &Path) -> (u32, u32, u32, u32, u32) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    assert_eq!(
+        &bytes[..12],
+        &[0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A],
+        "{}",
+        path.display()
+    );
+    (u32_at(&bytes, 12), u32_at(&bytes, 20), u32_at(&bytes, 24), u32_at(&bytes, 32), u32_at(&bytes, 40))
+}
+
+#[test]
+fn writes_every_output_for_the_real_maps_and_they_verify() {
+    for name in ["quarry_01_1k.hdr", "potsdamer_platz_1k.hdr"] {
+        let tmp = temp_dir();
+        let out = tmp.path().join("prefiltered");
+        let mut cmd = tool("envmap-prefilter");
+        cmd.arg(env_dir().join(name)).arg("--out").arg(&out).arg("--verify");
+        let r = run(cmd, "")
+            .expect_code(0)
+            .expect_stdout("7 layers match the EXR layers within half-float rounding")
+            .expect_stdout("10 mip levels match the source's mip chain within half-float rounding");
+        assert!(!r.stdout.contains("problem"), "{r}");
+
+        let asset = asset::read_file(&out.join("prefiltered.asset")).unwrap();
+        assert_eq!(asset.provenance.source_name, name);
+        assert_eq!(asset.provenance.source_sha256, asset::sha256_file(&env_dir().join(name)).unwrap());
+        let Payload::PrefilteredEnvmap(p) = asset.payload else { panic!("{name}: not a prefiltered envmap") };
+        assert_eq!(p.exponents, [1, 4, 16, 64, 256, 1024, 4096]);
+        assert_eq!((p.source_size, p.layer_size, p.mip_levels), ([1024, 512], [256, 128], 10));
+        assert_eq!(p.lobe_bandwidth.len(), 7);
+        for (k, nu) in p.lobe_bandwidth.iter().enumerate() {
+            let n = f64::from(p.exponents[k]);
+            assert!((nu - (n + 2.0).sqrt() / (2.0 * std::f64::consts::PI)).abs() < 1e-12);
+        }
+        for (t, pair) in p.bandwidth_thresholds.iter().zip(p.lobe_bandwidth.windows(2)) {
+            assert!((t - (pair[0] * pair[1]).sqrt()).abs() < 1e-12);
+        }
+        for (layer, source) in p.layer_mean_radiance.iter().map(|m| (m, p.source_mean_radiance)) {
+            for c in 0..3 {
+                assert!((layer[c] / source[c] - 1.0).abs() < 0.005, "{name}: layer mean {layer:?} vs {source:?}");
+            }
+        }
+        let files = [&p.layers_ktx2, &p.mips_ktx2, &p.contact_sheet_png].into_iter().chain(&p.layer_exrs);
+        for file in files {
+            let path = out.join(&file.name);
+            assert_eq!(asset::sha256_file(&path).unwrap(), file.sha256, "{}", path.display());
+        }
+        let names: Vec<&str> = p.layer_exrs.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "layer-n1.exr",
+                "layer-n4.exr",
+                "layer-n16.exr",
+                "layer-n64.exr",
+                "layer-n256.exr",
+                "layer-n1024.exr",
+                "layer-n4096.exr"
+            ]
+        );
+        // VK_FORMAT_R16G16B16A16_SFLOAT = 97; an array of 7 layers with one level, and a plain
+        // 2D texture with 10 levels.
+        assert_eq!(ktx2_header(&out.join(&p.layers_ktx2.name)), (97, 256, 128, 7, 1));
+        assert_eq!(ktx2_header(&out.join(&p.mips_ktx2.name)), (97, 1024, 512, 0, 10));
+        // Quarry's sun exceeds the largest half float: its mip chain is stored at half scale.
+        let expected_scale = if name.starts_with("quarry") { 0.5 } else { 1.0 };
+        assert_eq!((p.layers_radiance_scale, p.mips_radiance_scale), (1.0, expected_scale));
+
+        let mut cmd = tool("asset-info");
+        cmd.arg(out.join("prefiltered.asset"));
+        run(cmd, "")
+            .expect_code(0)
+            .expect_stdout("kind             prefiltered-envmap (3)")
+            .expect_stdout("payload: prefiltered envmap")
+            .expect_stdout("layer exr        n = 4096: layer-n4096.exr");
+        let mut cmd = tool("asset-info");
+        cmd.arg(out.join("prefiltered.asset")).arg("--json");
+        let json = run(cmd, "").expect_code(0).json();
+        assert_eq!(json["payload"]["layers_ktx2"]["name"], "layers.ktx2");
+        assert_eq!(json["payload"]["exponents"][6], 4096);
+    }
+}
+
+/// Options: other exponents and sizes, and the method forced.
+#[test]
+fn exponents_size_and_method_are_honoured() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("small");
+    let mut cmd = tool("envmap-prefilter");
+    cmd.arg(env_dir().join("studio_small_03_1k.hdr")).args(["--out"]).arg(&out).args([
+        "--exponents",
+        "2,30,900",
+        "--size",
+        "64x32",
+        "--method",
+        "window",
+        "--verify",
+    ]);
+    run(cmd, "").expect_code(0).expect_stdout("3 layers match");
+    let Payload::PrefilteredEnvmap(p) = asset::read_file(&out.join("prefiltered.asset")).unwrap().payload else {
+        panic!("not a prefiltered envmap")
+    };
+    assert_eq!((p.exponents.as_slice(), p.layer_size), (&[2, 30, 900][..], [64, 32]));
+    assert_eq!(ktx2_header(&out.join("layers.ktx2")), (97, 64, 32, 3, 1));
+    let provenance = asset::read_file(&out.join("prefiltered.asset")).unwrap().provenance;
+    assert!(provenance.parameters.contains(&("layer n=30".to_string(), "window".to_string())), "{provenance:?}");
+}
+
+#[test]
+fn bad_arguments_are_refused() {
+    let cases: [(&[&str], &str); 3] = [
+        (&["--exponents", "16,4"], "error: invalid arguments: exponents must increase strictly, found 16 then 4\n"),
+        (&["--exponents", "0"], "error: invalid arguments: exponent 0 outside 1 ..= 16777216\n"),
+        (
+            &["--size", "100x100"],
+            "error: invalid arguments: layer size 100 x 100: expected width = 2 x height, height 1 ..= 8192\n",
+        ),
+    ];
+    let tmp = temp_dir();
+    for (args, expected) in cases {
+        let mut cmd = tool("envmap-prefilter");
+        cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out").arg(tmp.path().join("x")).args(args);
+        let r = run(cmd, "").expect_code(2);
+        assert_eq!(r.stderr, expected, "{r}");
+        assert!(!tmp.path().join("x").exists(), "nothing is written\n{r}");
+    }
+    let mut cmd = tool("envmap-prefilter");
+    cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out").arg(tmp.path().join("x")).args(["--size", "256"]);
+    run(cmd, "").expect_code(2);
+}
+
+/// Runs the tool on `path`, expects exit 2, one line `error: reading PATH: ...` holding
+/// `problem`, nothing on stdout and nothing written.
+fn check_refused(path: &Path, problem: &str) {
+    let tmp = temp_dir();
+    let out = tmp.path().join("out");
+    let mut cmd = tool("envmap-prefilter");
+    cmd.arg(path).arg("--out").arg(&out);
+    let r = run(cmd, "").expect_code(2).expect_error(path, problem);
+    assert!(r.stdout.is_empty(), "nothing belongs on stdout\n{r}");
+    assert!(!out.exists(), "nothing is written\n{r}");
+}
+
+/// The awkward files of `decoder/` decode (the `envmap` tests check their values) but none is a
+/// 2:1 lat-long map: each is refused with the reason. The list must name every file there.
+#[test]
+fn awkward_decoder_files_are_refused_with_the_reason() {
+    let cases = [
+        ("imagers_old-rle.hdr", "not a lat-long map: 551 x 276, expected width = 2 x height"),
+        ("imagers_rgbr4x4.hdr", "not a lat-long map: 4 x 4, expected width = 2 x height"),
+        ("imagers_scale.hdr", "not a lat-long map: 256 x 8, expected width = 2 x height"),
+        ("memorial.exr", "not a lat-long map: 512 x 768, expected width = 2 x height"),
+    ];
+    let dir = env_dir().join("decoder");
+    let mut present: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    present.sort();
+    assert_eq!(present, cases.map(|c| c.0), "every file in {} needs an expected outcome here", dir.display());
+    for (file, problem) in cases {
+        check_refused(&dir.join(file), problem);
+    }
+}
+
+/// Damaged copies of real maps and files that are no map at all.
+#[test]
+fn damaged_inputs_are_refused_with_the_reason() {
+    let tmp = temp_dir();
+    let truncate = |name: &str, len: usize| {
+        let bytes = std::fs::read(env_dir().join(name)).unwrap();
+        let path = tmp.path().join(format!("truncated-{name}"));
+        std::fs::write(&path, &bytes[..len]).unwrap();
+        path
+    };
+    check_refused(&truncate("quarry_01_1k.hdr", 100_000), "radiance hdr: truncated: the file ends early");
+    check_refused(&truncate("piz_compressed.exr", 100_000), "openexr: truncated: the file ends early");
+    check_refused(&truncate("quarry_01_1k.hdr", 0), "empty file");
+    let text = tmp.path().join("notes.hdr");
+    std::fs::write(&text, "hello").unwrap();
+    check_refused(&text, "unsupported: unknown file format (starts with 68 65 6c 6c)");
+    check_refused(&tmp.path().join("missing.hdr"), "no such file or directory");
+}
