@@ -32,6 +32,7 @@ bench:
 	$(CARGO) bench -p envmap --bench load
 	$(CARGO) bench -p bandwidth --bench bandwidth
 	$(CARGO) bench -p prefilter --bench prefilter
+	$(CARGO) bench -p brdf-atlas --bench atlas
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

@@ -6,31 +6,7 @@ use importance::quality::{albedo_estimate, chi2_against_density, slice_quality};
 use importance::{Config, build};
 use merl::albedo::Quadrature;
 
-use crate::support::{nbrdf_table, png_size, run, temp_dir, tool};
-
-/// The 20 materials of `../shared/data/nbrdf/merl-dev.json`.
-const MATERIALS: [&str; 20] = [
-    "color-changing-paint3",
-    "gold-paint",
-    "red-metallic-paint",
-    "green-metallic-paint",
-    "blue-rubber",
-    "white-marble",
-    "white-paint",
-    "chrome",
-    "nickel",
-    "pink-fabric",
-    "brass",
-    "blue-acrylic",
-    "gray-plastic",
-    "yellow-paint",
-    "steel",
-    "alum-bronze",
-    "black-obsidian",
-    "cherry-235",
-    "teflon",
-    "silver-metallic-paint",
-];
+use crate::support::{MATERIALS, nbrdf_table, png_size, run, temp_dir, tool};
 
 /// Nine slices, 10 degrees apart: 0, 30, 60 and 80 degrees are slices 0, 3, 6 and 8.
 const SLICES: [usize; 4] = [0, 3, 6, 8];

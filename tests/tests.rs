@@ -4,6 +4,7 @@
 mod support;
 
 mod asset_info;
+mod brdf_bandwidth;
 mod envmap_bandwidth;
 mod envmap_prefilter;
 mod importance;

@@ -124,6 +124,30 @@ pub fn shared() -> PathBuf {
     dir
 }
 
+/// The 20 materials of `../shared/data/nbrdf/merl-dev.json`.
+pub const MATERIALS: [&str; 20] = [
+    "color-changing-paint3",
+    "gold-paint",
+    "red-metallic-paint",
+    "green-metallic-paint",
+    "blue-rubber",
+    "white-marble",
+    "white-paint",
+    "chrome",
+    "nickel",
+    "pink-fabric",
+    "brass",
+    "blue-acrylic",
+    "gray-plastic",
+    "yellow-paint",
+    "steel",
+    "alum-bronze",
+    "black-obsidian",
+    "cherry-235",
+    "teflon",
+    "silver-metallic-paint",
+];
+
 /// A MERL table rebuilt from the shared neural fits, made once under target/merl/ with
 /// `nbrdf2merl.py` (needs python3 with numpy).
 pub fn nbrdf_table(name: &str) -> PathBuf {

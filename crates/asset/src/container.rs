@@ -13,7 +13,10 @@ use sha2::{Digest, Sha256};
 
 use crate::error::Error;
 use crate::files::write_atomic;
-use crate::types::{Asset, AssetKind, ImportanceSamples, MaterialInfo, Payload, PrefilteredEnvmap, Provenance};
+use crate::types::{
+    Asset, AssetKind, BandwidthAtlas, BandwidthPca, ImportanceSamples, MaterialInfo, Payload, PrefilteredEnvmap,
+    Provenance,
+};
 
 /// The first eight bytes of every asset file.
 pub const MAGIC: [u8; 8] = *b"BRDFASET";
@@ -118,6 +121,8 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
         Payload::MaterialInfo(info) => encode_section(info),
         Payload::ImportanceSamples(samples) => encode_section(samples),
         Payload::PrefilteredEnvmap(prefiltered) => encode_section(prefiltered),
+        Payload::BandwidthAtlas(atlas) => encode_section(atlas),
+        Payload::BandwidthPca(pca) => encode_section(pca),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -165,6 +170,8 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
         AssetKind::PrefilteredEnvmap => {
             Payload::PrefilteredEnvmap(decode_section::<PrefilteredEnvmap>("payload", payload)?)
         }
+        AssetKind::BandwidthAtlas => Payload::BandwidthAtlas(decode_section::<BandwidthAtlas>("payload", payload)?),
+        AssetKind::BandwidthPca => Payload::BandwidthPca(decode_section::<BandwidthPca>("payload", payload)?),
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;
     Ok((header, Asset { provenance, payload }))

@@ -61,5 +61,6 @@ pub use error::Error;
 pub use files::{hex, sha256, sha256_file, sha256_from_hex, write_atomic};
 pub use manifest::{BakeManifest, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool};
 pub use types::{
-    Asset, AssetKind, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
+    Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LinkedFile, MaterialInfo,
+    Payload, PrefilteredEnvmap, Provenance,
 };

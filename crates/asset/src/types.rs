@@ -33,12 +33,21 @@ pub enum AssetKind {
     ImportanceSamples = 2,
     /// [`PrefilteredEnvmap`]: an environment map convolved with Phong lobes, and its mip chain.
     PrefilteredEnvmap = 3,
+    /// [`BandwidthAtlas`]: the angular bandwidth of a BRDF's lobes, packed in tiles.
+    BandwidthAtlas = 4,
+    /// [`BandwidthPca`]: a bandwidth atlas compressed by PCA.
+    BandwidthPca = 5,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 3] =
-        [AssetKind::MaterialInfo, AssetKind::ImportanceSamples, AssetKind::PrefilteredEnvmap];
+    pub const ALL: [AssetKind; 5] = [
+        AssetKind::MaterialInfo,
+        AssetKind::ImportanceSamples,
+        AssetKind::PrefilteredEnvmap,
+        AssetKind::BandwidthAtlas,
+        AssetKind::BandwidthPca,
+    ];
 
     /// The number stored in the header.
     pub fn code(self) -> u32 {
@@ -56,6 +65,8 @@ impl AssetKind {
             AssetKind::MaterialInfo => "material-info",
             AssetKind::ImportanceSamples => "importance-samples",
             AssetKind::PrefilteredEnvmap => "prefiltered-envmap",
+            AssetKind::BandwidthAtlas => "bandwidth-atlas",
+            AssetKind::BandwidthPca => "bandwidth-pca",
         }
     }
 }
@@ -283,6 +294,89 @@ impl PrefilteredEnvmap {
     }
 }
 
+/// How the lobes of a bandwidth atlas were analysed: shared by [`BandwidthAtlas`] and
+/// [`BandwidthPca`]. `data-schema/brdf-atlas.md` defines the parameterizations by name.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BandwidthAnalysis {
+    /// The lobe and incident-grid parameterization, e.g. `incidence-plane-equidistant`.
+    pub parameterization: String,
+    /// Side of the grid each lobe was analysed on, pixels.
+    pub analysis_size: u32,
+    /// The estimator's significance threshold and level-to-frequency constant.
+    pub eps: f64,
+    pub c: f64,
+}
+
+/// The angular bandwidth of a BRDF's lobes (payload of [`AssetKind::BandwidthAtlas`], written by
+/// `brdf-bandwidth`): `lobes_x x lobes_y` tiles of `tile x tile` texels, packed row-major into
+/// an atlas `lobes_x tile` texels wide; `data` holds its texels, top row first, in cycles per
+/// radian.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BandwidthAtlas {
+    pub lobes_x: u32,
+    pub lobes_y: u32,
+    pub tile: u32,
+    pub analysis: BandwidthAnalysis,
+    pub data: Vec<f32>,
+}
+
+impl BandwidthAtlas {
+    fn check(&self) -> Result<(), String> {
+        let texels = u64::from(self.lobes_x) * u64::from(self.lobes_y) * u64::from(self.tile) * u64::from(self.tile);
+        if texels == 0 || texels != self.data.len() as u64 {
+            return Err(format!(
+                "bandwidth atlas of {} x {} tiles of {} texels holds {} values, expected {texels} (and at least one)",
+                self.lobes_x,
+                self.lobes_y,
+                self.tile,
+                self.data.len()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A bandwidth atlas compressed by PCA (payload of [`AssetKind::BandwidthPca`], written by
+/// `bandwidth-pca`; Bagher et al. 2011, Fig. 8): tile `l` is `mean + sum_k coefficients[l][k]
+/// components[k]`, each tile a row-major `tile x tile` vector of `tile_len = tile^2` values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BandwidthPca {
+    pub lobes_x: u32,
+    pub lobes_y: u32,
+    pub tile: u32,
+    pub analysis: BandwidthAnalysis,
+    /// `K`.
+    pub n_components: u32,
+    /// `tile_len` values.
+    pub mean: Vec<f32>,
+    /// `K x tile_len`, by decreasing variance, unit length.
+    pub components: Vec<f32>,
+    /// `lobes_x lobes_y x K`, lobes row-major.
+    pub coefficients: Vec<f32>,
+}
+
+impl BandwidthPca {
+    fn check(&self) -> Result<(), String> {
+        let tile_len = u64::from(self.tile) * u64::from(self.tile);
+        let lobes = u64::from(self.lobes_x) * u64::from(self.lobes_y);
+        let k = u64::from(self.n_components);
+        let expect = [
+            ("mean", self.mean.len() as u64, tile_len),
+            ("components", self.components.len() as u64, k * tile_len),
+            ("coefficients", self.coefficients.len() as u64, lobes * k),
+        ];
+        if tile_len == 0 || lobes == 0 {
+            return Err("bandwidth pca needs at least one lobe of at least one texel".to_string());
+        }
+        for (what, found, expected) in expect {
+            if found != expected {
+                return Err(format!("bandwidth pca: {what} has {found} values, expected {expected}"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The payload of an asset, one variant per [`AssetKind`].
 ///
 /// Only the variant's content is serialized; the header's kind code says which type follows.
@@ -291,6 +385,8 @@ pub enum Payload {
     MaterialInfo(MaterialInfo),
     ImportanceSamples(ImportanceSamples),
     PrefilteredEnvmap(PrefilteredEnvmap),
+    BandwidthAtlas(BandwidthAtlas),
+    BandwidthPca(BandwidthPca),
 }
 
 impl Payload {
@@ -299,6 +395,8 @@ impl Payload {
             Payload::MaterialInfo(_) => AssetKind::MaterialInfo,
             Payload::ImportanceSamples(_) => AssetKind::ImportanceSamples,
             Payload::PrefilteredEnvmap(_) => AssetKind::PrefilteredEnvmap,
+            Payload::BandwidthAtlas(_) => AssetKind::BandwidthAtlas,
+            Payload::BandwidthPca(_) => AssetKind::BandwidthPca,
         }
     }
 
@@ -308,6 +406,8 @@ impl Payload {
             Payload::MaterialInfo(info) => info.check(),
             Payload::ImportanceSamples(samples) => samples.check(),
             Payload::PrefilteredEnvmap(prefiltered) => prefiltered.check(),
+            Payload::BandwidthAtlas(atlas) => atlas.check(),
+            Payload::BandwidthPca(pca) => pca.check(),
         }
     }
 }
@@ -321,6 +421,18 @@ impl From<MaterialInfo> for Payload {
 impl From<ImportanceSamples> for Payload {
     fn from(samples: ImportanceSamples) -> Payload {
         Payload::ImportanceSamples(samples)
+    }
+}
+
+impl From<BandwidthAtlas> for Payload {
+    fn from(atlas: BandwidthAtlas) -> Payload {
+        Payload::BandwidthAtlas(atlas)
+    }
+}
+
+impl From<BandwidthPca> for Payload {
+    fn from(pca: BandwidthPca) -> Payload {
+        Payload::BandwidthPca(pca)
     }
 }
 

@@ -116,7 +116,8 @@ fn the_unknown_kind_message_names_the_number() {
     bytes[12..16].copy_from_slice(&9u32.to_le_bytes());
     assert_eq!(
         decode(&bytes).unwrap_err().to_string(),
-        "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples), 3 (prefiltered-envmap)"
+        "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples), 3 (prefiltered-envmap), \
+         4 (bandwidth-atlas), 5 (bandwidth-pca)"
     );
 }
 

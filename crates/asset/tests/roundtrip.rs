@@ -1,8 +1,8 @@
 //! read(write(a)) = a for random assets, in memory and through files.
 
 use asset::{
-    Asset, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance, decode, encode,
-    read_file, write_file,
+    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LinkedFile, MaterialInfo, Payload,
+    PrefilteredEnvmap, Provenance, decode, encode, read_file, write_file,
 };
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -49,7 +49,7 @@ fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
 
 fn random_asset(rng: &mut StdRng) -> Asset {
     let angles = random_len(rng);
-    let payload = match rng.random_range(0..3) {
+    let payload = match rng.random_range(0..5) {
         0 => Payload::MaterialInfo(MaterialInfo {
             dims: rng.random(),
             no_data_cells: rng.random(),
@@ -63,7 +63,9 @@ fn random_asset(rng: &mut StdRng) -> Asset {
             albedo_no_data_fraction: (0..angles).map(|_| random_f64(rng)).collect(),
         }),
         1 => random_importance_samples(rng),
-        _ => random_prefiltered_envmap(rng),
+        2 => random_prefiltered_envmap(rng),
+        3 => random_bandwidth_atlas(rng),
+        _ => random_bandwidth_pca(rng),
     };
     Asset {
         provenance: Provenance {
@@ -78,6 +80,48 @@ fn random_asset(rng: &mut StdRng) -> Asset {
 }
 
 /// Consistent sizes (the payload's invariant), random contents.
+fn random_analysis(rng: &mut StdRng) -> BandwidthAnalysis {
+    BandwidthAnalysis {
+        parameterization: random_string(rng),
+        analysis_size: rng.random(),
+        eps: random_f64(rng),
+        c: random_f64(rng),
+    }
+}
+
+/// Consistent sizes (the payload's invariant), random contents.
+fn random_bandwidth_atlas(rng: &mut StdRng) -> Payload {
+    let (lobes_x, lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32), rng.random_range(1..4u32));
+    let n = (lobes_x * lobes_y * tile * tile) as usize;
+    Payload::BandwidthAtlas(BandwidthAtlas {
+        lobes_x,
+        lobes_y,
+        tile,
+        analysis: random_analysis(rng),
+        data: (0..n).map(|_| random_f64(rng) as f32).collect(),
+    })
+}
+
+/// Consistent sizes (the payload's invariant), random contents.
+fn random_bandwidth_pca(rng: &mut StdRng) -> Payload {
+    let (lobes_x, lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32), rng.random_range(1..4u32));
+    let k = rng.random_range(0..4u32);
+    let tile_len = (tile * tile) as usize;
+    let mut f32s = |n: usize| -> Vec<f32> { (0..n).map(|_| random_f64(rng) as f32).collect() };
+    let (mean, components, coefficients) =
+        (f32s(tile_len), f32s(k as usize * tile_len), f32s((lobes_x * lobes_y * k) as usize));
+    Payload::BandwidthPca(BandwidthPca {
+        lobes_x,
+        lobes_y,
+        tile,
+        analysis: random_analysis(rng),
+        n_components: k,
+        mean,
+        components,
+        coefficients,
+    })
+}
+
 fn random_importance_samples(rng: &mut StdRng) -> Payload {
     let (slices, rows, cols) = (rng.random_range(1..4), rng.random_range(1..5), rng.random_range(1..6));
     let (vectors, samples) = (rng.random_range(1..3u32), rng.random_range(1..5u32));

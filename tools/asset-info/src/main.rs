@@ -86,9 +86,31 @@ fn print_text(report: &Report) {
                 Payload::MaterialInfo(info) => print_material_info(info),
                 Payload::ImportanceSamples(samples) => print_importance_samples(samples),
                 Payload::PrefilteredEnvmap(prefiltered) => print_prefiltered_envmap(prefiltered),
+                Payload::BandwidthAtlas(atlas) => {
+                    cli::outln!("payload: bandwidth atlas");
+                    print_tiles(atlas.lobes_x, atlas.lobes_y, atlas.tile, &atlas.analysis);
+                    let max = atlas.data.iter().fold(0.0f32, |m, v| m.max(*v));
+                    cli::outln!("  max bandwidth    {max} cycles per radian");
+                }
+                Payload::BandwidthPca(pca) => {
+                    cli::outln!("payload: bandwidth pca");
+                    print_tiles(pca.lobes_x, pca.lobes_y, pca.tile, &pca.analysis);
+                    cli::outln!("  components       {}", pca.n_components);
+                }
             }
         }
     }
+}
+
+fn print_tiles(lobes_x: u32, lobes_y: u32, tile: u32, analysis: &asset::BandwidthAnalysis) {
+    cli::outln!("  lobes            {lobes_x} x {lobes_y}, tiles of {tile} x {tile} texels");
+    cli::outln!(
+        "  analysis         {} at {} px, eps {}, c {}",
+        analysis.parameterization,
+        analysis.analysis_size,
+        analysis.eps,
+        analysis.c
+    );
 }
 
 fn print_provenance(p: &Provenance) {
@@ -254,6 +276,19 @@ fn to_json(report: &Report) -> Value {
                     })
                 }
                 Payload::PrefilteredEnvmap(prefiltered) => prefiltered_envmap_json(prefiltered),
+                Payload::BandwidthAtlas(atlas) => json!({
+                    "lobes_x": atlas.lobes_x,
+                    "lobes_y": atlas.lobes_y,
+                    "tile": atlas.tile,
+                    "analysis": serde_json::to_value(&atlas.analysis).expect("analysis serializes to json"),
+                }),
+                Payload::BandwidthPca(pca) => json!({
+                    "lobes_x": pca.lobes_x,
+                    "lobes_y": pca.lobes_y,
+                    "tile": pca.tile,
+                    "n_components": pca.n_components,
+                    "analysis": serde_json::to_value(&pca.analysis).expect("analysis serializes to json"),
+                }),
             };
             json!({
                 "header": header_json,

@@ -1,0 +1,52 @@
+//! Benchmark: `brdf-bandwidth`'s work on a real-derived material (the default 64 x 64 lobes,
+//! 64 x 64 analysis, 16 x 16 tiles), against a baseline measured in the same run (reading and
+//! validating the same MERL file). Goal (issue 3): at most 1 s. Needs
+//! `target/merl/gold-paint.binary` (made by the tests, or
+//! `python3 ../shared/tools/nbrdf2merl.py --out target/merl gold-paint`).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+fn median(f: &mut dyn FnMut() -> Duration) -> Duration {
+    let mut runs: Vec<Duration> = (0..5).map(|_| f()).collect();
+    runs.sort();
+    runs[2]
+}
+
+fn main() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/merl/gold-paint.binary");
+    if !path.exists() {
+        println!(
+            "skipped: {} is missing (python3 ../shared/tools/nbrdf2merl.py --out target/merl gold-paint)",
+            path.display()
+        );
+        return;
+    }
+    let read = median(&mut || {
+        let start = Instant::now();
+        std::hint::black_box(merl::read_file(&path).unwrap());
+        start.elapsed()
+    });
+    let table = merl::read_file(&path).unwrap();
+    let config = brdf_atlas::Config::default();
+    let build = median(&mut || {
+        let start = Instant::now();
+        std::hint::black_box(brdf_atlas::build_atlas(&table, &config, &|_| {}).unwrap());
+        start.elapsed()
+    });
+    println!("material: gold-paint (real-derived); {} threads", rayon::current_num_threads());
+    println!("{:<48} {:>10} {:>12}", "operation", "median", "x baseline");
+    println!("{:<48} {:>8.1}ms {:>12.2}", "baseline: read and validate the MERL file", read.as_secs_f64() * 1e3, 1.0);
+    println!(
+        "{:<48} {:>8.1}ms {:>12.2}",
+        "bandwidth atlas (64 x 64 lobes, 16 x 16 tiles)",
+        build.as_secs_f64() * 1e3,
+        build.as_secs_f64() / read.as_secs_f64()
+    );
+    let total = read + build;
+    println!(
+        "goal: brdf-bandwidth <= 1 s (read + atlas {:.0} ms): {}",
+        total.as_secs_f64() * 1e3,
+        if total.as_secs_f64() <= 1.0 { "met" } else { "NOT met" }
+    );
+}

@@ -1,0 +1,158 @@
+//! The angular bandwidth of a measured BRDF's outgoing lobes, precomputed for rendering (`000`
+//! section 2.4 and Fig. 8, `001` section 2.3): for each incident direction of a grid, the lobe
+//! `f(wi, .)` as an image, its local bandwidth from the `bandwidth` crate's wavelet estimate in
+//! cycles per radian, reduced conservatively to a small tile; the tiles packed into one atlas;
+//! and the atlas compressed by PCA. No IO: the tools read and write the files.
+//!
+//! # Pipeline
+//!
+//! 1. The MERL table becomes one Rec. 709 luminance per cell ([`LuminanceTable`]), read by
+//!    `merl`'s trilinear interpolation (equal to `merl::luminance` of the RGB lookup to 1e-12).
+//! 2. For each row of the incident grid (one `theta_i`), the lobe image: `n x n` pixels
+//!    (`Config::analysis_size`, default 64) of the hemisphere of `wo` ([`LobeMap`]).
+//! 3. The image is continued to a periodic `2n x 2n` image by mirroring ([`extend_periodic`])
+//!    and handed to [`bandwidth::local_bandwidth`]: D4, `eps = 0.01`, `c = 2^-2.5`, the noise
+//!    floor scaled to the lobe's peak, [`analysis_levels`] levels. The estimate of the image's
+//!    own pixels, in cycles per pixel, times the map's pixels per radian, is cycles per radian.
+//! 4. Each texel of the `t x t` tile (`Config::tile`, default 16) takes the largest value of the
+//!    pixels of the hemisphere it covers ([`TileReduction`]).
+//! 5. The tiles go into the atlas row-major ([`Atlas`]); [`fit`] makes the PCA model.
+//!
+//! # Incident directions
+//!
+//! [`IncidentGrid`]: `lobes x lobes` cells (default 64 x 64, the paper's `n_b = 4096`). Row `j`
+//! is `cos(theta_i) = 1 - (j + 1/2) / lobes`, column `i` is `phi_i = 2 pi (i + 1/2) / lobes`.
+//!
+//! - **Rows in equal steps of `cos(theta_i)`**: every row covers the same solid angle of incident
+//!   directions, so a renderer's uniformly distributed samples meet every row equally often; the
+//!   steps are finest at grazing incidence (0.9 degrees for the last of 64 rows), where lobes
+//!   change fastest (Fresnel, the horizon cutting the lobe, off-specular peaks), and coarsest
+//!   near the normal (the first row is at 7.2 degrees), where a lobe is even in `theta_i` and
+//!   barely changes.
+//! - **Columns in `phi_i`, lobes in their own frame.** Each lobe image is drawn in the frame of
+//!   its plane of incidence ([`to_incidence_frame`]), and a MERL table is isotropic (it has no
+//!   `phi_h` axis), so every lobe of a row is the same image and the builder analyses each row
+//!   once ([`build_atlas`]). The second axis is kept for the paper's layout (64 x 64 lobes of
+//!   16 x 16 in a 1024 x 1024 texture), so that a renderer indexes the atlas by `wi` directly,
+//!   and so that an anisotropic source fits the same format. Drawing the lobes in the tangent
+//!   frame instead (the first version of this crate, with a concentric-disk grid of `wi`) makes
+//!   the tiles of a ring rotated copies of each other, which PCA cannot compress: on the 20
+//!   shared materials 2% relative RMSE then needed 186 to 212 of 256 components (a model of 77
+//!   to 88% of the atlas's size); in the frame of the plane of incidence it needs 28 to 52 (4.6
+//!   to 8.6 times smaller than the atlas).
+//!
+//! # Lobe images
+//!
+//! [`LobeMap`]: `n x n` pixels over the square `[-1, 1]^2` (column `x` along `a`, row `y` along
+//! `-b`), an azimuthal equidistant projection of `wo` in the frame of the plane of incidence:
+//! the point `(a, b) = r (cos phi, sin phi)` is `theta_o = (pi / 2) r`, `phi_o - phi_i = phi`.
+//! `wi` lies towards `+a`, its mirror direction (a glossy lobe's peak) on the left half. The
+//! projection is smooth everywhere, the normal included, and distorts little: along the radius
+//! a pixel spans `pi / n` radians everywhere, across it `(2 / n) sin(theta_o) / r`, from
+//! `pi / n` at the centre to `2 / n` on the horizon ([`LobeMap::radians_per_pixel`]).
+//!
+//! The values are the luminance of `f` in 1/sr, linear. The `bandwidth` crate reads HDR
+//! environment maps as `ln(1 + Y)` so that a sun does not mask the rest of the map; a BRDF lobe
+//! multiplies radiance linearly, and the bandwidth of that product is the one a renderer needs,
+//! so the lobe is read as it is. Eq. 7 is relative to each pixel's largest coefficient and the
+//! noise floor ([`Config::relative_noise_floor`], 1e-6 of the lobe's peak) scales with the
+//! lobe, so the estimate does not depend on the BRDF's scale. On a logarithm, a Phong lobe
+//! (a parabola in `ln f`) would read the same bandwidth for every exponent.
+//!
+//! The corners of the square (`r > 1`, 21% of the pixels, up to `theta_o = 127` degrees) are
+//! below the horizon, where the BRDF does not exist. They hold the lobe's odd reflection across
+//! the horizon along the radius, `2 f(theta_o = pi / 2) - f(pi - theta_o)` ([`Sample`]), which
+//! continues the image with its slope: D4 has two vanishing moments and ignores a linear trend,
+//! so the horizon reads neither as a jump nor as a kink. (An even reflection leaves a kink where
+//! the lobe is steep at the horizon: at 64 x 64, broad Phong lobes (n = 2) then read the grid's
+//! limit on the rim.) Pixels with no table data around them (all eight trilinear corners empty,
+//! which happens only near the horizon) are filled with the mean of their neighbours
+//! ([`lobe_image`]); on the 20 shared materials none is.
+//!
+//! # Boundaries
+//!
+//! The periodic transform would wrap the square's left edge onto its right edge, i.e. one side
+//! of the horizon onto the other. [`extend_periodic`] analyses instead the `2n x 2n` image made
+//! of the lobe image, its mirror image to the right and both mirrored below: periodic and
+//! continuous everywhere. Only the estimate of the top-left `n x n` pixels is kept.
+//!
+//! # Levels
+//!
+//! [`analysis_levels`]`(n) = log2(n) - 1` (5 for 64): from the finest level to the one whose
+//! wavelets have the scale of the hemisphere's radius (`n / 2` pixels); coarser levels of the
+//! `2n` image would only describe the mirror tiling. The `bandwidth` crate's default would take
+//! all 7 levels of a 128-pixel image; measured on Phong and real lobes, 5 and 7 give the same
+//! staircase, 5 is 13% faster and slightly less dependent on the lobe's orientation.
+//!
+//! # Units and the grid's limit
+//!
+//! Cycles per pixel become cycles per radian through the Jacobian: a pattern of `f` cycles per
+//! pixel along a direction where a pixel spans `s` radians has `f / s` cycles per radian, and
+//! the estimator does not know the direction, so the conversion divides by the smaller span,
+//! the tangential one ([`LobeMap::pixels_per_radian`]: `n / pi` at the centre, `n / 2` on the
+//! horizon), as the `bandwidth` crate does for lat-long maps. It never understates; content
+//! running along the radius is overstated by `theta_o / sin(theta_o)`, at most `pi / 2` (0.65
+//! octave) on the horizon. `cos(k alpha)` has `k / (2 pi)` cycles per radian; the papers'
+//! `nu_a` is `2 pi` times ours.
+//!
+//! The finest level reads `c / 2` cycles per pixel, i.e. `0.088 n / pi` cycles per radian at the
+//! centre (1.80 for 64) up to `0.088 n / 2` on the horizon (2.83): a pixel whose finest level is
+//! significant is at the grid's limit and its true bandwidth may be higher
+//! ([`BuildStats::nyquist_pixels`]; the tool reports the lobes). Measured on Phong lobes (tests
+//! `phong`): the estimate at the lobe's centre grows like `sqrt(n)` (log-log slope 0.49 over
+//! `n` = 2 to 256 at 256 x 256) while the lobe's full width at half maximum is at least 12
+//! pixels, and sits at the limit once it is below about 10 (n >= 23 at 64 x 64, n >= 362 at
+//! 256 x 256).
+//!
+//! # Tiles
+//!
+//! [`TileReduction`]: texel `(tx, ty)` of a `t x t` tile covers the `m x m` pixels
+//! `[tx m, (tx + 1) m) x [ty m, (ty + 1) m)` of the analysis grid (`m = n / t`, 4 by default)
+//! and holds the largest bandwidth of those of its pixels that lie on the hemisphere (the
+//! paper's "reduce it to 16 x 16", made conservative). Texels that cover no pixel of the
+//! hemisphere (the tile's corners) copy the nearest texel that does, so that bilinear filtering
+//! across the horizon reads the rim's value.
+//!
+//! # Known behaviour
+//!
+//! - The estimate comes in octaves (one wavelet level each), times the smooth Jacobian factor.
+//! - D4 is not symmetric: the same lobe turned by a quarter turn reads the same level on 70 to
+//!   99% of its pixels, and up to 0.3 octave apart on average on the others (measured on Phong
+//!   and gold-paint lobes).
+//! - The 20 shared materials are rebuilt from neural fits whose input is `sqrt(theta_h)`: their
+//!   lobes have a cusp at the mirror direction (gold-paint: 0.2498 at `theta_h = 0`, 0.2583 at
+//!   0.75 degrees), which has no finite bandwidth, and every lobe reaches the grid's limit
+//!   there.
+//!
+//! # PCA
+//!
+//! [`fit`]: every tile is a vector of `t^2` values; the model ([`PcaModel`]) is their mean, the
+//! first `K` eigenvectors of the covariance of the centred tiles (by decreasing eigenvalue, from
+//! `nalgebra`'s symmetric eigensolver in `f64`), and each lobe's `K` coefficients, stored as
+//! `f32`. [`PcaModel::reconstruct`] is `mean + sum_k coefficient_k component_k`. All components
+//! reproduce the atlas to 1e-6 of its largest texel; [`Components::MaxRelativeRmse`] keeps the
+//! fewest components whose relative RMSE (`|reconstruction - atlas| / |atlas|`, Frobenius norms
+//! over all texels) is within the bound. The reconstruction is not conservative: it may read
+//! below the atlas.
+//!
+//! # Performance
+//!
+//! One analysis per row: 64 lobe images of 4096 trilinear lookups and 64 estimates of 128 x 128
+//! images, in parallel over rows, each thread with its own buffers (only the `bandwidth` crate
+//! allocates per lobe). The default atlas of a real-derived material takes about 0.1 s in a
+//! release build on two cores, 0.3 s for the whole tool with reading and writing.
+
+mod analysis;
+mod atlas;
+pub mod colour;
+mod error;
+mod lobe;
+pub mod param;
+pub mod pca;
+
+pub use analysis::{Analyser, LobeBandwidth, TileReduction, analysis_levels, extend_periodic};
+pub use atlas::{Atlas, AtlasBuild, BuildStats, Config, MAX_TEXELS, Parameterization, build_atlas};
+pub use error::Error;
+pub use lobe::{LuminanceTable, lobe_image, lobe_image_from_fn};
+pub use param::{IncidentGrid, LobeMap, Sample, to_incidence_frame};
+pub use pca::{Components, PcaFit, PcaModel, PcaReport, evaluate, fit};

@@ -1,0 +1,217 @@
+//! What a lobe image holds: the Rec. 709 luminance of the BRDF, read from the MERL table by
+//! trilinear interpolation ([`merl::Interp::Trilinear`]), at the pixels of a [`LobeMap`].
+//!
+//! [`LuminanceTable`] is the table reduced to one luminance per cell, read by its own copy of
+//! `merl`'s trilinear lookup: the lookup is linear in the cell values and shares the same
+//! no-data rule (a cell with any negative channel holds none), so it returns exactly the
+//! luminance of `merl`'s RGB lookup (to rounding; the tests hold it to 1e-12) while reading a
+//! third of the memory and skipping the trigonometry the general half/difference conversion
+//! needs (`cos phi_h` and `sin phi_h` come from the half vector itself).
+
+use std::f64::consts::FRAC_2_PI;
+
+use glam::DVec3;
+use merl::{Dims, MerlTable};
+
+use crate::param::{LobeMap, Sample};
+
+/// A MERL table reduced to the luminance of each cell, in 1/sr; NaN where the cell holds no
+/// data.
+#[derive(Clone)]
+pub struct LuminanceTable {
+    dims: Dims,
+    luminance: Vec<f64>,
+}
+
+impl std::fmt::Debug for LuminanceTable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LuminanceTable").field("dims", &self.dims).finish_non_exhaustive()
+    }
+}
+
+impl LuminanceTable {
+    pub fn new(table: &MerlTable) -> Self {
+        let dims = table.dims();
+        let luminance =
+            (0..dims.cells()).map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance)).collect::<Vec<f64>>();
+        Self { dims, luminance }
+    }
+
+    pub fn dims(&self) -> Dims {
+        self.dims
+    }
+
+    /// The luminance of the BRDF for a pair of unit directions, trilinear between cells as in
+    /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`]; `None` where all eight
+    /// corners hold no data.
+    pub fn lookup(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
+        let [x_h, x_d, x_p] = self.grid_coords(wi, wo);
+        self.trilinear(x_h, x_d, x_p)
+    }
+
+    /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, computed without
+    /// trigonometric calls for the rotations: the half vector's own components are the cosines
+    /// and sines of `theta_h` and `phi_h`.
+    fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
+        let h = (wi + wo).normalize();
+        let rho = (h.x * h.x + h.y * h.y).sqrt();
+        let theta_h = rho.atan2(h.z);
+        let (cos_phi, sin_phi) = if rho > 0.0 { (h.x / rho, h.y / rho) } else { (1.0, 0.0) };
+        // d = rotate_y(rotate_z(wi, -phi_h), -theta_h), as in merl::coords.
+        let x1 = wi.x * cos_phi + wi.y * sin_phi;
+        let dy = -wi.x * sin_phi + wi.y * cos_phi;
+        let (cos_t, sin_t) = (h.z, rho);
+        let dx = x1 * cos_t - wi.z * sin_t;
+        let dz = x1 * sin_t + wi.z * cos_t;
+        let theta_d = (dx * dx + dy * dy).sqrt().atan2(dz);
+        let phi_d = dy.atan2(dx);
+
+        let d = self.dims;
+        let x_h = (theta_h.max(0.0) * FRAC_2_PI).sqrt() * d.n_theta_h as f64;
+        let x_d = theta_d * FRAC_2_PI * d.n_theta_d as f64;
+        let range = d.phi_d_range();
+        let phi_d = if phi_d < 0.0 { phi_d + range } else { phi_d };
+        [x_h, x_d, phi_d * (d.n_phi_d as f64 / range)]
+    }
+
+    /// The same interpolation as `merl`'s `trilinear`, on one channel: corners that hold no
+    /// data (NaN) or have weight 0 are left out and the other weights renormalized. Branch-free
+    /// over the eight corners.
+    fn trilinear(&self, x_h: f64, x_d: f64, x_p: f64) -> Option<f64> {
+        let d = self.dims;
+        let clamped = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let i0 = (x as usize).min(n - 1);
+            (i0, (i0 + 1).min(n - 1), x - i0 as f64)
+        };
+        let (h0, h1, th) = clamped(x_h, d.n_theta_h);
+        let (d0, d1, td) = clamped(x_d, d.n_theta_d);
+        // `grid_coords` keeps x_p in [0, n_phi_d]; merl's rem_euclid is this subtraction there.
+        let n_p = d.n_phi_d;
+        let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
+        let p0 = (x_p as usize).min(n_p - 1);
+        let (p1, tp) = (if p0 + 1 == n_p { 0 } else { p0 + 1 }, x_p - p0 as f64);
+
+        let rows = [(h0, d0), (h0, d1), (h1, d0), (h1, d1)];
+        let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for ((ih, id), wr) in rows.into_iter().zip(row_weights) {
+            let row = &self.luminance[(ih * d.n_theta_d + id) * n_p..][..n_p];
+            for (v, wp) in [(row[p0], 1.0 - tp), (row[p1], tp)] {
+                // A NaN (no data) corner contributes nothing; nor does a zero weight.
+                let w = if v.is_nan() { 0.0 } else { wr * wp };
+                sum += if w == 0.0 { 0.0 } else { w * v };
+                weight += w;
+            }
+        }
+        (weight > 0.0).then(|| sum / weight)
+    }
+}
+
+/// Fills `out` (row-major, `map.size^2` values) with the luminance of the BRDF at `wi` for the
+/// map's pixels (`samples`, from [`LobeMap::sample`]); NaN where the table holds no data
+/// around a pair the pixel needs.
+pub(crate) fn render(table: &LuminanceTable, wi: DVec3, samples: &[Sample], out: &mut [f64]) {
+    for (value, sample) in out.iter_mut().zip(samples) {
+        *value = sample.eval(|wo| table.lookup(wi, wo)).unwrap_or(f64::NAN);
+    }
+}
+
+/// Replaces the NaN pixels (no data around the pair: a few pixels near the horizon at grazing
+/// incidence) by the mean of their finite 4-neighbours, sweep after sweep, so that a hole reads
+/// as its surroundings instead of an edge. An image with no finite pixel becomes zeros.
+/// Returns the number of pixels filled. `next` is scratch space for the sweeps.
+pub(crate) fn fill_holes(size: usize, image: &mut [f64], next: &mut Vec<(usize, f64)>) -> usize {
+    let holes = image.iter().filter(|v| v.is_nan()).count();
+    if holes == 0 {
+        return 0;
+    }
+    if holes == image.len() {
+        image.fill(0.0);
+        return holes;
+    }
+    loop {
+        next.clear();
+        for y in 0..size {
+            for x in 0..size {
+                if !image[y * size + x].is_nan() {
+                    continue;
+                }
+                let (mut sum, mut count) = (0.0, 0);
+                let neighbours = [
+                    (x > 0).then(|| y * size + x - 1),
+                    (x + 1 < size).then(|| y * size + x + 1),
+                    (y > 0).then(|| (y - 1) * size + x),
+                    (y + 1 < size).then(|| (y + 1) * size + x),
+                ];
+                for v in neighbours.into_iter().flatten().map(|k| image[k]).filter(|v| !v.is_nan()) {
+                    sum += v;
+                    count += 1;
+                }
+                if count > 0 {
+                    next.push((y * size + x, sum / count as f64));
+                }
+            }
+        }
+        if next.is_empty() {
+            return holes;
+        }
+        for &(k, v) in next.iter() {
+            image[k] = v;
+        }
+    }
+}
+
+/// The lobe image of `wi` on `map`, with holes filled: row-major, `map.size^2` luminances in
+/// 1/sr (crate docs, "Lobe images").
+pub fn lobe_image(table: &LuminanceTable, map: LobeMap, wi: DVec3) -> Vec<f64> {
+    lobe_image_from_fn(map, |wo| table.lookup(wi, wo))
+}
+
+/// The lobe image of any BRDF slice `f(wo)` (luminance at a fixed `wi`; `None` where it has no
+/// value) on `map`, with holes filled, e.g. of an analytic BRDF.
+pub fn lobe_image_from_fn(map: LobeMap, mut f: impl FnMut(DVec3) -> Option<f64>) -> Vec<f64> {
+    let n = map.size;
+    let mut image: Vec<f64> = (0..n * n).map(|k| map.sample(k % n, k / n).eval(&mut f).unwrap_or(f64::NAN)).collect();
+    fill_holes(n, &mut image, &mut Vec::new());
+    image
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use merl::analytic::Analytic;
+    use merl::{Interp, spherical_dir};
+    use rand::{Rng, SeedableRng, rngs::StdRng};
+
+    #[test]
+    fn equals_the_luminance_of_merls_trilinear_lookup() {
+        // A table with structure in every coordinate, and holes below the horizon.
+        let table = Analytic::Ggx { alpha: 0.2, f0: [0.9, 0.5, 0.1] }.table(Dims::MERL);
+        let luminance = LuminanceTable::new(&table);
+        let mut rng = StdRng::seed_from_u64(3);
+        let mut missing = 0;
+        for _ in 0..200_000 {
+            let mut dir = || spherical_dir(rng.random::<f64>().acos(), rng.random::<f64>() * std::f64::consts::TAU);
+            let (wi, wo) = (dir(), dir());
+            let expect = table.lookup(wi, wo, Interp::Trilinear).map(merl::luminance);
+            let got = luminance.lookup(wi, wo);
+            match (expect, got) {
+                (Some(e), Some(g)) => assert!((e - g).abs() <= 1e-12 * e.abs().max(1e-3), "{wi} {wo}: {e} {g}"),
+                (None, None) => missing += 1,
+                _ => panic!("{wi} {wo}: {expect:?} vs {got:?}"),
+            }
+        }
+        println!("{missing} of 200000 random pairs have no data around them");
+    }
+
+    #[test]
+    fn holes_take_their_neighbours_values() {
+        let mut image = vec![2.0, f64::NAN, f64::NAN, 4.0];
+        assert_eq!(fill_holes(2, &mut image, &mut Vec::new()), 2);
+        assert_eq!(image, [2.0, 3.0, 3.0, 4.0]);
+        let mut all = vec![f64::NAN; 9];
+        fill_holes(3, &mut all, &mut Vec::new());
+        assert!(all.iter().all(|v| *v == 0.0));
+    }
+}

@@ -1,0 +1,125 @@
+//! The atlas builder: configuration checks, the layout of lobes and texels, and that its
+//! shortcut (one analysis per row of the incident grid, the table being isotropic) gives the
+//! tiles a direct analysis of each lobe gives.
+
+use brdf_atlas::{
+    Analyser, Atlas, Config, Error, IncidentGrid, LobeMap, LuminanceTable, Parameterization, build_atlas,
+    lobe_image_from_fn, to_incidence_frame,
+};
+use glam::DVec3;
+
+use crate::phong;
+
+#[test]
+fn invalid_configurations_are_errors() {
+    let table = phong(10.0);
+    let cases = [
+        (Config { lobes: 0, ..Config::default() }, "0 lobes"),
+        (Config { tile: 12, ..Config::default() }, "tile size 12 is not a power of two"),
+        (Config { analysis_size: 96, ..Config::default() }, "analysis size 96"),
+        (Config { analysis_size: 8, tile: 8, ..Config::default() }, "analysis size 8"),
+        (Config { tile: 128, ..Config::default() }, "exceeds the analysis size"),
+        (Config { eps: 0.0, ..Config::default() }, "eps"),
+        (Config { relative_noise_floor: -1.0, ..Config::default() }, "noise floor"),
+        (Config { lobes: 4096, tile: 16, ..Config::default() }, "exceeds the limit"),
+    ];
+    for (config, needle) in cases {
+        let err = build_atlas(&table, &config, &|_| {}).unwrap_err();
+        assert!(matches!(err, Error::Config(_)) && err.to_string().contains(needle), "{config:?}: {err}");
+    }
+}
+
+#[test]
+fn tiles_equal_a_direct_analysis_of_each_lobe() {
+    // Every lobe of a 6 x 6 grid, rendered directly from its own `wi` in the tangent frame
+    // (each pixel's direction turned from the frame of the plane of incidence by `phi_i`) and
+    // analysed, gives the tile the builder wrote at the lobe's place. The direct images equal
+    // the row's image to rounding (1e-16), which could only move a pixel across an eq. 7
+    // threshold at an exact tie: the tiles are compared exactly.
+    let table = phong(40.0);
+    let config = Config { lobes: 6, tile: 8, ..Config::default() };
+    let build = build_atlas(&table, &config, &|_| {}).unwrap();
+    let atlas = &build.atlas;
+    assert_eq!((atlas.width(), atlas.height(), atlas.data.len()), (48, 48, 48 * 48));
+    let analyser = Analyser::new(&config);
+    let luminance = LuminanceTable::new(&table);
+    let grid = IncidentGrid::new(6);
+    for j in 0..6 {
+        for i in 0..6 {
+            let (wi, phi_i) = (grid.wi(i, j), grid.phi_i(i));
+            let image = lobe_image_from_fn(LobeMap::new(64), |wo| luminance.lookup(wi, to_incidence_frame(wo, -phi_i)));
+            let direct = analyser.analyse_image(image);
+            let lobe = atlas.lobe_index(i, j);
+            assert_eq!(atlas.tile_of(lobe), direct.tile(8), "lobe ({i}, {j})");
+            assert_eq!(build.stats.nyquist_pixels[lobe] as usize, direct.nyquist_count(), "lobe ({i}, {j})");
+        }
+    }
+}
+
+#[test]
+fn the_limit_is_reached_around_the_mirror_direction() {
+    // A known answer for the layout: a sharp Phong lobe (fwhm 2 pixels at 64 x 64) reaches the
+    // grid's limit around its mirror direction and nowhere else. The limit anywhere (c/2 cycles
+    // per pixel, at least 0.088 x 64 / pi = 1.80 cycles per radian) exceeds the next level
+    // anywhere (c/4 cycles per pixel, at most 0.044 x 32 = 1.41 on the rim), so the texels at
+    // the limit are those of at least 1.80. The mirror of each tile's `wi`, found through the
+    // documented maps (the tile's row gives theta_i, LobeMap::uv the texel), must be one of
+    // them, and they must all lie within 3 texels of it (the finest wavelets span 4 pixels and
+    // a texel 4 pixels).
+    let config = Config { lobes: 8, tile: 16, ..Config::default() };
+    let atlas = build_atlas(&phong(1000.0), &config, &|_| {}).unwrap().atlas;
+    let limit = (config.c / 2.0 * 64.0 / std::f64::consts::PI) as f32 * (1.0 - 1e-6);
+    let grid = IncidentGrid::new(8);
+    let map = LobeMap::new(16);
+    let mut problems = Vec::new();
+    for j in 0..8 {
+        for i in 0..8 {
+            // In the frame of the plane of incidence wi lies towards +x, its mirror towards -x.
+            let theta_i = grid.theta_i(j);
+            let (u, v) = map.uv(DVec3::new(-theta_i.sin(), 0.0, theta_i.cos()));
+            let (tx, ty) = ((u * 16.0) as i64, (v * 16.0) as i64);
+            let tile = atlas.tile_of(atlas.lobe_index(i, j));
+            if tile[(ty * 16 + tx) as usize] < limit {
+                problems.push(format!(
+                    "lobe ({i}, {j}): mirror texel ({tx}, {ty}) holds {}",
+                    tile[(ty * 16 + tx) as usize]
+                ));
+            }
+            for (k, value) in tile.iter().enumerate() {
+                let (x, y) = ((k % 16) as i64, (k / 16) as i64);
+                if *value >= limit && ((x - tx).abs() > 3 || (y - ty).abs() > 3) {
+                    problems.push(format!("lobe ({i}, {j}): texel ({x}, {y}) at the limit, mirror at ({tx}, {ty})"));
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn tiles_round_trip_through_the_layout() {
+    let mut atlas = Atlas {
+        lobes_x: 3,
+        lobes_y: 2,
+        tile: 4,
+        data: vec![0.0; 12 * 8],
+        parameterization: Parameterization::IncidencePlaneEquidistant,
+        analysis_size: 16,
+        eps: 0.01,
+        c: bandwidth::DEFAULT_C,
+    };
+    for lobe in 0..6 {
+        let tile: Vec<f32> = (0..16).map(|t| (100 * lobe + t) as f32).collect();
+        atlas.set_tile(lobe, &tile);
+    }
+    // Lobe (2, 1) is lobe 5; its texel (1, 3) is atlas texel (2 * 4 + 1, 1 * 4 + 3).
+    assert_eq!(atlas.data[7 * 12 + 9], 513.0);
+    for lobe in 0..6 {
+        assert_eq!(atlas.tile_of(lobe), (0..16).map(|t| (100 * lobe + t) as f32).collect::<Vec<_>>());
+    }
+    atlas.check().unwrap();
+    atlas.data[5] = f32::NAN;
+    assert!(atlas.check().unwrap_err().to_string().contains("texel (5, 0)"));
+    atlas.data.pop();
+    assert!(atlas.check().unwrap_err().to_string().contains("holds 95 values"));
+}

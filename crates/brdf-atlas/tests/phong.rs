@@ -1,0 +1,98 @@
+//! Test 4: on Phong lobes the bandwidth at the lobe's centre grows like `sqrt(n)` while the
+//! analysis grid resolves the lobe, and sits at the grid's Nyquist limit beyond.
+//!
+//! A Phong lobe `cos^n(alpha)` is close to a Gaussian of standard deviation `1 / sqrt(n)`
+//! radians, whose bandwidth is proportional to `sqrt(n)`. The estimate comes in octaves (one
+//! wavelet level per factor 2, so one step per factor 4 in `n`); sampling `n` every half octave
+//! over several steps and fitting a line to `log(bandwidth)` against `log(n)` recovers the
+//! slope. Measured: the centre reads wavelet level 5 down to 2 as `n` goes from 2 to 256 at
+//! 256 x 256 pixels (steps near n = 4, 20, 70, 300), slope 0.44; the tolerance 0.5 +- 0.15 is
+//! a bit more than half a step of the staircase over the fitted range.
+
+use brdf_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
+use glam::DVec3;
+
+use crate::{phong, slope};
+
+/// Pixels per side of the lobe images: fine enough for four octaves below the limit.
+const SIZE: usize = 256;
+
+/// Eight angles of incidence from 10 to 59 degrees, all with the mirror direction well inside
+/// the hemisphere (rows 0, 2, ..., 14 of a 32-row grid).
+fn lobes() -> Vec<f64> {
+    let grid = IncidentGrid::new(32);
+    (0..16).step_by(2).map(|j| grid.theta_i(j)).collect()
+}
+
+/// Full width at half maximum of `cos^n`, in pixels of the lobe image (radial pitch `pi / SIZE`
+/// radians).
+fn fwhm_pixels(n: f64) -> f64 {
+    2.0 * 0.5f64.powf(1.0 / n).acos() / (std::f64::consts::PI / SIZE as f64)
+}
+
+/// For each incident direction: the bandwidth (cycles per radian) and the wavelet level at the
+/// pixel of the mirror direction, and whether the lobe has any pixel at the limit.
+fn centres(n: f64, analyser: &Analyser) -> Vec<(f64, u8, bool)> {
+    let table = LuminanceTable::new(&phong(n));
+    let map = analyser.map();
+    lobes()
+        .into_iter()
+        .map(|theta_i| {
+            // The mirror direction, in the frame of the plane of incidence.
+            let (u, v) = map.uv(DVec3::new(-theta_i.sin(), 0.0, theta_i.cos()));
+            let k = (v * SIZE as f64) as usize * SIZE + (u * SIZE as f64) as usize;
+            let lobe = analyser.analyse(&table, theta_i);
+            (lobe.cycles_per_radian[k], lobe.level[k], lobe.nyquist_count() > 0)
+        })
+        .collect()
+}
+
+#[test]
+fn centre_bandwidth_grows_like_sqrt_n_until_the_grid_limit() {
+    let analyser = Analyser::new(&Config { analysis_size: SIZE, tile: 16, ..Config::default() });
+    let (mut log_n, mut log_b) = (Vec::new(), Vec::new());
+    let mut failures = Vec::new();
+    println!("     n   fwhm px   centre cycles/rad (geometric mean)   levels   lobes at the limit");
+    for k in 2..=22 {
+        let n = 2f64.powf(k as f64 / 2.0);
+        let fwhm = fwhm_pixels(n);
+        let c = centres(n, &analyser);
+        let mean = (c.iter().map(|(b, _, _)| b.ln()).sum::<f64>() / c.len() as f64).exp();
+        let levels: String = c.iter().map(|(_, l, _)| char::from(b'0' + l)).collect();
+        let at_limit = c.iter().filter(|(_, _, nyquist)| *nyquist).count();
+        println!("{n:6.0} {fwhm:9.1} {mean:21.3} {levels:>24} {at_limit:>8}/{}", c.len());
+        if fwhm >= 12.0 {
+            // Resolved: the centre is below the limit and enters the fit.
+            if c.iter().any(|(_, l, _)| *l == 1) {
+                failures.push(format!("n {n}: a resolved lobe (fwhm {fwhm:.1} px) reads the limit at its centre"));
+            }
+            log_n.push(n.ln());
+            log_b.push(mean.ln());
+        } else if fwhm <= 8.0 && !c.iter().all(|(_, l, nyquist)| *l == 1 && *nyquist) {
+            failures.push(format!("n {n}: an unresolved lobe (fwhm {fwhm:.1} px) does not read the limit: {levels}"));
+        }
+    }
+    let s = slope(&log_n, &log_b);
+    println!("log-log slope over {} exponents with fwhm >= 12 px: {s:.3}", log_n.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!((s - 0.5).abs() <= 0.15, "slope {s:.3} is not 0.5 +- 0.15");
+}
+
+#[test]
+fn the_atlas_counts_the_lobes_at_the_limit() {
+    // The same statement at the default analysis size, through the atlas builder: a sharp lobe
+    // (fwhm 2 px at 64 x 64) reaches the limit in every lobe, a broad one (fwhm 19 px) in none
+    // away from grazing incidence.
+    let config = Config { lobes: 8, ..Config::default() };
+    let sharp = brdf_atlas::build_atlas(&phong(1000.0), &config, &|_| {}).unwrap();
+    assert_eq!(sharp.stats.nyquist_lobes(), 64, "{:?}", sharp.stats.nyquist_pixels);
+    let broad = brdf_atlas::build_atlas(&phong(6.0), &config, &|_| {}).unwrap();
+    let grid = IncidentGrid::new(8);
+    for j in 0..8 {
+        for i in 0..8 {
+            let theta_i = grid.theta_i(j).to_degrees();
+            let count = broad.stats.nyquist_pixels[j * 8 + i];
+            assert!(theta_i > 70.0 || count == 0, "lobe ({i}, {j}) at {theta_i:.0} deg: {count} pixels at the limit");
+        }
+    }
+}
