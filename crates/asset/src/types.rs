@@ -21,6 +21,25 @@ pub struct Provenance {
     pub parameters: Vec<(String, String)>,
 }
 
+impl Provenance {
+    /// The provenance of an asset that `tool` (name and version) made from the file at `source`
+    /// with `parameters`: the file's name and the SHA-256 of its bytes, read in a stream.
+    pub fn of_source(
+        source: &std::path::Path,
+        tool: &str,
+        tool_version: &str,
+        parameters: Vec<(String, String)>,
+    ) -> std::io::Result<Provenance> {
+        Ok(Provenance {
+            source_name: source.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
+            source_sha256: crate::files::sha256_file(source)?,
+            tool: tool.to_string(),
+            tool_version: tool_version.to_string(),
+            parameters,
+        })
+    }
+}
+
 /// The kinds of asset. The code is what the header stores; codes are never reused.
 ///
 /// In JSON (the bake manifest) a kind is written by [`AssetKind::name`].

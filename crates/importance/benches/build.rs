@@ -40,7 +40,7 @@ fn main() {
     let pairs: Vec<_> = (0..1_000_000u32)
         .map(|i| {
             let (a, b) = ((i as f64 * 0.618_034).fract(), (i as f64 * 0.754_877).fract());
-            (spherical_dir(a * 1.5, b * 6.28), spherical_dir(b * 1.5, a * 6.28))
+            (spherical_dir(a * 1.5, b * std::f64::consts::TAU), spherical_dir(b * 1.5, a * std::f64::consts::TAU))
         })
         .collect();
     let baseline = time(5, || {

@@ -163,13 +163,13 @@ fn write_model(path: &Path, model: &PcaModel, atlas_path: &Path) -> Result<()> {
         components: model.components.clone(),
         coefficients: model.coefficients.clone(),
     };
-    let provenance = asset::Provenance {
-        source_name: atlas_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-        source_sha256: asset::sha256_file(atlas_path).with_context(|| format!("hashing {}", atlas_path.display()))?,
-        tool: env!("CARGO_PKG_NAME").to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters: vec![("components".to_string(), model.n_components.to_string())],
-    };
+    let provenance = asset::Provenance::of_source(
+        atlas_path,
+        env!("CARGO_PKG_NAME"),
+        env!("CARGO_PKG_VERSION"),
+        vec![("components".to_string(), model.n_components.to_string())],
+    )
+    .with_context(|| format!("hashing {}", atlas_path.display()))?;
     asset::write_file(path, &asset::Asset { provenance, payload: payload.into() })?;
     Ok(())
 }

@@ -177,17 +177,17 @@ fn write_atlas(path: &Path, atlas: &Atlas, source: &Path, config: &Config) -> Re
         },
         data: atlas.data.clone(),
     };
-    let provenance = asset::Provenance {
-        source_name: source.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-        source_sha256: asset::sha256_file(source).with_context(|| format!("hashing {}", source.display()))?,
-        tool: env!("CARGO_PKG_NAME").to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters: vec![
+    let provenance = asset::Provenance::of_source(
+        source,
+        env!("CARGO_PKG_NAME"),
+        env!("CARGO_PKG_VERSION"),
+        vec![
             ("lobes".to_string(), config.lobes.to_string()),
             ("tile".to_string(), config.tile.to_string()),
             ("analysis_size".to_string(), config.analysis_size.to_string()),
         ],
-    };
+    )
+    .with_context(|| format!("hashing {}", source.display()))?;
     asset::write_file(path, &asset::Asset { provenance, payload: payload.into() })?;
     Ok(())
 }

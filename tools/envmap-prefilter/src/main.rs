@@ -237,13 +237,8 @@ fn provenance(args: &Args, prefiltered: &Prefiltered) -> Result<asset::Provenanc
         };
         parameters.push((format!("layer n={}", layer.exponent), how));
     }
-    Ok(asset::Provenance {
-        source_name: env.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-        source_sha256: asset::sha256_file(env).with_context(|| format!("hashing {}", env.display()))?,
-        tool: env!("CARGO_PKG_NAME").to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters,
-    })
+    asset::Provenance::of_source(env, env!("CARGO_PKG_NAME"), env!("CARGO_PKG_VERSION"), parameters)
+        .with_context(|| format!("hashing {}", env.display()))
 }
 
 fn join(exponents: &[u32]) -> String {

@@ -186,11 +186,11 @@ fn provenance(material: &Path, config: &Config) -> Result<asset::Provenance> {
         ("samples", config.n_samples.to_string()),
         ("seed", config.seed.to_string()),
     ];
-    Ok(asset::Provenance {
-        source_name: material.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-        source_sha256: asset::sha256_file(material).with_context(|| format!("hashing {}", material.display()))?,
-        tool: env!("CARGO_PKG_NAME").to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters: parameters.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
-    })
+    asset::Provenance::of_source(
+        material,
+        env!("CARGO_PKG_NAME"),
+        env!("CARGO_PKG_VERSION"),
+        parameters.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+    )
+    .with_context(|| format!("hashing {}", material.display()))
 }

@@ -260,21 +260,16 @@ fn summary_json(path: &Path, s: &Summary, args: &Args, problems: &[String]) -> s
 }
 
 fn write_asset(out: &Path, args: &Args, s: &Summary) -> Result<()> {
-    let source_sha256 = asset::sha256_file(&args.file).context("hashing the source")?;
-    let source_name = args.file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let provenance = asset::Provenance {
-        source_name,
-        source_sha256,
-        tool: env!("CARGO_PKG_NAME").to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters: vec![
-            ("albedo_interp".to_string(), interp_name(args.albedo_interp).to_string()),
-            ("quadrature".to_string(), {
-                let q = Quadrature::default();
-                format!("{} u nodes per theta_h cell x {} phi_h nodes", q.nodes_per_cell, q.n_phi_h)
-            }),
-        ],
-    };
+    let parameters = vec![
+        ("albedo_interp".to_string(), interp_name(args.albedo_interp).to_string()),
+        ("quadrature".to_string(), {
+            let q = Quadrature::default();
+            format!("{} u nodes per theta_h cell x {} phi_h nodes", q.nodes_per_cell, q.n_phi_h)
+        }),
+    ];
+    let provenance =
+        asset::Provenance::of_source(&args.file, env!("CARGO_PKG_NAME"), env!("CARGO_PKG_VERSION"), parameters)
+            .context("hashing the source")?;
     let d = s.dims;
     let ch = s.channels.unwrap_or([merl::summary::ChannelStats { min: 0.0, max: 0.0, mean: 0.0 }; 3]);
     let (peak_rgb, peak_cell) = s
