@@ -144,7 +144,6 @@
 
 mod analysis;
 mod atlas;
-pub mod colour;
 mod error;
 mod lobe;
 pub mod param;

@@ -53,6 +53,7 @@
 //! # Ok::<(), envmap::Error>(())
 //! ```
 
+pub mod colormap;
 mod error;
 pub mod geometry;
 mod map;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
-use brdf_atlas::{Atlas, Components, MAX_TEXELS, Parameterization, PcaModel, colour, evaluate, fit};
+use brdf_atlas::{Atlas, Components, MAX_TEXELS, Parameterization, PcaModel, evaluate, fit};
 use clap::{ArgGroup, Parser};
 
 /// Compress a bandwidth atlas (from brdf-bandwidth) by PCA: each lobe's tile is one vector; the
@@ -61,9 +61,14 @@ fn run(args: Args) -> Result<ExitCode> {
 
     write_model(&args.out, &fitted.model, &args.atlas).with_context(|| format!("writing {}", args.out.display()))?;
     let png = args.png.clone().unwrap_or_else(|| args.out.with_extension("png"));
-    let range = colour::log_range(&report.errors, 3.0).unwrap_or((1.0, 1.0));
-    envmap::write_png_rgb8(&png, atlas.width(), atlas.height(), &colour::false_colour_log(&report.errors, range))
-        .with_context(|| format!("writing {}", png.display()))?;
+    let range = envmap::colormap::log_range(&report.errors, 3.0).unwrap_or((1.0, 1.0));
+    envmap::write_png_rgb8(
+        &png,
+        atlas.width(),
+        atlas.height(),
+        &envmap::colormap::false_colour_log(&report.errors, range),
+    )
+    .with_context(|| format!("writing {}", png.display()))?;
 
     // The fewest components the eigenvalues predict for a few error levels.
     let k_for = |e: f64| fitted.predicted_relative_rmse.iter().position(|p| *p <= e).unwrap_or(atlas.tile_len());

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use brdf_atlas::{Atlas, AtlasBuild, Config, build_atlas, colour};
+use brdf_atlas::{Atlas, AtlasBuild, Config, build_atlas};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -72,8 +72,8 @@ fn run(args: Args) -> Result<ExitCode> {
     let (exr, png, bin) = (args.out.join(EXR), args.out.join(PNG), args.out.join(BIN));
     envmap::write_exr(&exr, atlas.width(), atlas.height(), &[("Y", &atlas.data)], envmap::SampleType::F32)
         .with_context(|| format!("writing {}", exr.display()))?;
-    let range = colour::log_range(&atlas.data, 3.0).unwrap_or((1.0, 1.0));
-    let rgb = colour::false_colour_log(&atlas.data, range);
+    let range = envmap::colormap::log_range(&atlas.data, 3.0).unwrap_or((1.0, 1.0));
+    let rgb = envmap::colormap::false_colour_log(&atlas.data, range);
     envmap::write_png_rgb8(&png, atlas.width(), atlas.height(), &rgb)
         .with_context(|| format!("writing {}", png.display()))?;
     write_atlas(&bin, atlas, &args.material, &config).with_context(|| format!("writing {}", bin.display()))?;

@@ -8,6 +8,8 @@
 //! so small textures stay visible), left-aligned on a canvas at least [`MIN_WIDTH`] wide; the
 //! legend is a strip of [`LEGEND_HEIGHT`] pixels below it.
 
+use envmap::colormap::inferno;
+
 use crate::font::{ADVANCE, GLYPH_H, glyph, text_width};
 
 /// The canvas is at least this wide, so the legend's lines fit.
@@ -148,30 +150,6 @@ fn nice_at_least(v: f64) -> f64 {
     let e = v.log10().floor() as i32;
     let candidates = (e - 1..=e + 1).flat_map(|e| NICE.map(|m| m * 10f64.powi(e)));
     candidates.filter(|n| *n >= v * (1.0 - 1e-9)).fold(f64::INFINITY, f64::min)
-}
-
-/// matplotlib's inferno at 0, 0.1, ..., 1 (viridisLite's `inferno(11)`), interpolated linearly
-/// in sRGB: close enough to the 256-entry table for a preview, and still monotone in lightness.
-const INFERNO: [[u8; 3]; 11] = [
-    [0x00, 0x00, 0x04],
-    [0x16, 0x0b, 0x39],
-    [0x42, 0x0a, 0x68],
-    [0x6a, 0x17, 0x6e],
-    [0x93, 0x26, 0x67],
-    [0xbc, 0x37, 0x54],
-    [0xdd, 0x51, 0x3a],
-    [0xf3, 0x78, 0x19],
-    [0xfc, 0xa5, 0x0a],
-    [0xf6, 0xd7, 0x46],
-    [0xfc, 0xff, 0xa4],
-];
-
-/// The colour of position `t` in `0..=1`.
-pub fn inferno(t: f64) -> [u8; 3] {
-    let s = t.clamp(0.0, 1.0) * (INFERNO.len() - 1) as f64;
-    let i = (s.floor() as usize).min(INFERNO.len() - 2);
-    let f = s - i as f64;
-    std::array::from_fn(|c| (f64::from(INFERNO[i][c]) * (1.0 - f) + f64::from(INFERNO[i + 1][c]) * f).round() as u8)
 }
 
 /// The colour of one map pixel.

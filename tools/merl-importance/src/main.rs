@@ -1,6 +1,8 @@
 //! `merl-importance`: importance-sampling tables and precomputed samples of a MERL BRDF, as one
 //! asset, plus a picture of the samples over the lobe. A thin layer over the `importance` crate.
 
+mod picture;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -86,7 +88,7 @@ fn run(args: Args) -> Result<ExitCode> {
     asset::write_file(&args.out, &asset).with_context(|| format!("writing {}", args.out.display()))?;
     let png = args.png.clone().unwrap_or_else(|| args.out.with_extension("png"));
     let shown = shown_slices(&config);
-    let picture = importance::picture::lobes(&table, &tables, &shown, 256);
+    let picture = picture::lobes(&table, &tables, &shown, 256);
     envmap::write_png_rgb8(&png, picture.width, picture.height, &picture.rgb)
         .with_context(|| format!("writing {}", png.display()))?;
     eprintln!(

@@ -1,5 +1,30 @@
-//! False-colour pictures of atlases and error maps: a logarithmic scale through the viridis
-//! colour map, black for zero (a flat texel).
+//! False colour for pictures people look at: matplotlib's perceptually uniform colour maps
+//! (inferno for maps over an image, viridis for atlases and error maps) and a logarithmic
+//! scale. Every tool that writes a false-colour PNG takes its colours from here.
+
+/// matplotlib's inferno at 0, 0.1, ..., 1 (viridisLite's `inferno(11)`), interpolated linearly
+/// in sRGB: close enough to the 256-entry table for a preview, and still monotone in lightness.
+const INFERNO: [[u8; 3]; 11] = [
+    [0x00, 0x00, 0x04],
+    [0x16, 0x0b, 0x39],
+    [0x42, 0x0a, 0x68],
+    [0x6a, 0x17, 0x6e],
+    [0x93, 0x26, 0x67],
+    [0xbc, 0x37, 0x54],
+    [0xdd, 0x51, 0x3a],
+    [0xf3, 0x78, 0x19],
+    [0xfc, 0xa5, 0x0a],
+    [0xf6, 0xd7, 0x46],
+    [0xfc, 0xff, 0xa4],
+];
+
+/// The colour of position `t` in `0..=1`.
+pub fn inferno(t: f64) -> [u8; 3] {
+    let s = t.clamp(0.0, 1.0) * (INFERNO.len() - 1) as f64;
+    let i = (s.floor() as usize).min(INFERNO.len() - 2);
+    let f = s - i as f64;
+    std::array::from_fn(|c| (f64::from(INFERNO[i][c]) * (1.0 - f) + f64::from(INFERNO[i + 1][c]) * f).round() as u8)
+}
 
 /// Viridis at 0, 1/8, ..., 1 (sRGB bytes); linear in between.
 const VIRIDIS: [[f64; 3]; 9] = [
@@ -51,6 +76,13 @@ pub fn false_colour_log(values: &[f32], range: (f64, f64)) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn inferno_ends() {
+        assert_eq!(inferno(0.0), [0, 0, 4]);
+        assert_eq!(inferno(1.0), [0xfc, 0xff, 0xa4]);
+        assert_eq!(inferno(-1.0), inferno(0.0));
+    }
 
     #[test]
     fn ends_and_zero() {
