@@ -23,8 +23,8 @@ fn worst_albedo_error(
     reference: [f64; 3],
 ) -> f64 {
     let slice = &tables.slices()[k];
-    let samples: Vec<_> = (0..tables.config().n_vectors).flat_map(|v| tables.samples(k, v).to_vec()).collect();
-    let estimate = albedo_estimate(table, slice, &samples);
+    let samples = tables.slice_samples(k);
+    let estimate = albedo_estimate(table, slice, samples);
     (0..3).map(|c| (estimate[c] / reference[c] - 1.0).abs()).fold(0.0, f64::max)
 }
 

@@ -310,6 +310,12 @@ impl ImportanceTables {
         &self.samples[start..start + c.n_samples]
     }
 
+    /// Every vector of slice `k`, one after the other.
+    pub fn slice_samples(&self, k: usize) -> &[DirectionSample] {
+        let per_slice = self.config.n_vectors * self.config.n_samples;
+        &self.samples[k * per_slice..(k + 1) * per_slice]
+    }
+
     /// Every sample, slice-major, then vector, then sample.
     pub fn all_samples(&self) -> &[DirectionSample] {
         &self.samples
@@ -398,7 +404,7 @@ fn build_slice(table: &MerlTable, config: &Config, rows: &HalfVectorRows, theta_
 /// How well a slice samples its material, by deterministic quadrature (no sampling noise): the
 /// numbers `merl-importance` reports and the tests hold to the bars.
 pub mod quality {
-    use merl::albedo::{Quadrature, directional_albedo, hemisphere_integral};
+    use merl::albedo::{Quadrature, hemisphere_integral};
     use merl::{Interp, MerlTable, luminance};
 
     use crate::{DirectionSample, Slice};
@@ -422,17 +428,19 @@ pub mod quality {
     /// Computes [`SliceQuality`] with the half-vector quadrature `q` of the `merl` crate.
     pub fn slice_quality(table: &MerlTable, slice: &Slice, q: Quadrature) -> SliceQuality {
         let wo = slice.wo();
-        let [g1, g2_p, g2_cos, upper_mass] = hemisphere_integral(
+        // One pass over the nodes: the same lookup feeds the variances and the albedo.
+        let [g1, g2_p, g2_cos, upper_mass, red, green, blue] = hemisphere_integral(
             |wi| {
                 let p = slice.pdf(wi);
-                let g = table.lookup(wi, wo, Interp::Nearest).map_or(0.0, |f| luminance(f) * wi.z);
+                let f = table.lookup(wi, wo, Interp::Nearest).unwrap_or([0.0; 3]);
+                let g = luminance(f) * wi.z;
                 let g2_p = if g > 0.0 { g * g / p } else { 0.0 };
-                [g, g2_p, g * g * std::f64::consts::PI / wi.z, p]
+                [g, g2_p, g * g * std::f64::consts::PI / wi.z, p, f[0] * wi.z, f[1] * wi.z, f[2] * wi.z]
             },
             wo,
             q,
         );
-        let albedo = directional_albedo(|wi, wo| table.lookup(wi, wo, Interp::Nearest), slice.theta_o(), q).rgb;
+        let albedo = [red, green, blue];
         let rv = |second: f64| if g1 > 0.0 { second / (g1 * g1) - 1.0 } else { 0.0 };
         SliceQuality { theta_o: slice.theta_o(), rv: rv(g2_p), rv_cos: rv(g2_cos), albedo, upper_mass }
     }

@@ -119,8 +119,8 @@ fn report(table: &MerlTable, tables: &ImportanceTables, shown: &[usize]) -> Exit
     for &k in shown {
         let slice = &tables.slices()[k];
         let q = slice_quality(table, slice, Quadrature::default());
-        let samples: Vec<_> = (0..tables.config().n_vectors).flat_map(|v| tables.samples(k, v).to_vec()).collect();
-        let estimate = albedo_estimate(table, slice, &samples);
+        let samples = tables.slice_samples(k);
+        let estimate = albedo_estimate(table, slice, samples);
         let error =
             std::array::from_fn::<f64, 3, _>(|c| if q.albedo[c] > 0.0 { estimate[c] / q.albedo[c] - 1.0 } else { 0.0 });
         let deg = q.theta_o.to_degrees();
