@@ -3,27 +3,44 @@
 CARGO ?= cargo
 DEMO := target/demo
 BIN := target/release
+TOOLS := $(notdir $(wildcard tools/*))
+PREFIX ?= /usr/local
 
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup build test demo lint bench clean-demo
+.PHONY: setup setup-gpu setup-python build install test demo bake lint bench clean-demo
 
-## setup: install what the tests need and the machine lacks (numpy for the shared data tool,
-## the software Vulkan driver lavapipe for the GPU tests). Idempotent.
-setup:
-	@python3 -c 'import numpy' 2>/dev/null || python3 -m pip install --quiet numpy
-	@if ! ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1; then \
-	  echo "installing the software Vulkan driver (mesa-vulkan-drivers libvulkan1)"; \
+## setup: everything the tests need (setup-gpu and setup-python). Idempotent.
+setup: setup-gpu setup-python
+
+## setup-gpu: the software Vulkan driver (lavapipe), for brdf-preview and the GPU tests on machines
+## without a GPU driver. Installed only when missing; quiet.
+setup-gpu:
+	@if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then \
+	  echo "installing mesa-vulkan-drivers and libvulkan1 (a software Vulkan driver for the previewer and the GPU tests)"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq mesa-vulkan-drivers libvulkan1; \
+	  $$SUDO apt-get update -qq >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null; \
 	fi
 
-build:
-	$(CARGO) build --release --workspace
+## setup-python: numpy, for ../shared/tools/nbrdf2merl.py (the real-derived test materials).
+setup-python:
+	@python3 -c 'import numpy' 2>/dev/null || { echo "installing numpy (for ../shared/tools/nbrdf2merl.py)"; python3 -m pip install --quiet numpy; }
 
-## test: every unit, property, GPU (lavapipe) and end-to-end test.
+## build: every tool, optimized, into target/release/.
+build:
+	$(CARGO) build --release
+
+## install: the tools into $(PREFIX)/bin (e.g. make install PREFIX=$$HOME/.local).
+install: build
+	install -d $(PREFIX)/bin
+	install -m 755 $(addprefix $(BIN)/,$(TOOLS)) $(PREFIX)/bin/
+
+## test: every unit, property, GPU (lavapipe) and end-to-end test. The tools are built first, once,
+## and the end-to-end tests run those binaries.
 test: setup
+	$(CARGO) build --workspace --bins
 	$(CARGO) test --workspace
 
 ## bench: timings against baselines measured in the same run (benchmarks, not tests).
@@ -34,19 +51,30 @@ bench:
 	$(CARGO) bench -p prefilter --bench prefilter
 	$(CARGO) bench -p brdf-atlas --bench atlas
 
-lint:
-	$(CARGO) clippy --workspace --all-targets -- -D warnings
-
-## demo: make a synthetic material, validate and summarize it, write its info asset and check it,
-## bake its importance-sampling tables (and a PNG of the samples over the lobe).
-demo: setup
-	$(CARGO) build --release -p merl-synth -p merl-info -p asset-info -p merl-importance
+## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
+## procedural calibration sky), then render a preview and a contact sheet of the bake.
+demo: setup-gpu build
 	@mkdir -p $(DEMO)
 	$(BIN)/merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out $(DEMO)/ggx-copper.binary
-	$(BIN)/merl-info $(DEMO)/ggx-copper.binary --asset $(DEMO)/ggx-copper.info.asset
-	$(BIN)/asset-info $(DEMO)/ggx-copper.info.asset
-	$(BIN)/merl-importance $(DEMO)/ggx-copper.binary --out $(DEMO)/ggx-copper.importance.asset --report
-	@echo "demo outputs are in $(DEMO)/"
+	$(BIN)/envmap-synth --out $(DEMO)/calibration-sky.exr
+	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --out-dir $(DEMO)/bake
+	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --sheet $(DEMO)/sheet.png --validate
+	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, sheet.png"
+
+## bake: every MERL table in IN (*.binary) into OUT/<name>/, in parallel with -j; ENV=map.hdr adds
+## the environment stages. E.g. make -j4 bake IN=target/merl OUT=target/bakes ENV=../shared/data/env/quarry_01_1k.hdr
+ifdef IN
+BAKES := $(patsubst $(IN)/%.binary,$(OUT)/%/manifest.json,$(wildcard $(IN)/*.binary))
+endif
+bake: build
+	@test -n "$(IN)" -a -n "$(OUT)" || { echo "usage: make bake IN=DIR OUT=DIR [ENV=map.hdr] [-j N]"; exit 2; }
+	@$(MAKE) --no-print-directory $(BAKES)
+
+$(OUT)/%/manifest.json: $(IN)/%.binary $(ENV)
+	$(BIN)/brdf-bake $< $(if $(ENV),--env $(ENV)) --out-dir $(OUT)/$* --quiet
+
+lint:
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
 clean-demo:
 	rm -rf $(DEMO)

@@ -1,86 +1,61 @@
 //! `envmap-bandwidth` end to end on the real maps of `../shared/data/env`: the outputs, their
-//! sizes, the printed and JSON statistics, the FFT diagnostic, and the errors (a file that is not
-//! 2:1, bad arguments), and that the EXR holds exactly the `bandwidth` crate's estimate in each
-//! mode.
+//! sizes, the printed and JSON statistics (`--json` on stdout, the report on stderr), the FFT
+//! diagnostic, and the errors (a file that is not 2:1, bad arguments), and that the EXR holds
+//! exactly the `bandwidth` crate's estimate in each mode.
 
 use std::path::Path;
 
 use bandwidth::{Config, latlong_bandwidth, local_bandwidth, local_bandwidth_zero_padded, log1p_luminance};
 
-use crate::support::{png_size, run, shared, temp_dir, tool};
+use crate::support::{Run, exr_header, png_decode, run, shared, temp_dir, tool};
 
-/// The legend strip below the map in the picture (`tools/envmap-bandwidth/src/picture.rs`).
-const LEGEND_HEIGHT: usize = 144;
+/// Runs envmap-bandwidth on `input` into `out_dir` with `args`.
+fn envmap_bandwidth(input: &Path, out_dir: &Path, args: &[&str]) -> Run {
+    let mut cmd = tool("envmap-bandwidth");
+    cmd.arg(input).arg("--out-dir").arg(out_dir).args(args);
+    run(cmd, "")
+}
 
-/// Width and height from an OpenEXR header's `dataWindow` (a box2i: x_min, y_min, x_max, y_max),
-/// and the channel list's names: enough to check the file without an EXR decoder.
-fn exr_header(path: &Path) -> ((usize, usize), Vec<String>) {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-    assert_eq!(&bytes[..4], [0x76, 0x2f, 0x31, 0x01], "{} is not OpenEXR", path.display());
-    let mut at = 8;
-    let cstr = |at: &mut usize| {
-        let end = *at + bytes[*at..].iter().position(|b| *b == 0).expect("a terminated name");
-        let s = String::from_utf8_lossy(&bytes[*at..end]).into_owned();
-        *at = end + 1;
-        s
-    };
-    let i32_at = |i: usize| i32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
-    let (mut size, mut channels) = (None, Vec::new());
-    loop {
-        let name = cstr(&mut at);
-        if name.is_empty() {
-            break;
-        }
-        let _kind = cstr(&mut at);
-        let len = i32_at(at) as usize;
-        let value = at + 4;
-        if name == "dataWindow" {
-            let [x0, y0, x1, y1] = [0, 4, 8, 12].map(|o| i32_at(value + o));
-            size = Some(((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize));
-        }
-        if name == "channels" {
-            // name, then pixel type, pLinear + reserved, x and y sampling: 16 bytes per channel.
-            let mut c = value;
-            while bytes[c] != 0 {
-                channels.push(cstr(&mut c));
-                assert_eq!(i32_at(c), 2, "channel {:?} is not 32-bit float", channels.last());
-                c += 16;
-            }
-        }
-        at = value + len;
+/// The figures of a `--json` run, after checking that its `files` are the two outputs in
+/// `out_dir` as they are on disk.
+fn figures(r: &Run, out_dir: &Path) -> serde_json::Value {
+    let json = r.json_object();
+    let paths: Vec<&str> = json["files"].as_array().unwrap().iter().map(|f| f["path"].as_str().unwrap()).collect();
+    let expected = [out_dir.join("env-bandwidth.exr"), out_dir.join("env-bandwidth.png")];
+    assert_eq!(paths, expected.iter().map(|p| p.to_str().unwrap()).collect::<Vec<_>>(), "{r}");
+    for (file, path) in json["files"].as_array().unwrap().iter().zip(&expected) {
+        let len = std::fs::metadata(path).unwrap().len();
+        assert_eq!(file["size_bytes"].as_u64(), Some(len), "{}\n{r}", path.display());
     }
-    (size.expect("a dataWindow"), channels)
+    json["figures"].clone()
 }
 
 #[test]
 fn quarry_end_to_end() {
     let dir = temp_dir();
-    let (out, json) = (dir.path().join("quarry-bw.exr"), dir.path().join("quarry.json"));
+    let out = dir.path().join("quarry");
     let input = shared().join("data/env/quarry_01_1k.hdr");
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(&input).arg("--out").arg(&out).arg("--json").arg(&json);
-    let r = run(cmd, "").expect_code(0).expect_stdout("cycles per radian").expect_stdout("median");
-    assert!(
-        r.stderr.contains("estimated the angular bandwidth") && r.stderr.contains("wrote"),
-        "no progress message\n{r}"
-    );
+    let r =
+        envmap_bandwidth(&input, &out, &[]).expect_code(0).expect_stdout("cycles per radian").expect_stdout("median");
+    assert!(r.stdout.contains(&input.display().to_string()), "the report names its input\n{r}");
+    assert!(r.stderr.contains("wrote"), "no message about the files written\n{r}");
     assert!(!r.stdout.contains("spearman"), "the fft diagnostic ran without --fft-diagnostic\n{r}");
 
-    assert_eq!(exr_header(&out), ((1024, 512), vec!["Y".to_string()]));
-    // The picture defaults to --out with the extension .png: the map at one pixel per pixel above
-    // the legend.
-    assert_eq!(png_size(&out.with_extension("png")), (1024, 512 + LEGEND_HEIGHT));
+    assert_eq!(exr_header(&out.join("env-bandwidth.exr")), ((1024, 512), vec!["Y".to_string()]));
+    png_decode(&out.join("env-bandwidth.png"));
 
-    let text = std::fs::read_to_string(&json).unwrap();
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
-    assert_eq!(v["mode"], "angular");
+    // The same run with --json: one object on stdout, the report on stderr.
+    let r_json = envmap_bandwidth(&input, &out, &["--json"]).expect_code(0);
+    assert!(r_json.stderr.contains("median"), "the report goes to stderr\n{r_json}");
+    let json = r_json.json_object();
+    let v = figures(&r_json, &out);
+    assert_eq!(json["parameters"]["mode"], "angular");
     assert_eq!(v["unit"], "cycles per radian");
     assert_eq!(
         (v["width"].as_u64(), v["height"].as_u64(), v["pixels"].as_u64()),
         (Some(1024), Some(512), Some(524288))
     );
-    assert_eq!((v["levels"].as_u64(), v["eps"].as_f64()), (Some(10), Some(0.01)));
-    assert!(v["input"].as_str().unwrap().ends_with("quarry_01_1k.hdr"), "{v}");
+    assert_eq!((json["parameters"]["levels"].as_u64(), json["parameters"]["eps"].as_f64()), (Some(10), Some(0.01)));
     let stat = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} missing or not a number\n{v}"));
     let (min, median, p95, max) = (stat("min"), stat("median"), stat("p95"), stat("max"));
     assert!(0.0 < min && min <= median && median <= p95 && p95 <= max, "{v}");
@@ -93,21 +68,15 @@ fn quarry_end_to_end() {
 }
 
 #[test]
-fn fft_diagnostic_and_explicit_png() {
+fn fft_diagnostic() {
     let dir = temp_dir();
-    let (out, png, json) = (dir.path().join("bw.exr"), dir.path().join("picture.png"), dir.path().join("s.json"));
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(shared().join("data/env/potsdamer_platz_1k.hdr"))
-        .args(["--fft-diagnostic", "--out"])
-        .arg(&out)
-        .arg("--png")
-        .arg(&png)
-        .arg("--json")
-        .arg(&json);
-    let r = run(cmd, "").expect_code(0).expect_stdout("log2(wavelet / fft)").expect_stdout("spearman");
-    assert!(!out.with_extension("png").exists(), "a default picture was written beside --png\n{r}");
-    assert_eq!(png_size(&png), (1024, 512 + LEGEND_HEIGHT));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let out = dir.path().join("potsdamer");
+    let input = shared().join("data/env/potsdamer_platz_1k.hdr");
+    let r =
+        envmap_bandwidth(&input, &out, &["--fft-diagnostic", "--json"]).expect_code(0).expect_stdout("fft_diagnostic");
+    assert!(r.stderr.contains("log2(wavelet / fft)") && r.stderr.contains("spearman"), "{r}");
+    png_decode(&out.join("env-bandwidth.png"));
+    let v = figures(&r, &out);
     let fft = &v["fft_diagnostic"];
     // 32 x 32 windows every 8 pixels, wholly inside 1024 x 512: 125 x 61.
     assert_eq!(fft["windows"].as_u64(), Some(125 * 61), "{v}");
@@ -124,25 +93,25 @@ fn fft_diagnostic_and_explicit_png() {
 fn not_two_to_one() {
     let dir = temp_dir();
     let input = shared().join("data/env/decoder/memorial.exr");
-    let out = dir.path().join("m.exr");
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(&input).arg("--out").arg(&out);
-    run(cmd, "").expect_code(2).expect_error(&input, "not a lat-long map: 512 x 768");
+    let out = dir.path().join("m");
+    envmap_bandwidth(&input, &out, &[]).expect_code(2).expect_error(&input, "not a lat-long map: 512 x 768");
     assert!(!out.exists());
 
-    for flags in [&["--spatial"][..], &["--spatial", "--pad"]] {
-        let json = dir.path().join("m.json");
-        let mut cmd = tool("envmap-bandwidth");
-        cmd.arg(&input).args(flags).arg("--out").arg(&out).arg("--json").arg(&json);
-        run(cmd, "").expect_code(0).expect_stdout("cycles per pixel");
-        assert_eq!(exr_header(&out).0, (512, 768));
-        // 512 x 768 fits 512 pixels: drawn at one pixel per pixel on a canvas at least 640 wide.
-        assert_eq!(png_size(&out.with_extension("png")), (640, 768 + LEGEND_HEIGHT));
-        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-        let mode = if flags.len() == 2 { "spatial-padded" } else { "spatial-periodic" };
-        assert_eq!((v["mode"].as_str(), v["unit"].as_str()), (Some(mode), Some("cycles per pixel")), "{v}");
+    for flags in [&["--spatial", "--json"][..], &["--spatial", "--pad", "--json"]] {
+        let r = envmap_bandwidth(&input, &out, flags).expect_code(0);
+        assert!(r.stderr.contains("cycles per pixel"), "{r}");
+        assert_eq!(exr_header(&out.join("env-bandwidth.exr")).0, (512, 768));
+        png_decode(&out.join("env-bandwidth.png"));
+        let json = r.json_object();
+        let v = figures(&r, &out);
+        let mode = if flags.contains(&"--pad") { "spatial-padded" } else { "spatial-periodic" };
+        assert_eq!(
+            (json["parameters"]["mode"].as_str(), v["unit"].as_str()),
+            (Some(mode), Some("cycles per pixel")),
+            "{r}"
+        );
         // Cycles per pixel never exceed the estimator's ceiling, c / 2.
-        assert!(v["max"].as_f64().unwrap() <= v["c"].as_f64().unwrap() / 2.0 + 1e-12, "{v}");
+        assert!(v["max"].as_f64().unwrap() <= json["parameters"]["c"].as_f64().unwrap() / 2.0 + 1e-12, "{r}");
     }
 }
 
@@ -150,65 +119,62 @@ fn not_two_to_one() {
 #[test]
 fn tiny_texture() {
     let dir = temp_dir();
-    let out = dir.path().join("t.exr");
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(shared().join("data/env/decoder/imagers_rgbr4x4.hdr")).args(["--spatial", "--pad", "--out"]).arg(&out);
-    run(cmd, "").expect_code(0);
-    assert_eq!(exr_header(&out).0, (4, 4));
-    assert_eq!(png_size(&out.with_extension("png")), (640, 512 + LEGEND_HEIGHT));
+    let out = dir.path().join("t");
+    envmap_bandwidth(&shared().join("data/env/decoder/imagers_rgbr4x4.hdr"), &out, &["--spatial", "--pad"])
+        .expect_code(0);
+    assert_eq!(exr_header(&out.join("env-bandwidth.exr")).0, (4, 4));
+    // Enlarged: at 4 x 4 picture pixels the map would be invisible; 64 is a generous floor
+    // whatever the legend's layout.
+    let (width, height) = png_decode(&out.join("env-bandwidth.png"));
+    assert!(width >= 64 && height >= 64, "a {width} x {height} picture of a 4 x 4 texture");
 }
 
 #[test]
 fn input_errors_name_the_file() {
     let dir = temp_dir();
-    let out = dir.path().join("x.exr");
+    let out = dir.path().join("x");
     let missing = dir.path().join("missing.hdr");
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(&missing).arg("--out").arg(&out);
-    run(cmd, "").expect_code(2).expect_error(&missing, "no such file");
+    envmap_bandwidth(&missing, &out, &[]).expect_code(2).expect_error(&missing, "no such file");
 
     let not_an_image = dir.path().join("notes.hdr");
     std::fs::write(&not_an_image, "hello").unwrap();
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(&not_an_image).arg("--out").arg(&out);
-    run(cmd, "").expect_code(2).expect_error(&not_an_image, "unknown file format");
+    envmap_bandwidth(&not_an_image, &out, &["--json"])
+        .expect_code(2)
+        .expect_error(&not_an_image, "unknown file format");
     assert!(!out.exists());
 }
 
 /// Usage errors exit 2 (clap's status) and say what was wrong; values that only the estimator
-/// refuses exit 2 with one line; the picture may not overwrite the map.
+/// refuses exit 2 with one line.
 #[test]
 fn bad_arguments() {
     let input = shared().join("data/env/quarry_01_1k.hdr");
     let dir = temp_dir();
-    let out = dir.path().join("bw.exr");
-    let usage: [(&[&str], &str); 6] = [
-        (&[], "--out"),
-        (&["--pad", "--out", "x.exr"], "--spatial"),
-        (&["--out", "x.exr", "--frobnicate"], "--frobnicate"),
-        (&["--out", "x.exr", "--levels", "many"], "--levels"),
-        (&["--out", "x.exr", "--eps", "2"], "2 is not in (0, 1]"),
-        (&["--out", "x.exr", "--eps", "NaN"], "NaN is not in (0, 1]"),
+    let out = dir.path().join("bw");
+    let usage: [(&[&str], &str); 7] = [
+        (&[], "--out-dir"),
+        (&["--pad", "--out-dir", "x"], "--spatial"),
+        (&["--out-dir", "x", "--frobnicate"], "--frobnicate"),
+        (&["--out-dir", "x", "--levels", "many"], "--levels"),
+        (&["--out-dir", "x", "--eps", "2"], "2 is not in (0, 1]"),
+        (&["--out-dir", "x", "--eps", "NaN"], "NaN is not in (0, 1]"),
+        // The options that no longer exist are refused, not ignored.
+        (&["--out-dir", "x", "--png", "x.png"], "--png"),
     ];
     for (args, needle) in usage {
         let mut cmd = tool("envmap-bandwidth");
         cmd.arg(&input).args(args);
         let r = run(cmd, "").expect_code(2);
         assert!(r.stderr.contains(needle), "stderr should mention {needle}\n{r}");
+        assert!(r.stdout.is_empty(), "{r}");
     }
     // Values that only the estimator refuses: one line naming the file.
     for levels in ["0", "11"] {
-        let mut cmd = tool("envmap-bandwidth");
-        cmd.arg(&input).arg("--out").arg(&out).args(["--levels", levels]);
-        let r = run(cmd, "").expect_code(2);
-        let prefix = format!("error: analysing {}: ", input.display());
-        assert!(r.stderr.starts_with(&prefix) && r.stderr.lines().count() == 1, "{r}");
+        let r = envmap_bandwidth(&input, &out, &["--levels", levels]).expect_code(2);
+        let names_the_file = r.stderr.contains(&input.display().to_string());
+        assert!(r.stderr.starts_with("error: ") && names_the_file && r.stderr.lines().count() == 1, "{r}");
     }
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(&input).arg("--out").arg(dir.path().join("same.png"));
-    let r = run(cmd, "").expect_code(2);
-    assert!(r.stderr.contains("--png") && r.stderr.lines().count() == 1, "{r}");
-    assert!(!out.exists() && !dir.path().join("same.png").exists());
+    assert!(!out.exists() && !dir.path().join("x").exists());
 
     let mut cmd = tool("envmap-bandwidth");
     cmd.arg("--help");
@@ -221,11 +187,8 @@ fn bad_arguments() {
 /// back (`Y` comes back as `R = G = B`).
 fn run_tool(input: &Path, extra: &[&str]) -> envmap::HdrImage {
     let dir = temp_dir();
-    let out = dir.path().join("bw.exr");
-    let mut cmd = tool("envmap-bandwidth");
-    cmd.arg(input).arg("--out").arg(&out).args(extra);
-    run(cmd, "").expect_code(0);
-    envmap::read_image(&out, &envmap::Limits::default()).unwrap()
+    envmap_bandwidth(input, dir.path(), extra).expect_code(0);
+    envmap::read_image(&dir.path().join("env-bandwidth.exr"), &envmap::Limits::default()).unwrap()
 }
 
 /// Every texel of `image` is exactly `expected` as `f32` (the EXR stores `f32`, so equality is

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use asset::Payload;
 
-use crate::support::{run, shared, temp_dir, tool};
+use crate::support::{png_decode, run, shared, temp_dir, tool};
 
 fn env_dir() -> PathBuf {
     shared().join("data").join("env")
@@ -35,7 +35,7 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
         let tmp = temp_dir();
         let out = tmp.path().join("prefiltered");
         let mut cmd = tool("envmap-prefilter");
-        cmd.arg(env_dir().join(name)).arg("--out").arg(&out).arg("--verify");
+        cmd.arg(env_dir().join(name)).arg("--out-dir").arg(&out).arg("--verify");
         let r = run(cmd, "")
             .expect_code(0)
             .expect_stdout("7 layers match the EXR layers within half-float rounding")
@@ -66,6 +66,20 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
             let path = out.join(&file.name);
             assert_eq!(asset::sha256_file(&path).unwrap(), file.sha256, "{}", path.display());
         }
+        assert_eq!(p.contact_sheet_png.name, "layers.png");
+        png_decode(&out.join("layers.png"));
+        // The folder holds what the asset names and nothing else (no temporary file).
+        let mut present: Vec<String> =
+            std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        present.sort();
+        let mut named: Vec<String> = [&p.layers_ktx2, &p.mips_ktx2, &p.contact_sheet_png]
+            .into_iter()
+            .chain(&p.layer_exrs)
+            .map(|f| f.name.clone())
+            .chain(["prefiltered.asset".to_string()])
+            .collect();
+        named.sort();
+        assert_eq!(present, named);
         let names: Vec<&str> = p.layer_exrs.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(
             names,
@@ -108,7 +122,7 @@ fn exponents_size_and_method_are_honoured() {
     let tmp = temp_dir();
     let out = tmp.path().join("small");
     let mut cmd = tool("envmap-prefilter");
-    cmd.arg(env_dir().join("studio_small_03_1k.hdr")).args(["--out"]).arg(&out).args([
+    cmd.arg(env_dir().join("studio_small_03_1k.hdr")).arg("--out-dir").arg(&out).args([
         "--exponents",
         "2,30,900",
         "--size",
@@ -124,7 +138,11 @@ fn exponents_size_and_method_are_honoured() {
     assert_eq!((p.exponents.as_slice(), p.layer_size), (&[2, 30, 900][..], [64, 32]));
     assert_eq!(ktx2_header(&out.join("layers.ktx2")), (97, 64, 32, 3, 1));
     let provenance = asset::read_file(&out.join("prefiltered.asset")).unwrap().provenance;
-    assert!(provenance.parameters.contains(&("layer n=30".to_string(), "window".to_string())), "{provenance:?}");
+    // The method each layer used is recorded, one ("layer", "n=N: METHOD") pair per layer.
+    for n in [2, 30, 900] {
+        let pair = ("layer".to_string(), format!("n={n}: window"));
+        assert!(provenance.parameters.contains(&pair), "{provenance:?}");
+    }
 }
 
 #[test]
@@ -140,13 +158,13 @@ fn bad_arguments_are_refused() {
     let tmp = temp_dir();
     for (args, expected) in cases {
         let mut cmd = tool("envmap-prefilter");
-        cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out").arg(tmp.path().join("x")).args(args);
+        cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out-dir").arg(tmp.path().join("x")).args(args);
         let r = run(cmd, "").expect_code(2);
         assert_eq!(r.stderr, expected, "{r}");
         assert!(!tmp.path().join("x").exists(), "nothing is written\n{r}");
     }
     let mut cmd = tool("envmap-prefilter");
-    cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out").arg(tmp.path().join("x")).args(["--size", "256"]);
+    cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out-dir").arg(tmp.path().join("x")).args(["--size", "256"]);
     run(cmd, "").expect_code(2);
 }
 
@@ -156,7 +174,7 @@ fn check_refused(path: &Path, problem: &str) {
     let tmp = temp_dir();
     let out = tmp.path().join("out");
     let mut cmd = tool("envmap-prefilter");
-    cmd.arg(path).arg("--out").arg(&out);
+    cmd.arg(path).arg("--out-dir").arg(&out);
     let r = run(cmd, "").expect_code(2).expect_error(path, problem);
     assert!(r.stdout.is_empty(), "nothing belongs on stdout\n{r}");
     assert!(!out.exists(), "nothing is written\n{r}");

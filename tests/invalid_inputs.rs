@@ -23,14 +23,35 @@ fn damaged_merl_files_are_rejected() {
         ("merl-truncated-header.binary", "truncated header: expected 12 bytes, found 8"),
         ("merl-truncated-payload.binary", "truncated payload: a 90 x 90 x 180 table is 34992012 bytes, found 1212"),
         ("merl-wrong-dims.binary", "unsupported dimensions 90 x 90 x 90"),
-        ("merl-negative-dims.binary", "unsupported dimensions -90 x 90 x 180"),
-        ("merl-huge-header.binary", "unsupported dimensions 2048 x 1024 x 1024"),
+        ("merl-negative-dims.binary", "not a MERL table: unsupported dimensions -90 x 90 x 180"),
+        ("merl-huge-header.binary", "not a MERL table: unsupported dimensions 2048 x 1024 x 1024"),
         ("merl-size-mismatch.binary", "truncated payload: a 90 x 90 x 360 table is 69984012 bytes, found 1212"),
     ];
     for (file, problem) in cases {
         check("merl-info", &dir.join(file), 2, problem);
     }
     check("merl-info", &dir.join("does-not-exist.binary"), 2, "no such file or directory");
+    // A table of another size is a MERL table this build does not support, not something else.
+    let mut cmd = tool("merl-info");
+    cmd.arg(dir.join("merl-wrong-dims.binary"));
+    let r = run(cmd, "").expect_code(2);
+    assert!(!r.stderr.contains("not a MERL table"), "{r}");
+}
+
+/// A file that is no MERL table at all (text) is called that, with the header it read, rather
+/// than a table of odd dimensions; by the tool that reads tables and by the bake.
+#[test]
+fn a_text_file_is_not_a_merl_table() {
+    let readme = root().join("README.md");
+    let problem = "not a MERL table: unsupported dimensions ";
+    check("merl-info", &readme, 2, problem);
+    let tmp = temp_dir();
+    let out = tmp.path().join("bake");
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(&readme).arg("--out-dir").arg(&out);
+    let r = run(cmd, "").expect_code(2).expect_error(&readme, problem);
+    assert!(r.stdout.is_empty(), "nothing belongs on stdout\n{r}");
+    assert!(!out.join("manifest.json").exists(), "{r}");
 }
 
 #[test]

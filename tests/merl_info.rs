@@ -51,6 +51,36 @@ fn lambertian_table_reports_its_albedo_at_every_angle() {
     }
     assert_eq!(json["no_data_cells"], 346_570);
     assert_eq!(json["dims"], serde_json::json!([90, 90, 180]));
+
+    // The text names the lookup the albedo was integrated with (other tools report albedos by
+    // the nearest lookup).
+    for (interp, label) in [("trilinear", "albedo (trilinear lookup)"), ("nearest", "albedo (nearest lookup)")] {
+        let mut cmd = tool("merl-info");
+        cmd.arg(&path).args(["--albedo-interp", interp]);
+        let r = run(cmd, "").expect_code(0).expect_stdout(label);
+        assert!(r.stdout.contains("theta_o 80 deg  0.5000 0.5000 0.5000"), "{r}");
+    }
+}
+
+/// `merl-synth` needs `--out` (a table is 35 MB: never a default place), and every argument of
+/// every BRDF has a help line.
+#[test]
+fn merl_synth_needs_out_and_explains_every_argument() {
+    let mut cmd = tool("merl-synth");
+    cmd.args(["phong", "-n", "10"]);
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("--out <FILE>") && r.stdout.is_empty(), "{r}");
+    for brdf in ["lambertian", "phong", "blinn-phong", "ggx"] {
+        let mut cmd = tool("merl-synth");
+        cmd.args([brdf, "-h"]);
+        let r = run(cmd, "").expect_code(0);
+        let options = r.stdout.split_once("Options:\n").unwrap_or_else(|| panic!("no options\n{r}")).1;
+        for line in options.lines().filter(|l| l.trim_start().starts_with('-')) {
+            // "  -n, --n <N>   help": the option, then at least two spaces, then its help.
+            let parts: Vec<&str> = line.trim().split("  ").filter(|p| !p.trim().is_empty()).collect();
+            assert!(parts.len() >= 2, "merl-synth {brdf}: {:?} has no help\n{r}", line.trim());
+        }
+    }
 }
 
 #[test]

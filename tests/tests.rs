@@ -4,9 +4,11 @@
 mod support;
 
 mod asset_info;
+mod brdf_bake;
 mod brdf_bandwidth;
 mod envmap_bandwidth;
 mod envmap_prefilter;
 mod importance;
 mod invalid_inputs;
+mod json_output;
 mod merl_info;

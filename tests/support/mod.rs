@@ -65,6 +65,20 @@ impl Run {
         serde_json::from_str(&self.stdout).unwrap_or_else(|e| panic!("stdout is not JSON: {e}\n{self}"))
     }
 
+    /// stdout is exactly one JSON object and nothing else (white space aside): what every tool
+    /// prints with `--json`.
+    pub fn json_object(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut values = serde_json::Deserializer::from_str(&self.stdout).into_iter::<serde_json::Value>();
+        let first = match values.next() {
+            Some(Ok(serde_json::Value::Object(map))) => map,
+            Some(Ok(other)) => panic!("stdout is JSON but not an object: {other}\n{self}"),
+            Some(Err(e)) => panic!("stdout is not JSON: {e}\n{self}"),
+            None => panic!("stdout is empty\n{self}"),
+        };
+        assert!(values.next().is_none(), "stdout holds more than one JSON value\n{self}");
+        first
+    }
+
     /// stderr is exactly one line `error: reading FILE: problem`, the problem in lower case,
     /// without a trailing period, and containing `needle`; and nothing panicked.
     pub fn expect_error(self, file: &Path, needle: &str) -> Run {
@@ -181,11 +195,120 @@ pub fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir_in(base).expect("creating a temporary folder")
 }
 
-/// Width and height from a PNG's IHDR chunk (right after the 8-byte signature).
-pub fn png_size(path: &Path) -> (usize, usize) {
+/// Decodes the whole of a PNG (every row and checksum, so a truncated file fails) and returns its
+/// width and height; panics naming the file otherwise.
+pub fn png_decode(path: &Path) -> (usize, usize) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
-    assert_eq!(&bytes[12..16], b"IHDR");
-    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
-    (be(16), be(20))
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{} is not a PNG", path.display());
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
+        .read_info()
+        .unwrap_or_else(|e| panic!("decoding {}: {e}", path.display()));
+    let mut buffer = vec![0; reader.output_buffer_size().expect("a PNG that fits in memory")];
+    let info = reader.next_frame(&mut buffer).unwrap_or_else(|e| panic!("decoding {}: {e}", path.display()));
+    (info.width as usize, info.height as usize)
+}
+
+/// Width and height from an OpenEXR header's `dataWindow` (a box2i: x_min, y_min, x_max, y_max),
+/// and the channel list's names: enough to check the file without an EXR decoder.
+pub fn exr_header(path: &Path) -> ((usize, usize), Vec<String>) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    assert_eq!(&bytes[..4], [0x76, 0x2f, 0x31, 0x01], "{} is not OpenEXR", path.display());
+    let mut at = 8;
+    let cstr = |at: &mut usize| {
+        let end = *at + bytes[*at..].iter().position(|b| *b == 0).expect("a terminated name");
+        let s = String::from_utf8_lossy(&bytes[*at..end]).into_owned();
+        *at = end + 1;
+        s
+    };
+    let i32_at = |i: usize| i32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+    let (mut size, mut channels) = (None, Vec::new());
+    loop {
+        let name = cstr(&mut at);
+        if name.is_empty() {
+            break;
+        }
+        let _kind = cstr(&mut at);
+        let len = i32_at(at) as usize;
+        let value = at + 4;
+        if name == "dataWindow" {
+            let [x0, y0, x1, y1] = [0, 4, 8, 12].map(|o| i32_at(value + o));
+            size = Some(((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize));
+        }
+        if name == "channels" {
+            // name, then pixel type, pLinear + reserved, x and y sampling: 16 bytes per channel.
+            let mut c = value;
+            while bytes[c] != 0 {
+                channels.push(cstr(&mut c));
+                assert_eq!(i32_at(c), 2, "channel {:?} is not 32-bit float", channels.last());
+                c += 16;
+            }
+        }
+        at = value + len;
+    }
+    (size.expect("a dataWindow"), channels)
+}
+
+/// A GGX table with a copper-like Fresnel (`merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54`),
+/// written once per test run at target/test-tmp/ggx-copper.binary: a small but real material for
+/// the bake tests.
+pub fn ggx_copper() -> &'static Path {
+    static PATH: OnceLock<PathBuf> = OnceLock::new();
+    PATH.get_or_init(|| {
+        let dir = root().join("target").join("test-tmp");
+        std::fs::create_dir_all(&dir).expect("creating target/test-tmp");
+        let path = dir.join("ggx-copper.binary");
+        let mut cmd = tool("merl-synth");
+        cmd.args(["ggx", "--alpha", "0.2", "--f0", "0.95,0.64,0.54", "--out"]).arg(&path);
+        run(cmd, "").expect_code(0);
+        path
+    })
+}
+
+/// The smallest shared environment map that works (1024 x 512, a smooth overcast street): the
+/// environment of the bake tests.
+pub fn bake_env() -> PathBuf {
+    shared().join("data").join("env").join("potsdamer_platz_1k.hdr")
+}
+
+/// A finished bake of [`ggx_copper`] in [`bake_env`], made once per test run (with `--force`,
+/// so never a leftover) at target/test-tmp/reference-bake; tests copy it rather than bake again.
+#[derive(Debug)]
+pub struct ReferenceBake {
+    pub dir: PathBuf,
+    /// The `--json` run that made it.
+    pub run: Run,
+    /// How long that bake took.
+    pub duration: std::time::Duration,
+}
+
+pub fn reference_bake() -> &'static ReferenceBake {
+    static BAKE: OnceLock<ReferenceBake> = OnceLock::new();
+    BAKE.get_or_init(|| {
+        let dir = root().join("target").join("test-tmp").join("reference-bake");
+        match std::fs::remove_dir_all(&dir) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => panic!("removing {}: {e}", dir.display()),
+        }
+        let start = std::time::Instant::now();
+        let run = run(bake_command(&dir, &["--force", "--json"]), "").expect_code(0);
+        ReferenceBake { dir, run, duration: start.elapsed() }
+    })
+}
+
+/// `brdf-bake` of [`ggx_copper`] in [`bake_env`] into `dir`, with `args`.
+pub fn bake_command(dir: &Path, args: &[&str]) -> Command {
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(ggx_copper()).arg("--env").arg(bake_env()).arg("--out-dir").arg(dir).args(args);
+    cmd
+}
+
+/// Copies the files of `from` (a flat folder) into a new folder `to`.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap_or_else(|e| panic!("creating {}: {e}", to.display()));
+    for entry in std::fs::read_dir(from).unwrap_or_else(|e| panic!("listing {}: {e}", from.display())) {
+        let entry = entry.expect("a folder entry");
+        std::fs::copy(entry.path(), to.join(entry.file_name()))
+            .unwrap_or_else(|e| panic!("copying {}: {e}", entry.path().display()));
+    }
 }

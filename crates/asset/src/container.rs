@@ -14,8 +14,8 @@ use sha2::{Digest, Sha256};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::types::{
-    Asset, AssetKind, BandwidthAtlas, BandwidthPca, ImportanceSamples, MaterialInfo, Payload, PrefilteredEnvmap,
-    Provenance,
+    Asset, AssetKind, BandwidthAtlas, BandwidthPca, ImportanceSamples, LayerSelection, MaterialInfo, Payload,
+    PrefilteredEnvmap, Provenance,
 };
 
 /// The first eight bytes of every asset file.
@@ -123,6 +123,7 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
         Payload::PrefilteredEnvmap(prefiltered) => encode_section(prefiltered),
         Payload::BandwidthAtlas(atlas) => encode_section(atlas),
         Payload::BandwidthPca(pca) => encode_section(pca),
+        Payload::LayerSelection(selection) => encode_section(selection),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -172,6 +173,7 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
         }
         AssetKind::BandwidthAtlas => Payload::BandwidthAtlas(decode_section::<BandwidthAtlas>("payload", payload)?),
         AssetKind::BandwidthPca => Payload::BandwidthPca(decode_section::<BandwidthPca>("payload", payload)?),
+        AssetKind::LayerSelection => Payload::LayerSelection(decode_section::<LayerSelection>("payload", payload)?),
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;
     Ok((header, Asset { provenance, payload }))
@@ -217,6 +219,13 @@ fn decode_problem(e: DecodeError) -> String {
 /// Writes an asset atomically (see [`write_atomic`]) after checking that a reader would accept
 /// it: the payload's invariants and the section limits.
 pub fn write_file(path: &Path, asset: &Asset) -> Result<(), Error> {
+    write_atomic(path, &encode_checked(asset)?)?;
+    Ok(())
+}
+
+/// [`encode`] after the checks [`write_file`] makes: the payload's invariants and the section
+/// limits. For writers that hold every output in memory before writing any.
+pub fn encode_checked(asset: &Asset) -> Result<Vec<u8>, Error> {
     asset
         .payload
         .check()
@@ -224,8 +233,7 @@ pub fn write_file(path: &Path, asset: &Asset) -> Result<(), Error> {
     let bytes = encode(asset);
     // The header parser is the one place that knows the limits.
     read_header(&bytes)?;
-    write_atomic(path, &bytes)?;
-    Ok(())
+    Ok(bytes)
 }
 
 /// Reads and checks an asset file. The header is read and checked against the file's size

@@ -55,12 +55,14 @@ mod types;
 
 pub use container::{
     FORMAT_VERSION, HEADER_BYTES, Header, MAGIC, PAYLOAD_LIMIT, PROVENANCE_LIMIT, READABLE_VERSIONS, decode,
-    decode_with_header, encode, read_file, read_file_with_header, read_header, write_file,
+    decode_with_header, encode, encode_checked, read_file, read_file_with_header, read_header, write_file,
 };
 pub use error::Error;
 pub use files::{hex, sha256, sha256_file, sha256_from_hex, write_atomic};
-pub use manifest::{BakeManifest, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool};
+pub use manifest::{
+    BakeManifest, FileFormat, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool,
+};
 pub use types::{
-    Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LinkedFile, MaterialInfo,
-    Payload, PrefilteredEnvmap, Provenance,
+    Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LayerSelection, LinkedFile,
+    MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
 };

@@ -1,7 +1,9 @@
 //! The bake manifest: the JSON file a bake writes next to its outputs, saying what went in
-//! (material, environment, tool) and what each stage wrote (path, kind, size, hash), so that a
-//! later step can check its inputs without decoding them. Its JSON Schema is
-//! `data-schema/bake-manifest.schema.json`; the two must agree (a test checks).
+//! (material, environment, tool, parameters) and what each stage wrote (path, format, role, size,
+//! hash) and measured (figures), so that a later step can check its inputs without decoding them
+//! and a rerun can tell that nothing changed. Its JSON Schema is
+//! `data-schema/bake-manifest.schema.json` (version 2; version 1's is kept beside it); the two
+//! must agree (a test checks).
 
 use std::path::Path;
 
@@ -10,12 +12,13 @@ use serde::{Deserialize, Serialize};
 use crate::container::FORMAT_VERSION;
 use crate::error::Error;
 use crate::files::{hex, sha256_file};
+
 use crate::types::AssetKind;
 
 /// The manifest version this build writes.
-pub const MANIFEST_VERSION: u32 = 1;
+pub const MANIFEST_VERSION: u32 = 2;
 /// Every manifest version this build reads.
-pub const READABLE_MANIFEST_VERSIONS: &[u32] = &[1];
+pub const READABLE_MANIFEST_VERSIONS: &[u32] = &[1, 2];
 
 /// What a bake read and wrote.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -27,6 +30,9 @@ pub struct BakeManifest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub environment: Option<SourceFile>,
     pub tool: Tool,
+    /// The settings of the bake as a whole (version 2; empty when read from version 1). With the
+    /// inputs' hashes and the tool's version they decide whether a bake is up to date.
+    pub parameters: serde_json::Map<String, serde_json::Value>,
     /// In the order they ran.
     pub stages: Vec<Stage>,
 }
@@ -58,7 +64,42 @@ pub struct Stage {
     pub name: String,
     /// The settings that shaped the outputs; free-form per stage.
     pub parameters: serde_json::Map<String, serde_json::Value>,
+    /// What the stage measured to validate its outputs (version 2; empty when read from
+    /// version 1); free-form per stage, documented with the stage.
+    pub figures: serde_json::Map<String, serde_json::Value>,
     pub outputs: Vec<StageOutput>,
+}
+
+/// The file formats a bake writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FileFormat {
+    /// The asset container (`data-schema/README.md`).
+    Asset,
+    /// Khronos KTX 2.0 texture.
+    Ktx2,
+    /// OpenEXR image.
+    Exr,
+    /// PNG picture, for people.
+    Png,
+    /// JSON document.
+    Json,
+}
+
+impl FileFormat {
+    pub const ALL: [FileFormat; 5] =
+        [FileFormat::Asset, FileFormat::Ktx2, FileFormat::Exr, FileFormat::Png, FileFormat::Json];
+
+    /// The name in the manifest.
+    pub fn name(self) -> &'static str {
+        match self {
+            FileFormat::Asset => "asset",
+            FileFormat::Ktx2 => "ktx2",
+            FileFormat::Exr => "exr",
+            FileFormat::Png => "png",
+            FileFormat::Json => "json",
+        }
+    }
 }
 
 /// One file a stage wrote.
@@ -67,45 +108,103 @@ pub struct Stage {
 pub struct StageOutput {
     /// Relative to the manifest's folder, with `/` separators.
     pub path: String,
-    pub kind: AssetKind,
-    /// The container format version of the file.
-    pub format_version: u32,
+    pub format: FileFormat,
+    /// What the file is for, stable across versions of the tools (e.g. `phong-layers`,
+    /// `bandwidth-atlas-picture`): readers find a bake's files by role, not by name.
+    pub role: String,
+    /// The asset kind; present exactly when `format` is [`FileFormat::Asset`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<AssetKind>,
+    /// The container format version of an asset; present exactly when `format` is
+    /// [`FileFormat::Asset`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub format_version: Option<u32>,
     pub size_bytes: u64,
     /// SHA-256 of the whole file, 64 lower-case hexadecimal digits.
     pub sha256: String,
 }
 
 impl StageOutput {
-    /// Describes an asset file that this build wrote at `manifest_dir/path`, hashing it.
-    pub fn of_file(manifest_dir: &Path, path: &str, kind: AssetKind) -> std::io::Result<StageOutput> {
-        let full = manifest_dir.join(path);
+    /// Describes a file of `bytes` that this build writes at `path` (relative to the manifest).
+    /// An asset's kind is read from its header.
+    pub fn of_bytes(path: &str, format: FileFormat, role: &str, bytes: &[u8]) -> Result<StageOutput, Error> {
+        let kind = match format {
+            FileFormat::Asset => Some(crate::container::read_header(bytes)?.kind),
+            _ => None,
+        };
         Ok(StageOutput {
             path: path.to_owned(),
+            format,
+            role: role.to_owned(),
             kind,
-            format_version: FORMAT_VERSION,
-            size_bytes: std::fs::metadata(&full)?.len(),
-            sha256: hex(&sha256_file(&full)?),
+            format_version: kind.map(|_| FORMAT_VERSION),
+            size_bytes: bytes.len() as u64,
+            sha256: hex(&crate::files::sha256(bytes)),
         })
+    }
+
+    /// Whether the file at `manifest_dir/path` is still the one described: same size and hash.
+    pub fn matches_file(&self, manifest_dir: &Path) -> std::io::Result<bool> {
+        let full = manifest_dir.join(&self.path);
+        match std::fs::metadata(&full) {
+            Ok(meta) if meta.len() == self.size_bytes => Ok(hex(&sha256_file(&full)?) == self.sha256),
+            Ok(_) => Ok(false),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Checks the invariants the types cannot express: `kind` and `format_version` come with
+    /// assets and only with them; the path is relative and stays inside the manifest's folder.
+    fn check(&self) -> Result<(), String> {
+        let is_asset = self.format == FileFormat::Asset;
+        if is_asset != self.kind.is_some() || is_asset != self.format_version.is_some() {
+            return Err(format!("output {:?}: kind and format_version belong to assets and only to them", self.path));
+        }
+        let escapes = self.path.split('/').any(|part| part == "..");
+        if self.path.is_empty() || self.path.starts_with(['/', '\\']) || escapes {
+            return Err(format!("output path {:?} must be relative and inside the bake's folder", self.path));
+        }
+        Ok(())
     }
 }
 
 impl BakeManifest {
     /// A manifest of the current version with no stages yet.
-    pub fn new(material: SourceFile, environment: Option<SourceFile>, tool: Tool) -> BakeManifest {
-        BakeManifest { manifest_version: MANIFEST_VERSION, material, environment, tool, stages: Vec::new() }
+    pub fn new(
+        material: SourceFile,
+        environment: Option<SourceFile>,
+        tool: Tool,
+        parameters: serde_json::Map<String, serde_json::Value>,
+    ) -> BakeManifest {
+        BakeManifest { manifest_version: MANIFEST_VERSION, material, environment, tool, parameters, stages: Vec::new() }
     }
 
-    /// Parses a manifest and checks its version. The JSON Schema says more (hash patterns);
-    /// this checks what the types can.
+    /// Parses a manifest of any readable version (version 1 is converted: its outputs are
+    /// assets whose role is their kind's name, with no figures and no bake parameters) and checks
+    /// what the types cannot (paths, asset fields). The JSON Schema says more (hash patterns).
     pub fn from_json(text: &str) -> Result<BakeManifest, Error> {
-        let manifest: BakeManifest =
-            serde_json::from_str(text).map_err(|e| Error::Invalid(format!("invalid bake manifest: {e}")))?;
-        if !READABLE_MANIFEST_VERSIONS.contains(&manifest.manifest_version) {
-            return Err(Error::UnsupportedVersion {
-                what: "manifest",
-                found: manifest.manifest_version,
-                readable: READABLE_MANIFEST_VERSIONS,
-            });
+        let invalid = |e: serde_json::Error| Error::Invalid(format!("invalid bake manifest: {e}"));
+        let value: serde_json::Value = serde_json::from_str(text).map_err(invalid)?;
+        let version = value.get("manifest_version").and_then(serde_json::Value::as_u64);
+        let manifest = match version {
+            Some(1) => serde_json::from_value::<v1::BakeManifest>(value).map_err(invalid)?.into(),
+            Some(2) => serde_json::from_value::<BakeManifest>(value).map_err(invalid)?,
+            Some(found) => {
+                return Err(Error::UnsupportedVersion {
+                    what: "manifest",
+                    found: u32::try_from(found).unwrap_or(u32::MAX),
+                    readable: READABLE_MANIFEST_VERSIONS,
+                });
+            }
+            None => return Err(Error::Invalid("invalid bake manifest: no integer manifest_version".into())),
+        };
+        // Version 1 allowed any relative path (its example points outside its folder); its
+        // outputs are all assets, so there is nothing else to check.
+        if manifest.manifest_version >= 2 {
+            for output in manifest.outputs() {
+                output.check().map_err(|e| Error::Invalid(format!("invalid bake manifest: {e}")))?;
+            }
         }
         Ok(manifest)
     }
@@ -116,5 +215,93 @@ impl BakeManifest {
         let mut text = serde_json::to_string_pretty(self).expect("manifest types always serialize");
         text.push('\n');
         text
+    }
+
+    /// Every output of every stage, in order.
+    pub fn outputs(&self) -> impl Iterator<Item = &StageOutput> {
+        self.stages.iter().flat_map(|s| &s.outputs)
+    }
+
+    /// The output with this role, if the bake wrote one.
+    pub fn output(&self, role: &str) -> Option<&StageOutput> {
+        self.outputs().find(|o| o.role == role)
+    }
+
+    /// The output at this path, if the bake wrote one.
+    pub fn output_by_path(&self, path: &str) -> Option<&StageOutput> {
+        self.outputs().find(|o| o.path == path)
+    }
+}
+
+/// Manifest version 1, read and converted; never written.
+mod v1 {
+    use serde::Deserialize;
+
+    use super::{FileFormat, SourceFile, Tool};
+    use crate::types::AssetKind;
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct BakeManifest {
+        #[allow(dead_code, reason = "checked by from_json before this type is chosen")]
+        manifest_version: u32,
+        material: SourceFile,
+        #[serde(default)]
+        environment: Option<SourceFile>,
+        tool: Tool,
+        stages: Vec<Stage>,
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Stage {
+        name: String,
+        parameters: serde_json::Map<String, serde_json::Value>,
+        outputs: Vec<StageOutput>,
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct StageOutput {
+        path: String,
+        kind: AssetKind,
+        format_version: u32,
+        size_bytes: u64,
+        sha256: String,
+    }
+
+    impl From<BakeManifest> for super::BakeManifest {
+        fn from(m: BakeManifest) -> super::BakeManifest {
+            let stages = m
+                .stages
+                .into_iter()
+                .map(|s| super::Stage {
+                    name: s.name,
+                    parameters: s.parameters,
+                    figures: serde_json::Map::new(),
+                    outputs: s
+                        .outputs
+                        .into_iter()
+                        .map(|o| super::StageOutput {
+                            path: o.path,
+                            format: FileFormat::Asset,
+                            role: o.kind.name().to_string(),
+                            kind: Some(o.kind),
+                            format_version: Some(o.format_version),
+                            size_bytes: o.size_bytes,
+                            sha256: o.sha256,
+                        })
+                        .collect(),
+                })
+                .collect();
+            super::BakeManifest {
+                manifest_version: 1,
+                material: m.material,
+                environment: m.environment,
+                tool: m.tool,
+                parameters: serde_json::Map::new(),
+                stages,
+            }
+        }
     }
 }

@@ -56,16 +56,20 @@ pub enum AssetKind {
     BandwidthAtlas = 4,
     /// [`BandwidthPca`]: a bandwidth atlas compressed by PCA.
     BandwidthPca = 5,
+    /// [`LayerSelection`]: which Phong layer of a pre-convolved environment serves each view of a
+    /// material.
+    LayerSelection = 6,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 5] = [
+    pub const ALL: [AssetKind; 6] = [
         AssetKind::MaterialInfo,
         AssetKind::ImportanceSamples,
         AssetKind::PrefilteredEnvmap,
         AssetKind::BandwidthAtlas,
         AssetKind::BandwidthPca,
+        AssetKind::LayerSelection,
     ];
 
     /// The number stored in the header.
@@ -86,6 +90,7 @@ impl AssetKind {
             AssetKind::PrefilteredEnvmap => "prefiltered-envmap",
             AssetKind::BandwidthAtlas => "bandwidth-atlas",
             AssetKind::BandwidthPca => "bandwidth-pca",
+            AssetKind::LayerSelection => "layer-selection",
         }
     }
 }
@@ -341,14 +346,20 @@ pub struct BandwidthAtlas {
 
 impl BandwidthAtlas {
     fn check(&self) -> Result<(), String> {
-        let texels = u64::from(self.lobes_x) * u64::from(self.lobes_y) * u64::from(self.tile) * u64::from(self.tile);
-        if texels == 0 || texels != self.data.len() as u64 {
+        // Sizes come from the file: a product that overflows is a size no file can hold.
+        let texels = u64::from(self.lobes_x)
+            .checked_mul(u64::from(self.lobes_y))
+            .and_then(|n| n.checked_mul(u64::from(self.tile)))
+            .and_then(|n| n.checked_mul(u64::from(self.tile)));
+        if texels.is_none_or(|t| t == 0 || t != self.data.len() as u64) {
             return Err(format!(
-                "bandwidth atlas of {} x {} tiles of {} texels holds {} values, expected {texels} (and at least one)",
+                "bandwidth atlas of {} x {} tiles of {} x {} texels holds {} values, expected {} (and at least one)",
                 self.lobes_x,
                 self.lobes_y,
                 self.tile,
-                self.data.len()
+                self.tile,
+                self.data.len(),
+                texels.map_or("more than any file holds".to_string(), |t| t.to_string())
             ));
         }
         Ok(())
@@ -376,21 +387,75 @@ pub struct BandwidthPca {
 
 impl BandwidthPca {
     fn check(&self) -> Result<(), String> {
-        let tile_len = u64::from(self.tile) * u64::from(self.tile);
-        let lobes = u64::from(self.lobes_x) * u64::from(self.lobes_y);
+        // Sizes come from the file: a product that overflows is a size no file can hold.
+        let tile_len = u64::from(self.tile).checked_mul(u64::from(self.tile));
+        let lobes = u64::from(self.lobes_x).checked_mul(u64::from(self.lobes_y));
         let k = u64::from(self.n_components);
-        let expect = [
-            ("mean", self.mean.len() as u64, tile_len),
-            ("components", self.components.len() as u64, k * tile_len),
-            ("coefficients", self.coefficients.len() as u64, lobes * k),
-        ];
+        let (Some(tile_len), Some(lobes)) = (tile_len, lobes) else {
+            return Err("bandwidth pca sizes exceed what any file holds".to_string());
+        };
         if tile_len == 0 || lobes == 0 {
             return Err("bandwidth pca needs at least one lobe of at least one texel".to_string());
         }
+        let expect = [
+            ("mean", self.mean.len() as u64, Some(tile_len)),
+            ("components", self.components.len() as u64, k.checked_mul(tile_len)),
+            ("coefficients", self.coefficients.len() as u64, lobes.checked_mul(k)),
+        ];
         for (what, found, expected) in expect {
-            if found != expected {
+            if Some(found) != expected {
+                let expected = expected.map_or("more than any file holds".to_string(), |e| e.to_string());
                 return Err(format!("bandwidth pca: {what} has {found} values, expected {expected}"));
             }
+        }
+        Ok(())
+    }
+}
+
+/// Which Phong layer of a pre-convolved environment serves each view elevation of a material
+/// (payload of [`AssetKind::LayerSelection`], written by `brdf-bake`; crate `brdf-atlas`,
+/// module `view`). The material's lobes and the layers' own Phong lobes were measured with the
+/// same analysis (`analysis`, `reduction`); a view uses the layer whose bandwidth is nearest on a
+/// log scale. `data-schema/README.md` says how a renderer reads it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LayerSelection {
+    pub analysis: BandwidthAnalysis,
+    /// `R`: view elevations in equal steps of `cos theta_o`, row `r` covering
+    /// `1 - cos theta_o` in `[r / R, (r + 1) / R)` (the rows of the bandwidth atlas).
+    pub rows: u32,
+    /// How a lobe became one number, e.g. `band-0.99` or `max`.
+    pub reduction: String,
+    /// The layers' Phong exponents, `K` of them (those of the prefiltered environment).
+    pub exponents: Vec<u32>,
+    /// `K` bandwidths, cycles per radian: each layer's lobe measured like the material's.
+    pub layer_bandwidth: Vec<f64>,
+    /// `R` bandwidths, cycles per radian: the material's lobe for views in each row.
+    pub view_bandwidth: Vec<f64>,
+    /// `R` layer indices (`< K`): the layer each row of views reads.
+    pub view_layer: Vec<u32>,
+}
+
+impl LayerSelection {
+    fn check(&self) -> Result<(), String> {
+        let (k, rows) = (self.exponents.len(), self.rows as usize);
+        if k == 0 || rows == 0 {
+            return Err("layer selection needs at least one layer and one row".into());
+        }
+        let expect = [
+            ("layer bandwidths", self.layer_bandwidth.len(), k),
+            ("view bandwidths", self.view_bandwidth.len(), rows),
+            ("view layers", self.view_layer.len(), rows),
+        ];
+        for (what, found, expected) in expect {
+            if found != expected {
+                return Err(format!("layer selection: {what} has {found} entries, expected {expected}"));
+            }
+        }
+        if let Some(bad) = self.view_layer.iter().find(|&&l| l as usize >= k) {
+            return Err(format!("layer selection names layer {bad} of {k}"));
+        }
+        if !self.layer_bandwidth.iter().chain(&self.view_bandwidth).all(|b| b.is_finite() && *b >= 0.0) {
+            return Err("layer selection bandwidths must be finite and not negative".into());
         }
         Ok(())
     }
@@ -406,6 +471,7 @@ pub enum Payload {
     PrefilteredEnvmap(PrefilteredEnvmap),
     BandwidthAtlas(BandwidthAtlas),
     BandwidthPca(BandwidthPca),
+    LayerSelection(LayerSelection),
 }
 
 impl Payload {
@@ -416,6 +482,7 @@ impl Payload {
             Payload::PrefilteredEnvmap(_) => AssetKind::PrefilteredEnvmap,
             Payload::BandwidthAtlas(_) => AssetKind::BandwidthAtlas,
             Payload::BandwidthPca(_) => AssetKind::BandwidthPca,
+            Payload::LayerSelection(_) => AssetKind::LayerSelection,
         }
     }
 
@@ -427,6 +494,7 @@ impl Payload {
             Payload::PrefilteredEnvmap(prefiltered) => prefiltered.check(),
             Payload::BandwidthAtlas(atlas) => atlas.check(),
             Payload::BandwidthPca(pca) => pca.check(),
+            Payload::LayerSelection(selection) => selection.check(),
         }
     }
 }
@@ -452,6 +520,12 @@ impl From<BandwidthAtlas> for Payload {
 impl From<BandwidthPca> for Payload {
     fn from(pca: BandwidthPca) -> Payload {
         Payload::BandwidthPca(pca)
+    }
+}
+
+impl From<LayerSelection> for Payload {
+    fn from(selection: LayerSelection) -> Payload {
+        Payload::LayerSelection(selection)
     }
 }
 

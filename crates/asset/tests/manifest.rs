@@ -1,9 +1,9 @@
-//! The bake manifest: the JSON Schema, the committed example and the `BakeManifest` type agree,
-//! and the schema rejects what it should.
+//! The bake manifest: the JSON Schemas (versions 1 and 2), the committed examples and the
+//! `BakeManifest` type agree, and the schemas reject what they should.
 
 use std::path::{Path, PathBuf};
 
-use asset::{AssetKind, BakeManifest, Error, SourceFile, Stage, StageOutput, Tool};
+use asset::{AssetKind, BakeManifest, Error, FileFormat, SourceFile, Stage, StageOutput, Tool};
 use serde_json::{Value, json};
 
 fn schema_dir() -> PathBuf {
@@ -15,13 +15,21 @@ fn read_json(path: &Path) -> Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("parsing {}: {e}", path.display()))
 }
 
+fn validator_of(file: &str) -> jsonschema::Validator {
+    let schema = read_json(&schema_dir().join(file));
+    jsonschema::draft202012::new(&schema).unwrap_or_else(|e| panic!("{file} itself is invalid: {e}"))
+}
+
 fn validator() -> jsonschema::Validator {
-    let schema = read_json(&schema_dir().join("bake-manifest.schema.json"));
-    jsonschema::draft202012::new(&schema).unwrap_or_else(|e| panic!("the schema itself is invalid: {e}"))
+    validator_of("bake-manifest.schema.json")
 }
 
 fn example() -> Value {
     read_json(&schema_dir().join("examples/bake-manifest.json"))
+}
+
+fn example_v1() -> Value {
+    read_json(&schema_dir().join("examples/bake-manifest-v1.json"))
 }
 
 /// Panics with every validation error, so a failure says which field is wrong.
@@ -37,26 +45,33 @@ fn sample_manifest(environment: bool) -> BakeManifest {
         source_path: format!("inputs/{name}"),
         source_sha256: asset::hex(&asset::sha256(bytes)),
     };
+    let mut parameters = serde_json::Map::new();
+    parameters.insert("pca_max_error".into(), json!(0.02));
     let mut manifest = BakeManifest::new(
         source("blue-acrylic", b"material"),
         environment.then(|| source("studio-é", b"environment")),
         Tool { name: "bake".into(), version: "0.1.0".into() },
+        parameters.clone(),
     );
-    let mut parameters = serde_json::Map::new();
-    parameters.insert("n_samples".into(), json!(1024));
-    parameters.insert("interp".into(), json!("nearest"));
+    let golden = std::fs::read(schema_dir().join("examples/material-info.asset")).unwrap();
+    let mut figures = serde_json::Map::new();
+    figures.insert("albedo".into(), json!([0.5, 0.5, 0.5]));
     manifest.stages.push(Stage {
         name: "material-info".into(),
         parameters,
-        outputs: vec![StageOutput {
-            path: "blue-acrylic/material-info.asset".into(),
-            kind: AssetKind::MaterialInfo,
-            format_version: asset::FORMAT_VERSION,
-            size_bytes: 1234,
-            sha256: asset::hex(&asset::sha256(b"output")),
-        }],
+        figures,
+        outputs: vec![
+            StageOutput::of_bytes("blue-acrylic/material-info.asset", FileFormat::Asset, "material-info", &golden)
+                .unwrap(),
+            StageOutput::of_bytes("blue-acrylic/lobes.png", FileFormat::Png, "lobe-picture", b"png bytes").unwrap(),
+        ],
     });
-    manifest.stages.push(Stage { name: "empty".into(), parameters: serde_json::Map::new(), outputs: vec![] });
+    manifest.stages.push(Stage {
+        name: "empty".into(),
+        parameters: serde_json::Map::new(),
+        figures: serde_json::Map::new(),
+        outputs: vec![],
+    });
     manifest
 }
 
@@ -72,13 +87,37 @@ fn the_example_parses_into_the_type_and_back_unchanged() {
     assert_eq!(serde_json::to_value(&manifest).unwrap(), example());
 }
 
-/// The example's output is the golden file, so its size and hash are real and checkable.
+/// The examples' outputs are real files beside them, so their sizes and hashes are checkable.
 #[test]
-fn the_example_describes_the_golden_file() {
-    let manifest: BakeManifest = serde_json::from_value(example()).unwrap();
+fn the_examples_describe_real_files() {
+    for (name, value) in [("bake-manifest.json", example()), ("bake-manifest-v1.json", example_v1())] {
+        let manifest = BakeManifest::from_json(&value.to_string()).unwrap();
+        assert!(!manifest.stages[0].outputs.is_empty(), "{name}");
+        for output in manifest.outputs() {
+            let dir = schema_dir().join("examples");
+            assert!(output.matches_file(&dir).unwrap(), "{name}: {} is not the file described", output.path);
+            let bytes = std::fs::read(dir.join(&output.path)).unwrap();
+            let described = StageOutput::of_bytes(&output.path, output.format, &output.role, &bytes).unwrap();
+            assert_eq!(&described, output, "{name}");
+        }
+    }
+}
+
+/// Version 1 still reads: it validates against its own schema and converts to outputs that are
+/// assets, with the kind's name as the role.
+#[test]
+fn version_1_reads_and_converts() {
+    let v1 = example_v1();
+    assert_valid(&validator_of("bake-manifest-v1.schema.json"), &v1);
+    assert!(!validator().is_valid(&v1), "version 2's schema must not accept version 1");
+    let manifest = BakeManifest::from_json(&v1.to_string()).unwrap();
+    assert_eq!(manifest.manifest_version, 1);
+    assert!(manifest.parameters.is_empty());
     let output = &manifest.stages[0].outputs[0];
-    let described = StageOutput::of_file(&schema_dir().join("examples"), &output.path, output.kind).unwrap();
-    assert_eq!(&described, output);
+    assert_eq!(output.format, FileFormat::Asset);
+    assert_eq!(output.kind, Some(AssetKind::MaterialInfo));
+    assert_eq!(output.role, "material-info");
+    assert_eq!(output.sha256, v1["stages"][0]["outputs"][0]["sha256"]);
 }
 
 #[test]
@@ -100,6 +139,12 @@ fn the_schema_lists_every_asset_kind() {
     assert_eq!(listed, &json!(known));
     for kind in AssetKind::ALL {
         assert_eq!(serde_json::to_value(kind).unwrap(), json!(kind.name()));
+    }
+    let formats = &schema["$defs"]["output"]["properties"]["format"]["enum"];
+    let known: Vec<Value> = FileFormat::ALL.iter().map(|f| json!(f.name())).collect();
+    assert_eq!(formats, &json!(known));
+    for format in FileFormat::ALL {
+        assert_eq!(serde_json::to_value(format).unwrap(), json!(format.name()));
     }
 }
 
@@ -129,8 +174,8 @@ const BROKEN: &[Broken] = &[
         edit: |m| m["material"]["source_sha256"] = json!("AB".repeat(32)),
         type_refuses: false,
     },
-    Broken { what: "version as a string", edit: |m| m["manifest_version"] = json!("1"), type_refuses: true },
-    Broken { what: "version 2", edit: |m| m["manifest_version"] = json!(2), type_refuses: false },
+    Broken { what: "version as a string", edit: |m| m["manifest_version"] = json!("2"), type_refuses: true },
+    Broken { what: "version 3", edit: |m| m["manifest_version"] = json!(3), type_refuses: true },
     Broken { what: "extra top-level property", edit: |m| m["comment"] = json!("hi"), type_refuses: true },
     Broken {
         what: "extra output property",
@@ -150,7 +195,42 @@ const BROKEN: &[Broken] = &[
     Broken {
         what: "absolute output path",
         edit: |m| m["stages"][0]["outputs"][0]["path"] = json!("/tmp/x.asset"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "output path leaving the folder",
+        edit: |m| m["stages"][0]["outputs"][0]["path"] = json!("a/../../x.asset"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "asset without its kind",
+        edit: |m| drop(m["stages"][0]["outputs"][0].as_object_mut().unwrap().remove("kind")),
+        type_refuses: true,
+    },
+    Broken {
+        what: "picture with an asset kind",
+        edit: |m| m["stages"][0]["outputs"][1]["kind"] = json!("material-info"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "unknown format",
+        edit: |m| m["stages"][0]["outputs"][1]["format"] = json!("jpeg"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "role with spaces",
+        edit: |m| m["stages"][0]["outputs"][1]["role"] = json!("lobe picture"),
         type_refuses: false,
+    },
+    Broken {
+        what: "missing figures",
+        edit: |m| drop(m["stages"][0].as_object_mut().unwrap().remove("figures")),
+        type_refuses: true,
+    },
+    Broken {
+        what: "missing bake parameters",
+        edit: |m| drop(m.as_object_mut().unwrap().remove("parameters")),
+        type_refuses: true,
     },
     Broken {
         what: "parameters not an object",
@@ -178,10 +258,10 @@ fn broken_manifests_are_rejected() {
 #[test]
 fn an_unknown_manifest_version_is_named() {
     let mut manifest = example();
-    manifest["manifest_version"] = json!(2);
+    manifest["manifest_version"] = json!(7);
     match BakeManifest::from_json(&manifest.to_string()) {
         Err(e @ Error::UnsupportedVersion { .. }) => {
-            assert_eq!(e.to_string(), "unsupported manifest version 2: this build reads version 1")
+            assert_eq!(e.to_string(), "unsupported manifest version 7: this build reads versions 1, 2")
         }
         other => panic!("expected an unsupported version, got {other:?}"),
     }

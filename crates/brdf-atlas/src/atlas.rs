@@ -226,6 +226,9 @@ impl BuildStats {
 pub struct AtlasBuild {
     pub atlas: Atlas,
     pub stats: BuildStats,
+    /// Per row of the incident grid: the lobe image's wavelet detail energy per level, finest
+    /// first ([`crate::view::band_energy`]), for the per-view reductions of [`crate::view`].
+    pub band_energy: Vec<Vec<f64>>,
 }
 
 /// Builds the bandwidth atlas of a MERL table. `progress` is called with the number of lobes
@@ -247,15 +250,16 @@ pub fn build_atlas(
     let tile_len = config.tile * config.tile;
 
     let mut rows = vec![0.0f32; config.lobes * tile_len];
-    let per_row: Vec<(u32, usize, usize)> = rows
+    let per_row: Vec<(u32, usize, usize, Vec<f64>)> = rows
         .par_chunks_mut(tile_len)
         .enumerate()
         .map_init(Scratch::default, |scratch, (j, tile)| {
             let filled = analyser.render(&luminance, grid.theta_i(j), scratch);
+            let band_energy = crate::view::band_energy(&scratch.image, config.analysis_size);
             analyser.analyse_scratch(scratch);
             let nyquist_texels = analyser.reduction().reduce(&scratch.cycles_per_radian, &scratch.level, tile);
             progress(config.lobes);
-            (analyser.nyquist_pixels(scratch) as u32, nyquist_texels, filled)
+            (analyser.nyquist_pixels(scratch) as u32, nyquist_texels, filled, band_energy)
         })
         .collect();
 
@@ -272,7 +276,11 @@ pub fn build_atlas(
     };
     let n_lobes = config.lobes * config.lobes;
     let mut stats = BuildStats { nyquist_pixels: vec![0; n_lobes], nyquist_texels: 0, filled_pixels: 0 };
-    for (j, (tile, (nyquist_pixels, nyquist_texels, filled))) in rows.chunks_exact(tile_len).zip(per_row).enumerate() {
+    let mut band_energy = Vec::with_capacity(config.lobes);
+    for (j, (tile, (nyquist_pixels, nyquist_texels, filled, energy))) in
+        rows.chunks_exact(tile_len).zip(per_row).enumerate()
+    {
+        band_energy.push(energy);
         for i in 0..config.lobes {
             let lobe = atlas.lobe_index(i, j);
             atlas.set_tile(lobe, tile);
@@ -281,5 +289,5 @@ pub fn build_atlas(
         stats.nyquist_texels += config.lobes * nyquist_texels;
         stats.filled_pixels += config.lobes * filled;
     }
-    Ok(AtlasBuild { atlas, stats })
+    Ok(AtlasBuild { atlas, stats, band_energy })
 }

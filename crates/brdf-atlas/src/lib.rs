@@ -148,6 +148,7 @@ mod error;
 mod lobe;
 pub mod param;
 pub mod pca;
+pub mod view;
 
 pub use analysis::{Analyser, LobeBandwidth, TileReduction, analysis_levels, extend_periodic};
 pub use atlas::{Atlas, AtlasBuild, BuildStats, Config, MAX_TEXELS, Parameterization, build_atlas};

@@ -4,11 +4,18 @@
 //! process quietly when the reader goes away (`merl-info x.binary --json | head`) instead of
 //! panicking as `println!` does.
 //!
+//! It also holds the one way tools print what they did ([`finish`]: a report for people, or with
+//! `--json` one JSON object on stdout and the human lines on stderr) and the one progress bar
+//! ([`Progress`]).
+//!
 //! Only tools depend on this crate.
 
 use std::fmt;
-use std::io::{ErrorKind, Write};
+use std::io::{ErrorKind, IsTerminal, Write};
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// Runs a tool's `run` and turns its result into the process exit status.
 pub fn main(run: impl FnOnce() -> anyhow::Result<ExitCode>) -> ExitCode {
@@ -59,6 +66,91 @@ pub fn write_line(args: fmt::Arguments<'_>) {
 macro_rules! outln {
     () => { $crate::write_line(format_args!("")) };
     ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
+}
+
+/// Prints a tool's outcome the way every tool does and returns its exit status. With `json`,
+/// stdout gets exactly `value` (one JSON object, which lists the files written) and the report
+/// goes to stderr; without, the report and the problems go to stdout. Either way the files written
+/// are listed on stderr. Exit 1 when there are problems, else 0.
+pub fn finish(
+    json: bool,
+    value: &serde_json::Value,
+    report: &[String],
+    problems: &[String],
+    written: &[String],
+) -> ExitCode {
+    if json {
+        for line in report {
+            eprintln!("{line}");
+        }
+        for problem in problems {
+            eprintln!("problem: {problem}");
+        }
+        write_line(format_args!("{}", serde_json::to_string_pretty(value).expect("json values serialize")));
+    } else {
+        for line in report {
+            write_line(format_args!("{line}"));
+        }
+        for problem in problems {
+            write_line(format_args!("problem: {problem}"));
+        }
+    }
+    if !written.is_empty() {
+        eprintln!("wrote {}", written.join(", "));
+    }
+    if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) }
+}
+
+/// The progress bar of a long job, on stderr. It appears only on a terminal, only once the job has
+/// run for a second (quick runs stay quiet), never with `quiet`; it shows the current step's name
+/// and, when the step reports its work, how far it is.
+#[derive(Debug)]
+pub struct Progress {
+    bar: ProgressBar,
+    start: Instant,
+    enabled: bool,
+    shown: std::sync::atomic::AtomicBool,
+}
+
+impl Progress {
+    pub fn new(quiet: bool) -> Progress {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("{msg} [{bar:30}] {percent:>3}% {elapsed}").expect("a valid template"),
+        );
+        let enabled = !quiet && std::io::stderr().is_terminal();
+        Progress { bar, start: Instant::now(), enabled, shown: std::sync::atomic::AtomicBool::new(false) }
+    }
+
+    /// A new step begins: `message` says which (e.g. "2/5 bandwidth atlas").
+    pub fn step(&self, message: String) {
+        self.bar.set_message(message);
+        self.bar.set_length(1);
+        self.bar.set_position(0);
+        self.show_if_slow();
+    }
+
+    /// Within the current step, `done` of `total` units are done.
+    pub fn work(&self, done: u64, total: u64) {
+        self.bar.set_length(total.max(1));
+        self.bar.set_position(done.min(total));
+        self.show_if_slow();
+    }
+
+    fn show_if_slow(&self) {
+        if self.enabled
+            && self.start.elapsed() > Duration::from_secs(1)
+            && !self.shown.swap(true, std::sync::atomic::Ordering::Relaxed)
+        {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            self.bar.enable_steady_tick(Duration::from_millis(100));
+        }
+    }
+
+    /// Removes the bar (call before printing the report).
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
 }
 
 #[cfg(test)]

@@ -53,12 +53,12 @@
 //! # Ok::<(), envmap::Error>(())
 //! ```
 
-pub mod colormap;
 mod error;
 pub mod geometry;
 mod map;
 mod mip;
 mod read;
+pub mod synthetic;
 mod write;
 
 pub use error::Error;

@@ -120,6 +120,18 @@ impl EnvMap {
         self.lookup_uv(u, v)
     }
 
+    /// `exp(sum omega ln(1e-4 + Y) / (4 pi))`: the geometric mean of the luminance over directions,
+    /// weighted by solid angle (the small offset keeps black texels finite).
+    pub fn log_average_luminance(&self) -> f64 {
+        let luminance = self.luminance();
+        let mut sum = 0.0;
+        for (y, row) in luminance.chunks_exact(self.width).enumerate() {
+            let omega = self.texel_solid_angle(y);
+            sum += omega * row.iter().map(|&v| (1e-4 + f64::from(v)).ln()).sum::<f64>();
+        }
+        (sum / (4.0 * std::f64::consts::PI)).exp()
+    }
+
     /// The solid-angle-weighted mean radiance per channel, `sum(L omega) / (4 pi)`: the average
     /// over all directions (a plain mean over texels would over-weight the poles).
     pub fn mean_radiance(&self) -> [f64; 3] {

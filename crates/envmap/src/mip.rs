@@ -5,6 +5,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::error::Error;
 use crate::geometry;
 use crate::map::EnvMap;
 
@@ -29,6 +30,28 @@ impl MipChain {
             levels.push(next);
         }
         MipChain { levels }
+    }
+
+    /// A chain made elsewhere, e.g. read back from a KTX2 file: at least one level, each half the
+    /// size of the one before (rounded down), as [`MipChain::new`] makes them.
+    pub fn from_levels(levels: Vec<EnvMap>) -> Result<MipChain, Error> {
+        if levels.is_empty() {
+            return Err(Error::Invalid("a mip chain needs at least one level".into()));
+        }
+        for (l, pair) in levels.windows(2).enumerate() {
+            let (fine, coarse) = (&pair[0], &pair[1]);
+            if (coarse.width(), coarse.height()) != (fine.width() / 2, fine.height() / 2) {
+                return Err(Error::Invalid(format!(
+                    "mip level {} is {} x {}, expected half of level {l} ({} x {})",
+                    l + 1,
+                    coarse.width(),
+                    coarse.height(),
+                    fine.width(),
+                    fine.height()
+                )));
+            }
+        }
+        Ok(MipChain { levels })
     }
 
     /// The number of levels, at least 1.

@@ -139,6 +139,19 @@ pub struct Preview {
     pub tone_map: ToneMap,
 }
 
+impl Preview {
+    /// Reinhard's key: [`Preview::auto`] maps a map's log-average luminance to this.
+    pub const KEY: f64 = 0.18;
+
+    /// The preview of pictures lit by `map`: the exposure that maps the map's log-average
+    /// luminance ([`EnvMap::log_average_luminance`]) to [`Preview::KEY`], then Reinhard (Reinhard
+    /// et al. 2002: a scene's "key" sets its exposure). Every picture of a comparison shares it.
+    pub fn auto(map: &EnvMap) -> Preview {
+        let exposure_ev = (Self::KEY / map.log_average_luminance()).log2() as f32;
+        Preview { exposure_ev, tone_map: ToneMap::Reinhard }
+    }
+}
+
 impl Default for Preview {
     /// No exposure change, Reinhard: suns and lamps stay visible without a chosen exposure.
     fn default() -> Self {

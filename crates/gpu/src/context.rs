@@ -1,13 +1,16 @@
-//! A headless wgpu device for compute and offscreen work, on whatever adapter the machine has:
-//! a real GPU, or lavapipe (Mesa's software Vulkan driver) in CI.
+//! A wgpu device for compute and offscreen work, on whatever adapter the machine has: a real GPU,
+//! or lavapipe (Mesa's software Vulkan driver) in CI. Headless by default; [`Gpu::for_surface`]
+//! picks an adapter that can also present to a window the caller made (the crate knows no
+//! windowing library).
 
 use crate::error::GpuError;
-use crate::merl_lookup::table_bytes;
+use crate::merl_lookup::{capture_errors, table_bytes};
 
 /// An adapter, its device and its queue. Created once per process (a device on lavapipe takes
 /// tens of milliseconds, a MERL table upload more); share it by reference.
 #[derive(Debug)]
 pub struct Gpu {
+    adapter: wgpu::Adapter,
     info: wgpu::AdapterInfo,
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -26,15 +29,32 @@ impl Gpu {
 
     async fn new_async() -> Result<Gpu, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Gpu::open(&instance, None).await
+    }
+
+    /// Opens the preferred adapter of `instance` among those that can present to `surface` (a
+    /// window's), by the same preference and with the same checks as [`Gpu::new`]. The instance
+    /// must be the one the surface was created with. Fails with [`GpuError::NoPresentAdapter`]
+    /// where adapters exist but none can present to the surface.
+    pub fn for_surface(instance: &wgpu::Instance, surface: &wgpu::Surface<'_>) -> Result<Gpu, GpuError> {
+        pollster::block_on(Gpu::open(instance, Some(surface)))
+    }
+
+    async fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Gpu, GpuError> {
         let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let found: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
         let need = table_bytes(merl::Dims::MERL_FULL_PHI);
         let adapter = adapters
             .into_iter()
+            .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
             .max_by_key(|a| {
                 let fits = check_buffer_fits(&a.limits(), &a.get_info(), need, "").is_ok();
                 (fits, preference(&a.get_info()))
             })
-            .ok_or(GpuError::NoAdapter)?;
+            .ok_or_else(|| match (surface, found.is_empty()) {
+                (Some(_), false) => GpuError::NoPresentAdapter { adapters: found.join(", ") },
+                _ => GpuError::NoAdapter,
+            })?;
         let info = adapter.get_info();
         // Asking for everything the adapter has costs nothing here and lets batch sizes follow
         // the hardware; the WebGPU defaults are a floor for portability we do not need.
@@ -48,7 +68,23 @@ impl Gpu {
             })
             .await
             .map_err(|error| GpuError::RequestDevice { adapter: describe(&info), error })?;
-        Ok(Gpu { info, device, queue })
+        Ok(Gpu { adapter, info, device, queue })
+    }
+
+    /// Configures `surface` (of the instance this device was opened from) for this device, with
+    /// wgpu's validation errors (a surface whose window has gone, a configuration it does not
+    /// support) returned as [`GpuError::Wgpu`] rather than wgpu's default of panicking.
+    pub fn configure_surface(
+        &self,
+        surface: &wgpu::Surface<'_>,
+        config: &wgpu::SurfaceConfiguration,
+    ) -> Result<(), GpuError> {
+        capture_errors(&self.device, || surface.configure(&self.device, config))
+    }
+
+    /// The adapter the device was opened on (for a surface's capabilities).
+    pub fn adapter(&self) -> &wgpu::Adapter {
+        &self.adapter
     }
 
     /// Name, backend and driver of the adapter, for tools and CI logs to say what ran.

@@ -1,7 +1,11 @@
-//! The GPU side of the toolchain: a headless wgpu device ([`Gpu`]) and the WGSL port of the MERL
-//! nearest lookup ([`MERL_LOOKUP_WGSL`]) that the previewer shades with. [`MerlLookup`] runs that
+//! The GPU side of the toolchain: a wgpu device ([`Gpu`], headless, or able to present to a
+//! window's surface that the caller made: the crate knows no windowing library), the WGSL port of
+//! the MERL nearest lookup ([`MERL_LOOKUP_WGSL`]) and the previewer's renderer
+//! ([`preview::Renderer`]), which shades with it, accumulates frames progressively and is drawn,
+//! tone mapped, into a texture or a window by [`preview::Presenter`]. [`MerlLookup`] runs that
 //! port on batches of direction pairs and reads the results back, so that tests can hold the
-//! shader to the CPU reference in the `merl` crate, cell for cell.
+//! shader to the CPU reference in the `merl` crate, cell for cell; the renderer is held the same
+//! way to the CPU renderer of the `render` crate, and the present pass to `envmap::tonemap_rgb8`.
 //!
 //! Architecture Invariant: the WGSL is the only copy of the lookup on the GPU. The previewer
 //! includes [`MERL_LOOKUP_WGSL`] rather than a rewrite, so the agreement the tests establish is
@@ -10,6 +14,7 @@
 mod context;
 mod error;
 mod merl_lookup;
+pub mod preview;
 
 pub use context::Gpu;
 pub use error::GpuError;

@@ -10,9 +10,14 @@ use merl::{Dims, MerlTable};
 use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
 
-/// The WGSL source: the lookup functions (`merl_half_diff`, `merl_nearest_cell`,
-/// `merl_lookup_nearest`, ...) and the compute entry point `merl_lookup_batch`.
+/// The WGSL source of the lookup: its functions (`merl_half_diff`, `merl_nearest_cell`,
+/// `merl_lookup_nearest`, ...) and the table's bindings (group 0), with no entry point, so that
+/// every shader that looks up the table starts with this text.
 pub const MERL_LOOKUP_WGSL: &str = include_str!("merl_lookup.wgsl");
+
+/// The compute entry point `merl_lookup_batch` and its batch bindings (group 1), compiled after
+/// [`MERL_LOOKUP_WGSL`].
+const MERL_LOOKUP_BATCH_WGSL: &str = include_str!("merl_lookup_batch.wgsl");
 
 /// Must equal `MERL_WORKGROUP_SIZE` in the WGSL (checked by a test below).
 const WORKGROUP_SIZE: u32 = 64;
@@ -113,8 +118,8 @@ impl MerlLookup {
         let (pipeline, table_group) = capture_errors(&device, || {
             use wgpu::util::DeviceExt;
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("merl_lookup.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(MERL_LOOKUP_WGSL.into()),
+                label: Some("merl_lookup_batch.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(format!("{MERL_LOOKUP_WGSL}\n{MERL_LOOKUP_BATCH_WGSL}").into()),
             });
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("merl_lookup_batch"),
@@ -227,7 +232,7 @@ impl MerlLookup {
                 encoder.copy_buffer_to_buffer(&sample_buffer, 0, &readback, 0, n * SAMPLE_BYTES);
                 self.queue.submit([encoder.finish()]);
             })?;
-            samples.extend(read_back(&self.device, &readback, n * SAMPLE_BYTES)?);
+            samples.extend(read_back::<GpuSample>(&self.device, &readback, n * SAMPLE_BYTES)?);
         }
         Ok(samples)
     }
@@ -238,7 +243,7 @@ fn binding(buffer: &wgpu::Buffer, bytes: u64) -> wgpu::BindingResource<'_> {
 }
 
 /// Maps the first `bytes` of `buffer`, waits for the GPU, and copies them out.
-fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<GpuSample>, GpuError> {
+pub(crate) fn read_back<T: Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<T>, GpuError> {
     let slice = buffer.slice(..bytes);
     let (sender, receiver) = mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {
@@ -250,18 +255,18 @@ fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, bytes: u64) -> Result
         .recv()
         .map_err(|_| GpuError::Readback("the map callback did not run".into()))?
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let samples = {
+    let values = {
         let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
         // Copies through an aligned vector: the mapped bytes carry no alignment promise.
         bytemuck::pod_collect_to_vec(&view)
     };
     buffer.unmap();
-    Ok(samples)
+    Ok(values)
 }
 
 /// Runs `f` with wgpu's errors captured, so that a validation or out-of-memory error becomes a
 /// [`GpuError`] instead of wgpu's default of panicking.
-fn capture_errors<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+pub(crate) fn capture_errors<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, GpuError> {
     let scopes = [wgpu::ErrorFilter::Validation, wgpu::ErrorFilter::OutOfMemory, wgpu::ErrorFilter::Internal]
         .map(|filter| device.push_error_scope(filter));
     let value = f();
@@ -281,7 +286,15 @@ mod tests {
     #[test]
     fn workgroup_size_matches_the_shader() {
         let decl = format!("const MERL_WORKGROUP_SIZE: u32 = {WORKGROUP_SIZE}u;");
-        assert!(MERL_LOOKUP_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        assert!(MERL_LOOKUP_BATCH_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+    }
+
+    #[test]
+    fn the_shared_lookup_has_no_entry_point_or_batch_binding() {
+        // Other shaders start with MERL_LOOKUP_WGSL and bind their own groups from 1 on.
+        for batch_only in ["@compute", "@group(1)", "merl_samples"] {
+            assert!(!MERL_LOOKUP_WGSL.contains(batch_only), "MERL_LOOKUP_WGSL contains `{batch_only}`");
+        }
     }
 
     #[test]

@@ -1,17 +1,13 @@
 //! WGSL port of the MERL nearest-cell lookup: `merl::half_diff`, `merl::Dims::nearest_cell` and
-//! `merl::MerlTable::cell_value`, line for line, in f32. The batch evaluator of the `gpu` crate
-//! runs it through `merl_lookup_batch` to check it against the CPU; the previewer includes the
-//! same functions in its shaders, so what the tests establish holds for what is drawn.
+//! `merl::MerlTable::cell_value`, line for line, in f32. Only functions and the table's bindings:
+//! the batch evaluator of the `gpu` crate appends `merl_lookup_batch.wgsl` (its entry point) to
+//! check it against the CPU, and the previewer appends its own shader to the same text, so what
+//! the tests establish holds for what is drawn.
 //!
 //! Conventions are those of the `merl` crate: radians, `z` is the surface normal, `wi` and `wo`
-//! point away from the surface. Group 0 is the table (the previewer binds it too); group 1 is the
-//! batch of the compute entry point only.
+//! point away from the surface. Group 0 is the table, in every shader that includes this file.
 
 const MERL_HALF_PI: f32 = 1.5707963267948966;
-
-// The host rounds batches up to whole workgroups with this size (`WORKGROUP_SIZE` in Rust; a test
-// there checks the two agree).
-const MERL_WORKGROUP_SIZE: u32 = 64u;
 
 struct MerlDims {
     n_theta_h: u32,
@@ -114,31 +110,4 @@ fn merl_has_data(rgb: vec3<f32>) -> bool {
 // The nearest lookup of `merl::MerlTable::lookup`, with no data as a negative value.
 fn merl_lookup_nearest(wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     return merl_cell_value(merl_nearest_cell(merl_dims, merl_half_diff(wi, wo)));
-}
-
-// vec4 so that the host layout is two plain [f32; 4] with no padding rules to get wrong; w unused.
-struct MerlDirPair {
-    wi: vec4<f32>,
-    wo: vec4<f32>,
-}
-
-// 16 bytes: vec3 then u32 in its fourth slot, the layout of `gpu::GpuSample`.
-struct MerlSample {
-    rgb: vec3<f32>,
-    cell: u32,
-}
-
-@group(1) @binding(0) var<storage, read> merl_pairs: array<MerlDirPair>;
-// Bound to exactly the pairs of this dispatch, so its length is the batch size.
-@group(1) @binding(1) var<storage, read_write> merl_samples: array<MerlSample>;
-
-@compute @workgroup_size(MERL_WORKGROUP_SIZE)
-fn merl_lookup_batch(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= arrayLength(&merl_samples)) {
-        return;
-    }
-    let pair = merl_pairs[i];
-    let cell = merl_nearest_cell(merl_dims, merl_half_diff(pair.wi.xyz, pair.wo.xyz));
-    merl_samples[i] = MerlSample(merl_cell_value(cell), cell);
 }

@@ -6,14 +6,15 @@
 //! machine without an adapter they fail with the message that says how to install one.
 
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::io::Write;
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use gpu::{Gpu, GpuSample, MerlLookup};
+use gpu::{GpuSample, MerlLookup};
 use merl::analytic::Analytic;
 use merl::{Cell, Dims, HalfDiff, MerlTable, half_diff, spherical_dir};
 use rand::{Rng, SeedableRng, rngs::StdRng};
+
+use crate::support::{gpu, log};
 
 /// Budget for the absolute error of each angle the shader computes (theta_h, phi_h, theta_d,
 /// phi_d), in radians. Spec-level reasoning gives no useful bound: Vulkan lets atan2 be off by 4096
@@ -33,27 +34,6 @@ const COORD_ULPS: f64 = 4.0;
 const MAX_BORDERLINE_FRACTION: f64 = 0.01;
 
 const N_RANDOM_PAIRS: usize = 10_000;
-
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
-    let gpu = GPU.get_or_init(|| {
-        let gpu = Gpu::new().map_err(|e| e.to_string());
-        if let Ok(gpu) = &gpu {
-            log(&format!("gpu tests run on {}", gpu.adapter_summary()));
-        }
-        gpu
-    });
-    match gpu {
-        Ok(gpu) => gpu,
-        Err(e) => panic!("{e}"),
-    }
-}
-
-/// Straight to stderr: the test harness captures `eprintln!` of passing tests, and CI logs must
-/// show which adapter ran.
-fn log(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
 
 fn cached(cell: &'static OnceLock<MerlTable>, brdf: Analytic) -> &'static MerlTable {
     cell.get_or_init(|| brdf.table(Dims::MERL))

@@ -66,6 +66,7 @@ pub fn directional_albedo(
 /// `integral g(wi) dwi` over the upper hemisphere (`wi.z > 0`), by the half-vector quadrature
 /// about `wo` described in the module docs: the nodes are dense where `wi` is near the mirror
 /// direction of `wo`, so peaked integrands (BRDF lobes, importance-sampling densities) converge.
+/// Deterministic: the same bits whatever the number of threads.
 pub fn hemisphere_integral<const N: usize>(g: impl Fn(DVec3) -> [f64; N] + Sync, wo: DVec3, q: Quadrature) -> [f64; N] {
     let n_u = 90 * q.nodes_per_cell;
     let du = 1.0 / n_u as f64;
@@ -94,13 +95,15 @@ pub fn hemisphere_integral<const N: usize>(g: impl Fn(DVec3) -> [f64; N] + Sync,
             }
             sum
         })
-        .reduce(
-            || [0.0; N],
-            |mut a, b| {
-                a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
-                a
-            },
-        )
+        // Rows are summed in order, not by rayon's reduce, whose grouping follows the thread
+        // count: the result is then the same bits on every machine and run (bakes are compared by
+        // their bytes).
+        .collect::<Vec<[f64; N]>>()
+        .into_iter()
+        .fold([0.0; N], |mut a, b| {
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+            a
+        })
 }
 
 #[cfg(test)]

@@ -17,6 +17,11 @@ pub const NO_DATA_RAW: f64 = -1.0;
 /// Size of the header: three little-endian `i32`.
 pub const HEADER_BYTES: usize = 12;
 
+/// The largest header dimension read as a table of another resolution rather than as a file
+/// that is not a MERL table at all. A table of 1024^3 cells would be 24 GiB; the first bytes of a
+/// text or image file, read as integers, are in the millions or negative.
+pub const PLAUSIBLE_DIM: i32 = 1024;
+
 /// The resolutions of a table. Only MERL's own are accepted: 90 x 90 x 180, or 360 in `phi_d`
 /// for a table that covers `phi_d` in `[0, 2 pi)` instead of relying on reciprocity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,12 +36,16 @@ impl Dims {
     pub const MERL_FULL_PHI: Dims = Dims { n_theta_h: 90, n_theta_d: 90, n_phi_d: 360 };
 
     /// Checks header values read from a file (as `i32`, before anything is allocated).
+    ///
+    /// Dimensions that no table could have (zero, negative, or beyond [`PLAUSIBLE_DIM`]) mean
+    /// the file is something else: the error then starts with `not a MERL table`, so that a
+    /// text file is not reported as a table of an odd size.
     pub fn from_header(header: [i32; 3]) -> Result<Dims, Error> {
         let [h, d, p] = header;
         if h != 90 || d != 90 || (p != 180 && p != 360) {
-            return Err(Error::Invalid(format!(
-                "unsupported dimensions {h} x {d} x {p}: expected 90 x 90 x 180 (or 360 in phi_d)"
-            )));
+            let detail = format!("unsupported dimensions {h} x {d} x {p}: expected 90 x 90 x 180 (or 360 in phi_d)");
+            let plausible = header.iter().all(|n| (1..=PLAUSIBLE_DIM).contains(n));
+            return Err(Error::Invalid(if plausible { detail } else { format!("not a MERL table: {detail}") }));
         }
         Ok(Dims { n_theta_h: 90, n_theta_d: 90, n_phi_d: p as usize })
     }
@@ -316,6 +325,25 @@ pub fn check_size(dims: Dims, file_bytes: u64) -> Result<(), Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A table of another size is "unsupported"; a header no table could have (the first bytes
+    /// of a text file, a negative or zero size) is "not a MERL table", with the same detail.
+    #[test]
+    fn implausible_headers_are_not_merl_tables() {
+        let message = |header: [i32; 3]| Dims::from_header(header).unwrap_err().to_string();
+        assert_eq!(
+            message([90, 90, 90]),
+            "unsupported dimensions 90 x 90 x 90: expected 90 x 90 x 180 (or 360 in phi_d)"
+        );
+        assert!(message([1024, 1, 1024]).starts_with("unsupported dimensions 1024 x 1 x 1024"));
+        let text = parse_header(b"# BRDF toolchain").unwrap();
+        for header in [text, [-90, 90, 180], [0, 90, 180], [90, 90, 1025]] {
+            let m = message(header);
+            let detail = format!("unsupported dimensions {} x {} x {}: expected", header[0], header[1], header[2]);
+            assert!(m.starts_with(&format!("not a MERL table: {detail}")), "{m}");
+        }
+        assert_eq!(Dims::from_header([90, 90, 360]).unwrap(), Dims::MERL_FULL_PHI);
+    }
 
     #[test]
     fn index_round_trip() {

@@ -98,7 +98,7 @@ use rayon::prelude::*;
 pub use error::Error;
 pub use lobe::{LayerMapping, legendre_coefficients, lobe, lobe_bandwidth};
 pub use reference::Reference;
-pub use sheet::{ContactSheet, contact_sheet};
+pub use sheet::{COLUMNS, ContactSheet, MIN_PANEL_WIDTH, contact_sheet, panel_titles, signed};
 
 /// The exponents of the default layers: lobes from a cosine (`n = 1`, diffuse-like) to
 /// a fraction of a degree (`n = 4096`, standard deviation 0.9 degrees), a factor 4 apart (a factor

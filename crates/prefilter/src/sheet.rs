@@ -1,14 +1,15 @@
-//! The contact sheet: the source and the layers side by side as one 8-bit picture, for a person
-//! to look at.
+//! The contact sheet: the source and every layer as one 8-bit picture for a person to look at, a
+//! labelled grid of panels tone mapped alike, with the exposure written under it.
 
-use envmap::{EnvMap, MipChain, Preview, ToneMap};
+use envmap::{EnvMap, MipChain, Preview};
+use picture::layout::{Grid, caption};
+use picture::{Canvas, format_number};
 
-/// Grey columns between panels.
-const GAP: usize = 4;
-const GAP_VALUE: u8 = 64;
-
-/// Reinhard's key: the log-average luminance maps to this before the tone curve.
-const KEY: f64 = 0.18;
+/// Panels per row of the sheet.
+pub const COLUMNS: usize = 4;
+/// Panels narrower than this are enlarged by a whole factor (nearest), so that small layers stay
+/// visible under their titles.
+pub const MIN_PANEL_WIDTH: usize = 256;
 
 /// An 8-bit sRGB picture, interleaved RGB, row-major.
 #[derive(Clone, Debug, PartialEq)]
@@ -18,15 +19,23 @@ pub struct ContactSheet {
     pub rgb8: Vec<u8>,
     /// The exposure every panel was shown at.
     pub exposure_ev: f32,
+    /// Each panel enlarged this many times (nearest).
+    pub zoom: usize,
 }
 
-/// The source (its mip level nearest the layers' size) and then each layer, left to right,
-/// `GAP` grey columns apart, all tone mapped alike: exposed so that the source's solid-angle-
-/// weighted log-average luminance becomes 0.18, then Reinhard's `x / (1 + x)` (Reinhard et al.
-/// 2002). The layers must all have the same size.
-pub fn contact_sheet(source: &MipChain, layers: &[&EnvMap]) -> ContactSheet {
+/// The panels' titles: `source`, then `n = ` each layer's exponent.
+pub fn panel_titles(exponents: impl IntoIterator<Item = u32>) -> Vec<String> {
+    std::iter::once("source".to_string()).chain(exponents.into_iter().map(|n| format!("n = {n}"))).collect()
+}
+
+/// The source (its mip level nearest the layers' size, looked up at the layers' texel centres)
+/// and then each layer, given with its Phong exponent, in a grid of [`COLUMNS`] panels, each
+/// titled, all tone mapped alike: exposed so that the source's solid-angle-weighted log-average
+/// luminance becomes 0.18, then Reinhard's `x / (1 + x)` (Reinhard et al. 2002); under them a
+/// caption with the exposure. The layers must all have the same size.
+pub fn contact_sheet(source: &MipChain, layers: &[(u32, &EnvMap)]) -> ContactSheet {
     let (w, h) =
-        layers.first().map_or((source.level(0).width(), source.level(0).height()), |l| (l.width(), l.height()));
+        layers.first().map_or((source.level(0).width(), source.level(0).height()), |(_, l)| (l.width(), l.height()));
     let lod = (source.level(0).width() as f64 / w as f64).log2().max(0.0);
     let mut panels: Vec<Vec<f32>> = Vec::with_capacity(layers.len() + 1);
     let mut panel = Vec::with_capacity(3 * w * h);
@@ -37,31 +46,35 @@ pub fn contact_sheet(source: &MipChain, layers: &[&EnvMap]) -> ContactSheet {
         }
     }
     panels.push(panel);
-    panels.extend(layers.iter().map(|layer| layer.rgb().to_vec()));
+    panels.extend(layers.iter().map(|(_, layer)| layer.rgb().to_vec()));
 
-    let exposure_ev = (KEY / log_average_luminance(source.level(0))).log2() as f32;
-    let preview = Preview { exposure_ev, tone_map: ToneMap::Reinhard };
-    let mapped: Vec<Vec<u8>> = panels.iter().map(|rgb| envmap::tonemap_rgb8(rgb, &preview)).collect();
-    let width = panels.len() * w + (panels.len() - 1) * GAP;
-    let mut rgb8 = vec![GAP_VALUE; 3 * width * h];
-    for (i, panel) in mapped.iter().enumerate() {
-        let x0 = i * (w + GAP);
-        for y in 0..h {
-            let row = &panel[3 * y * w..3 * (y + 1) * w];
-            rgb8[3 * (y * width + x0)..3 * (y * width + x0 + w)].copy_from_slice(row);
-        }
+    let preview = Preview::auto(source.level(0));
+    let exposure_ev = preview.exposure_ev;
+    let zoom = (MIN_PANEL_WIDTH / w.max(1)).max(1);
+    let mut grid = Grid::new(COLUMNS);
+    grid.title(format!("Phong layers: the map convolved with normalized Phong lobes of exponent n, {w} x {h} each"));
+    let titles = panel_titles(layers.iter().map(|(n, _)| *n));
+    for (rgb, title) in panels.iter().zip(titles) {
+        let mut enlarged = Canvas::new(w * zoom, h * zoom, picture::BACKGROUND);
+        enlarged.blit_rgb8(w, h, &envmap::tonemap_rgb8(rgb, &preview), 0, 0, zoom);
+        grid.add(enlarged, title);
     }
-    ContactSheet { width, height: h, rgb8, exposure_ev }
+    let text = format!(
+        "Every panel tone mapped alike: exposure {} EV (the source's solid-angle-weighted log-average luminance to \
+         0.18), then Reinhard x / (1 + x). Source: its mip chain at level {}, looked up at the layers' texel \
+         centres.{}",
+        signed(exposure_ev),
+        format_number((lod * 100.0).round() / 100.0),
+        if zoom > 1 { format!(" Panels enlarged {zoom}x.") } else { String::new() }
+    );
+    let width = grid.width();
+    grid.footer(caption(&text, width));
+    let sheet = grid.render();
+    ContactSheet { width: sheet.width, height: sheet.height, rgb8: sheet.rgb, exposure_ev, zoom }
 }
 
-/// `exp(sum omega ln(1e-4 + Y) / (4 pi))`: the geometric mean of the luminance over directions
-/// (the small offset keeps black texels finite).
-fn log_average_luminance(map: &EnvMap) -> f64 {
-    let luminance = map.luminance();
-    let mut sum = 0.0;
-    for (y, row) in luminance.chunks_exact(map.width()).enumerate() {
-        let omega = map.texel_solid_angle(y);
-        sum += omega * row.iter().map(|&v| (1e-4 + f64::from(v)).ln()).sum::<f64>();
-    }
-    (sum / (4.0 * std::f64::consts::PI)).exp()
+/// An exposure rounded to hundredths, with its sign: `+1.25`, `-0.5`, `+0`.
+pub fn signed(ev: f32) -> String {
+    let text = format_number((f64::from(ev) * 100.0).round() / 100.0);
+    if ev >= 0.0 { format!("+{text}") } else { text }
 }

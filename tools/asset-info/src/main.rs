@@ -97,8 +97,21 @@ fn print_text(report: &Report) {
                     print_tiles(pca.lobes_x, pca.lobes_y, pca.tile, &pca.analysis);
                     cli::outln!("  components       {}", pca.n_components);
                 }
+                Payload::LayerSelection(selection) => print_layer_selection(selection),
             }
         }
+    }
+}
+
+fn print_layer_selection(selection: &asset::LayerSelection) {
+    cli::outln!("payload: layer selection");
+    let a = &selection.analysis;
+    cli::outln!("  analysis         {} at {} px, eps {}, c {}", a.parameterization, a.analysis_size, a.eps, a.c);
+    cli::outln!("  reduction        {}", selection.reduction);
+    cli::outln!("  layer            exponent  bandwidth (cycles per radian)  views (rows of {})", selection.rows);
+    for (k, (n, b)) in selection.exponents.iter().zip(&selection.layer_bandwidth).enumerate() {
+        let views = selection.view_layer.iter().filter(|&&l| l as usize == k).count();
+        cli::outln!("  {k:>5}            {n:>8}  {b:>29.4}  {views:>5}");
     }
 }
 
@@ -289,6 +302,9 @@ fn to_json(report: &Report) -> Value {
                     "n_components": pca.n_components,
                     "analysis": serde_json::to_value(&pca.analysis).expect("analysis serializes to json"),
                 }),
+                Payload::LayerSelection(selection) => {
+                    serde_json::to_value(selection).expect("layer selection serializes to json")
+                }
             };
             json!({
                 "header": header_json,

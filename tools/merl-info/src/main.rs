@@ -23,7 +23,8 @@ struct Args {
     /// The MERL table to read.
     file: PathBuf,
 
-    /// Print the summary as JSON instead of text.
+    /// Print the summary as one JSON object on stdout, with `files`: the --asset written, if
+    /// any; the text goes to stderr.
     #[arg(long, conflicts_with = "eval")]
     json: bool,
 
@@ -92,18 +93,14 @@ fn run(args: Args) -> Result<ExitCode> {
     let albedo_interp = Interp::from(args.albedo_interp);
     let summary = summarize(&table, albedo_interp, Quadrature::default());
     let problems = problems(&summary);
-    if args.json {
-        cli::outln!("{}", serde_json::to_string_pretty(&summary_json(&args.file, &summary, &args, &problems))?);
-    } else {
-        print_summary(&args.file, &summary, &args);
-        for p in &problems {
-            cli::outln!("problem: {p}");
-        }
-    }
+    // The asset is written before anything is printed, so that the JSON can list it.
+    let mut files = Vec::new();
     if let Some(out) = &args.asset {
-        write_asset(out, &args, &summary).with_context(|| format!("writing {}", out.display()))?;
+        files.push(write_asset(out, &args, &summary).with_context(|| format!("writing {}", out.display()))?);
     }
-    Ok(if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    let value = summary_json(&args.file, &summary, &args, &problems, files);
+    let written: Vec<String> = args.asset.iter().map(|p| p.display().to_string()).collect();
+    Ok(cli::finish(args.json, &value, &summary_lines(&args.file, &summary, &args), &problems, &written))
 }
 
 fn problems(s: &Summary) -> Vec<String> {
@@ -178,35 +175,36 @@ fn interp_name(i: InterpArg) -> &'static str {
     }
 }
 
-fn print_summary(path: &Path, s: &Summary, args: &Args) {
+fn summary_lines(path: &Path, s: &Summary, args: &Args) -> Vec<String> {
     let d = s.dims;
-    cli::outln!("file       {}", path.display());
-    cli::outln!("dims       {} x {} x {} (theta_h x theta_d x phi_d)", d.n_theta_h, d.n_theta_d, d.n_phi_d);
-    cli::outln!(
+    let mut lines = Vec::new();
+    lines.push(format!("file       {}", path.display()));
+    lines.push(format!("dims       {} x {} x {} (theta_h x theta_d x phi_d)", d.n_theta_h, d.n_theta_d, d.n_phi_d));
+    lines.push(format!(
         "no data    {} of {} cells per channel ({:.1}%)",
         s.no_data_cells,
         s.cells,
         100.0 * s.no_data_cells as f64 / s.cells as f64
-    );
+    ));
     if let Some(ch) = &s.channels {
-        cli::outln!("BRDF (1/sr)        red        green       blue");
+        lines.push("BRDF (1/sr)        red        green       blue".to_string());
         for (name, pick) in [("min", 0), ("max", 1), ("mean", 2)] {
             let v = ch.map(|c| [c.min, c.max, c.mean][pick]);
-            cli::outln!("  {name:<10} {:>11.5e} {:>11.5e} {:>11.5e}", v[0], v[1], v[2]);
+            lines.push(format!("  {name:<10} {:>11.5e} {:>11.5e} {:>11.5e}", v[0], v[1], v[2]));
         }
     }
-    cli::outln!("directional albedo ({} lookup, half-vector quadrature)", interp_name(args.albedo_interp));
+    lines.push(format!("directional albedo ({} lookup), half-vector quadrature", interp_name(args.albedo_interp)));
     for (deg, a) in &s.albedo {
-        cli::outln!(
+        lines.push(format!(
             "  theta_o {deg:>2} deg  {:.4} {:.4} {:.4}   no data {:.2}%",
             a.rgb[0],
             a.rgb[1],
             a.rgb[2],
             100.0 * a.no_data_fraction
-        );
+        ));
     }
     if let Some(p) = &s.peak {
-        cli::outln!(
+        lines.push(format!(
             "peak       {:.5e} {:.5e} {:.5e} (luminance {:.5e}) at cell ({}, {}, {}): theta_h {:.3} deg, theta_d {:.3} deg, phi_d {:.3} deg",
             p.rgb[0],
             p.rgb[1],
@@ -218,11 +216,20 @@ fn print_summary(path: &Path, s: &Summary, args: &Args) {
             p.at.theta_h.to_degrees(),
             p.at.theta_d.to_degrees(),
             p.at.phi_d.to_degrees()
-        );
+        ));
     }
+    lines
 }
 
-fn summary_json(path: &Path, s: &Summary, args: &Args, problems: &[String]) -> serde_json::Value {
+/// The summary as JSON, with `files`: what this run wrote (the `--asset`, described as a bake
+/// manifest describes its outputs).
+fn summary_json(
+    path: &Path,
+    s: &Summary,
+    args: &Args,
+    problems: &[String],
+    files: Vec<serde_json::Value>,
+) -> serde_json::Value {
     let d = s.dims;
     let channels = s.channels.map(|ch| {
         json!({
@@ -256,10 +263,12 @@ fn summary_json(path: &Path, s: &Summary, args: &Args, problems: &[String]) -> s
         "albedo": albedo,
         "peak": peak,
         "problems": problems,
+        "files": files,
     })
 }
 
-fn write_asset(out: &Path, args: &Args, s: &Summary) -> Result<()> {
+/// Writes the summary as a `material-info` asset and returns the file's description for `files`.
+fn write_asset(out: &Path, args: &Args, s: &Summary) -> Result<serde_json::Value> {
     let parameters = vec![
         ("albedo_interp".to_string(), interp_name(args.albedo_interp).to_string()),
         ("quadrature".to_string(), {
@@ -287,6 +296,9 @@ fn write_asset(out: &Path, args: &Args, s: &Summary) -> Result<()> {
         albedo_rgb: s.albedo.iter().map(|(_, a)| a.rgb).collect(),
         albedo_no_data_fraction: s.albedo.iter().map(|(_, a)| a.no_data_fraction).collect(),
     };
-    asset::write_file(out, &asset::Asset { provenance, payload: asset::Payload::MaterialInfo(info) })?;
-    Ok(())
+    let bytes = asset::encode_checked(&asset::Asset { provenance, payload: asset::Payload::MaterialInfo(info) })?;
+    asset::write_atomic(out, &bytes)?;
+    let path = out.display().to_string();
+    let output = asset::StageOutput::of_bytes(&path, asset::FileFormat::Asset, "material-info", &bytes)?;
+    Ok(serde_json::to_value(output)?)
 }

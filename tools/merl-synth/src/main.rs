@@ -4,58 +4,72 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand};
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser, Subcommand};
 use merl::Dims;
 use merl::analytic::Analytic;
+use serde_json::json;
 
-/// Write a MERL BRDF table (.binary, 35 MB) sampled from an analytic BRDF with a known answer.
-/// Cells are sampled at their lower edge; configurations below the horizon hold no data (-1),
-/// as in MERL's files.
+/// Write a MERL BRDF table (.binary, 35 MB) sampled from an analytic BRDF with a known answer,
+/// to the file --out names. Cells are sampled at their lower edge; configurations below the
+/// horizon hold no data (-1), as in MERL's files.
+///
+/// Example: merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out copper.binary
+///
+/// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about)]
 struct Args {
     #[command(subcommand)]
     brdf: Brdf,
 
-    /// Output file.
-    #[arg(long, short, global = true, default_value = "synthetic.binary")]
-    out: PathBuf,
+    /// The table to write (required: 35 MB, never written to a default place).
+    #[arg(long, short, global = true, value_name = "FILE")]
+    out: Option<PathBuf>,
 
     /// Store 360 phi_d cells over [0, 2 pi) instead of MERL's 180 over [0, pi).
     #[arg(long, global = true)]
     full_phi: bool,
+
+    /// Print one JSON object (the BRDF, its parameters, the file written) on stdout; the report
+    /// goes to stderr.
+    #[arg(long, global = true)]
+    json: bool,
 }
 
 #[derive(Debug, Subcommand)]
 enum Brdf {
     /// f = albedo / pi.
     Lambertian {
-        /// Albedo: one value, or three (r,g,b).
-        #[arg(long, default_value = "0.5", value_delimiter = ',')]
+        /// Albedo: one value, or three (r,g,b), each in [0, 1].
+        #[arg(long, default_value = "0.5", value_delimiter = ',', value_name = "A")]
         albedo: Vec<f64>,
     },
     /// Energy-normalized Phong, f = ks (n+2)/(2 pi) max(0, wi . reflect(wo))^n.
     Phong {
-        #[arg(long, short)]
+        /// Phong exponent n (> 0): larger is sharper.
+        #[arg(long, short, value_name = "N")]
         n: f64,
-        /// Specular reflectance: one value, or three (r,g,b).
-        #[arg(long, default_value = "1", value_delimiter = ',')]
+        /// Specular reflectance: one value, or three (r,g,b), each in [0, 1].
+        #[arg(long, default_value = "1", value_delimiter = ',', value_name = "KS")]
         ks: Vec<f64>,
     },
     /// Blinn-Phong, f = ks (n+8)/(8 pi) cos^n theta_h.
     BlinnPhong {
-        #[arg(long, short)]
+        /// Blinn-Phong exponent n (> 0) of cos theta_h: larger is sharper.
+        #[arg(long, short, value_name = "N")]
         n: f64,
-        #[arg(long, default_value = "1", value_delimiter = ',')]
+        /// Specular reflectance: one value, or three (r,g,b), each in [0, 1].
+        #[arg(long, default_value = "1", value_delimiter = ',', value_name = "KS")]
         ks: Vec<f64>,
     },
     /// GGX microfacets with height-correlated Smith masking and Schlick Fresnel.
     Ggx {
-        /// Roughness alpha (GGX width).
-        #[arg(long)]
+        /// Roughness alpha (> 0, the GGX width).
+        #[arg(long, value_name = "ALPHA")]
         alpha: f64,
-        /// Reflectance at normal incidence: one value, or three (r,g,b).
-        #[arg(long, default_value = "0.04", value_delimiter = ',')]
+        /// Reflectance at normal incidence: one value, or three (r,g,b), each in [0, 1].
+        #[arg(long, default_value = "0.04", value_delimiter = ',', value_name = "F0")]
         f0: Vec<f64>,
     },
 }
@@ -80,19 +94,52 @@ fn positive(name: &str, v: f64) -> Result<f64> {
 }
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()).map(|()| ExitCode::SUCCESS))
+    cli::main(|| run(Args::parse()))
 }
 
-fn run(args: Args) -> Result<()> {
-    let brdf = match &args.brdf {
-        Brdf::Lambertian { albedo } => Analytic::Lambertian { albedo: rgb("albedo", albedo, 1.0)? },
-        Brdf::Phong { n, ks } => Analytic::Phong { n: positive("n", *n)?, ks: rgb("ks", ks, 1.0)? },
-        Brdf::BlinnPhong { n, ks } => Analytic::BlinnPhong { n: positive("n", *n)?, ks: rgb("ks", ks, 1.0)? },
-        Brdf::Ggx { alpha, f0 } => Analytic::Ggx { alpha: positive("alpha", *alpha)?, f0: rgb("f0", f0, 1.0)? },
+fn run(args: Args) -> Result<ExitCode> {
+    // `--out` is global (it may come before or after the BRDF), and clap cannot require a global
+    // argument: refuse its absence the way clap refuses a missing argument (usage, exit 2).
+    let Some(out) = &args.out else {
+        Args::command()
+            .error(ErrorKind::MissingRequiredArgument, "the following required argument was not provided: --out <FILE>")
+            .exit()
+    };
+    let (brdf, kind, parameters) = match &args.brdf {
+        Brdf::Lambertian { albedo } => {
+            let albedo = rgb("albedo", albedo, 1.0)?;
+            (Analytic::Lambertian { albedo }, "lambertian", json!({ "albedo": albedo }))
+        }
+        Brdf::Phong { n, ks } => {
+            let (n, ks) = (positive("n", *n)?, rgb("ks", ks, 1.0)?);
+            (Analytic::Phong { n, ks }, "phong", json!({ "n": n, "ks": ks }))
+        }
+        Brdf::BlinnPhong { n, ks } => {
+            let (n, ks) = (positive("n", *n)?, rgb("ks", ks, 1.0)?);
+            (Analytic::BlinnPhong { n, ks }, "blinn-phong", json!({ "n": n, "ks": ks }))
+        }
+        Brdf::Ggx { alpha, f0 } => {
+            let (alpha, f0) = (positive("alpha", *alpha)?, rgb("f0", f0, 1.0)?);
+            (Analytic::Ggx { alpha, f0 }, "ggx", json!({ "alpha": alpha, "f0": f0 }))
+        }
     };
     let dims = if args.full_phi { Dims::MERL_FULL_PHI } else { Dims::MERL };
-    let table = brdf.table(dims);
-    asset::write_atomic(&args.out, &table.to_bytes()).with_context(|| format!("writing {}", args.out.display()))?;
-    eprintln!("wrote {} ({brdf:?}, {} x {} x {})", args.out.display(), dims.n_theta_h, dims.n_theta_d, dims.n_phi_d);
-    Ok(())
+    let bytes = brdf.table(dims).to_bytes();
+    asset::write_atomic(out, &bytes).with_context(|| format!("writing {}", out.display()))?;
+
+    let dims_text = format!("{} x {} x {}", dims.n_theta_h, dims.n_theta_d, dims.n_phi_d);
+    let value = json!({
+        "kind": kind,
+        "parameters": parameters,
+        "dims": [dims.n_theta_h, dims.n_theta_d, dims.n_phi_d],
+        "files": [{
+            "path": out.display().to_string(),
+            "format": "merl",
+            "role": "merl-table",
+            "size_bytes": bytes.len(),
+            "sha256": asset::hex(&asset::sha256(&bytes)),
+        }],
+    });
+    let report = [format!("{brdf:?}: a {dims_text} table (theta_h x theta_d x phi_d)")];
+    Ok(cli::finish(args.json, &value, &report, &[], &[out.display().to_string()]))
 }

@@ -1,8 +1,10 @@
-//! A 5 x 7 bitmap font for the legend's labels, so that the tool needs no font crate: digits,
-//! upper-case letters (lower case is drawn upper case) and the punctuation the labels use.
+//! A 5 x 7 bitmap font, so that labels need no font crate: digits, upper-case letters (lower
+//! case is drawn upper case) and the punctuation labels use. [`crate::Canvas::text`] draws it;
+//! [`wrap`] breaks a paragraph into lines that fit a width.
 
-/// Glyph width and height in font pixels.
+/// Glyph width in font pixels.
 pub const GLYPH_W: usize = 5;
+/// Glyph height in font pixels.
 pub const GLYPH_H: usize = 7;
 /// Horizontal advance per character in font pixels: the glyph and one pixel of space.
 pub const ADVANCE: usize = GLYPH_W + 1;
@@ -60,37 +62,62 @@ pub fn glyph(c: char) -> Option<[u8; GLYPH_H]> {
         '<' => [0b00010, 0b00100, 0b01000, 0b10000, 0b01000, 0b00100, 0b00010],
         '>' => [0b01000, 0b00100, 0b00010, 0b00001, 0b00010, 0b00100, 0b01000],
         '%' => [0b11000, 0b11001, 0b00010, 0b00100, 0b01000, 0b10011, 0b00011],
+        '_' => [0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b11111],
+        '[' => [0b01110, 0b01000, 0b01000, 0b01000, 0b01000, 0b01000, 0b01110],
+        ']' => [0b01110, 0b00010, 0b00010, 0b00010, 0b00010, 0b00010, 0b01110],
+        '*' => [0b00000, 0b00100, 0b10101, 0b01110, 0b10101, 0b00100, 0b00000],
+        '\'' => [0b00100, 0b00100, 0b01000, 0b00000, 0b00000, 0b00000, 0b00000],
+        '!' => [0b00100, 0b00100, 0b00100, 0b00100, 0b00100, 0b00000, 0b00100],
+        '?' => [0b01110, 0b10001, 0b00001, 0b00010, 0b00100, 0b00000, 0b00100],
+        '|' => [0b00100, 0b00100, 0b00100, 0b00100, 0b00100, 0b00100, 0b00100],
+        ';' => [0b00000, 0b01100, 0b01100, 0b00000, 0b01100, 0b00100, 0b01000],
+        '\u{b0}' => [0b01100, 0b10010, 0b10010, 0b01100, 0b00000, 0b00000, 0b00000],
         _ => return None,
     };
     Some(rows)
 }
 
-/// The width in pixels of `text` drawn at `scale` (no trailing space).
+/// Vertical advance per line of text in font pixels: the glyph and three pixels of space.
+pub const LINE_HEIGHT: usize = GLYPH_H + 3;
+
+/// What a character the font lacks is drawn as: a hollow box, so that it shows instead of
+/// vanishing.
+pub const MISSING: [u8; GLYPH_H] = [0b11111, 0b10001, 0b10001, 0b10001, 0b10001, 0b10001, 0b11111];
+
+/// The width in pixels of `text` drawn at `scale` (no trailing space): its longest line.
 pub fn text_width(text: &str, scale: usize) -> usize {
-    (text.chars().count() * ADVANCE).saturating_sub(1) * scale
+    let widest = text.split('\n').map(|line| (line.chars().count() * ADVANCE).saturating_sub(1)).max();
+    widest.unwrap_or(0).saturating_mul(scale)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// The height in pixels of `text` drawn at `scale`: one glyph height per line and the space
+/// between lines.
+pub fn text_height(text: &str, scale: usize) -> usize {
+    let lines = text.split('\n').count();
+    ((lines - 1) * LINE_HEIGHT + GLYPH_H).saturating_mul(scale)
+}
 
-    /// Every glyph fits in 5 columns, and no two characters share a glyph (a copy-paste slip
-    /// would make two labels read alike).
-    #[test]
-    fn glyphs_are_five_wide_and_distinct() {
-        let chars: Vec<char> = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ.,:-+=()/<>%".chars().collect();
-        let glyphs: Vec<[u8; 7]> = chars.iter().map(|&c| glyph(c).unwrap()).collect();
-        for (c, g) in chars.iter().zip(&glyphs) {
-            assert!(g.iter().all(|row| row >> GLYPH_W == 0), "{c} is wider than 5");
-            assert!(g.iter().any(|row| *row != 0), "{c} is empty");
-        }
-        for i in 0..glyphs.len() {
-            for j in i + 1..glyphs.len() {
-                assert_ne!(glyphs[i], glyphs[j], "{} and {} look alike", chars[i], chars[j]);
+/// `text` broken into lines of at most `width` pixels at `scale`, between words (greedy: as many
+/// words per line as fit). Existing line breaks are kept; a word longer than a line gets a line
+/// of its own and sticks out (the canvas clips it).
+pub fn wrap(text: &str, width: usize, scale: usize) -> String {
+    let per_char = ADVANCE * scale.max(1);
+    // `n` characters take `n * ADVANCE - 1` font pixels.
+    let max_chars = (width + scale.max(1)) / per_char;
+    let mut lines = Vec::new();
+    for paragraph in text.split('\n') {
+        let mut line = String::new();
+        for word in paragraph.split(' ').filter(|w| !w.is_empty()) {
+            let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
+            if !line.is_empty() && needed > max_chars {
+                lines.push(std::mem::take(&mut line));
             }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(word);
         }
-        assert_eq!(glyph('e'), glyph('E'));
-        assert_eq!(glyph('~'), None);
-        assert_eq!(text_width("10", 2), 22);
+        lines.push(line);
     }
+    lines.join("\n")
 }

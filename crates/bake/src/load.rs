@@ -1,0 +1,179 @@
+//! A finished bake read back for the renderers: the manifest, the MERL table it was made from
+//! (checked against the manifest's hash), the importance samples, and with an environment the mip
+//! chain and the Phong layers as the KTX2 files hold them (half floats, divided by the file's
+//! radiance scale), so that what the previewer draws is what an engine would load.
+
+use std::path::{Path, PathBuf};
+
+use asset::{BakeManifest, Payload};
+use envmap::{EnvMap, MipChain};
+
+use crate::Error;
+use crate::run::MANIFEST;
+
+/// A bake in memory.
+#[derive(Debug)]
+pub struct Loaded {
+    pub dir: PathBuf,
+    pub manifest: BakeManifest,
+    pub material: render::Material,
+    /// Present when the bake has an environment.
+    pub lighting: Option<render::Lighting>,
+}
+
+/// Reads the bake in `dir`. The MERL table is `material` when given, else the manifest's
+/// `source_path` (as given to the bake: absolute, or relative to the working folder or, failing
+/// that, to the bake's parent folder); either way its SHA-256 must be the manifest's.
+pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
+    let manifest_path = dir.join(MANIFEST);
+    let text = std::fs::read_to_string(&manifest_path).map_err(|e| Error::read(&manifest_path, e))?;
+    let manifest = BakeManifest::from_json(&text).map_err(|e| Error::read(&manifest_path, e))?;
+    let file = |role: &str| -> Result<PathBuf, Error> {
+        let output = manifest.output(role).ok_or_else(|| {
+            Error::read(&manifest_path, format!("the bake has no {role} output: bake it again with this version"))
+        })?;
+        let path = dir.join(&output.path);
+        if !output.matches_file(dir).map_err(|e| Error::read(&path, e))? {
+            return Err(Error::read(&path, "not the file the manifest describes (size or sha256 differ): bake again"));
+        }
+        Ok(path)
+    };
+
+    let table_path = match material {
+        Some(path) => path.to_path_buf(),
+        None => locate(&manifest.material.source_path, dir),
+    };
+    let sha256 = asset::sha256_file(&table_path).map_err(|e| Error::read(&table_path, e))?;
+    if asset::hex(&sha256) != manifest.material.source_sha256 {
+        return Err(Error::read(
+            &table_path,
+            format!("not the material of the bake in {} (its sha256 differs)", dir.display()),
+        ));
+    }
+    let table = merl::read_file(&table_path).map_err(|e| Error::read(&table_path, e))?;
+
+    let samples_path = file("importance-samples")?;
+    let samples = match read_payload(&samples_path)? {
+        Payload::ImportanceSamples(s) => sample_set(s).map_err(|e| Error::read(&samples_path, e))?,
+        other => {
+            return Err(Error::read(&samples_path, format!("expected importance samples, found {}", other.kind())));
+        }
+    };
+
+    let mut view_layers = Vec::new();
+    let lighting = if manifest.environment.is_some() {
+        let asset_path = file("prefiltered-envmap")?;
+        let Payload::PrefilteredEnvmap(prefiltered) = read_payload(&asset_path)? else {
+            return Err(Error::read(&asset_path, "expected a prefiltered-envmap asset"));
+        };
+        let mips_path = file("environment-mips")?;
+        let mips = read_ktx2(&mips_path, prefiltered.mips_radiance_scale as f32)?;
+        let levels: Vec<EnvMap> = mips.into_iter().map(|mut layers| layers.remove(0)).collect();
+        let mips = MipChain::from_levels(levels).map_err(|e| Error::read(&mips_path, e))?;
+        let layers_path = file("phong-layers")?;
+        let mut layers = read_ktx2(&layers_path, prefiltered.layers_radiance_scale as f32)?;
+        let layers = layers.remove(0);
+        if layers.len() != prefiltered.exponents.len() {
+            return Err(Error::read(
+                &layers_path,
+                format!("{} layers for {} exponents", layers.len(), prefiltered.exponents.len()),
+            ));
+        }
+        let selection_path = file("layer-selection")?;
+        let Payload::LayerSelection(selection) = read_payload(&selection_path)? else {
+            return Err(Error::read(&selection_path, "expected a layer-selection asset"));
+        };
+        if selection.exponents != prefiltered.exponents {
+            return Err(Error::read(
+                &selection_path,
+                format!(
+                    "selects among exponents {:?}, the layers have {:?}",
+                    selection.exponents, prefiltered.exponents
+                ),
+            ));
+        }
+        view_layers = selection.view_layer;
+        Some(render::Lighting { mips, layers, exponents: prefiltered.exponents })
+    } else {
+        None
+    };
+    Ok(Loaded {
+        dir: dir.to_path_buf(),
+        manifest,
+        material: render::Material { table, samples, view_layers },
+        lighting,
+    })
+}
+
+/// A path as the bake was given it: absolute, relative to the working folder, or relative to the
+/// bake's parent folder (for bakes moved with their inputs).
+fn locate(source_path: &str, dir: &Path) -> PathBuf {
+    let given = PathBuf::from(source_path);
+    if given.is_absolute() || given.exists() {
+        return given;
+    }
+    dir.parent().map(|parent| parent.join(&given)).filter(|p| p.exists()).unwrap_or(given)
+}
+
+fn read_payload(path: &Path) -> Result<Payload, Error> {
+    asset::read_file(path).map(|a| a.payload).map_err(|e| Error::read(path, e))
+}
+
+/// The samples as the renderers read them; the slices must be the uniform ones
+/// `merl-importance` writes (`theta_o[k] = k / S * pi / 2`).
+fn sample_set(s: asset::ImportanceSamples) -> Result<render::SampleSet, String> {
+    let n_slices = s.theta_o.len();
+    for (k, theta) in s.theta_o.iter().enumerate() {
+        let expected = k as f64 / n_slices as f64 * std::f64::consts::FRAC_PI_2;
+        if (theta - expected).abs() > 1e-9 {
+            return Err(format!("slice {k} is at theta_o {theta}, expected {expected} (uniform slices)"));
+        }
+    }
+    if !s.n_samples.is_power_of_two() {
+        return Err(format!("{} samples per vector: the renderers need a power of two", s.n_samples));
+    }
+    Ok(render::SampleSet {
+        n_slices,
+        n_vectors: s.n_vectors as usize,
+        n_samples: s.n_samples as usize,
+        texels: s.samples,
+    })
+}
+
+/// The texels of an RGBA16F KTX2 file as maps: `[level][layer]` (a plain 2D texture has one
+/// layer), radiance divided by `scale`.
+fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
+    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
+    let reader = ktx2::Reader::new(&bytes[..]).map_err(|e| Error::read(path, format!("not a ktx2 file: {e:?}")))?;
+    let header = reader.header();
+    if header.format != Some(ktx2::Format::R16G16B16A16_SFLOAT) || header.face_count != 1 {
+        return Err(Error::read(path, format!("expected an rgba16f 2d texture, found {:?}", header.format)));
+    }
+    let layers = header.layer_count.max(1) as usize;
+    let mut out = Vec::new();
+    for (l, level) in reader.levels().enumerate() {
+        let (w, h) = ((header.pixel_width >> l).max(1) as usize, (header.pixel_height >> l).max(1) as usize);
+        let texel_bytes = 8 * w * h;
+        if level.data.len() != texel_bytes * layers {
+            return Err(Error::read(
+                path,
+                format!("level {l} holds {} bytes, expected {}", level.data.len(), texel_bytes * layers),
+            ));
+        }
+        let maps = level
+            .data
+            .chunks_exact(texel_bytes)
+            .map(|layer| {
+                let rgb: Vec<f32> = layer
+                    .chunks_exact(8)
+                    .flat_map(|t| {
+                        (0..3).map(move |c| half::f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32() / scale)
+                    })
+                    .collect();
+                EnvMap::new(w, h, rgb).map_err(|e| Error::read(path, format!("level {l}: {e}")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        out.push(maps);
+    }
+    Ok(out)
+}

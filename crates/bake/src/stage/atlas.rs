@@ -1,0 +1,224 @@
+//! The bandwidth atlas of a material (`brdf-bandwidth`; `000` section 2.4): every lobe's wavelet
+//! bandwidth reduced to a tile, as an asset of kind `bandwidth-atlas`, a float EXR and a
+//! false-colour picture.
+
+pub(crate) mod picture;
+
+use brdf_atlas::{Atlas, AtlasBuild, Config, build_atlas};
+use merl::MerlTable;
+use serde_json::json;
+
+use crate::{Error, OutFile, Program, Source, Staged, object};
+
+pub const ASSET: &str = "bandwidth-atlas.asset";
+pub const EXR: &str = "bandwidth-atlas.exr";
+pub const PICTURE: &str = "bandwidth-atlas.png";
+
+/// Builds the atlas of `table` with `config`; `tick(n)` is called as `n` more lobes are done (a
+/// progress bar's hook).
+pub fn run(
+    table: &MerlTable,
+    source: &Source,
+    program: &Program,
+    config: &Config,
+    tick: &(dyn Fn(usize) + Sync),
+) -> Result<(Staged, AtlasBuild), Error> {
+    config.check().map_err(|e| Error::stage("bandwidth atlas", e))?;
+    let build = build_atlas(table, config, tick).map_err(|e| Error::stage("bandwidth atlas", e))?;
+    let atlas = &build.atlas;
+    let exr = envmap::encode_exr(atlas.width(), atlas.height(), &[("Y", &atlas.data)], envmap::SampleType::F32)
+        .map_err(|e| Error::Internal(format!("encoding {EXR}: {e}")))?;
+    let notes = format!(
+        "{} {} of {} lobes reach the analysis grid's limit: their values are lower bounds ({:.2} cycles per \
+         radian at a lobe's centre).",
+        picture::tile_notes(atlas),
+        build.stats.nyquist_lobes(),
+        atlas.n_lobes(),
+        limit_at_centre(config)
+    );
+    let title = format!("bandwidth atlas of {}", source.stem());
+    let text = picture::Text {
+        title: &title,
+        legend: "local bandwidth of the lobe, cycles per radian (log scale)",
+        zero: "0: flat, no detail above the noise floor",
+        notes: &notes,
+    };
+    let (figure, scale) = picture::figure(atlas, &atlas.data, &text);
+    let range = (scale.lo(), scale.hi());
+    let png = envmap::encode_png_rgb8(figure.width, figure.height, &figure.rgb)
+        .map_err(|e| Error::Internal(format!("encoding {PICTURE}: {e}")))?;
+    let parameters = [
+        ("lobes", config.lobes.to_string()),
+        ("tile", config.tile.to_string()),
+        ("analysis_size", config.analysis_size.to_string()),
+    ];
+    let asset = asset::encode_checked(&asset::Asset {
+        provenance: source.provenance(program, &parameters),
+        payload: to_asset(atlas).into(),
+    })
+    .map_err(|e| Error::Internal(format!("encoding {ASSET}: {e}")))?;
+
+    let (figures, report) = describe(config, &build, range);
+    let staged = Staged {
+        name: "bandwidth-atlas",
+        parameters: object([
+            ("lobes", json!(config.lobes)),
+            ("tile", json!(config.tile)),
+            ("analysis_size", json!(config.analysis_size)),
+            ("eps", json!(config.eps)),
+            ("c", json!(config.c)),
+        ]),
+        figures,
+        files: vec![
+            OutFile { name: ASSET.into(), format: asset::FileFormat::Asset, role: "bandwidth-atlas", bytes: asset },
+            OutFile { name: EXR.into(), format: asset::FileFormat::Exr, role: "bandwidth-atlas-exr", bytes: exr },
+            OutFile {
+                name: PICTURE.into(),
+                format: asset::FileFormat::Png,
+                role: "bandwidth-atlas-picture",
+                bytes: png,
+            },
+        ],
+        report,
+        problems: Vec::new(),
+    };
+    Ok((staged, build))
+}
+
+/// The highest bandwidth the analysis grid can report at a lobe's centre, cycles per radian: the
+/// finest level's `c / 2` cycles per pixel over `pi / n` radians per pixel.
+pub fn limit_at_centre(config: &Config) -> f64 {
+    config.c / 2.0 * config.analysis_size as f64 / std::f64::consts::PI
+}
+
+fn describe(
+    config: &Config,
+    build: &AtlasBuild,
+    range: (f64, f64),
+) -> (serde_json::Map<String, serde_json::Value>, Vec<String>) {
+    let atlas = &build.atlas;
+    let stats = &build.stats;
+    let mut sorted: Vec<f32> = atlas.data.clone();
+    sorted.sort_by(f32::total_cmp);
+    let quantile = |q: f64| f64::from(sorted[((sorted.len() - 1) as f64 * q).round() as usize]);
+    let n_lobes = atlas.n_lobes();
+    let flat = sorted.iter().filter(|v| **v == 0.0).count();
+    let at_limit = stats.nyquist_lobes();
+    let figures = object([
+        ("lobes", json!(n_lobes)),
+        ("texels", json!(sorted.len())),
+        ("median", json!(quantile(0.5))),
+        ("p90", json!(quantile(0.9))),
+        ("p99", json!(quantile(0.99))),
+        ("max", json!(quantile(1.0))),
+        ("flat_texels", json!(flat)),
+        ("lobes_at_limit", json!(at_limit)),
+        ("texels_at_limit", json!(stats.nyquist_texels)),
+        ("limit_at_centre", json!(limit_at_centre(config))),
+        ("filled_pixels", json!(stats.filled_pixels)),
+    ]);
+    let mut report = vec![
+        format!(
+            "atlas         {} x {} lobes of {} x {} texels ({} x {}), each lobe analysed at {} x {}",
+            atlas.lobes_x,
+            atlas.lobes_y,
+            atlas.tile,
+            atlas.tile,
+            atlas.width(),
+            atlas.height(),
+            config.analysis_size,
+            config.analysis_size
+        ),
+        format!(
+            "bandwidth     cycles per radian: median {:.3}, 90% {:.3}, 99% {:.3}, max {:.3}; {flat} of {} texels flat (0)",
+            quantile(0.5),
+            quantile(0.9),
+            quantile(0.99),
+            quantile(1.0),
+            sorted.len()
+        ),
+        format!(
+            "limit         {at_limit} of {n_lobes} lobes reach the analysis grid's limit ({} texels): {}",
+            stats.nyquist_texels,
+            if at_limit == 0 {
+                "every bandwidth is resolved".to_string()
+            } else {
+                format!(
+                    "their bandwidth is a lower bound ({:.2} cycles per radian at a lobe's centre); a larger \
+                     --analysis-size resolves more",
+                    limit_at_centre(config)
+                )
+            }
+        ),
+    ];
+    if stats.filled_pixels > 0 {
+        report.push(format!(
+            "filled        {} lobe pixels had no table data around them: filled from their neighbours",
+            stats.filled_pixels
+        ));
+    }
+    report.push(format!(
+        "picture       the atlas {} with axes, log colour scale from {} (dark violet) to {} (yellow) cycles per \
+         radian, black 0",
+        picture::Shown::of(atlas.width(), atlas.height()).words(),
+        ::picture::format_number(range.0),
+        ::picture::format_number(range.1)
+    ));
+    (figures, report)
+}
+
+/// The asset's payload (`data-schema/README.md`), the input of `bandwidth-pca`.
+pub fn to_asset(atlas: &Atlas) -> asset::BandwidthAtlas {
+    asset::BandwidthAtlas {
+        lobes_x: atlas.lobes_x as u32,
+        lobes_y: atlas.lobes_y as u32,
+        tile: atlas.tile as u32,
+        analysis: analysis_of(atlas),
+        data: atlas.data.clone(),
+    }
+}
+
+/// The analysis record both the atlas and its PCA carry.
+pub fn analysis_of(atlas: &Atlas) -> asset::BandwidthAnalysis {
+    asset::BandwidthAnalysis {
+        parameterization: atlas.parameterization.name().to_string(),
+        analysis_size: atlas.analysis_size as u32,
+        eps: atlas.eps,
+        c: atlas.c,
+    }
+}
+
+/// An atlas read back from its asset, checked.
+pub fn from_asset(a: asset::BandwidthAtlas) -> Result<Atlas, String> {
+    let name = a.analysis.parameterization.as_str();
+    let Some(parameterization) = brdf_atlas::Parameterization::from_name(name) else {
+        return Err(format!(
+            "unknown parameterization {name:?}: this build knows {:?}",
+            brdf_atlas::Parameterization::IncidencePlaneEquidistant.name()
+        ));
+    };
+    let texels = u64::from(a.lobes_x)
+        .checked_mul(u64::from(a.tile))
+        .and_then(|w| u64::from(a.lobes_y).checked_mul(u64::from(a.tile)).and_then(|h| w.checked_mul(h)));
+    match texels {
+        Some(t) if t <= brdf_atlas::MAX_TEXELS as u64 => {}
+        _ => {
+            return Err(format!(
+                "an atlas of {} x {} tiles of {} texels exceeds the limit",
+                a.lobes_x, a.lobes_y, a.tile
+            ));
+        }
+    }
+    let atlas = Atlas {
+        lobes_x: a.lobes_x as usize,
+        lobes_y: a.lobes_y as usize,
+        tile: a.tile as usize,
+        data: a.data,
+        parameterization,
+        analysis_size: a.analysis.analysis_size as usize,
+        eps: a.analysis.eps,
+        c: a.analysis.c,
+    };
+    atlas.check().map_err(|e| e.to_string())?;
+    Ok(atlas)
+}

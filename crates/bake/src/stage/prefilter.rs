@@ -1,0 +1,302 @@
+//! An environment map convolved with normalized Phong lobes (`envmap-prefilter`; `001` sections 2.5
+//! and 4.3) and the map's mip chain (`002`): a KTX2 array of the layers, one EXR per layer, the
+//! mip chain as KTX2, a contact sheet, and the asset of kind `prefiltered-envmap` that ties them
+//! together. [`verify`] reads the KTX2 files back with the maintained `ktx2` reader.
+
+use std::path::Path;
+
+use envmap::{EnvMap, MipChain, SampleType};
+use prefilter::{Config, Method, Prefiltered};
+use serde_json::json;
+
+use crate::{Error, OutFile, Program, Source, Staged, object};
+
+pub const ASSET: &str = "prefiltered.asset";
+pub const LAYERS_KTX2: &str = "layers.ktx2";
+pub const MIPS_KTX2: &str = "mips.ktx2";
+pub const CONTACT_SHEET: &str = "layers.png";
+
+/// The EXR file of the layer of exponent `n`.
+pub fn layer_exr(n: u32) -> String {
+    format!("layer-n{n}.exr")
+}
+
+/// Convolves `map` (read from `source`) with the lobes of `config`; `progress(done, total)` is
+/// called as the work advances (a progress bar's hook).
+pub fn run(
+    map: &EnvMap,
+    source: &Source,
+    program: &Program,
+    config: &Config,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Staged, Prefiltered), Error> {
+    config.check().map_err(|e| Error::stage("prefilter", e))?;
+    let prefiltered = prefilter::prefilter_with_progress(map, config, &|p| progress(p.done, p.total))
+        .map_err(|e| Error::stage("prefilter", e))?;
+    let staged = outputs(map, source, program, config, &prefiltered)?;
+    Ok((staged, prefiltered))
+}
+
+fn outputs(
+    map: &EnvMap,
+    source: &Source,
+    program: &Program,
+    config: &Config,
+    prefiltered: &Prefiltered,
+) -> Result<Staged, Error> {
+    let writer = format!("{} {}", program.name, program.version);
+    let encoding = |what: &str, e: &dyn std::fmt::Display| Error::Internal(format!("encoding {what}: {e}"));
+    let mut files = Vec::new();
+    let mut linked = |name: String, format, role, bytes: Vec<u8>| -> asset::LinkedFile {
+        let file = asset::LinkedFile { name: name.clone(), sha256: asset::sha256(&bytes) };
+        files.push(OutFile { name, format, role, bytes });
+        file
+    };
+    let layer_maps: Vec<&EnvMap> = prefiltered.layers.iter().map(|layer| &layer.map).collect();
+    let layers = prefilter::ktx::encode_array(&layer_maps, &writer).map_err(|e| encoding(LAYERS_KTX2, &e))?;
+    let layers_ktx2 = linked(LAYERS_KTX2.into(), asset::FileFormat::Ktx2, "phong-layers", layers.bytes);
+    let chain = MipChain::new(map);
+    let mips = prefilter::ktx::encode_mip_chain(&chain, &writer).map_err(|e| encoding(MIPS_KTX2, &e))?;
+    let mips_ktx2 = linked(MIPS_KTX2.into(), asset::FileFormat::Ktx2, "environment-mips", mips.bytes);
+    let mut layer_exrs = Vec::new();
+    for layer in &prefiltered.layers {
+        let name = layer_exr(layer.exponent);
+        let texels = layer.map.texels();
+        let planes: [Vec<f32>; 3] = std::array::from_fn(|c| texels.iter().map(|t| t[c]).collect());
+        let channels = [("R", planes[0].as_slice()), ("G", &planes[1]), ("B", &planes[2])];
+        let bytes = envmap::encode_exr(layer.map.width(), layer.map.height(), &channels, SampleType::F32)
+            .map_err(|e| encoding(&name, &e))?;
+        layer_exrs.push(linked(name, asset::FileFormat::Exr, "phong-layer-exr", bytes));
+    }
+    let exponents_and_maps: Vec<(u32, &EnvMap)> =
+        prefiltered.layers.iter().map(|layer| (layer.exponent, &layer.map)).collect();
+    let sheet = prefilter::contact_sheet(&chain, &exponents_and_maps);
+    let png =
+        envmap::encode_png_rgb8(sheet.width, sheet.height, &sheet.rgb8).map_err(|e| encoding(CONTACT_SHEET, &e))?;
+    let contact_sheet_png = linked(CONTACT_SHEET.into(), asset::FileFormat::Png, "phong-layers-picture", png);
+
+    let source_mean = map.mean_radiance();
+    let layer_means: Vec<[f64; 3]> = layer_maps.iter().map(|m| m.mean_radiance()).collect();
+    let payload = asset::PrefilteredEnvmap {
+        source_size: [map.width() as u32, map.height() as u32],
+        source_mean_radiance: source_mean,
+        layer_size: [config.width as u32, config.height as u32],
+        mip_levels: chain.n_levels() as u32,
+        layers_radiance_scale: f64::from(layers.radiance_scale),
+        mips_radiance_scale: f64::from(mips.radiance_scale),
+        exponents: config.exponents.clone(),
+        lobe_bandwidth: prefiltered.mapping.bandwidths().to_vec(),
+        bandwidth_thresholds: prefiltered.mapping.thresholds().to_vec(),
+        layer_mean_radiance: layer_means.clone(),
+        layers_ktx2,
+        layer_exrs,
+        mips_ktx2,
+        contact_sheet_png,
+    };
+    let asset = asset::encode_checked(&asset::Asset {
+        provenance: source.provenance(program, &provenance_parameters(config, prefiltered)),
+        payload: payload.into(),
+    })
+    .map_err(|e| encoding(ASSET, &e))?;
+    // The asset names the other files with their hashes, so it comes last: a reader that finds it
+    // finds them.
+    files.push(OutFile {
+        name: ASSET.into(),
+        format: asset::FileFormat::Asset,
+        role: "prefiltered-envmap",
+        bytes: asset,
+    });
+
+    // Every lobe integrates to 1, so every layer keeps the source's mean radiance.
+    let mean_error = layer_means
+        .iter()
+        .flat_map(|m| (0..3).map(move |c| (m[c] - source_mean[c]).abs() / source_mean[c].max(f64::MIN_POSITIVE)))
+        .fold(0.0f64, f64::max);
+    let methods: Vec<serde_json::Value> = prefiltered
+        .layers
+        .iter()
+        .map(|l| json!({ "exponent": l.exponent, "method": l.method.name(), "degree": l.degree }))
+        .collect();
+    let mut report = vec![format!(
+        "{} layers of {} x {} (exponents {}) from a {} x {} map with {} mip levels",
+        config.exponents.len(),
+        config.width,
+        config.height,
+        join(&config.exponents),
+        map.width(),
+        map.height(),
+        chain.n_levels()
+    )];
+    report.push(format!(
+        "layer means   within {:.2e} of the source's mean radiance (relative, worst channel and layer)",
+        mean_error
+    ));
+    for (what, scale) in [("layers", layers.radiance_scale), ("mips", mips.radiance_scale)] {
+        if scale != 1.0 {
+            report.push(format!("note: {what} texels are radiance x {scale} (the brightest exceed half floats)"));
+        }
+    }
+    Ok(Staged {
+        name: "prefilter",
+        parameters: object([
+            ("exponents", json!(config.exponents)),
+            ("size", json!([config.width, config.height])),
+            ("method", json!(config.method.name())),
+        ]),
+        figures: object([
+            ("mip_levels", json!(chain.n_levels())),
+            ("layers_radiance_scale", json!(layers.radiance_scale)),
+            ("mips_radiance_scale", json!(mips.radiance_scale)),
+            ("layer_mean_max_relative_error", json!(mean_error)),
+            ("layers", json!(methods)),
+        ]),
+        files,
+        report,
+        problems: Vec::new(),
+    })
+}
+
+fn provenance_parameters(config: &Config, prefiltered: &Prefiltered) -> Vec<(&'static str, String)> {
+    let mut parameters = vec![
+        ("exponents", join(&config.exponents)),
+        ("size", format!("{}x{}", config.width, config.height)),
+        ("method", Method::name(config.method).to_string()),
+    ];
+    for layer in &prefiltered.layers {
+        let how = match layer.degree {
+            Some(degree) => format!("{} to degree {degree}", layer.method.name()),
+            None => layer.method.name().to_string(),
+        };
+        // Provenance names are free text; one per layer, in order.
+        parameters.push(("layer", format!("n={}: {how}", layer.exponent)));
+    }
+    parameters
+}
+
+fn join(exponents: &[u32]) -> String {
+    exponents.iter().map(u32::to_string).collect::<Vec<_>>().join(",")
+}
+
+/// Half-float rounding: round to nearest keeps 11 significant bits (relative error at most
+/// `2^-11`), and below the smallest normal half (`2^-14`) the spacing is `2^-24`, so the absolute
+/// error there is at most `2^-25`. Stored values are radiance times the file's scale.
+fn half_tolerance(value: f32, scale: f32) -> f32 {
+    value.abs() * 2f32.powi(-11) + 2f32.powi(-25) / scale
+}
+
+/// What [`verify`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verified {
+    /// One line per file checked.
+    pub report: Vec<String>,
+    pub problems: Vec<String>,
+}
+
+/// Reads both KTX2 files in `dir` back with the `ktx2` crate and compares them with the EXR
+/// layers (read back with `envmap`) and the mip chain of `map`.
+pub fn verify(dir: &Path, map: &EnvMap, prefiltered: &Prefiltered) -> Result<Verified, Error> {
+    let asset_path = dir.join(ASSET);
+    let asset = asset::read_file(&asset_path).map_err(|e| Error::read(&asset_path, e))?;
+    let asset::Payload::PrefilteredEnvmap(payload) = asset.payload else {
+        return Err(Error::read(
+            &asset_path,
+            format!("expected a prefiltered-envmap asset, found {}", asset.payload.kind()),
+        ));
+    };
+    let mut problems = Vec::new();
+    let mut report = Vec::new();
+    let exrs: Vec<Vec<f32>> = prefiltered
+        .layers
+        .iter()
+        .map(|layer| {
+            let path = dir.join(layer_exr(layer.exponent));
+            let image = envmap::read_image(&path, &envmap::Limits::default()).map_err(|e| Error::read(&path, e))?;
+            Ok(image.rgb)
+        })
+        .collect::<Result<_, Error>>()?;
+    let first = &prefiltered.layers[0].map;
+    let layers_path = dir.join(LAYERS_KTX2);
+    let worst = compare_ktx2(
+        &layers_path,
+        (first.width(), first.height(), prefiltered.layers.len() as u32),
+        &[exrs.iter().map(Vec::as_slice).collect()],
+        payload.layers_radiance_scale as f32,
+        &mut problems,
+    )?;
+    report.push(format!(
+        "{}: {} layers match the EXR layers within half-float rounding (largest relative difference {worst:.2e})",
+        layers_path.display(),
+        prefiltered.layers.len()
+    ));
+    let chain = MipChain::new(map);
+    let mips_path = dir.join(MIPS_KTX2);
+    let level0 = chain.level(0);
+    let levels: Vec<Vec<&[f32]>> = chain.levels().iter().map(|level| vec![level.rgb()]).collect();
+    let worst = compare_ktx2(
+        &mips_path,
+        (level0.width(), level0.height(), 0),
+        &levels,
+        payload.mips_radiance_scale as f32,
+        &mut problems,
+    )?;
+    report.push(format!(
+        "{}: {} mip levels match the source's mip chain within half-float rounding (largest relative difference \
+         {worst:.2e})",
+        mips_path.display(),
+        chain.n_levels()
+    ));
+    Ok(Verified { report, problems })
+}
+
+/// Checks one KTX2 file's header and texels against `expected[level][layer]` (interleaved RGB),
+/// returning the largest relative difference; mismatches go to `problems`.
+fn compare_ktx2(
+    path: &Path,
+    (width, height, layer_count): (usize, usize, u32),
+    expected: &[Vec<&[f32]>],
+    scale: f32,
+    problems: &mut Vec<String>,
+) -> Result<f32, Error> {
+    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
+    let reader = ktx2::Reader::new(&bytes[..]).map_err(|e| Error::read(path, format!("{e:?}")))?;
+    let header = reader.header();
+    let found = (header.format, header.pixel_width, header.pixel_height, header.layer_count, header.level_count);
+    let wanted =
+        (Some(ktx2::Format::R16G16B16A16_SFLOAT), width as u32, height as u32, layer_count, expected.len() as u32);
+    if found != wanted {
+        problems.push(format!("{}: header {found:?}, expected {wanted:?}", path.display()));
+        return Ok(f32::INFINITY);
+    }
+    let mut worst = 0.0f32;
+    for (l, (level, images)) in reader.levels().zip(expected).enumerate() {
+        let texels: Vec<f32> =
+            level.data.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect();
+        let per_layer = texels.len() / images.len().max(1);
+        for (layer, image) in images.iter().enumerate() {
+            let stored = &texels[layer * per_layer..(layer + 1) * per_layer];
+            if stored.len() != image.len() / 3 * 4 {
+                problems.push(format!("{}: level {l} layer {layer} has {} values", path.display(), stored.len()));
+                continue;
+            }
+            for (i, (rgba, rgb)) in stored.chunks_exact(4).zip(image.chunks_exact(3)).enumerate() {
+                for c in 0..3 {
+                    let (got, want) = (rgba[c] / scale, rgb[c]);
+                    let difference = (got - want).abs();
+                    if difference > half_tolerance(want, scale) {
+                        problems.push(format!(
+                            "{}: level {l} layer {layer} texel {i} channel {c}: {got}, expected {want}",
+                            path.display()
+                        ));
+                    }
+                    if want > 0.0 {
+                        worst = worst.max(difference / want);
+                    }
+                }
+                if rgba[3] != 1.0 {
+                    problems.push(format!("{}: level {l} layer {layer} texel {i}: alpha {}", path.display(), rgba[3]));
+                }
+            }
+        }
+    }
+    Ok(worst)
+}

@@ -1,0 +1,3 @@
+//! The bake crate's tests, one binary: a module per topic.
+
+mod layers;

@@ -1,0 +1,198 @@
+//! One bandwidth per view direction, and the Phong layer it selects (`001` sections 2.5 and 4.3:
+//! "look up pre-filtered illumination ... according to the maximum frequency of the BRDF").
+//!
+//! A renderer that shades a pixel with a pre-convolved environment needs one number per view
+//! direction, where the atlas holds a tile per incident direction. By reciprocity the lobe the
+//! atlas holds for incidence `wi` is also the lobe a renderer integrates over when it looks along
+//! `wo = wi`, so row `j` of the atlas serves the views whose `cos theta_o` lies in that row.
+//! [`ViewReduction`] turns a row's lobe into one number:
+//!
+//! - [`ViewReduction::Max`]: the largest texel of the row's tile, the papers' "maximum
+//!   frequency" read literally.
+//! - [`ViewReduction::BandQuantile`]: the frequency below which a share `q` of the lobe image's
+//!   wavelet detail energy lies ([`band_quantile`]): the same D4 decomposition of the same
+//!   periodic continuation the estimator reads, its energy per level accumulated from the
+//!   coarsest, the crossing interpolated within its level, level `j` read as `c 2^-j` cycles per
+//!   pixel as the estimator reads it, converted at the lobe map's centre (`n / pi` pixels per
+//!   radian).
+//!
+//! Why not the tile alone: the estimator reads whole octaves, and the layers are an octave apart
+//! (exponents a factor 4 apart are lobes a factor 2 apart in width), so a per-texel maximum or
+//! an energy-weighted quantile of texels puts two neighbouring layers on the same value as often
+//! as not (measured on the default layers at analysis sizes 64 to 1024: every size ties at least
+//! one pair, e.g. n = 256 and 1024 both read 7.2 cycles per radian at 512). The maximum is also
+//! set by the lobe's far tail, where a Gaussian-like lobe's local frequency keeps growing while
+//! its value vanishes. The detail energy is a property of the whole lobe that moves smoothly with
+//! its width.
+//!
+//! The Phong layers are put on the same scale by measuring each layer's own lobe with exactly
+//! the analysis the atlas uses ([`layer_bandwidth`]): the lobe `max(0, w . r)^n` drawn as a lobe
+//! image of the same size and parameterization, at normal incidence (the centre of the lobe map,
+//! where it distorts least), analysed and reduced the same way. A view then uses the layer whose
+//! measured bandwidth is nearest on a log scale ([`nearest_layer`]).
+
+use merl::MerlTable;
+
+use crate::analysis::{Analyser, analysis_levels, extend_periodic};
+use crate::atlas::{AtlasBuild, Config};
+use crate::error::Error;
+use crate::lobe::lobe_image_from_fn;
+
+/// How a lobe becomes one number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewReduction {
+    /// The largest texel of the lobe's tile.
+    Max,
+    /// The frequency below which this share (in `(0, 1)`) of the lobe's wavelet detail energy
+    /// lies ([`band_quantile`]).
+    BandQuantile(f64),
+}
+
+impl ViewReduction {
+    /// The name in files and on the command line: `max`, or `band-0.99`.
+    pub fn name(self) -> String {
+        match self {
+            ViewReduction::Max => "max".to_string(),
+            ViewReduction::BandQuantile(q) => format!("band-{q}"),
+        }
+    }
+
+    /// Parses [`ViewReduction::name`].
+    pub fn from_name(name: &str) -> Option<ViewReduction> {
+        if name == "max" {
+            return Some(ViewReduction::Max);
+        }
+        let q: f64 = name.strip_prefix("band-")?.parse().ok()?;
+        (q > 0.0 && q < 1.0).then_some(ViewReduction::BandQuantile(q))
+    }
+
+    /// The bandwidth, in cycles per radian, of a lobe whose tile is `tile` and whose image's
+    /// detail energy per level (finest first, [`band_energy`]) is `energy`, analysed with
+    /// `config`.
+    pub fn reduce(self, tile: &[f32], energy: &[f64], config: &Config) -> f64 {
+        match self {
+            ViewReduction::Max => tile.iter().fold(0.0f64, |m, &v| m.max(f64::from(v))),
+            ViewReduction::BandQuantile(q) => {
+                band_quantile(energy, q, config.c) * config.analysis_size as f64 / std::f64::consts::PI
+            }
+        }
+    }
+}
+
+/// The energy of each detail level of a lobe image's wavelet decomposition: the periodic
+/// continuation the estimator reads ([`extend_periodic`]), D4, [`analysis_levels`] levels;
+/// finest first, the three orientations of a level summed.
+pub fn band_energy(image: &[f64], n: usize) -> Vec<f64> {
+    let decomposition = wavelet::wavedec2(&extend_periodic(image, n), wavelet::Wavelet::D4, analysis_levels(n))
+        .expect("lobe images have a power-of-two size of at least 16");
+    decomposition.details.iter().map(|level| level.iter().map(wavelet::Image::energy).sum()).collect()
+}
+
+/// The frequency, in cycles per pixel, below which a share `q` of the detail energy `energy`
+/// (per level, finest first) lies. Levels are accumulated from the coarsest; within the level
+/// where the share is reached, a fraction `t` of its energy needed moves the answer geometrically
+/// from `c 2^-(j+1)` (none of level `j`) to `c 2^-j` (all of it), level `j` read as the estimator
+/// reads it. 0 for a lobe with no detail (flat).
+pub fn band_quantile(energy: &[f64], q: f64, c: f64) -> f64 {
+    let total: f64 = energy.iter().sum();
+    if total <= 0.0 {
+        return 0.0;
+    }
+    let mut cumulative = 0.0;
+    for j in (1..=energy.len()).rev() {
+        let e = energy[j - 1];
+        if cumulative + e >= q * total {
+            let t = ((q * total - cumulative) / e).clamp(0.0, 1.0);
+            return c * 2f64.powf(-(j as f64 + 1.0 - t));
+        }
+        cumulative += e;
+    }
+    c / 2.0
+}
+
+/// The bandwidth the analysis of `config` measures for the Phong lobe `max(0, w . r)^n` around
+/// the normal, reduced like a view: the layer of exponent `n`'s place on the atlas's scale. The
+/// lobe's normalization does not matter (the estimator is relative to each lobe's peak).
+pub fn layer_bandwidth(config: &Config, n: u32, reduction: ViewReduction) -> f64 {
+    let analyser = Analyser::new(config);
+    let image = lobe_image_from_fn(analyser.map(), |w| Some(w.z.max(0.0).powi(n as i32)));
+    let energy = band_energy(&image, config.analysis_size);
+    let tile = analyser.analyse_image(image).tile(config.tile);
+    reduction.reduce(&tile, &energy, config)
+}
+
+/// The index of the layer whose bandwidth is nearest to `nu` on a log scale (ties to the lower
+/// index); a flat view (`nu = 0`) takes the layer of lowest bandwidth.
+pub fn nearest_layer(nu: f64, layers: &[f64]) -> usize {
+    let by = |distance: &dyn Fn(f64) -> f64| {
+        let key = |k: &(usize, &f64)| distance(*k.1);
+        layers.iter().enumerate().min_by(|a, b| key(a).total_cmp(&key(b))).map_or(0, |(k, _)| k)
+    };
+    if nu > 0.0 {
+        by(&|b: f64| if b > 0.0 { (nu.ln() - b.ln()).abs() } else { f64::INFINITY })
+    } else {
+        by(&|b: f64| b)
+    }
+}
+
+/// Which Phong layer serves each view elevation of a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerSelection {
+    pub reduction: ViewReduction,
+    pub exponents: Vec<u32>,
+    /// Each layer's measured bandwidth ([`layer_bandwidth`]), cycles per radian.
+    pub layer_bandwidth: Vec<f64>,
+    /// Per row of the atlas (equal steps of `cos theta_o`, row `j` at `1 - (j + 1/2) / rows`):
+    /// the material's bandwidth for views in that row, cycles per radian.
+    pub view_bandwidth: Vec<f64>,
+    /// Per row: the layer index whose bandwidth is nearest to the view's.
+    pub view_layer: Vec<u32>,
+}
+
+impl LayerSelection {
+    /// How many rows select each layer.
+    pub fn histogram(&self) -> Vec<usize> {
+        let mut counts = vec![0; self.exponents.len()];
+        for &k in &self.view_layer {
+            counts[k as usize] += 1;
+        }
+        counts
+    }
+}
+
+/// The layer selection of a material from its atlas build (made with `config`, which keeps each
+/// row's band energy), for layers of `exponents`. The atlas's first column of tiles serves: a
+/// MERL table is isotropic, every tile of a row is the same.
+pub fn select_layers(
+    build: &AtlasBuild,
+    config: &Config,
+    exponents: &[u32],
+    reduction: ViewReduction,
+) -> Result<LayerSelection, Error> {
+    config.check()?;
+    let atlas = &build.atlas;
+    if (atlas.lobes_y, atlas.tile, atlas.analysis_size) != (config.lobes, config.tile, config.analysis_size) {
+        return Err(Error::Config(format!(
+            "the atlas ({} rows, tiles of {}, analysed at {}) was not made with this configuration ({} rows, tiles \
+             of {}, analysed at {})",
+            atlas.lobes_y, atlas.tile, atlas.analysis_size, config.lobes, config.tile, config.analysis_size
+        )));
+    }
+    let layer_bandwidth: Vec<f64> = exponents.iter().map(|&n| layer_bandwidth(config, n, reduction)).collect();
+    let view_bandwidth: Vec<f64> = (0..config.lobes)
+        .map(|j| reduction.reduce(&atlas.tile_of(atlas.lobe_index(0, j)), &build.band_energy[j], config))
+        .collect();
+    let view_layer = view_bandwidth.iter().map(|&nu| nearest_layer(nu, &layer_bandwidth) as u32).collect();
+    Ok(LayerSelection { reduction, exponents: exponents.to_vec(), layer_bandwidth, view_bandwidth, view_layer })
+}
+
+/// Convenience for tests and tools that have only the table: builds the atlas and selects.
+pub fn select_layers_of_table(
+    table: &MerlTable,
+    config: &Config,
+    exponents: &[u32],
+    reduction: ViewReduction,
+) -> Result<LayerSelection, Error> {
+    let build = crate::build_atlas(table, config, &|_| {})?;
+    select_layers(&build, config, exponents, reduction)
+}

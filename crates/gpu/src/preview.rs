@@ -1,0 +1,862 @@
+//! The previewer's renderer on the GPU: the `render` crate's specification (its crate
+//! documentation), step for step, in two passes. A raster pass draws the index of the triangle
+//! that covers each pixel centre (`preview_raster.wgsl`): coverage and the depth test are the
+//! rasterizer's, whose rules the specification follows. A compute pass then interpolates the
+//! vertices at the pixel centre the way the specification does (from the snapped coordinates,
+//! where a rasterizer's own interpolation may differ by a fraction of a sub-pixel), shades one
+//! frame per dispatch and adds it into an accumulation buffer (`preview_shade.wgsl`, compiled
+//! after [`MERL_LOOKUP_WGSL`], whose nearest lookup is the BRDF). [`Renderer::render_frames`]
+//! reads back the average of the frames; [`Renderer::accumulate`] keeps adding frames across
+//! calls (an interactive view refines as it is shown), and a [`Presenter`] tone maps the running
+//! average into a texture, a window's included, exactly as `envmap::tonemap_rgb8` maps pictures.
+//! [`View`] names the debug views the shading pass can accumulate instead of the estimate.
+//!
+//! The CPU renderer `render::render` is the reference: with the same inputs the two images agree
+//! to f32 rounding (the CPU shades in f64), apart from the rare sample whose MERL cell, slice or
+//! coverage sits on a boundary that rounding crosses. The tests hold it to that. One step is
+//! not the CPU's to the letter: a triangle the CPU clips (at the near plane or the guard band) is
+//! interpolated at the exact point where the pixel ray meets it, not from the clipped polygon's
+//! snapped vertices (the two differ by that snapping, 1/512 pixel).
+//!
+//! Everything the shaders read lives in storage buffers (the samples, the mip chain and the
+//! prefiltered layers as f32 RGB, the view-layer table) rather than textures: float32 textures
+//! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
+
+use std::cell::Cell;
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings};
+use wgpu::util::DeviceExt;
+
+use crate::context::{Gpu, check_buffer_fits};
+use crate::error::GpuError;
+use crate::merl_lookup::{MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, read_back, table_bytes};
+
+mod present;
+
+pub use present::{PREVIEW_PRESENT_WGSL, Presenter};
+
+/// The raster pass: vertex and fragment entry points `raster_vertex`, `raster_fragment`.
+pub const PREVIEW_RASTER_WGSL: &str = include_str!("preview_raster.wgsl");
+
+/// The shading pass, compiled after [`MERL_LOOKUP_WGSL`]: entry point `shade_frame`.
+pub const PREVIEW_SHADE_WGSL: &str = include_str!("preview_shade.wgsl");
+
+/// Must equal `SHADE_WORKGROUP` in the WGSL (checked by a test below).
+const SHADE_WORKGROUP: u32 = 8;
+
+/// Frames recorded into one command buffer: enough to amortize a submission, few enough that no
+/// single submission runs for long on a slow adapter.
+const FRAMES_PER_SUBMIT: u32 = 16;
+
+/// The G-buffer: the covering triangle's index plus one, 0 where none covers the pixel.
+const TRIANGLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// `Shade` of the WGSL.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct ShadeUniform {
+    view_proj: [f32; 16],
+    eye: [f32; 4],
+    ray_forward: [f32; 4],
+    ray_right: [f32; 4],
+    ray_up: [f32; 4],
+    width: u32,
+    height: u32,
+    seed: u32,
+    mode: u32,
+    spp: u32,
+    n_slices: u32,
+    n_vectors: u32,
+    n_samples: u32,
+    n_levels: u32,
+    n_view_rows: u32,
+    _pad: [u32; 2],
+}
+
+/// `MODE_*` of the WGSL.
+fn mode_index(mode: Mode) -> u32 {
+    match mode {
+        Mode::Reference => 0,
+        Mode::Fis => 1,
+        Mode::Prefiltered => 2,
+    }
+}
+
+/// `MODE_GBUFFER_*` of the WGSL: the shading pass writes the G-buffer instead of shading.
+const MODE_GBUFFER_POSITION: u32 = 3;
+const MODE_GBUFFER_NORMAL: u32 = 4;
+
+/// What [`Renderer::accumulate`] adds up at each pixel: the estimate of the settings' mode, or a
+/// debug view of what the estimators read there. Pixels no triangle covers show the environment
+/// in every view. The debug views are the same in every frame, so their average is their value
+/// (one frame shows them whole).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum View {
+    /// The mode's estimate of the radiance: what [`Renderer::render_frames`] renders.
+    #[default]
+    Shaded,
+    /// The interpolated, normalized normal `(x, y, z)` at every covered pixel.
+    Normal,
+    /// The prefiltered layer that the view-layer table picks for the pixel (whatever the mode):
+    /// `(layer, 1, 0)`, `(-1, 1, 0)` where the material has no table, `(0, 0, 0)` where the pixel
+    /// has no shading frame (it is black in every mode).
+    Layer,
+    /// The slice of the baked samples the pixel reads: `(slice, 1, 0)`, or `(0, 0, 0)` where the
+    /// pixel has no shading frame.
+    Slice,
+}
+
+impl View {
+    pub const ALL: [View; 4] = [View::Shaded, View::Normal, View::Layer, View::Slice];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Shaded => "shaded",
+            View::Normal => "normals",
+            View::Layer => "prefiltered layer",
+            View::Slice => "sample slice",
+        }
+    }
+
+    /// Whether frames after the first change nothing but rounding.
+    pub fn is_deterministic(self) -> bool {
+        self != View::Shaded
+    }
+
+    /// `MODE_*` of the WGSL for this view of a render in `mode`.
+    fn mode_index(self, mode: Mode) -> u32 {
+        match self {
+            View::Shaded => mode_index(mode),
+            View::Normal => MODE_DEBUG_NORMAL,
+            View::Layer => MODE_DEBUG_LAYER,
+            View::Slice => MODE_DEBUG_SLICE,
+        }
+    }
+}
+
+/// `MODE_DEBUG_*` of the WGSL.
+const MODE_DEBUG_NORMAL: u32 = 5;
+const MODE_DEBUG_LAYER: u32 = 6;
+const MODE_DEBUG_SLICE: u32 = 7;
+
+/// What the accumulation buffer holds: the sum of frames `0 .. frames` of one render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Progress {
+    mode: Mode,
+    spp: u32,
+    seed: u32,
+    view: View,
+    frames: u32,
+}
+
+/// The visible surface at every pixel centre as the shading pass sees it, row-major, row 0 at the
+/// top: for the tests to hold visibility to `render::raster` on its own, before any shading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GBuffer {
+    pub width: usize,
+    pub height: usize,
+    /// The index of the triangle that covers the pixel centre, if any.
+    pub triangle: Vec<Option<u32>>,
+    /// The interpolated world position (0 where not covered).
+    pub position: Vec<[f32; 3]>,
+    /// The interpolated vertex normal, normalized, or zero where it interpolates to zero (0 where
+    /// not covered).
+    pub normal: Vec<[f32; 3]>,
+}
+
+impl GBuffer {
+    /// Whether a triangle covers each pixel centre.
+    pub fn coverage(&self) -> Vec<bool> {
+        self.triangle.iter().map(Option::is_some).collect()
+    }
+}
+
+/// A scene, a material and its lighting on the GPU, ready to render frames of any
+/// [`Settings`].
+#[derive(Debug)]
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    width: u32,
+    height: u32,
+    camera: Camera,
+    n_indices: u32,
+    raster_pipeline: wgpu::RenderPipeline,
+    raster_uniform: wgpu::Buffer,
+    raster_group: wgpu::BindGroup,
+    triangle_target: wgpu::Texture,
+    depth_target: wgpu::Texture,
+    shade_pipeline: wgpu::ComputePipeline,
+    table_group: wgpu::BindGroup,
+    bake_group: wgpu::BindGroup,
+    render_group: wgpu::BindGroup,
+    shade_uniform: wgpu::Buffer,
+    frame_uniform: wgpu::Buffer,
+    /// Bytes between the frame slots of `frame_uniform` (the dynamic-offset alignment).
+    frame_stride: u64,
+    accumulation: wgpu::Buffer,
+    /// What `accumulation` holds; `None` when it holds nothing to continue (after a camera change
+    /// or a G-buffer read). A `Cell` because reading the G-buffer (`&self`) uses the buffer too.
+    progress: Cell<Option<Progress>>,
+    /// What settings are checked against.
+    n_slices: u32,
+    n_vectors: u32,
+    n_samples: u32,
+    n_levels: u32,
+    n_layers: usize,
+    view_layers: Vec<u32>,
+}
+
+impl Renderer {
+    /// Checks the inputs as `render::render` does, uploads the mesh, the MERL table, the samples,
+    /// the mip chain, the prefiltered layers and the view-layer table, and draws the G-buffer
+    /// (the triangle at each pixel centre).
+    /// Fails with [`GpuError::Scene`] on inconsistent inputs and [`GpuError::AdapterLimit`] where
+    /// a buffer or the image exceeds what the adapter can hold.
+    pub fn new(gpu: &Gpu, scene: &Scene, material: &Material, lighting: &Lighting) -> Result<Renderer, GpuError> {
+        check_scene(scene, material, lighting)?;
+        let (width, height) = (scene.width as u32, scene.height as u32);
+        let limits = gpu.limits();
+        let info = gpu.adapter_info();
+        if width.max(height) > limits.max_texture_dimension_2d {
+            return Err(GpuError::AdapterLimit {
+                adapter: gpu.adapter_summary(),
+                limit: "max_texture_dimension_2d",
+                have: limits.max_texture_dimension_2d.into(),
+                need: width.max(height).into(),
+                what: "the image",
+            });
+        }
+
+        let table = &material.table;
+        check_buffer_fits(&limits, info, table_bytes(table.dims()), "the MERL table")?;
+        let samples = &material.samples;
+        check_buffer_fits(&limits, info, 16 * samples.texels.len() as u64, "the importance samples")?;
+        let (env_maps, env_texels) = env_buffers(lighting);
+        check_buffer_fits(&limits, info, 4 * env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
+        let pixels = u64::from(width) * u64::from(height);
+        check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
+        // Positions and normals interleaved: one storage buffer for both, so that the shading
+        // pass stays within the 8 storage buffers every adapter offers.
+        let vertices: Vec<[f32; 6]> = scene
+            .mesh
+            .positions
+            .iter()
+            .zip(&scene.mesh.normals)
+            .map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
+            .collect();
+        check_buffer_fits(&limits, info, 24 * vertices.len() as u64, "the mesh's vertices")?;
+        check_buffer_fits(&limits, info, 4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
+
+        let device = gpu.device().clone();
+        let queue = gpu.queue().clone();
+        let frame_stride = u64::from(limits.min_uniform_buffer_offset_alignment).max(16);
+        let renderer = capture_errors(&device, || {
+            let storage = |label: &str, contents: &[u8]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+            };
+            let uniform = |label: &str, size: u64| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
+
+            // The mesh, read by both passes.
+            let vertex_buffer = storage("preview mesh vertices", bytemuck::cast_slice(&vertices));
+            let index_buffer = storage("preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
+
+            // The raster pass.
+            let vertex = wgpu::ShaderStages::VERTEX;
+            let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("preview raster"),
+                entries: &[
+                    uniform_entry(0, vertex, false),
+                    storage_entry(1, vertex, true),
+                    storage_entry(2, vertex, true),
+                ],
+            });
+            let raster_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("preview_raster.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(PREVIEW_RASTER_WGSL.into()),
+            });
+            let raster_pipeline = raster_pipeline(&device, &raster_layout, &raster_module);
+            let raster_uniform = uniform("preview view_proj", size_of::<[f32; 16]>() as u64);
+            let raster_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview raster"),
+                layout: &raster_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: raster_uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: vertex_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: index_buffer.as_entire_binding() },
+                ],
+            });
+            let target = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            };
+            use wgpu::TextureUsages as T;
+            let triangle_target =
+                target("preview gbuffer triangle", TRIANGLE_FORMAT, T::RENDER_ATTACHMENT | T::TEXTURE_BINDING);
+            let depth_target = target("preview depth", DEPTH_FORMAT, T::RENDER_ATTACHMENT);
+
+            // The shading pass.
+            let compute = wgpu::ShaderStages::COMPUTE;
+            let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("merl table"),
+                entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
+            });
+            let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("preview bake"),
+                entries: &(0..6).map(|binding| storage_entry(binding, compute, true)).collect::<Vec<_>>(),
+            });
+            let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("preview render"),
+                entries: &[
+                    uniform_entry(0, compute, false),
+                    uniform_entry(1, compute, true),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: compute,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Uint,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    storage_entry(3, compute, false),
+                ],
+            });
+            let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("preview_shade.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(format!("{MERL_LOOKUP_WGSL}\n{PREVIEW_SHADE_WGSL}").into()),
+            });
+            let shade_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("shade_frame"),
+                layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("preview shade"),
+                    bind_group_layouts: &[Some(&table_layout), Some(&bake_layout), Some(&render_layout)],
+                    immediate_size: 0,
+                })),
+                module: &shade_module,
+                entry_point: Some("shade_frame"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+
+            let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("merl dims"),
+                contents: bytemuck::bytes_of(&MerlDimsUniform::new(table.dims())),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let table_buffer = storage("merl table", bytemuck::cast_slice(&gpu_table_values(table)));
+            let table_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("merl table"),
+                layout: &table_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: dims_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: table_buffer.as_entire_binding() },
+                ],
+            });
+            let samples_buffer = storage("preview samples", bytemuck::cast_slice(&samples.texels));
+            let maps_buffer = storage("preview env maps", bytemuck::cast_slice(&env_maps));
+            let texels_buffer = storage("preview env texels", bytemuck::cast_slice(&env_texels));
+            // A binding cannot be empty; a table nobody reads (the mode check rejects the
+            // prefiltered mode without one) holds one unused entry.
+            let view_layers = if material.view_layers.is_empty() { &[0][..] } else { &material.view_layers[..] };
+            let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(view_layers));
+            let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview bake"),
+                layout: &bake_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: samples_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: maps_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: texels_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: view_layers_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: vertex_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: index_buffer.as_entire_binding() },
+                ],
+            });
+
+            let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
+            let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
+            let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("preview accumulation"),
+                size: 16 * pixels,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let view = |texture: &wgpu::Texture| texture.create_view(&Default::default());
+            let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview render"),
+                layout: &render_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: shade_uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &frame_uniform,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&view(&triangle_target)),
+                    },
+                    wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
+                ],
+            });
+            Renderer {
+                device: device.clone(),
+                queue: queue.clone(),
+                width,
+                height,
+                camera: scene.camera,
+                n_indices: scene.mesh.indices.len() as u32,
+                raster_pipeline,
+                raster_uniform,
+                raster_group,
+                triangle_target,
+                depth_target,
+                shade_pipeline,
+                table_group,
+                bake_group,
+                render_group,
+                shade_uniform,
+                frame_uniform,
+                frame_stride,
+                accumulation,
+                progress: Cell::new(None),
+                n_slices: samples.n_slices as u32,
+                n_vectors: samples.n_vectors as u32,
+                n_samples: samples.n_samples as u32,
+                n_levels: lighting.mips.n_levels() as u32,
+                n_layers: lighting.layers.len(),
+                view_layers: material.view_layers.clone(),
+            }
+        })?;
+        renderer.rasterize()?;
+        Ok(renderer)
+    }
+
+    pub fn width(&self) -> usize {
+        self.width as usize
+    }
+
+    pub fn height(&self) -> usize {
+        self.height as usize
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Looks from `camera` instead: draws the G-buffer again and restarts the accumulation. The
+    /// image size stays.
+    pub fn set_camera(&mut self, camera: &Camera) -> Result<(), GpuError> {
+        self.camera = *camera;
+        self.restart();
+        self.rasterize()
+    }
+
+    /// Renders `settings.frames` frames (`f = 0 .. frames`) and reads back their average, with
+    /// which pixels a triangle covers. Checks the settings as `render::render` does. Leaves those
+    /// frames in the accumulation (a [`Presenter`] shows them, [`Renderer::accumulate`] goes on
+    /// from them).
+    pub fn render_frames(&mut self, settings: &Settings) -> Result<Image, GpuError> {
+        self.check_settings(settings)?;
+        self.restart();
+        self.accumulate(settings, View::Shaded)?;
+        self.accumulated_image()
+    }
+
+    /// Adds `settings.frames` frames of `view` to the accumulation, continuing with the frame
+    /// after the last one added: calls of 1 frame each add frames 0, 1, 2, ... and their sum is
+    /// that of one render of as many frames. Starts again from frame 0 where the accumulation
+    /// holds another mode, spp, seed or view, or nothing (after [`Renderer::restart`] or a camera
+    /// change). Checks the settings as [`Renderer::render_frames`] does. Returns the frames now
+    /// accumulated. Submits the work without waiting for it (`wgpu::Device::poll` waits).
+    pub fn accumulate(&mut self, settings: &Settings, view: View) -> Result<u32, GpuError> {
+        self.check_settings(settings)?;
+        let progress = match self.progress.get() {
+            Some(p) if (p.mode, p.spp, p.seed, p.view) == (settings.mode, settings.spp, settings.seed, view) => p,
+            _ => Progress { mode: settings.mode, spp: settings.spp, seed: settings.seed, view, frames: 0 },
+        };
+        let frames = progress.frames.checked_add(settings.frames).ok_or_else(|| {
+            GpuError::Scene(render::Error::Invalid(format!(
+                "{} frames accumulated, {} more would overflow the frame index",
+                progress.frames, settings.frames
+            )))
+        })?;
+        // Nothing to continue is recorded before the work, so that a failure leaves none.
+        self.progress.set(None);
+        let shade = self.shade_uniform(view.mode_index(settings.mode), settings);
+        self.shade_frames(&shade, progress.frames, settings.frames, progress.frames == 0)?;
+        self.progress.set(Some(Progress { frames, ..progress }));
+        Ok(frames)
+    }
+
+    /// Frames in the accumulation: 0 after [`Renderer::restart`] or a camera change.
+    pub fn frames_accumulated(&self) -> u32 {
+        self.progress.get().map_or(0, |p| p.frames)
+    }
+
+    /// The view the accumulation holds, if it holds any frame.
+    pub fn accumulated_view(&self) -> Option<View> {
+        self.progress.get().map(|p| p.view)
+    }
+
+    /// Forgets the accumulation: the next [`Renderer::accumulate`] starts from frame 0.
+    pub fn restart(&mut self) {
+        self.progress.set(None);
+    }
+
+    /// Reads back the average of the accumulated frames, in the units of their [`View`] (linear
+    /// radiance for [`View::Shaded`]), with which pixels a triangle covers. Fails with
+    /// [`GpuError::Scene`] when no frame has been accumulated.
+    pub fn accumulated_image(&self) -> Result<Image, GpuError> {
+        let frames = self.frames_accumulated();
+        if frames == 0 {
+            return Err(GpuError::Scene(render::Error::Invalid("no frame has been accumulated".into())));
+        }
+        let sums = self.read_accumulation()?;
+        let frames = frames as f32;
+        Ok(Image {
+            width: self.width(),
+            height: self.height(),
+            rgb: sums.iter().flat_map(|s| [s[0] / frames, s[1] / frames, s[2] / frames]).collect(),
+            covered: sums.iter().map(|s| s[3] > 0.0).collect(),
+        })
+    }
+
+    /// The visible surface at every pixel centre, as the shading pass interpolates it.
+    pub fn gbuffer(&self) -> Result<GBuffer, GpuError> {
+        // Any valid sample choice: these modes read no sample.
+        let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+        let positions = self.run_shading(&self.shade_uniform(MODE_GBUFFER_POSITION, &settings))?;
+        let normals = self.run_shading(&self.shade_uniform(MODE_GBUFFER_NORMAL, &settings))?;
+        Ok(GBuffer {
+            width: self.width(),
+            height: self.height(),
+            // The index plus one, exact in f32 up to the 2^24 triangles a mesh may have.
+            triangle: positions.iter().map(|p| (p[3] > 0.0).then(|| p[3] as u32 - 1)).collect(),
+            position: positions.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+            normal: normals.iter().map(|n| [n[0], n[1], n[2]]).collect(),
+        })
+    }
+
+    /// Runs the shading pass once with `shade` into the cleared accumulation buffer (which then
+    /// holds nothing to continue) and reads it back.
+    fn run_shading(&self, shade: &ShadeUniform) -> Result<Vec<[f32; 4]>, GpuError> {
+        self.progress.set(None);
+        self.shade_frames(shade, 0, 1, true)?;
+        self.read_accumulation()
+    }
+
+    /// Runs the shading pass with `shade` for frames `first .. first + frames`, adding into the
+    /// accumulation buffer, cleared first if `clear`.
+    fn shade_frames(&self, shade: &ShadeUniform, first: u32, frames: u32, clear: bool) -> Result<(), GpuError> {
+        let end = first + frames;
+        capture_errors(&self.device, || {
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(shade));
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            if clear {
+                encoder.clear_buffer(&self.accumulation, 0, None);
+            }
+            let mut first = first;
+            while first < end {
+                let count = FRAMES_PER_SUBMIT.min(end - first);
+                let mut slots = vec![0u8; (self.frame_stride * u64::from(count)) as usize];
+                for (i, slot) in slots.chunks_exact_mut(self.frame_stride as usize).enumerate() {
+                    slot[..4].copy_from_slice(&(first + i as u32).to_le_bytes());
+                }
+                // Takes effect before the submission below and after the ones before it.
+                self.queue.write_buffer(&self.frame_uniform, 0, &slots);
+                {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("shade_frame"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(&self.shade_pipeline);
+                    pass.set_bind_group(0, &self.table_group, &[]);
+                    pass.set_bind_group(1, &self.bake_group, &[]);
+                    for i in 0..count {
+                        pass.set_bind_group(2, &self.render_group, &[(u64::from(i) * self.frame_stride) as u32]);
+                        pass.dispatch_workgroups(
+                            self.width.div_ceil(SHADE_WORKGROUP),
+                            self.height.div_ceil(SHADE_WORKGROUP),
+                            1,
+                        );
+                    }
+                }
+                self.queue.submit([encoder.finish()]);
+                encoder = self.device.create_command_encoder(&Default::default());
+                first += count;
+            }
+            // A clear with no frame after it still has to reach the GPU.
+            self.queue.submit([encoder.finish()]);
+        })
+    }
+
+    /// The accumulation buffer's sums, read back.
+    fn read_accumulation(&self) -> Result<Vec<[f32; 4]>, GpuError> {
+        let bytes = 16 * u64::from(self.width) * u64::from(self.height);
+        let readback = capture_errors(&self.device, || {
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("preview readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            encoder.copy_buffer_to_buffer(&self.accumulation, 0, &readback, 0, bytes);
+            self.queue.submit([encoder.finish()]);
+            readback
+        })?;
+        read_back(&self.device, &readback, bytes)
+    }
+
+    /// Draws the G-buffer with the current camera.
+    fn rasterize(&self) -> Result<(), GpuError> {
+        let view_proj = self.view_proj();
+        capture_errors(&self.device, || {
+            self.queue.write_buffer(&self.raster_uniform, 0, bytemuck::cast_slice(&view_proj.to_cols_array()));
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let triangle = self.triangle_target.create_view(&Default::default());
+                let depth = self.depth_target.create_view(&Default::default());
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("preview raster"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &triangle,
+                        depth_slice: None,
+                        resolve_target: None,
+                        // Zero marks a pixel no triangle covers.
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.raster_pipeline);
+                pass.set_bind_group(0, &self.raster_group, &[]);
+                // Not indexed: the vertex shader reads the indices, and vertex i / 3 is triangle i.
+                pass.draw(0..self.n_indices, 0..1);
+            }
+            self.queue.submit([encoder.finish()]);
+        })
+    }
+
+    /// The camera's matrix, with the CPU's aspect in f32 (`render::shade::visibility`).
+    fn view_proj(&self) -> glam::Mat4 {
+        self.camera.view_proj(self.width as f32 / self.height as f32)
+    }
+
+    /// The `Shade` uniform of a render with `settings` in `MODE_*` `mode`.
+    fn shade_uniform(&self, mode: u32, settings: &Settings) -> ShadeUniform {
+        let camera = &self.camera;
+        // `render::Camera::ray`'s basis, in f64 like the CPU, rounded once.
+        let eye = camera.eye().as_dvec3();
+        let forward = (camera.target().as_dvec3() - eye).normalize();
+        let right = forward.cross(DVec3::Z).normalize();
+        let up = right.cross(forward);
+        let aspect = f64::from(self.width) / f64::from(self.height);
+        let tan_half = (0.5 * f64::from(camera.fov_y())).tan();
+        let vec4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        ShadeUniform {
+            view_proj: self.view_proj().to_cols_array(),
+            eye: vec4(eye),
+            ray_forward: vec4(forward),
+            ray_right: vec4(right * (tan_half * aspect)),
+            ray_up: vec4(up * tan_half),
+            width: self.width,
+            height: self.height,
+            seed: settings.seed,
+            mode,
+            spp: settings.spp,
+            n_slices: self.n_slices,
+            n_vectors: self.n_vectors,
+            n_samples: self.n_samples,
+            n_levels: self.n_levels,
+            n_view_rows: self.view_layers.len() as u32,
+            _pad: [0; 2],
+        }
+    }
+
+    /// The checks of `render::render` on the settings.
+    fn check_settings(&self, settings: &Settings) -> Result<(), GpuError> {
+        Ok(render::check_settings(settings, self.n_samples as usize, self.n_layers, &self.view_layers)?)
+    }
+}
+
+/// The checks of `render::render` on the scene, the material and the lighting, before anything is
+/// allocated from them.
+fn check_scene(scene: &Scene, material: &Material, lighting: &Lighting) -> Result<(), GpuError> {
+    scene.mesh.validate()?;
+    render::raster::check_size(scene.width, scene.height)?;
+    Ok(render::check_inputs(material, lighting)?)
+}
+
+/// The maps' descriptors `(width, height, offset, 0)` (the mip levels, then the prefiltered
+/// layers) and their texels, concatenated.
+fn env_buffers(lighting: &Lighting) -> (Vec<[u32; 4]>, Vec<f32>) {
+    let maps = lighting.mips.levels().iter().chain(&lighting.layers);
+    let mut descriptors = Vec::new();
+    let mut texels = Vec::new();
+    for map in maps {
+        descriptors.push([map.width() as u32, map.height() as u32, texels.len() as u32, 0]);
+        texels.extend_from_slice(map.rgb());
+    }
+    (descriptors, texels)
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn raster_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    module: &wgpu::ShaderModule,
+) -> wgpu::RenderPipeline {
+    let target =
+        Some(wgpu::ColorTargetState { format: TRIANGLE_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("preview raster"),
+        layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("preview raster"),
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        })),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("raster_vertex"),
+            compilation_options: Default::default(),
+            // The vertex shader reads the mesh from storage buffers.
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            // Back faces are drawn: the CPU keeps them, and the shading frame blackens them.
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            // Strictly less: of two equal depths the triangle drawn first stays, as on the CPU.
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("raster_fragment"),
+            compilation_options: Default::default(),
+            targets: &[target],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn workgroup_size_matches_the_shader() {
+        let decl = format!("const SHADE_WORKGROUP: u32 = {SHADE_WORKGROUP}u;");
+        assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+    }
+
+    #[test]
+    fn rasterization_constants_match_the_cpu_rasterizer() {
+        let guard_band = format!("const GUARD_BAND: f32 = {:?};", render::raster::GUARD_BAND);
+        let subpixels = format!("const SUBPIXELS: f32 = {:?};", (1u32 << render::raster::SUBPIXEL_BITS) as f32);
+        for decl in [guard_band, subpixels] {
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
+    }
+
+    #[test]
+    fn host_layouts_match_the_wgsl_structs() {
+        // WGSL `Shade`: a mat4x4<f32> and four vec4<f32> (128 bytes), ten u32 (40), rounded up
+        // to its 16-byte alignment: 176.
+        assert_eq!(size_of::<ShadeUniform>(), 176);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, eye), 64);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, width), 128);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 164);
+    }
+
+    #[test]
+    fn mode_indices_match_the_shader() {
+        let modes = [
+            ("REFERENCE", mode_index(Mode::Reference)),
+            ("FIS", mode_index(Mode::Fis)),
+            ("PREFILTERED", mode_index(Mode::Prefiltered)),
+            ("GBUFFER_POSITION", MODE_GBUFFER_POSITION),
+            ("GBUFFER_NORMAL", MODE_GBUFFER_NORMAL),
+            ("DEBUG_NORMAL", MODE_DEBUG_NORMAL),
+            ("DEBUG_LAYER", MODE_DEBUG_LAYER),
+            ("DEBUG_SLICE", MODE_DEBUG_SLICE),
+        ];
+        for (name, index) in modes {
+            let decl = format!("const MODE_{name}: u32 = {index}u;");
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
+    }
+}

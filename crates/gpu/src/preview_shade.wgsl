@@ -1,0 +1,465 @@
+//! The previewer's shading pass: one frame of the estimators of the `render` crate (its crate
+//! documentation is the specification), per pixel of the triangle-index G-buffer that
+//! `preview_raster.wgsl` drew, added into an accumulation buffer. Compiled after
+//! `merl_lookup.wgsl`, whose nearest lookup (`merl_lookup_nearest`, group 0) is the BRDF.
+//!
+//! Every step is a function named after the CPU's (`render::raster`, `render::shade`, `envmap`),
+//! in the same order and with the same branches, so that the two images differ by f32 rounding
+//! only: the CPU works in f64. Group 1 is what the scene, material and lighting upload once,
+//! group 2 the render.
+
+const PI: f32 = 3.14159265358979;
+const HALF_PI: f32 = 1.5707963267948966;
+
+// The host rounds the image up to whole workgroups of this size (`SHADE_WORKGROUP` in Rust; a
+// test there checks the two agree).
+const SHADE_WORKGROUP: u32 = 8u;
+
+const MODE_REFERENCE: u32 = 0u;
+const MODE_FIS: u32 = 1u;
+const MODE_PREFILTERED: u32 = 2u;
+// Not estimators: write the G-buffer's interpolated (position, triangle) or (normal, covered) of
+// each pixel in place of the sum, so that tests can hold visibility to `render::raster` alone.
+const MODE_GBUFFER_POSITION: u32 = 3u;
+const MODE_GBUFFER_NORMAL: u32 = 4u;
+// Debug views, accumulated like the estimators (so that their average is the value) and with the
+// environment behind the mesh as in every mode: per covered pixel the interpolated normal; or
+// (index, 1, 0) with the prefiltered layer the view-layer table picks (-1 without a table) or
+// the sample slice, and (0, 0, 0) where the pixel has no shading frame (black in the picture).
+const MODE_DEBUG_NORMAL: u32 = 5u;
+const MODE_DEBUG_LAYER: u32 = 6u;
+const MODE_DEBUG_SLICE: u32 = 7u;
+
+// `render::raster::GUARD_BAND`: triangles reaching beyond it are clipped on the CPU. (A test in
+// Rust checks both constants against `render::raster`.)
+const GUARD_BAND: f32 = 4.0;
+// 2^`render::raster::SUBPIXEL_BITS`: viewport coordinates snap to 1/256 pixel.
+const SUBPIXELS: f32 = 256.0;
+
+// Group 1: the samples, every environment map, the view-layer table and the mesh.
+
+// `render::SampleSet::texels`: (wi_local.xyz, pdf), slice-major, then vector, then sample.
+@group(1) @binding(0) var<storage, read> samples: array<vec4<f32>>;
+// One lat-long map per entry: (width, height, offset of its first value in `env_texels`, unused).
+// Entries 0 .. n_levels are the mip chain (level 0 first), then one per prefiltered layer.
+@group(1) @binding(1) var<storage, read> env_maps: array<vec4<u32>>;
+// Every map's texels, RGB interleaved and row-major like `envmap::EnvMap::rgb`. Storage rather
+// than textures: float32 textures need not be filterable, and doing the bilinear weights by hand
+// makes them the CPU's arithmetic.
+@group(1) @binding(2) var<storage, read> env_texels: array<f32>;
+// `render::Material::view_layers`.
+@group(1) @binding(3) var<storage, read> view_layers: array<u32>;
+// The mesh, as `preview_raster.wgsl` reads it: six values per vertex (position, normal), three
+// indices per triangle.
+@group(1) @binding(4) var<storage, read> mesh_vertices: array<f32>;
+@group(1) @binding(5) var<storage, read> mesh_indices: array<u32>;
+
+// Group 2: the render.
+
+struct Shade {
+    // The camera: the matrix the raster pass projected with, the eye, and the pixel ray's basis
+    // as `render::Camera::ray` builds it, `forward`, `right tan(fov_y / 2) aspect` and
+    // `up tan(fov_y / 2)`.
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    ray_forward: vec4<f32>,
+    ray_right: vec4<f32>,
+    ray_up: vec4<f32>,
+    width: u32,
+    height: u32,
+    seed: u32,
+    mode: u32,
+    spp: u32,
+    n_slices: u32,
+    n_vectors: u32,
+    n_samples: u32,
+    // Mip levels: the prefiltered layer `l` is map `n_levels + l`.
+    n_levels: u32,
+    n_view_rows: u32,
+}
+
+// Its own uniform, at a dynamic offset: one command buffer holds many frames.
+struct Frame {
+    index: u32,
+}
+
+@group(2) @binding(0) var<uniform> shade: Shade;
+@group(2) @binding(1) var<uniform> frame: Frame;
+// The index plus one of the triangle that covers the pixel centre, 0 where none does.
+@group(2) @binding(2) var gbuffer_triangle: texture_2d<u32>;
+// Per pixel: the sum of the frames' radiance, and in w whether a triangle covers it.
+@group(2) @binding(3) var<storage, read_write> accumulation: array<vec4<f32>>;
+
+// `render::pcg_hash`: Jarzynski and Olano 2020. WGSL's u32 arithmetic wraps like Rust's
+// wrapping_*, so the words are the CPU's bit for bit.
+fn pcg_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// `render::sample_range`: (vector, first sample) of pixel `pixel` in frame `f`. The seed is hashed
+// before it meets the frame, so that renders with small seeds do not share their frames' words.
+fn sample_range(pixel: u32, f: u32) -> vec2<u32> {
+    let h = pcg_hash(pixel ^ pcg_hash(f ^ pcg_hash(shade.seed)));
+    let vector = h % shade.n_vectors;
+    let chunk = (h / shade.n_vectors) % (shade.n_samples / shade.spp);
+    return vec2<u32>(vector, chunk * shade.spp);
+}
+
+// What covers a pixel (`render::raster::Hit`): the world position and the normalized normal
+// (zero where it interpolates to zero) at the pixel centre.
+struct Hit {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+fn mesh_position(v: u32) -> vec3<f32> {
+    return vec3<f32>(mesh_vertices[6u * v], mesh_vertices[6u * v + 1u], mesh_vertices[6u * v + 2u]);
+}
+
+fn mesh_normal(v: u32) -> vec3<f32> {
+    return vec3<f32>(mesh_vertices[6u * v + 3u], mesh_vertices[6u * v + 4u], mesh_vertices[6u * v + 5u]);
+}
+
+// Whether a clip-space vertex lies in the volume `render::raster` clips to
+// (`plane_distances` all >= 0): 0 <= z <= w, |x|, |y| <= G w.
+fn inside_clip_volume(c: vec4<f32>) -> bool {
+    let g = GUARD_BAND * c.w;
+    return c.z >= 0.0 && c.w - c.z >= 0.0 && c.x + g >= 0.0 && g - c.x >= 0.0 && c.y + g >= 0.0 && g - c.y >= 0.0;
+}
+
+// `render::raster::to_viewport` then `snap`: viewport x and y in 1/256 pixels, rounded half to
+// even (WGSL's round), as integers held exactly in f32 (below 2^24 within the guard band of any
+// image of up to 16384 pixels a side).
+fn snapped_viewport(c: vec4<f32>) -> vec2<f32> {
+    let half_w = f32(shade.width) * 0.5;
+    let half_h = f32(shade.height) * 0.5;
+    let ndc = c.xyz / c.w;
+    return round(vec2<f32>(half_w * ndc.x + half_w, -half_h * ndc.y + half_h) * SUBPIXELS);
+}
+
+// 2D cross product: the edge function of `render::raster::for_each_covered` for the edge from
+// `a` to `b`, both relative to the point it is evaluated at.
+fn edge(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// Steps 5 and 6 of `render::raster` at pixel (x, y) for a triangle drawn whole (no vertex outside
+// the clip volume): screen-space barycentrics from the snapped vertices' edge functions at the
+// pixel centre, then perspective-correct weights (b_i / w_i) / sum_j (b_j / w_j). Coordinates are
+// taken relative to the pixel centre, so the edge functions are products of small integers.
+fn snapped_weights(clip: array<vec4<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
+    let centre = vec2<f32>(SUBPIXELS * f32(x), SUBPIXELS * f32(y)) + 0.5 * SUBPIXELS;
+    let a = snapped_viewport(clip[0]) - centre;
+    let b = snapped_viewport(clip[1]) - centre;
+    let c = snapped_viewport(clip[2]) - centre;
+    // Edge k is opposite vertex k; its function is vertex k's weight.
+    let e = vec3<f32>(edge(b, c), edge(c, a), edge(a, b));
+    let bary = e / (e.x + e.y + e.z);
+    let q = bary / vec3<f32>(clip[0].w, clip[1].w, clip[2].w);
+    return q / (q.x + q.y + q.z);
+}
+
+// The weights of a triangle the CPU clips (a vertex behind the near plane, beyond the far plane
+// or the guard band): those of the point where the pixel ray meets the triangle's plane. The
+// CPU interpolates the clipped polygon's snapped vertices, which comes to the same up to that
+// snapping: such triangles are rare in a preview (the near plane is at 1% of the distance).
+fn ray_weights(p: array<vec3<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
+    let eye = shade.eye.xyz;
+    let dir = camera_ray(x, y);
+    let normal = cross(p[1] - p[0], p[2] - p[0]);
+    let hit = eye + dot(p[0] - eye, normal) / dot(dir, normal) * dir;
+    let area = dot(normal, normal);
+    return vec3<f32>(
+        dot(cross(p[1] - hit, p[2] - hit), normal),
+        dot(cross(p[2] - hit, p[0] - hit), normal),
+        dot(cross(p[0] - hit, p[1] - hit), normal),
+    ) / area;
+}
+
+// `render::raster`'s hit at pixel (x, y) on triangle `t`: position and normal interpolated with
+// the weights above, the normal normalized unless it is zero (glam's normalize_or_zero).
+fn interpolate_hit(t: u32, x: u32, y: u32) -> Hit {
+    var p: array<vec3<f32>, 3>;
+    var n: array<vec3<f32>, 3>;
+    var clip: array<vec4<f32>, 3>;
+    var whole = true;
+    for (var k = 0u; k < 3u; k++) {
+        let v = mesh_indices[3u * t + k];
+        p[k] = mesh_position(v);
+        n[k] = mesh_normal(v);
+        clip[k] = shade.view_proj * vec4<f32>(p[k], 1.0);
+        whole = whole && inside_clip_volume(clip[k]);
+    }
+    var weights: vec3<f32>;
+    if (whole) {
+        weights = snapped_weights(clip, x, y);
+    } else {
+        weights = ray_weights(p, x, y);
+    }
+    let position = weights.x * p[0] + weights.y * p[1] + weights.z * p[2];
+    let normal = weights.x * n[0] + weights.y * n[1] + weights.z * n[2];
+    let length_squared = dot(normal, normal);
+    if (!(length_squared > 0.0)) {
+        return Hit(position, vec3<f32>(0.0));
+    }
+    return Hit(position, normal / sqrt(length_squared));
+}
+
+struct ShadingFrame {
+    t: vec3<f32>,
+    b: vec3<f32>,
+    n: vec3<f32>,
+    cos_o: f32,
+    // (sin theta_o, 0, cos theta_o): the frame of the baked samples, phi_o = 0.
+    wo_local: vec3<f32>,
+}
+
+// `render::shade::duff_tangent`: the first tangent of Duff et al. 2017's branchless basis. The
+// sign is read from the bit so that n.z = -0 takes -1, as Rust's copysign does.
+fn duff_tangent(n: vec3<f32>) -> vec3<f32> {
+    let s = select(1.0, -1.0, (bitcast<u32>(n.z) & 0x80000000u) != 0u);
+    let a = -1.0 / (s + n.z);
+    return vec3<f32>(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
+}
+
+// `render::shade::ShadingFrame::new`; `valid` is false where the pixel is black: the normal
+// interpolated to zero or faces away from the eye (silhouettes).
+struct MaybeFrame {
+    valid: bool,
+    frame: ShadingFrame,
+}
+
+fn shading_frame(hit: Hit) -> MaybeFrame {
+    var none: MaybeFrame;
+    none.valid = false;
+    let n = hit.normal;
+    if (all(n == vec3<f32>(0.0))) {
+        return none;
+    }
+    let wo = normalize(shade.eye.xyz - hit.position);
+    let cos_o = dot(n, wo);
+    if (!(cos_o > 0.0)) {
+        return none;
+    }
+    let tangent = wo - cos_o * n;
+    let sin_o = length(tangent);
+    var t: vec3<f32>;
+    if (sin_o < 1e-6) {
+        // wo along the normal: any tangent will do, as long as it is the CPU's.
+        t = duff_tangent(n);
+    } else {
+        t = tangent / sin_o;
+    }
+    let b = cross(n, t);
+    let wo_local = normalize(vec3<f32>(sin_o, 0.0, cos_o));
+    return MaybeFrame(true, ShadingFrame(t, b, n, cos_o, wo_local));
+}
+
+fn to_world(frame: ShadingFrame, local: vec3<f32>) -> vec3<f32> {
+    return local.x * frame.t + local.y * frame.b + local.z * frame.n;
+}
+
+// `render::shade::slice_of`: the slice nearest theta_o = atan2(wo_local.x, wo_local.z).
+fn slice_of(frame: ShadingFrame) -> u32 {
+    let theta_o = merl_atan2(frame.wo_local.x, frame.wo_local.z);
+    let k = max(floor(theta_o / HALF_PI * f32(shade.n_slices) + 0.5), 0.0);
+    return min(u32(k), shade.n_slices - 1u);
+}
+
+// `envmap::geometry::uv`: map coordinates of a direction (need not be normalized); u in [0, 1),
+// 0 on the poles.
+fn env_uv(w: vec3<f32>) -> vec2<f32> {
+    // atan2 of the two legs rather than acos(z), as on the CPU (precision near the poles).
+    let theta = merl_atan2(length(w.xy), w.z);
+    var u = merl_atan2(w.y, w.x) / (2.0 * PI);
+    if (u < 0.0) {
+        u += 1.0;
+        // A tiny negative phi rounds to exactly 1, the same meridian as 0.
+        if (u >= 1.0) {
+            u = 0.0;
+        }
+    }
+    return vec2<f32>(u, theta / PI);
+}
+
+// `envmap::geometry::uv_jacobian`: d omega / (du dv).
+fn uv_jacobian(v: f32) -> f32 {
+    return 2.0 * PI * PI * sin(PI * v);
+}
+
+fn env_texel(base: u32, index: u32) -> vec3<f32> {
+    let i = base + 3u * index;
+    return vec3<f32>(env_texels[i], env_texels[i + 1u], env_texels[i + 2u]);
+}
+
+// `envmap::EnvMap::lookup_uv` of map `m`: bilinear with texel centres at (x + 1/2) / width, u
+// wrapping, v clamped to the centres of the first and last rows.
+fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
+    let map = env_maps[m];
+    let w = map.x;
+    let h = map.y;
+    let s = uv.x * f32(w) - 0.5;
+    let t = clamp(uv.y * f32(h) - 0.5, 0.0, f32(h - 1u));
+    let s0 = floor(s);
+    let fx = s - s0;
+    let fy = t - floor(t);
+    // rem_euclid: WGSL's % truncates towards zero like Rust's, so add w once more.
+    let x0 = u32((i32(s0) % i32(w) + i32(w)) % i32(w));
+    let x1 = select(x0 + 1u, 0u, x0 + 1u == w);
+    let y0 = min(u32(t), h - 1u);
+    let y1 = min(y0 + 1u, h - 1u);
+    let a = env_texel(map.z, y0 * w + x0);
+    let b = env_texel(map.z, y0 * w + x1);
+    let c = env_texel(map.z, y1 * w + x0);
+    let d = env_texel(map.z, y1 * w + x1);
+    let top = a * (1.0 - fx) + b * fx;
+    let bottom = c * (1.0 - fx) + d * fx;
+    return top * (1.0 - fy) + bottom * fy;
+}
+
+// `envmap::MipChain::lod` for one of `spp` samples of density `pdf_uv` over the unit square:
+// max(log4(width height / (spp pdf_uv)), 0). As a difference of logarithms, because the quotient
+// overflows f32 for the tiny densities near the poles, where the CPU's f64 does not. A density
+// that is not positive (sin(pi v) rounds to 0 or below at the poles in f32) stands for the
+// CPU's infinite level: the last.
+fn mip_lod(pdf_uv: f32) -> f32 {
+    if (!(pdf_uv > 0.0)) {
+        return f32(shade.n_levels - 1u);
+    }
+    let level0 = env_maps[0];
+    let texels = f32(level0.x) * f32(level0.y);
+    return max(0.5 * (log2(texels) - log2(f32(shade.spp)) - log2(pdf_uv)), 0.0);
+}
+
+// `envmap::MipChain::lookup_uv`: bilinear in the two levels around `lod` (clamped to the chain),
+// then linear between them.
+fn mip_trilinear(uv: vec2<f32>, lod: f32) -> vec3<f32> {
+    let last = f32(shade.n_levels - 1u);
+    var l = 0.0;
+    if (lod > 0.0) {
+        l = min(lod, last);
+    }
+    let l0 = floor(l);
+    let t = l - l0;
+    let a = env_bilinear(u32(l0), uv);
+    if (t == 0.0) {
+        return a;
+    }
+    let b = env_bilinear(u32(l0) + 1u, uv);
+    return a * (1.0 - t) + b * t;
+}
+
+// `L(wi)` of each mode (crate documentation of `render`, "The estimators"). `map` is the map a
+// bilinear mode reads: level 0, or the pixel's prefiltered layer.
+fn incident_radiance(map: u32, wi: vec3<f32>, pdf: f32) -> vec3<f32> {
+    let uv = env_uv(wi);
+    if (shade.mode == MODE_FIS) {
+        let pdf_uv = pdf * uv_jacobian(uv.y);
+        return mip_trilinear(uv, mip_lod(pdf_uv));
+    }
+    return env_bilinear(map, uv);
+}
+
+// The prefiltered layer of the pixel: row r = min(floor((1 - cos_o) R), R - 1) of the view-layer
+// table (which must not be empty).
+fn view_layer(frame: ShadingFrame) -> u32 {
+    let rows = shade.n_view_rows;
+    let r = min(u32(max(floor((1.0 - frame.cos_o) * f32(rows)), 0.0)), rows - 1u);
+    return view_layers[r];
+}
+
+// The map a bilinear mode reads at this pixel: level 0 (reference), or for the prefiltered mode
+// the pixel's layer.
+fn source_map(frame: ShadingFrame) -> u32 {
+    if (shade.mode != MODE_PREFILTERED) {
+        return 0u;
+    }
+    return shade.n_levels + view_layer(frame);
+}
+
+// What a debug mode shows at a pixel with a shading frame: (index, 1, 0).
+fn debug_index(frame: ShadingFrame) -> vec3<f32> {
+    if (shade.mode == MODE_DEBUG_SLICE) {
+        return vec3<f32>(f32(slice_of(frame)), 1.0, 0.0);
+    }
+    if (shade.n_view_rows == 0u) {
+        return vec3<f32>(-1.0, 1.0, 0.0);
+    }
+    return vec3<f32>(f32(view_layer(frame)), 1.0, 0.0);
+}
+
+// One frame's estimate at a covered pixel: 1 / spp sum_j f(wi_j, wo) L(wi_j) cos(theta_j) / pdf_j
+// over the pixel's samples; a sample with pdf <= 0, wi below the horizon or no table data adds 0.
+fn estimate(frame: ShadingFrame, pixel: u32, f: u32) -> vec3<f32> {
+    let k = slice_of(frame);
+    let map = source_map(frame);
+    let range = sample_range(pixel, f);
+    let start = (k * shade.n_vectors + range.x) * shade.n_samples + range.y;
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < shade.spp; j++) {
+        let texel = samples[start + j];
+        let wi_local = texel.xyz;
+        let pdf = texel.w;
+        if (!(pdf > 0.0 && wi_local.z > 0.0)) {
+            continue;
+        }
+        let brdf = merl_lookup_nearest(wi_local, frame.wo_local);
+        // No data (negative) counts as 0; the CPU skips zeros too.
+        if (!merl_has_data(brdf) || all(brdf == vec3<f32>(0.0))) {
+            continue;
+        }
+        let radiance = incident_radiance(map, to_world(frame, wi_local), pdf);
+        sum += brdf * radiance * (wi_local.z / pdf);
+    }
+    return sum / f32(shade.spp);
+}
+
+// `render::Camera::ray`: the ray from the eye through the centre of pixel (x, y), row 0 at the
+// top.
+fn camera_ray(x: u32, y: u32) -> vec3<f32> {
+    let x_ndc = 2.0 * (f32(x) + 0.5) / f32(shade.width) - 1.0;
+    let y_ndc = 1.0 - 2.0 * (f32(y) + 0.5) / f32(shade.height);
+    return normalize(shade.ray_forward.xyz + x_ndc * shade.ray_right.xyz + y_ndc * shade.ray_up.xyz);
+}
+
+@compute @workgroup_size(SHADE_WORKGROUP, SHADE_WORKGROUP)
+fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= shade.width || gid.y >= shade.height) {
+        return;
+    }
+    let pixel = gid.y * shade.width + gid.x;
+    let triangle = textureLoad(gbuffer_triangle, vec2<i32>(gid.xy), 0).x;
+    let covered = triangle > 0u;
+    var hit: Hit;
+    if (covered) {
+        hit = interpolate_hit(triangle - 1u, gid.x, gid.y);
+    }
+    if (shade.mode == MODE_GBUFFER_POSITION) {
+        accumulation[pixel] = vec4<f32>(hit.position, f32(triangle));
+        return;
+    }
+    if (shade.mode == MODE_GBUFFER_NORMAL) {
+        accumulation[pixel] = vec4<f32>(hit.normal, select(0.0, 1.0, covered));
+        return;
+    }
+    var radiance = vec3<f32>(0.0);
+    if (covered && shade.mode == MODE_DEBUG_NORMAL) {
+        radiance = hit.normal;
+    } else if (covered) {
+        let maybe = shading_frame(hit);
+        if (maybe.valid) {
+            if (shade.mode == MODE_DEBUG_LAYER || shade.mode == MODE_DEBUG_SLICE) {
+                radiance = debug_index(maybe.frame);
+            } else {
+                radiance = estimate(maybe.frame, pixel, frame.index);
+            }
+        }
+    } else {
+        // The environment behind the mesh in every mode, so that its orientation can be checked.
+        radiance = env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y)));
+    }
+    let sum = accumulation[pixel].xyz + radiance;
+    accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));
+}

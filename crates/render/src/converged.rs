@@ -1,0 +1,210 @@
+//! The converged estimate: the same integral as [`crate::Mode::Reference`],
+//! `L_o = int f(wi, wo) L(wi) cos theta_i dwi` with `f` the table's nearest lookup and `L` level
+//! 0 of the environment, bilinear, over the same G-buffer and shading frame, estimated without
+//! any baked table by multiple importance sampling of three strategies with the balance
+//! heuristic. Each round draws one direction from each strategy; a direction `x_s` contributes
+//! `g(x_s) / (p_env + p_cos + p_h)(x_s)`, so the estimate is unbiased wherever one density is
+//! positive, and the cosine density is positive on the whole upper hemisphere.
+//!
+//! - **Environment** (`p_env`): a `sampling::Distribution2D` over level 0's texels, texel
+//!   `(x, y)` weighted by `Y(x, y) sin theta_y` (`theta_y` at the row centre) where `Y` is the
+//!   Rec. 709 luminance of the **bilinear reconstruction averaged over the texel**: the texels
+//!   filtered by `[1, 6, 1] / 8` along each axis (wrapping in `u`, the edge rows repeated in `v`,
+//!   as the bilinear lookup clamps there). Within a texel the direction is uniform in `(u, v)`,
+//!   so its density per solid angle is `func / integral / (2 pi^2 sin theta)`, `theta` the
+//!   direction's own. Weighting by the filtered luminance rather than the texel's own keeps the
+//!   density positive wherever the bilinear lookup is (half a texel around a bright texel, where
+//!   the texel's own value may be 0) and follows the integrand within a texel, so a sun does not
+//!   throw fireflies; any positive density would leave the estimate unbiased, as it is evaluated
+//!   exactly for every direction.
+//! - **Cosine** (`p_cos = cos theta_i / pi`): Malley's method, `wi = (sqrt(u0) cos 2 pi u1,
+//!   sqrt(u0) sin 2 pi u1, sqrt(1 - u0))`.
+//! - **MERL-grid half vector** (`p_h`): `x_h = u0`, `theta_h = (pi / 2) x_h^2` (MERL's
+//!   square-root spacing: uniform over its `theta_h` cells), `phi_h = 2 pi u1`,
+//!   `wi = 2 (wo . h) h - wo`; `wo . h <= 0` draws nothing. Over the solid angle of `h`,
+//!   `dw_h = sin theta_h (pi x_h) dx_h dphi_h`, so `p(h) = 1 / (2 pi^2 x_h sin theta_h)`, and over
+//!   `wi`, `p_h(wi) = p(h) / (4 (wo . h))` at `h = normalize(wi + wo)` (0 where `h.z <= 0`).
+//!
+//! The points are Owen-scrambled Sobol' sequences (`sampling::OwenSobol2D`), one per pixel and
+//! strategy, drawn from `seed`: every point is uniform (no bias) and the rounds are stratified.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use envmap::EnvMap;
+use glam::DVec3;
+use rayon::prelude::*;
+use sampling::{Distribution2D, OwenSobol2D};
+
+use crate::error::Error;
+use crate::shade::{ShadingFrame, background, brdf, visibility};
+use crate::{Image, Lighting, Material, Scene};
+
+/// The converged estimate of every covered pixel with `samples_per_strategy` rounds (see the
+/// module documentation); uncovered pixels show the environment as in [`crate::render`].
+/// Deterministic for a `seed`, whatever the number of threads.
+pub fn converged(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    samples_per_strategy: u32,
+    seed: u64,
+) -> Result<Image, Error> {
+    if samples_per_strategy == 0 {
+        return Err(Error::Invalid("the converged estimate needs at least one sample per strategy".into()));
+    }
+    let gbuffer = visibility(scene)?;
+    let level0 = lighting.mips.level(0);
+    let env = EnvSampler::new(level0);
+    let eye = scene.camera.eye().as_dvec3();
+    let width = scene.width;
+    let mut rgb = vec![0.0f32; 3 * width * scene.height];
+    rgb.par_chunks_mut(3 * width).enumerate().for_each(|(y, row)| {
+        for (x, out) in row.chunks_exact_mut(3).enumerate() {
+            let value = match gbuffer.hit(x, y) {
+                Some(hit) => match ShadingFrame::new(hit, eye) {
+                    Some(frame) => {
+                        let pixel = (y * width + x) as u64;
+                        estimate(&frame, material, level0, &env, samples_per_strategy, seed, pixel)
+                    }
+                    None => [0.0; 3],
+                },
+                None => background(scene, level0, x, y),
+            };
+            out.copy_from_slice(&value.map(|v| v as f32));
+        }
+    });
+    Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
+}
+
+/// The environment strategy.
+struct EnvSampler {
+    dist: Distribution2D,
+}
+
+impl EnvSampler {
+    fn new(map: &EnvMap) -> EnvSampler {
+        let (w, h) = (map.width(), map.height());
+        let luminance = map.luminance();
+        // [1, 6, 1] / 8 is the mean over a texel of the linear interpolation between texel
+        // centres (1/8 of each neighbour, 3/4 of itself); along u it wraps, along v the lookup
+        // clamps to the edge rows' centres, which the repeated edge row reproduces.
+        let mut along_u = vec![0.0f64; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let at = |x: usize| f64::from(luminance[y * w + x]);
+                along_u[y * w + x] = (at((x + w - 1) % w) + 6.0 * at(x) + at((x + 1) % w)) / 8.0;
+            }
+        }
+        let mut func = vec![0.0f64; w * h];
+        for y in 0..h {
+            let sin_theta = (PI * (y as f64 + 0.5) / h as f64).sin();
+            let (up, down) = (y.saturating_sub(1), (y + 1).min(h - 1));
+            for x in 0..w {
+                let filtered = (along_u[up * w + x] + 6.0 * along_u[y * w + x] + along_u[down * w + x]) / 8.0;
+                // Luminance of non-negative radiance with positive weights: finite and >= 0.
+                func[y * w + x] = filtered.max(0.0) * sin_theta;
+            }
+        }
+        let dist = Distribution2D::new(&func, w, h).expect("a valid map gives finite, non-negative weights");
+        EnvSampler { dist }
+    }
+
+    /// A direction and its density per solid angle (0 on the poles, where it draws nothing).
+    fn sample(&self, u: [f64; 2]) -> (DVec3, f64) {
+        let s = self.dist.sample(u);
+        let [x, v] = s.p;
+        let sin_theta = (PI * v).sin();
+        let pdf = if sin_theta > 0.0 { s.pdf / (2.0 * PI * PI * sin_theta) } else { 0.0 };
+        (envmap::direction(x, v), pdf)
+    }
+
+    fn pdf(&self, wi: DVec3) -> f64 {
+        let (u, v) = envmap::uv(wi);
+        let sin_theta = wi.x.hypot(wi.y) / wi.length();
+        if sin_theta > 0.0 { self.dist.pdf([u, v]) / (2.0 * PI * PI * sin_theta) } else { 0.0 }
+    }
+}
+
+/// The cosine strategy, in the shading frame (density [`pdf_cosine`]).
+fn sample_cosine(u: [f64; 2]) -> DVec3 {
+    let r = u[0].sqrt();
+    let (sin_phi, cos_phi) = (2.0 * PI * u[1]).sin_cos();
+    DVec3::new(r * cos_phi, r * sin_phi, (1.0 - u[0]).max(0.0).sqrt())
+}
+
+fn pdf_cosine(wi_local: DVec3) -> f64 {
+    wi_local.z.max(0.0) / PI
+}
+
+/// The density over the solid angle of `h` of the MERL-grid half-vector strategy.
+fn half_vector_density(theta_h: f64) -> f64 {
+    let x_h = (theta_h / FRAC_PI_2).sqrt();
+    let jacobian = 2.0 * PI * PI * x_h * theta_h.sin();
+    if jacobian > 0.0 { 1.0 / jacobian } else { 0.0 }
+}
+
+/// The MERL-grid half-vector strategy, in the shading frame (density [`pdf_half_vector`]);
+/// `None` when `wo . h <= 0`.
+fn sample_half_vector(u: [f64; 2], wo: DVec3) -> Option<DVec3> {
+    let h = merl::spherical_dir(FRAC_PI_2 * u[0] * u[0], 2.0 * PI * u[1]);
+    let wo_h = wo.dot(h);
+    (wo_h > 0.0).then(|| 2.0 * wo_h * h - wo)
+}
+
+fn pdf_half_vector(wi_local: DVec3, wo: DVec3) -> f64 {
+    let sum = wi_local + wo;
+    if sum.length_squared() == 0.0 {
+        return 0.0;
+    }
+    let h = sum.normalize();
+    let wo_h = wo.dot(h);
+    if !(h.z > 0.0 && wo_h > 0.0) {
+        return 0.0;
+    }
+    half_vector_density(merl::coords::theta_of(h)) / (4.0 * wo_h)
+}
+
+/// One pixel's estimate.
+fn estimate(
+    frame: &ShadingFrame,
+    material: &Material,
+    level0: &EnvMap,
+    env: &EnvSampler,
+    rounds: u32,
+    seed: u64,
+    pixel: u64,
+) -> [f64; 3] {
+    let wo = frame.wo_local;
+    let sequences = [0, 1, 2].map(|s| OwenSobol2D::for_vector(seed, 3 * pixel + s));
+    // `g / (p_env + p_cos + p_h)` of one direction, given in both frames.
+    let contribution = |wi_local: DVec3, wi: DVec3, sum: &mut [f64; 3], env_pdf: Option<f64>| {
+        if wi_local.z.is_nan() || wi_local.z <= 0.0 {
+            return;
+        }
+        let f = brdf(&material.table, wi_local, wo);
+        if f == [0.0; 3] {
+            return;
+        }
+        let p = env_pdf.unwrap_or_else(|| env.pdf(wi)) + pdf_cosine(wi_local) + pdf_half_vector(wi_local, wo);
+        if !(p > 0.0 && p.is_finite()) {
+            return;
+        }
+        let radiance = level0.lookup(wi);
+        for c in 0..3 {
+            sum[c] += f[c] * f64::from(radiance[c]) * wi_local.z / p;
+        }
+    };
+    let mut sum = [0.0f64; 3];
+    for round in 0..rounds {
+        let (wi, pdf) = env.sample(sequences[0].point(round));
+        if pdf > 0.0 {
+            contribution(frame.to_local(wi), wi, &mut sum, Some(pdf));
+        }
+        let wi_local = sample_cosine(sequences[1].point(round));
+        contribution(wi_local, frame.to_world(wi_local), &mut sum, None);
+        if let Some(wi_local) = sample_half_vector(sequences[2].point(round), wo) {
+            contribution(wi_local, frame.to_world(wi_local), &mut sum, None);
+        }
+    }
+    sum.map(|s| s / f64::from(rounds))
+}

@@ -1,0 +1,13 @@
+//! The render crate's integration tests, one module per topic.
+
+mod support;
+
+mod converged;
+mod determinism;
+mod known_answer;
+mod mesh;
+mod metrics;
+mod obj;
+mod raster;
+mod sample_choice;
+mod validation;

@@ -1,0 +1,131 @@
+//! `brdf-bake`: the pipeline step. Runs every per-material stage and, with an environment, every
+//! environment stage into one folder with a `manifest.json`. Argument parsing and printing around
+//! `bake::run_bake`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use bake::{BakeConfig, Program, Progress};
+use clap::Parser;
+use serde_json::json;
+
+/// Bake a MERL material (and, with --env, an environment map) for real-time rendering. Writes,
+/// in DIR: the importance samples (importance.asset, importance.png), the bandwidth atlas
+/// (bandwidth-atlas.asset/.exr/.png), with --pca-max-error its PCA model (bandwidth-pca.asset,
+/// .png), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
+/// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png);
+/// then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool
+/// version and each stage's validation figures), written last.
+///
+/// A rerun with the same inputs (by sha256), parameters and tool version finds the manifest up to
+/// date and writes nothing (--force bakes anyway). Outputs are deterministic: reruns and thread
+/// counts give identical bytes. An interrupted bake leaves no manifest naming a missing or stale
+/// file; the next run cleans up and bakes again.
+///
+/// Exit status: 0 ok, 1 a stage's validation found a problem (the bake is written and says so),
+/// 2 error.
+#[derive(Debug, Parser)]
+#[command(version, about, long_about)]
+struct Args {
+    /// The MERL table (.binary).
+    material: PathBuf,
+
+    /// The environment map (lat-long OpenEXR or Radiance HDR, 2:1), for the environment stages.
+    #[arg(long, value_name = "ENV")]
+    env: Option<PathBuf>,
+
+    /// The folder to bake into (created if missing).
+    #[arg(long, short, value_name = "DIR")]
+    out_dir: PathBuf,
+
+    /// Also compress the bandwidth atlas by PCA, with the fewest components whose relative RMSE
+    /// is at most E (e.g. 0.02).
+    #[arg(long, value_name = "E")]
+    pca_max_error: Option<f64>,
+
+    /// Bake even when the folder's manifest is up to date.
+    #[arg(long)]
+    force: bool,
+
+    /// Print one JSON object on stdout: whether the bake was up to date, the manifest, and the
+    /// problems found; the report goes to stderr.
+    #[arg(long)]
+    json: bool,
+
+    /// No progress bar and no report (errors and problems still print).
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
+
+fn main() -> ExitCode {
+    cli::main(|| run(Args::parse()))
+}
+
+fn run(args: Args) -> Result<ExitCode> {
+    if let Some(e) = args.pca_max_error
+        && !(e > 0.0 && e < 1.0)
+    {
+        anyhow::bail!("--pca-max-error {e} is not in (0, 1)");
+    }
+    let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
+    config.pca_max_error = args.pca_max_error;
+    config.force = args.force;
+    let progress = cli::Progress::new(args.quiet);
+    let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {
+        Progress::Stage { index, count, name } => progress.step(format!("{}/{count} {name}", index + 1)),
+        Progress::Work { done, total } => progress.work(done, total),
+    })?;
+    progress.finish();
+
+    let dir = &args.out_dir;
+    let mut report = Vec::new();
+    if outcome.up_to_date {
+        report.push(format!(
+            "{} is up to date: same inputs, parameters and tool version; nothing written",
+            dir.join(bake::MANIFEST).display()
+        ));
+    } else if !args.quiet {
+        for (stage, lines) in &outcome.reports {
+            report.push(format!("[{stage}]"));
+            report.extend(lines.iter().map(|l| format!("  {l}")));
+        }
+    }
+    // Like every tool's `files`: what this run wrote, each with its format, role, size and hash.
+    let written: Vec<serde_json::Value> = if outcome.up_to_date {
+        Vec::new()
+    } else {
+        let manifest_path = dir.join(bake::MANIFEST);
+        let manifest_bytes = outcome.manifest.to_json().into_bytes();
+        outcome
+            .manifest
+            .outputs()
+            .map(|o| {
+                let mut v = json!(o);
+                v["path"] = json!(dir.join(&o.path).display().to_string());
+                v
+            })
+            .chain([json!({
+                "path": manifest_path.display().to_string(),
+                "format": "json",
+                "role": "manifest",
+                "size_bytes": manifest_bytes.len(),
+                "sha256": asset::hex(&asset::sha256(&manifest_bytes)),
+            })])
+            .collect()
+    };
+    let value = json!({
+        "up_to_date": outcome.up_to_date,
+        "manifest": outcome.manifest,
+        "problems": outcome.problems,
+        "files": written,
+    });
+    let written_line: Vec<String> = if written.is_empty() || args.quiet {
+        Vec::new()
+    } else {
+        vec![format!("{} files in {}", written.len(), dir.display())]
+    };
+    Ok(cli::finish(args.json, &value, &report, &outcome.problems, &written_line))
+}

@@ -1,0 +1,218 @@
+//! The previewer's benchmark (a benchmark, not a test): over the six cases (white-paint,
+//! gold-paint and chrome under potsdamer_platz and quarry_01, a 128 x 128 sphere),
+//!
+//! 1. the layer selection's calibration: the prefiltered mode's PSNR against the converged
+//!    estimate for each analysis size and per-view reduction (CPU renders, which equal the GPU's
+//!    to rounding), the figures that chose the bake's defaults;
+//! 2. each mode against the converged estimate at equal sample counts, with the GPU's
+//!    milliseconds per frame (lavapipe in CI; a real GPU elsewhere).
+//!
+//! `cargo bench -p brdf-preview --bench preview [-- --quick] [-- --no-calibration]`. Needs
+//! `../shared` (the maps, and nbrdf2merl.py with numpy for the materials, made once under
+//! target/merl/) and a GPU adapter (lavapipe: `make setup-gpu`).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use brdf_atlas::view::{ViewReduction, select_layers_of_table};
+use render::{Camera, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
+
+const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
+const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k.hdr", "quarry_01_1k.hdr"];
+const SIZE: usize = 128;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn shared() -> PathBuf {
+    let dir = root().join("../shared");
+    assert!(dir.join("data").is_dir(), "the shared data is missing: expected it at {}", dir.display());
+    dir
+}
+
+/// A real-derived MERL table, made once under target/merl/ by nbrdf2merl.py.
+fn material(name: &str) -> merl::MerlTable {
+    let path = root().join("target/merl").join(format!("{name}.binary"));
+    if !path.exists() {
+        let status = std::process::Command::new("python3")
+            .arg(shared().join("tools/nbrdf2merl.py"))
+            .arg("--out")
+            .arg(root().join("target/merl"))
+            .arg(name)
+            .status()
+            .expect("running python3");
+        assert!(status.success(), "nbrdf2merl.py {name} failed (it needs numpy)");
+    }
+    merl::read_file(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+}
+
+struct Case {
+    name: String,
+    table: merl::MerlTable,
+    samples: render::SampleSet,
+    lighting: Lighting,
+    preview: envmap::Preview,
+    converged: render::Image,
+    converged_picture: Vec<u8>,
+}
+
+fn scene() -> Scene {
+    Scene { mesh: Mesh::sphere(1.0, 128, 64), camera: Camera::default(), width: SIZE, height: SIZE }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let calibrate = !args.iter().any(|a| a == "--no-calibration");
+    let converged_samples: u32 = if quick { 256 } else { 1024 };
+    let scene = scene();
+    let exponents = prefilter::DEFAULT_EXPONENTS.to_vec();
+
+    let mut environments = Vec::new();
+    for env in ENVIRONMENTS {
+        let map = envmap::load(&shared().join("data/env").join(env)).expect("loading the map");
+        let config = prefilter::Config { exponents: exponents.clone(), ..prefilter::Config::default() };
+        let layers =
+            prefilter::prefilter(&map, &config).expect("prefiltering").layers.into_iter().map(|l| l.map).collect();
+        let preview = metrics::auto_preview(&map);
+        let lighting = Lighting { mips: envmap::MipChain::new(&map), layers, exponents: exponents.clone() };
+        environments.push((env.trim_end_matches(".hdr").to_string(), lighting, preview));
+    }
+    let mut cases = Vec::new();
+    for name in MATERIALS {
+        let table = material(name);
+        let tables = importance::build(&table, &importance::Config::default()).expect("importance tables");
+        let samples = bake::stage::importance::sample_set(&tables);
+        for (env, lighting, preview) in &environments {
+            let start = Instant::now();
+            let material = Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0] };
+            let converged =
+                render::converged::converged(&scene, &material, lighting, converged_samples, 1).expect("converged");
+            let converged_picture = metrics::tonemap(&converged, preview);
+            eprintln!(
+                "{name} under {env}: converged estimate ({converged_samples} per strategy) in {:.1} s",
+                start.elapsed().as_secs_f64()
+            );
+            cases.push(Case {
+                name: format!("{name} / {env}"),
+                table: table.clone(),
+                samples: samples.clone(),
+                lighting: lighting.clone(),
+                preview: *preview,
+                converged,
+                converged_picture,
+            });
+        }
+    }
+
+    if calibrate {
+        calibration(&cases, &scene, &exponents, quick);
+    }
+    modes(&cases, &scene, &exponents);
+}
+
+/// Table 1: the prefiltered mode's PSNR against the converged estimate per analysis size and
+/// reduction.
+fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
+    let sizes: &[usize] = if quick { &[64, 256] } else { &[64, 128, 256, 512] };
+    let reductions = [
+        ViewReduction::Max,
+        ViewReduction::BandQuantile(0.9),
+        ViewReduction::BandQuantile(0.95),
+        ViewReduction::BandQuantile(0.99),
+    ];
+    println!("\nLayer selection: prefiltered mode (16 spp, 1 frame) against the converged estimate, PSNR in dB");
+    print!("{:<14} {:<10}", "analysis", "reduction");
+    for case in cases {
+        print!(" {:>24}", case.name);
+    }
+    println!(" {:>8}", "mean");
+    for &size in sizes {
+        let config = brdf_atlas::Config { analysis_size: size, ..brdf_atlas::Config::default() };
+        // One atlas per material and size, shared by its two environments and every reduction.
+        let mut selections: Vec<Vec<Vec<u32>>> = Vec::new();
+        for pair in cases.chunks(ENVIRONMENTS.len()) {
+            let build = brdf_atlas::build_atlas(&pair[0].table, &config, &|_| {}).expect("atlas");
+            selections.push(
+                reductions
+                    .iter()
+                    .map(|&r| {
+                        brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection").view_layer
+                    })
+                    .collect(),
+            );
+        }
+        for (r, reduction) in reductions.iter().enumerate() {
+            print!("{:<14} {:<10}", format!("{size} x {size}"), reduction.name());
+            let mut sum = 0.0;
+            for (c, case) in cases.iter().enumerate() {
+                let view_layers = selections[c / ENVIRONMENTS.len()][r].clone();
+                let psnr = psnr_of(case, scene, view_layers, Mode::Prefiltered, 16, 1);
+                sum += psnr;
+                print!(" {psnr:>24.2}");
+            }
+            println!(" {:>8.2}", sum / cases.len() as f64);
+        }
+    }
+}
+
+/// PSNR of one CPU render against the case's converged estimate.
+fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<u32>, mode: Mode, spp: u32, frames: u32) -> f64 {
+    let material = Material { table: case.table.clone(), samples: case.samples.clone(), view_layers };
+    let image =
+        render::render(scene, &material, &case.lighting, &Settings { mode, spp, frames, seed: 0 }).expect("render");
+    metrics::psnr_db(&metrics::tonemap(&image, &case.preview), &case.converged_picture)
+}
+
+/// Table 2: every mode against the converged estimate at equal sample counts, timed on the GPU.
+fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
+    let gpu = gpu::Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    println!("\nModes against the converged estimate on {} (128 x 128 sphere)", gpu.adapter_summary());
+    println!(
+        "{:<26} {:<12} {:>5} {:>7} {:>9} {:>10} {:>12} {:>10}",
+        "case", "mode", "spp", "frames", "PSNR dB", "rel. error", "mean lum.", "ms/frame"
+    );
+    let config = brdf_atlas::Config { analysis_size: bake::DEFAULT_ANALYSIS_SIZE, ..brdf_atlas::Config::default() };
+    for pair in cases.chunks(ENVIRONMENTS.len()) {
+        let selection =
+            select_layers_of_table(&pair[0].table, &config, exponents, bake::stage::layers::DEFAULT_REDUCTION)
+                .expect("selection");
+        for case in pair {
+            let material = Material {
+                table: case.table.clone(),
+                samples: case.samples.clone(),
+                view_layers: selection.view_layer.clone(),
+            };
+            let mut renderer = gpu::preview::Renderer::new(&gpu, scene, &material, &case.lighting).expect("renderer");
+            let runs = [
+                (Mode::Reference, 16, 1),
+                (Mode::Fis, 16, 1),
+                (Mode::Prefiltered, 16, 1),
+                (Mode::Reference, 64, 16),
+                (Mode::Fis, 64, 1),
+                (Mode::Prefiltered, 64, 1),
+            ];
+            for (mode, spp, frames) in runs {
+                let settings = Settings { mode, spp, frames, seed: 0 };
+                renderer.render_frames(&Settings { frames: 1, ..settings }).expect("warm-up");
+                let repeats = (16 / frames).max(1);
+                let start = Instant::now();
+                let mut image = renderer.render_frames(&settings).expect("render");
+                for _ in 1..repeats {
+                    image = renderer.render_frames(&settings).expect("render");
+                }
+                let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(frames * repeats);
+                let picture = metrics::tonemap(&image, &case.preview);
+                let psnr = metrics::psnr_db(&picture, &case.converged_picture);
+                let relative = metrics::relative_error(&image.rgb, &case.converged.rgb);
+                let luminance = metrics::mean_luminance(&image) / metrics::mean_luminance(&case.converged);
+                println!(
+                    "{:<26} {:<12} {spp:>5} {frames:>7} {psnr:>9.2} {relative:>10.4} {luminance:>12.4} {ms:>10.1}",
+                    case.name,
+                    mode.name()
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,377 @@
+//! `brdf-preview`: renders a bake on the GPU so that a person (or a script) can check it before
+//! it ships; validates the GPU image against the CPU reference renderer. Argument parsing,
+//! loading and printing around `bake::load`, `gpu::preview` and `render`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::{Parser, ValueEnum};
+use picture::Canvas;
+use render::{Camera, Mesh, Mode, Scene, Settings, metrics};
+use serde_json::json;
+
+mod window;
+
+/// Render a baked material on a mesh under the bake's environment with wgpu (headless; --window
+/// for an interactive view), by one of the estimators of the papers:
+///
+///   reference    BRDF importance sampling with the baked sample vectors, accumulated over frames
+///                (001 section 3.3)
+///   fis          filtered importance sampling: each sample reads the environment's mip chain at
+///                level max(log4(w h / (N p)), 0) (002)
+///   prefiltered  the Phong layer the bake's layer selection picks for the view, read by few
+///                samples (001 sections 2.5 and 4.3)
+///
+/// The environment is drawn behind the mesh, so its orientation can be checked. Pictures are
+/// tone mapped: exposure 2^EV (by default the one that maps the environment's log-average
+/// luminance to 0.18), Reinhard's x / (1 + x) per channel, then the sRGB transfer function to 8
+/// bits; a caption strip below the image says what was rendered.
+///
+/// --validate renders the same image on the CPU (crate render: the same estimator, the same
+/// samples) and reports the PSNR of the two 8-bit pictures and the relative error of their linear
+/// radiance, and writes OUT-difference.png (|GPU - CPU| x 4). --converged N also renders an
+/// independent estimate (multiple importance sampling of the environment, the cosine and the
+/// MERL grid's half vectors, N samples per strategy, no baked table) and reports PSNR and the
+/// ratio of mean luminances against it. --sheet writes a contact sheet of every picture in the
+/// bake.
+///
+/// Exit status: 0 ok, 1 --min-psnr was not met, 2 error (including no GPU adapter).
+#[derive(Debug, Parser)]
+#[command(version, about, long_about)]
+struct Args {
+    /// The bake's folder (made by brdf-bake, with --env for rendering).
+    bake: PathBuf,
+
+    /// The picture to write (PNG).
+    #[arg(long, short, value_name = "FILE.png", required_unless_present_any = ["window", "sheet"])]
+    out: Option<PathBuf>,
+
+    /// The MERL table, when it is no longer where the bake read it (its sha256 must match).
+    #[arg(long, value_name = "FILE")]
+    material: Option<PathBuf>,
+
+    /// The mesh: sphere, torus, or a Wavefront OBJ file (scaled to the unit sphere).
+    #[arg(long, default_value = "sphere", value_name = "sphere|torus|FILE.obj")]
+    mesh: String,
+
+    /// The estimator.
+    #[arg(long, value_enum, default_value_t = ModeArg::Reference)]
+    mode: ModeArg,
+
+    /// Samples per pixel and frame: a power of two up to the bake's samples per vector (256 by
+    /// default). Default: 64 for reference, 16 for fis and prefiltered.
+    #[arg(long, value_name = "N")]
+    spp: Option<u32>,
+
+    /// Frames averaged. Default: 16 for reference, 1 for fis and prefiltered.
+    #[arg(long, value_name = "N")]
+    frames: Option<u32>,
+
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "256x256", value_parser = parse_size)]
+    size: (usize, usize),
+
+    /// Exposure in stops; default: the environment's log-average luminance maps to 0.18.
+    #[arg(long, value_name = "EV", allow_negative_numbers = true)]
+    exposure: Option<f32>,
+
+    /// Camera azimuth and elevation in degrees (it orbits the mesh, looking at its centre; 0,0
+    /// looks from +x towards -x, horizontally).
+    #[arg(long, value_name = "AZ,EL", default_value = "0,0", value_parser = parse_camera, allow_hyphen_values = true)]
+    camera: (f32, f32),
+
+    /// Mixed into every pixel's sample choice.
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+
+    /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
+    /// and write OUT-difference.png.
+    #[arg(long)]
+    validate: bool,
+
+    /// Also render the independent converged estimate with N samples per strategy; report PSNR and
+    /// mean luminance against it and write OUT-converged.png.
+    #[arg(long, value_name = "N")]
+    converged: Option<u32>,
+
+    /// Exit 1 when a reported PSNR (against the CPU, and against the converged estimate when
+    /// asked for) is below this, in dB.
+    #[arg(long, value_name = "DB")]
+    min_psnr: Option<f64>,
+
+    /// Write a contact sheet of every picture the bake holds (PNG).
+    #[arg(long, value_name = "FILE.png")]
+    sheet: Option<PathBuf>,
+
+    /// Open an interactive window instead of rendering a file (needs a display): the render
+    /// refines frame by frame; drag to orbit, scroll to zoom, 1/2/3 switch modes, D cycles the
+    /// debug views (normals, prefiltered layer, sample slice), +/- exposure, R resets the camera,
+    /// Esc or Q quits.
+    #[arg(long)]
+    window: bool,
+
+    #[command(flatten)]
+    window_options: window::Options,
+
+    /// Print one JSON object (mode, psnr_db, relative_error, ms_per_frame, ... and the files
+    /// written) on stdout; the report goes to stderr.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ModeArg {
+    Reference,
+    Fis,
+    Prefiltered,
+}
+
+impl From<ModeArg> for Mode {
+    fn from(m: ModeArg) -> Mode {
+        match m {
+            ModeArg::Reference => Mode::Reference,
+            ModeArg::Fis => Mode::Fis,
+            ModeArg::Prefiltered => Mode::Prefiltered,
+        }
+    }
+}
+
+fn parse_size(text: &str) -> Result<(usize, usize), String> {
+    let parse = |s: &str| s.trim().parse::<usize>().map_err(|e| format!("{s:?}: {e}"));
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        return Err(format!("{w}x{h}: each side must be between 1 and 8192"));
+    }
+    Ok((w, h))
+}
+
+fn parse_camera(text: &str) -> Result<(f32, f32), String> {
+    let parse = |s: &str| s.trim().parse::<f32>().map_err(|e| format!("{s:?}: {e}"));
+    let (a, e) = text.split_once(',').ok_or_else(|| format!("expected AZ,EL in degrees, got {text:?}"))?;
+    Ok((parse(a)?, parse(e)?))
+}
+
+fn main() -> ExitCode {
+    cli::main(|| run(Args::parse()))
+}
+
+fn run(args: Args) -> Result<ExitCode> {
+    let loaded = bake::load(&args.bake, args.material.as_deref())?;
+    let mut files: Vec<(PathBuf, Vec<u8>, (usize, usize))> = Vec::new();
+    let mut report = Vec::new();
+    let mut value = json!({});
+    if let Some(path) = &args.sheet {
+        let sheet = contact_sheet(&loaded)?;
+        files.push((path.clone(), sheet.rgb, (sheet.width, sheet.height)));
+    }
+    let mut problems = Vec::new();
+    if args.out.is_some() || args.window {
+        let Some(lighting) = &loaded.lighting else {
+            bail!(
+                "{}: the bake has no environment, nothing to light the material with: bake it with brdf-bake --env",
+                args.bake.display()
+            );
+        };
+        let mode = Mode::from(args.mode);
+        let settings = Settings {
+            mode,
+            spp: args.spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 }),
+            frames: args.frames.unwrap_or(if mode == Mode::Reference { 16 } else { 1 }),
+            seed: args.seed,
+        };
+        let scene = scene(&args)?;
+        let preview = match args.exposure {
+            Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
+            None => metrics::auto_preview(lighting.mips.level(0)),
+        };
+        if args.window {
+            return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
+        }
+        let gpu = gpu::Gpu::new()?;
+        let out = args.out.as_ref().expect("clap requires --out without --window");
+        let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
+        let start = Instant::now();
+        let image = renderer.render_frames(&settings)?;
+        let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
+        let picture = metrics::tonemap(&image, &preview);
+        let names = names(&loaded.manifest);
+        let caption = format!(
+            "{} | {} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+            names,
+            mode.name(),
+            settings.spp,
+            settings.frames,
+            scene.width,
+            scene.height,
+            preview.exposure_ev
+        );
+        let captioned = with_caption(&picture, scene.width, scene.height, &caption);
+        files.push((out.clone(), captioned.rgb, (captioned.width, captioned.height)));
+        report.push(format!(
+            "{}: {} on {} ({}), {:.1} ms per frame",
+            out.display(),
+            mode.name(),
+            gpu.adapter_summary(),
+            args.mesh,
+            ms_per_frame
+        ));
+        value = json!({
+            "bake": args.bake.display().to_string(),
+            "mode": mode.name(),
+            "spp": settings.spp,
+            "frames": settings.frames,
+            "width": scene.width,
+            "height": scene.height,
+            "exposure_ev": preview.exposure_ev,
+            "adapter": gpu.adapter_summary(),
+            "ms_per_frame": ms_per_frame,
+            "mean_luminance": metrics::mean_luminance(&image),
+        });
+
+        if args.validate {
+            let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
+            let cpu_picture = metrics::tonemap(&cpu, &preview);
+            let psnr = metrics::psnr_db(&picture, &cpu_picture);
+            let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
+            let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
+            let difference = metrics::difference_rgb8(&picture, &cpu_picture);
+            files.push((sibling(out, "difference"), difference, (scene.width, scene.height)));
+            report.push(format!(
+                "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
+                 pixels covered by one renderer only",
+                db(psnr)
+            ));
+            value["psnr_db"] = json_db(psnr);
+            value["relative_error"] = json!(relative);
+            value["coverage_mismatches"] = json!(coverage);
+            check_psnr(&args, "against the CPU", psnr, &mut problems);
+        }
+        if let Some(n) = args.converged {
+            let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+            let converged_picture = metrics::tonemap(&converged, &preview);
+            let psnr = metrics::psnr_db(&picture, &converged_picture);
+            let relative = metrics::relative_error(&image.rgb, &converged.rgb);
+            let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
+            files.push((sibling(out, "converged"), converged_picture, (scene.width, scene.height)));
+            report.push(format!(
+                "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
+                 mean luminance ratio {luminance_ratio:.4}",
+                db(psnr)
+            ));
+            value["converged"] = json!({
+                "samples_per_strategy": n,
+                "psnr_db": json_db(psnr),
+                "relative_error": relative,
+                "mean_luminance_ratio": luminance_ratio,
+            });
+            check_psnr(&args, "against the converged estimate", psnr, &mut problems);
+        }
+    }
+
+    // Every output is made; now write them, so that an error leaves none behind.
+    for (path, rgb, (w, h)) in &files {
+        envmap::write_png_rgb8(path, *w, *h, rgb).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let written: Vec<String> = files.iter().map(|(p, _, _)| p.display().to_string()).collect();
+    value["files"] = json!(written);
+    Ok(cli::finish(args.json, &value, &report, &problems, &written))
+}
+
+/// Every picture of the bake on one labelled page (`bake::sheet`).
+fn contact_sheet(loaded: &bake::Loaded) -> Result<Canvas> {
+    Ok(bake::sheet::contact_sheet(&loaded.dir, &loaded.manifest)?)
+}
+
+/// The scene the arguments describe.
+fn scene(args: &Args) -> Result<Scene> {
+    let mesh = match args.mesh.as_str() {
+        "sphere" => Mesh::sphere(1.0, 128, 64),
+        "torus" => Mesh::torus(0.7, 0.3, 128, 48),
+        path => {
+            let text = std::fs::read_to_string(path).with_context(|| format!("reading {path}"))?;
+            Mesh::from_obj(&text).with_context(|| format!("reading {path}"))?
+        }
+    };
+    let default = Camera::default();
+    let (azimuth, elevation) = args.camera;
+    let camera = Camera::orbit(
+        default.target(),
+        default.distance(),
+        azimuth.to_radians(),
+        elevation.to_radians(),
+        default.fov_y(),
+    )
+    .map_err(|e| anyhow!("--camera: {e}"))?;
+    Ok(Scene { mesh, camera, width: args.size.0, height: args.size.1 })
+}
+
+/// "material under environment", from the manifest.
+fn names(manifest: &asset::BakeManifest) -> String {
+    match &manifest.environment {
+        Some(env) => format!("{} under {}", manifest.material.name, env.name),
+        None => manifest.material.name.clone(),
+    }
+}
+
+/// `out` with `-suffix` before its extension: preview.png -> preview-difference.png.
+fn sibling(out: &Path, suffix: &str) -> PathBuf {
+    let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    out.with_file_name(format!("{stem}-{suffix}.png"))
+}
+
+fn db(psnr: f64) -> String {
+    if psnr.is_finite() { format!("{psnr:.2}") } else { "infinite (identical)".to_string() }
+}
+
+/// PSNR in JSON: a number, or null for identical pictures (JSON has no infinity).
+fn json_db(psnr: f64) -> serde_json::Value {
+    if psnr.is_finite() { json!(psnr) } else { serde_json::Value::Null }
+}
+
+fn check_psnr(args: &Args, what: &str, psnr: f64, problems: &mut Vec<String>) {
+    if let Some(min) = args.min_psnr
+        && psnr < min
+    {
+        problems.push(format!("PSNR {what} is {psnr:.2} dB, below --min-psnr {min}"));
+    }
+}
+
+/// The picture with a strip of text below it.
+fn with_caption(rgb: &[u8], width: usize, height: usize, caption: &str) -> Canvas {
+    let scale = if width >= 480 { 2 } else { 1 };
+    let line = picture::font::LINE_HEIGHT * scale;
+    let lines = wrap(caption, (width.saturating_sub(8)) / (picture::font::ADVANCE * scale));
+    let mut canvas = Canvas::new(width, height + 8 + lines.len() * line, picture::BACKGROUND);
+    canvas.blit_rgb8(width, height, rgb, 0, 0, 1);
+    for (i, text) in lines.iter().enumerate() {
+        canvas.text(4, (height + 5 + i * line) as isize, text, scale, picture::INK);
+    }
+    canvas
+}
+
+/// Breaks `text` at ` | ` separators (then anywhere) into lines of at most `columns` characters.
+fn wrap(text: &str, columns: usize) -> Vec<String> {
+    let columns = columns.max(8);
+    let mut lines: Vec<String> = Vec::new();
+    for part in text.split(" | ") {
+        match lines.last_mut() {
+            Some(last) if last.len() + 3 + part.len() <= columns => {
+                last.push_str(" | ");
+                last.push_str(part);
+            }
+            _ => {
+                let mut rest = part;
+                while rest.len() > columns {
+                    let (head, tail) = rest.split_at(rest.floor_char_boundary(columns));
+                    lines.push(head.to_string());
+                    rest = tail;
+                }
+                lines.push(rest.to_string());
+            }
+        }
+    }
+    lines
+}
