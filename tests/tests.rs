@@ -12,3 +12,4 @@ mod importance;
 mod invalid_inputs;
 mod json_output;
 mod merl_info;
+mod preview;

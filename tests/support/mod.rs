@@ -36,6 +36,18 @@ pub fn tool(name: &str) -> Command {
     assert!(path.exists(), "{} was not built", path.display());
     let mut cmd = Command::new(path);
     cmd.current_dir(root());
+    // The Vulkan loader complains on stderr when XDG_RUNTIME_DIR is unset (as it is under a bare
+    // `cargo test`); `make test` sets it, and so does this, to a private folder.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = root().join("target").join("xdg-runtime");
+        std::fs::create_dir_all(&dir).expect("creating target/xdg-runtime");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).expect("chmod 0700");
+        }
+        cmd.env("XDG_RUNTIME_DIR", dir);
+    }
     cmd
 }
 

@@ -56,6 +56,27 @@ impl BakeConfig {
         }
     }
 
+    /// Checks every stage's settings, so that a bake that cannot finish refuses to start (and
+    /// leaves the folder as it was).
+    pub fn check(&self) -> Result<(), Error> {
+        self.importance.check().map_err(|e| Error::stage("importance samples", e))?;
+        if !self.importance.n_samples.is_power_of_two() {
+            return Err(Error::Invalid(format!(
+                "{} importance samples per vector: the renderers take power-of-two blocks of a vector, so it must \
+                 be a power of two",
+                self.importance.n_samples
+            )));
+        }
+        self.atlas.check().map_err(|e| Error::stage("bandwidth atlas", e))?;
+        if let Some(e) = self.pca_max_error
+            && !(e > 0.0 && e < 1.0)
+        {
+            return Err(Error::Invalid(format!("the pca's largest relative rmse {e} is not in (0, 1)")));
+        }
+        self.prefilter.check().map_err(|e| Error::stage("prefilter", e))?;
+        Ok(())
+    }
+
     /// Every setting that shapes an output, as the manifest records it.
     pub fn parameters(&self) -> serde_json::Map<String, serde_json::Value> {
         let i = &self.importance;
@@ -129,6 +150,7 @@ pub fn run_bake(
     program: &Program,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<BakeOutcome, Error> {
+    config.check()?;
     let out = &config.out_dir;
     let material_source = Source::hash(&config.material)?;
     let environment_source = config.environment.as_deref().map(Source::hash).transpose()?;

@@ -101,10 +101,11 @@ fn pcg_hash(v: u32) -> u32 {
 // `render::sample_range`: (vector, first sample) of pixel `pixel` in frame `f`. The seed is hashed
 // before it meets the frame, so that renders with small seeds do not share their frames' words.
 fn sample_range(pixel: u32, f: u32) -> vec2<u32> {
-    let h = pcg_hash(pixel ^ pcg_hash(f ^ pcg_hash(shade.seed)));
-    let vector = h % shade.n_vectors;
-    let chunk = (h / shade.n_vectors) % (shade.n_samples / shade.spp);
-    return vec2<u32>(vector, chunk * shade.spp);
+    let per_vector = shade.n_samples / shade.spp;
+    let chunks = shade.n_vectors * per_vector;
+    let h = pcg_hash(pixel ^ pcg_hash(shade.seed));
+    let chunk = (h % chunks + f % chunks) % chunks;
+    return vec2<u32>(chunk / per_vector, (chunk % per_vector) * shade.spp);
 }
 
 // What covers a pixel (`render::raster::Hit`): the world position and the normalized normal

@@ -85,7 +85,9 @@ pub enum Error {
 }
 
 impl Config {
-    fn check(&self) -> Result<(), Error> {
+    /// Checks every setting against its range ([`build`] calls it; callers that want to refuse a
+    /// configuration before doing anything else call it first).
+    pub fn check(&self) -> Result<(), Error> {
         let positive = [
             ("theta_o count", self.n_theta_o),
             ("theta_h subdivision", self.theta_h_subdivision),

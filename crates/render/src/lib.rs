@@ -47,15 +47,19 @@
 //! angle (`data-schema/README.md`, kind 2). A pixel uses the slice nearest its `theta_o =
 //! atan2(wo_local.x, wo_local.z)`: `k = min(floor(theta_o / (pi / 2) * S + 1/2), S - 1)`.
 //!
-//! In frame `f` of a render with `spp` samples per pixel (a power of two dividing `N`), pixel
-//! `i = y * width + x` draws one random word `h = pcg_hash(i ^ pcg_hash(f ^ pcg_hash(seed)))`
-//! ([`pcg_hash`]: Jarzynski and Olano 2020, wrapping `u32` arithmetic, so both renderers draw the
-//! same word; the seed is hashed first because `f ^ seed` over `f = 0 .. frames` is the same set
-//! of words for every seed below `frames`, which would make such renders identical, not
-//! independent) and takes vector `v = h % V` and, within it, the `spp` consecutive samples
-//! starting at `c * spp` with `c = (h / V) % (N / spp)`. Each vector is an Owen-scrambled Sobol' sequence,
-//! so every aligned block of a power-of-two length is itself stratified (`001` section 3.3: "we
-//! read N_p samples randomly, from multiple pre-computed vectors").
+//! With `spp` samples per pixel and frame (a power of two dividing `N`), a slice holds
+//! `C = V N / spp` chunks of `spp` consecutive samples: chunk `c` is vector `c / (N / spp)`,
+//! samples from `(c % (N / spp)) spp`. Pixel `i = y * width + x` draws one random word
+//! `h = pcg_hash(i ^ pcg_hash(seed))` ([`pcg_hash`]: Jarzynski and Olano 2020, wrapping `u32`
+//! arithmetic, so both renderers draw the same word; the seed is hashed so that neighbouring seeds
+//! give unrelated words) and in frame `f` takes chunk `c = (h % C + f % C) % C`: the frames walk
+//! through the slice's chunks from a random start, each chunk once per `C` frames. Each vector is
+//! an Owen-scrambled Sobol' sequence, so every aligned block of a power-of-two length is itself
+//! stratified (`001` section 3.3: "we read N_p samples randomly, from multiple pre-computed
+//! vectors"). After `C` frames a pixel has used every baked sample of its slice exactly once: the
+//! image is then the estimator's expectation over the sample choice, exactly, and more frames only
+//! repeat it (a render that wants less noise than the bake's `V N` samples allow needs a bake
+//! with more samples).
 //!
 //! # The estimators ([`Mode`])
 //!
@@ -219,10 +223,18 @@ pub fn pcg_hash(v: u32) -> u32 {
 }
 
 /// The samples pixel `pixel` uses in frame `frame`: `(vector, first sample)` within its slice
-/// (see the crate documentation). `spp` must be a power of two dividing `n_samples`.
+/// (see the crate documentation). `spp` must be a power of two dividing `n_samples`, and
+/// `n_vectors * n_samples / spp` must fit a `u32`.
 pub fn sample_range(pixel: u32, frame: u32, seed: u32, n_vectors: u32, n_samples: u32, spp: u32) -> (u32, u32) {
-    let h = pcg_hash(pixel ^ pcg_hash(frame ^ pcg_hash(seed)));
-    let vector = h % n_vectors;
-    let chunk = (h / n_vectors) % (n_samples / spp);
-    (vector, chunk * spp)
+    let per_vector = n_samples / spp;
+    let chunks = n_vectors * per_vector;
+    let h = pcg_hash(pixel ^ pcg_hash(seed));
+    let chunk = (h % chunks + frame % chunks) % chunks;
+    (chunk / per_vector, (chunk % per_vector) * spp)
+}
+
+/// The frames after which a pixel has used every sample of its slice once ([`sample_range`]):
+/// `n_vectors * n_samples / spp`.
+pub fn frames_to_exhaust(n_vectors: usize, n_samples: usize, spp: u32) -> u32 {
+    (n_vectors * n_samples / spp as usize) as u32
 }

@@ -26,8 +26,24 @@ fn pcg_hash_known_values() {
 fn sample_range_follows_its_formula() {
     // The crate documentation's formula, written out again.
     let (pixel, frame, seed) = (1234, 5, 77);
-    let h = pcg_hash(pixel ^ pcg_hash(frame ^ pcg_hash(seed)));
-    assert_eq!(sample_range(pixel, frame, seed, 8, 256, 32), (h % 8, (h / 8) % 8 * 32));
+    let h = pcg_hash(pixel ^ pcg_hash(seed));
+    // 8 vectors of 256 samples in chunks of 32: 8 chunks per vector, 64 in all.
+    let chunk = (h % 64 + 5) % 64;
+    assert_eq!(sample_range(pixel, frame, seed, 8, 256, 32), (chunk / 8, chunk % 8 * 32));
+}
+
+#[test]
+fn the_frames_use_every_sample_of_the_slice_once_before_repeating() {
+    for (pixel, seed) in [(0, 0), (77, 3), (40_000, 123)] {
+        let frames = render::frames_to_exhaust(8, 256, 64);
+        assert_eq!(frames, 32);
+        let mut used = std::collections::BTreeSet::new();
+        for f in 0..frames {
+            assert!(used.insert(sample_range(pixel, f, seed, 8, 256, 64)), "frame {f} repeats a chunk");
+        }
+        assert_eq!(used.len(), 32);
+        assert_eq!(sample_range(pixel, frames, seed, 8, 256, 64), sample_range(pixel, 0, seed, 8, 256, 64));
+    }
 }
 
 #[test]

@@ -44,6 +44,21 @@ struct Args {
     #[arg(long, value_name = "E")]
     pca_max_error: Option<f64>,
 
+    /// Vectors of importance samples per view elevation (each of --samples samples): the
+    /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
+    /// needs tens of vectors for percent-level agreement).
+    #[arg(long, value_name = "V", default_value_t = importance::Config::default().n_vectors)]
+    vectors: usize,
+
+    /// Importance samples per vector (a power of two).
+    #[arg(long, value_name = "N", default_value_t = importance::Config::default().n_samples)]
+    samples: usize,
+
+    /// Pixels per side of the images each lobe is analysed on, for the bandwidth atlas and the
+    /// layer selection (a power of two from 16 up; at least 256 tells the default layers apart).
+    #[arg(long = "analysis-size", value_name = "N", default_value_t = bake::DEFAULT_ANALYSIS_SIZE)]
+    analysis_size: usize,
+
     /// Bake even when the folder's manifest is up to date.
     #[arg(long)]
     force: bool,
@@ -72,6 +87,9 @@ fn run(args: Args) -> Result<ExitCode> {
     }
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;
+    config.importance.n_vectors = args.vectors;
+    config.importance.n_samples = args.samples;
+    config.atlas.analysis_size = args.analysis_size;
     config.force = args.force;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {

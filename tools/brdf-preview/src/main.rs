@@ -65,7 +65,9 @@ struct Args {
     #[arg(long, value_name = "N")]
     spp: Option<u32>,
 
-    /// Frames averaged. Default: 16 for reference, 1 for fis and prefiltered.
+    /// Frames averaged. Frames walk through the bake's samples, each once (render crate docs).
+    /// Default: for reference, enough frames to use every baked sample of a pixel's slice once
+    /// (32 at 64 spp with the default bake); 1 for fis and prefiltered.
     #[arg(long, value_name = "N")]
     frames: Option<u32>,
 
@@ -160,12 +162,13 @@ fn main() -> ExitCode {
 
 fn run(args: Args) -> Result<ExitCode> {
     let loaded = bake::load(&args.bake, args.material.as_deref())?;
-    let mut files: Vec<(PathBuf, Vec<u8>, (usize, usize))> = Vec::new();
+    // (path, role, PNG bytes): every output is encoded before any is written.
+    let mut files: Vec<(PathBuf, &'static str, Vec<u8>)> = Vec::new();
     let mut report = Vec::new();
     let mut value = json!({});
     if let Some(path) = &args.sheet {
         let sheet = contact_sheet(&loaded)?;
-        files.push((path.clone(), sheet.rgb, (sheet.width, sheet.height)));
+        files.push((path.clone(), "contact-sheet", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
     let mut problems = Vec::new();
     if args.out.is_some() || args.window {
@@ -176,10 +179,16 @@ fn run(args: Args) -> Result<ExitCode> {
             );
         };
         let mode = Mode::from(args.mode);
+        let spp = args.spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
         let settings = Settings {
             mode,
-            spp: args.spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 }),
-            frames: args.frames.unwrap_or(if mode == Mode::Reference { 16 } else { 1 }),
+            spp,
+            frames: args.frames.unwrap_or(if mode == Mode::Reference {
+                let samples = &loaded.material.samples;
+                render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp)
+            } else {
+                1
+            }),
             seed: args.seed,
         };
         let scene = scene(&args)?;
@@ -209,7 +218,7 @@ fn run(args: Args) -> Result<ExitCode> {
             preview.exposure_ev
         );
         let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-        files.push((out.clone(), captioned.rgb, (captioned.width, captioned.height)));
+        files.push((out.clone(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?));
         report.push(format!(
             "{}: {} on {} ({}), {:.1} ms per frame",
             out.display(),
@@ -238,7 +247,7 @@ fn run(args: Args) -> Result<ExitCode> {
             let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
             let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
             let difference = metrics::difference_rgb8(&picture, &cpu_picture);
-            files.push((sibling(out, "difference"), difference, (scene.width, scene.height)));
+            files.push((sibling(out, "difference"), "difference", png(&difference, scene.width, scene.height)?));
             report.push(format!(
                 "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
                  pixels covered by one renderer only",
@@ -255,7 +264,7 @@ fn run(args: Args) -> Result<ExitCode> {
             let psnr = metrics::psnr_db(&picture, &converged_picture);
             let relative = metrics::relative_error(&image.rgb, &converged.rgb);
             let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
-            files.push((sibling(out, "converged"), converged_picture, (scene.width, scene.height)));
+            files.push((sibling(out, "converged"), "converged", png(&converged_picture, scene.width, scene.height)?));
             report.push(format!(
                 "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
                  mean luminance ratio {luminance_ratio:.4}",
@@ -272,12 +281,28 @@ fn run(args: Args) -> Result<ExitCode> {
     }
 
     // Every output is made; now write them, so that an error leaves none behind.
-    for (path, rgb, (w, h)) in &files {
-        envmap::write_png_rgb8(path, *w, *h, rgb).with_context(|| format!("writing {}", path.display()))?;
+    for (path, _, bytes) in &files {
+        asset::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))?;
     }
     let written: Vec<String> = files.iter().map(|(p, _, _)| p.display().to_string()).collect();
-    value["files"] = json!(written);
+    value["files"] = files
+        .iter()
+        .map(|(path, role, bytes)| {
+            json!({
+                "path": path.display().to_string(),
+                "format": "png",
+                "role": role,
+                "size_bytes": bytes.len(),
+                "sha256": asset::hex(&asset::sha256(bytes)),
+            })
+        })
+        .collect();
     Ok(cli::finish(args.json, &value, &report, &problems, &written))
+}
+
+/// An 8-bit RGB picture as PNG bytes.
+fn png(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>> {
+    Ok(envmap::encode_png_rgb8(width, height, rgb)?)
 }
 
 /// Every picture of the bake on one labelled page (`bake::sheet`).
