@@ -70,8 +70,10 @@ bake: build
 	@test -n "$(IN)" -a -n "$(OUT)" || { echo "usage: make bake IN=DIR OUT=DIR [ENV=map.hdr] [-j N]"; exit 2; }
 	@$(MAKE) --no-print-directory $(BAKES)
 
-$(OUT)/%/manifest.json: $(IN)/%.binary $(ENV)
-	$(BIN)/brdf-bake $< $(if $(ENV),--env $(ENV)) --out-dir $(OUT)/$* --quiet
+# Exit 1 (a stage's validation found a problem; the bake is written and its manifest says what)
+# does not stop the other bakes; exit 2 (an error) does.
+$(OUT)/%/manifest.json: $(IN)/%.binary $(ENV) $(BIN)/brdf-bake
+	@$(BIN)/brdf-bake $< $(if $(ENV),--env $(ENV)) --out-dir $(OUT)/$* --quiet || test $$? -eq 1
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

@@ -107,7 +107,10 @@ fn every_tool_prints_one_json_object_listing_the_files_it_wrote() {
                 "16".into(),
             ],
         ),
-        ("brdf-bandwidth", vec![os(&table), "--lobes".into(), "4".into(), "--quiet".into()]),
+        (
+            "brdf-bandwidth",
+            vec![os(&table), "--lobes".into(), "4".into(), "--analysis-size".into(), "128".into(), "--quiet".into()],
+        ),
         (
             "bandwidth-pca",
             vec![os(&dir("brdf-bandwidth").join("bandwidth-atlas.asset")), "--components".into(), "2".into()],

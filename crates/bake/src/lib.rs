@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 pub use error::Error;
 pub use load::{Loaded, load};
-pub use run::{BakeConfig, BakeOutcome, DEFAULT_ANALYSIS_SIZE, MANIFEST, Progress, run_bake};
+pub use run::{BakeConfig, BakeOutcome, MANIFEST, Progress, run_bake};
 
 use asset::{FileFormat, StageOutput};
 

@@ -12,12 +12,6 @@ use crate::{Error, Program, Source, Staged, object};
 /// The manifest's file name in a bake's folder.
 pub const MANIFEST: &str = "manifest.json";
 
-/// The size of the images each lobe is analysed on, in the bake (the single-stage
-/// `brdf-bandwidth` keeps `brdf_atlas::Config`'s default): large enough that the layer selection
-/// tells the default layers apart up to n = 4096 (at 128 the two sharpest measure within 10% of
-/// each other; at 256 a factor 1.9).
-pub const DEFAULT_ANALYSIS_SIZE: usize = 256;
-
 /// What to bake and how.
 #[derive(Clone, Debug)]
 pub struct BakeConfig {
@@ -47,7 +41,7 @@ impl BakeConfig {
             environment,
             out_dir,
             importance: ::importance::Config::default(),
-            atlas: brdf_atlas::Config { analysis_size: DEFAULT_ANALYSIS_SIZE, ..brdf_atlas::Config::default() },
+            atlas: brdf_atlas::Config::default(),
             pca_max_error: None,
             env_bandwidth: env_bandwidth::Settings::default(),
             prefilter: ::prefilter::Config::default(),

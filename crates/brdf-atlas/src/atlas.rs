@@ -19,7 +19,11 @@ pub struct Config {
     /// Pixels per side of the grid each lobe is analysed on ([`crate::LobeMap`]): a power of
     /// two from 16 to 4096, at least `tile`. The highest bandwidth it can report is
     /// [`DEFAULT_C`](bandwidth::DEFAULT_C)` / 2` cycles per pixel, `0.088 size / pi` cycles per
-    /// radian at the centre of the lobe image (5.6 for 64).
+    /// radian at the centre of the lobe image (1.8 for 64, 14.4 for 512). The default, 512,
+    /// resolves normalized Phong lobes up to n = 1000 wherever their lobe lies above the horizon
+    /// (at 256 every lobe of n = 1000 reaches the limit); the lobes that straddle the horizon at
+    /// the grazing rows still read the limit there (320 of 4096 lobes for n = 1000, 64 at 1024).
+    /// It costs about 2.5 s for a real-derived material in a release build on two cores.
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).
     pub eps: f64,
@@ -33,7 +37,7 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Self { lobes: 64, tile: 16, analysis_size: 64, eps: 0.01, c: bandwidth::DEFAULT_C, relative_noise_floor: 1e-6 }
+        Self { lobes: 64, tile: 16, analysis_size: 512, eps: 0.01, c: bandwidth::DEFAULT_C, relative_noise_floor: 1e-6 }
     }
 }
 

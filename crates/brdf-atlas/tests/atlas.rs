@@ -18,7 +18,7 @@ fn invalid_configurations_are_errors() {
         (Config { tile: 12, ..Config::default() }, "tile size 12 is not a power of two"),
         (Config { analysis_size: 96, ..Config::default() }, "analysis size 96"),
         (Config { analysis_size: 8, tile: 8, ..Config::default() }, "analysis size 8"),
-        (Config { tile: 128, ..Config::default() }, "exceeds the analysis size"),
+        (Config { tile: 64, analysis_size: 32, ..Config::default() }, "exceeds the analysis size"),
         (Config { eps: 0.0, ..Config::default() }, "eps"),
         (Config { relative_noise_floor: -1.0, ..Config::default() }, "noise floor"),
         (Config { lobes: 4096, tile: 16, ..Config::default() }, "exceeds the limit"),
@@ -37,7 +37,7 @@ fn tiles_equal_a_direct_analysis_of_each_lobe() {
     // the row's image to rounding (1e-16), which could only move a pixel across an eq. 7
     // threshold at an exact tie: the tiles are compared exactly.
     let table = phong(40.0);
-    let config = Config { lobes: 6, tile: 8, ..Config::default() };
+    let config = Config { lobes: 6, tile: 8, analysis_size: 64, ..Config::default() };
     let build = build_atlas(&table, &config, &|_| {}).unwrap();
     let atlas = &build.atlas;
     assert_eq!((atlas.width(), atlas.height(), atlas.data.len()), (48, 48, 48 * 48));
@@ -66,7 +66,7 @@ fn the_limit_is_reached_around_the_mirror_direction() {
     // documented maps (the tile's row gives theta_i, LobeMap::uv the texel), must be one of
     // them, and they must all lie within 3 texels of it (the finest wavelets span 4 pixels and
     // a texel 4 pixels).
-    let config = Config { lobes: 8, tile: 16, ..Config::default() };
+    let config = Config { lobes: 8, tile: 16, analysis_size: 64, ..Config::default() };
     let atlas = build_atlas(&phong(1000.0), &config, &|_| {}).unwrap().atlas;
     let limit = (config.c / 2.0 * 64.0 / std::f64::consts::PI) as f32 * (1.0 - 1e-6);
     let grid = IncidentGrid::new(8);

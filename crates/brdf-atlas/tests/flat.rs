@@ -14,7 +14,7 @@ fn lambertian() -> merl::MerlTable {
 fn a_lambertian_atlas_is_flat() {
     // Every lobe of a 16 x 16 grid, grazing ones included (the table has no data below the
     // horizon, so those lobes exercise the hole filling and the renormalized lookups).
-    let config = Config { lobes: 16, ..Config::default() };
+    let config = Config { lobes: 16, analysis_size: 64, ..Config::default() };
     let build = build_atlas(&lambertian(), &config, &|_| {}).unwrap();
     let nonzero = build.atlas.data.iter().filter(|v| **v != 0.0).count();
     println!(
@@ -32,7 +32,7 @@ fn without_the_noise_floor_rounding_noise_reads_as_signal() {
     // The same material with the floor at zero: the lookups' rounding (1e-16 relative) is all
     // the detail there is, and the relative test of eq. 7 reads it. This is why the test above
     // can fail.
-    let config = Config { lobes: 4, relative_noise_floor: 0.0, ..Config::default() };
+    let config = Config { lobes: 4, analysis_size: 64, relative_noise_floor: 0.0, ..Config::default() };
     let build = build_atlas(&lambertian(), &config, &|_| {}).unwrap();
     let nonzero = build.atlas.data.iter().filter(|v| **v != 0.0).count();
     println!("lambertian without a noise floor: {nonzero} of {} texels nonzero", build.atlas.data.len());

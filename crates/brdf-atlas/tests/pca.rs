@@ -41,7 +41,7 @@ const FULL_TOLERANCE: f64 = 1e-6;
 fn all_components_reproduce_the_atlas() {
     for atlas in [
         random_atlas(16, 8, 1),
-        build_atlas(&phong(30.0), &Config { lobes: 8, ..Config::default() }, &|_| {}).unwrap().atlas,
+        build_atlas(&phong(30.0), &Config { lobes: 8, analysis_size: 64, ..Config::default() }, &|_| {}).unwrap().atlas,
     ] {
         let model = fit(&atlas, Components::Count(atlas.tile_len())).unwrap().model;
         model.check().unwrap();

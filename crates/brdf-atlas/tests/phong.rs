@@ -83,7 +83,7 @@ fn the_atlas_counts_the_lobes_at_the_limit() {
     // The same statement at the default analysis size, through the atlas builder: a sharp lobe
     // (fwhm 2 px at 64 x 64) reaches the limit in every lobe, a broad one (fwhm 19 px) in none
     // away from grazing incidence.
-    let config = Config { lobes: 8, ..Config::default() };
+    let config = Config { lobes: 8, analysis_size: 64, ..Config::default() };
     let sharp = brdf_atlas::build_atlas(&phong(1000.0), &config, &|_| {}).unwrap();
     assert_eq!(sharp.stats.nyquist_lobes(), 64, "{:?}", sharp.stats.nyquist_pixels);
     let broad = brdf_atlas::build_atlas(&phong(6.0), &config, &|_| {}).unwrap();

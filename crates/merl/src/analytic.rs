@@ -67,6 +67,19 @@ impl Analytic {
     }
 }
 
+/// For people: `ggx alpha 0.2, f0 0.95 0.64 0.54`.
+impl std::fmt::Display for Analytic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let rgb = |c: [f64; 3]| format!("{} {} {}", c[0], c[1], c[2]);
+        match *self {
+            Analytic::Lambertian { albedo } => write!(f, "lambertian albedo {}", rgb(albedo)),
+            Analytic::Phong { n, ks } => write!(f, "normalized phong n {n}, ks {}", rgb(ks)),
+            Analytic::BlinnPhong { n, ks } => write!(f, "blinn-phong n {n}, ks {}", rgb(ks)),
+            Analytic::Ggx { alpha, f0 } => write!(f, "ggx alpha {alpha}, f0 {}", rgb(f0)),
+        }
+    }
+}
+
 /// GGX normal distribution, normalized so that `integral D(h) cos theta_h dh = 1`.
 pub fn ggx_d(alpha: f64, cos_theta_h: f64) -> f64 {
     if cos_theta_h <= 0.0 {
@@ -95,6 +108,15 @@ mod tests {
         let n = 200_000;
         let dt = FRAC_PI_2 / n as f64;
         (0..n).map(|i| (i as f64 + 0.5) * dt).map(|t| g(t) * t.sin() * dt).sum::<f64>() * 2.0 * PI
+    }
+
+    #[test]
+    fn display_is_plain() {
+        assert_eq!(
+            Analytic::Ggx { alpha: 0.2, f0: [0.95, 0.64, 0.54] }.to_string(),
+            "ggx alpha 0.2, f0 0.95 0.64 0.54"
+        );
+        assert_eq!(Analytic::Phong { n: 1000.0, ks: [1.0; 3] }.to_string(), "normalized phong n 1000, ks 1 1 1");
     }
 
     #[test]

@@ -55,8 +55,9 @@ struct Args {
     samples: usize,
 
     /// Pixels per side of the images each lobe is analysed on, for the bandwidth atlas and the
-    /// layer selection (a power of two from 16 up; at least 256 tells the default layers apart).
-    #[arg(long = "analysis-size", value_name = "N", default_value_t = bake::DEFAULT_ANALYSIS_SIZE)]
+    /// layer selection (a power of two from 16 to 4096; 256 or more tells the default layers
+    /// apart, and 512 resolves Phong lobes up to n = 1000).
+    #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size)]
     analysis_size: usize,
 
     /// Bake even when the folder's manifest is up to date.

@@ -173,7 +173,7 @@ fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
         "{:<26} {:<12} {:>5} {:>7} {:>9} {:>10} {:>12} {:>10}",
         "case", "mode", "spp", "frames", "PSNR dB", "rel. error", "mean lum.", "ms/frame"
     );
-    let config = brdf_atlas::Config { analysis_size: bake::DEFAULT_ANALYSIS_SIZE, ..brdf_atlas::Config::default() };
+    let config = brdf_atlas::Config::default();
     for pair in cases.chunks(ENVIRONMENTS.len()) {
         let selection =
             select_layers_of_table(&pair[0].table, &config, exponents, bake::stage::layers::DEFAULT_REDUCTION)

@@ -140,6 +140,6 @@ fn run(args: Args) -> Result<ExitCode> {
             "sha256": asset::hex(&asset::sha256(&bytes)),
         }],
     });
-    let report = [format!("{brdf:?}: a {dims_text} table (theta_h x theta_d x phi_d)")];
+    let report = [format!("{brdf}: a {dims_text} table (theta_h x theta_d x phi_d)")];
     Ok(cli::finish(args.json, &value, &report, &[], &[out.display().to_string()]))
 }

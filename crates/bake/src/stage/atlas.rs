@@ -80,9 +80,26 @@ pub fn run(
             },
         ],
         report,
-        problems: Vec::new(),
+        problems: limit_problem(config, &build),
     };
     Ok((staged, build))
+}
+
+/// A validation problem when most lobes reach the analysis grid's limit: their bandwidth is then
+/// a lower bound, and a renderer would shade too coarsely.
+fn limit_problem(config: &Config, build: &AtlasBuild) -> Vec<String> {
+    let (at_limit, lobes) = (build.stats.nyquist_lobes(), build.atlas.n_lobes());
+    if 2 * at_limit <= lobes {
+        return Vec::new();
+    }
+    vec![format!(
+        "{at_limit} of {lobes} lobes reach the analysis grid's limit ({:.2} cycles per radian at a lobe's centre at \
+         {} x {}): their bandwidth is a lower bound; analyse at a larger size (--analysis-size, up to 4096; each \
+         doubling doubles the limit)",
+        limit_at_centre(config),
+        config.analysis_size,
+        config.analysis_size
+    )]
 }
 
 /// The highest bandwidth the analysis grid can report at a lobe's centre, cycles per radian: the
