@@ -52,14 +52,16 @@ bench:
 	$(CARGO) bench -p brdf-atlas --bench atlas
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
-## procedural calibration sky), then render a preview and a contact sheet of the bake.
+## procedural calibration sky), then render previews (pre-convolved; reference, validated against
+## the CPU) and a contact sheet of the bake.
 demo: setup-gpu build
 	@mkdir -p $(DEMO)
 	$(BIN)/merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out $(DEMO)/ggx-copper.binary
 	$(BIN)/envmap-synth --out $(DEMO)/calibration-sky.exr
-	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --out-dir $(DEMO)/bake
-	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --sheet $(DEMO)/sheet.png --validate
-	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, sheet.png"
+	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --vectors 32 --out-dir $(DEMO)/bake
+	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --mode prefiltered --size 384x384 --camera 200,15 --sheet $(DEMO)/sheet.png
+	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview-reference.png --size 384x384 --camera 200,15 --validate
+	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png, sheet.png"
 
 ## bake: every MERL table in IN (*.binary) into OUT/<name>/, in parallel with -j; ENV=map.hdr adds
 ## the environment stages. E.g. make -j4 bake IN=target/merl OUT=target/bakes ENV=../shared/data/env/quarry_01_1k.hdr

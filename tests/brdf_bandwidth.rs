@@ -29,12 +29,24 @@ fn bandwidth_pca(atlas: &Path, out: &Path, args: &[&str]) -> Run {
     run(cmd, "")
 }
 
-/// The payload of an asset file, which must be of the expected kind.
-fn read_atlas(path: &Path) -> asset::BandwidthAtlas {
+/// The payload of an asset file, which must be of the expected kind: a MERL table's atlas is
+/// isotropic, so `brdf-bandwidth` stores it once per row (kind 7).
+fn read_rows(path: &Path) -> asset::BandwidthRows {
     match asset::read_file(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display())).payload {
-        asset::Payload::BandwidthAtlas(a) => a,
-        other => panic!("{} holds {}, expected a bandwidth atlas", path.display(), other.kind()),
+        asset::Payload::BandwidthRows(r) => r,
+        other => panic!("{} holds {}, expected bandwidth rows", path.display(), other.kind()),
     }
+}
+
+/// The full atlas texture the rows stand for, as `data-schema/brdf-atlas.md` tells a renderer to
+/// expand it: texel `(x, y)` is texel `(x mod tile, y mod tile)` of row `y / tile`'s tile.
+fn expand(rows: &asset::BandwidthRows) -> Vec<f32> {
+    let (t, width) = (rows.tile as usize, (rows.lobes_x * rows.tile) as usize);
+    let height = (rows.lobes_y * rows.tile) as usize;
+    (0..width * height)
+        .map(|k| (k % width, k / width))
+        .map(|(x, y)| rows.data[(y / t) * t * t + (y % t) * t + x % t])
+        .collect()
 }
 
 fn read_model(path: &Path) -> asset::BandwidthPca {
@@ -60,35 +72,50 @@ fn tools_end_to_end() {
     let tmp = temp_dir();
     let material = write_table(tmp.path(), "phong30.binary", Analytic::Phong { n: 30.0, ks: [0.9, 0.6, 0.3] });
     let out = tmp.path().join("atlas");
-    let r = brdf_bandwidth(&material, &out, &["--lobes", "8"]).expect_code(0).expect_stdout("8 x 8 lobes of 16 x 16");
+    let r = brdf_bandwidth(&material, &out, &["--lobes", "8", "--json"]).expect_code(0);
+    assert!(r.stderr.contains("8 x 8 lobes of 16 x 16") && r.stderr.contains("kind 7 (bandwidth-rows)"), "{r}");
 
-    // An 8 x 8 grid of 16 x 16 tiles: 128 x 128 texels in the EXR and the asset. (The picture's
-    // layout belongs to the picture code: it must decode.)
-    assert_eq!(exr_header(&out.join("bandwidth-atlas.exr")), ((128, 128), vec!["Y".to_string()]), "{r}");
+    // An 8 x 8 grid of 16 x 16 tiles: 128 x 128 texels in the EXR (the renderers' texture), the
+    // 8 row tiles in the asset, which expand to the EXR's texels exactly. (The picture's layout
+    // belongs to the picture code: it must decode.)
+    let exr = out.join("bandwidth-atlas.exr");
+    assert_eq!(exr_header(&exr), ((128, 128), vec!["Y".to_string()]), "{r}");
     png_decode(&out.join("bandwidth-atlas.png"));
-    let atlas = read_atlas(&out.join("bandwidth-atlas.asset"));
-    assert_eq!((atlas.lobes_x, atlas.lobes_y, atlas.tile), (8, 8, 16));
-    let texels = atlas.data;
-    assert_eq!(texels.len(), 128 * 128);
+    let rows = read_rows(&out.join("bandwidth-atlas.asset"));
+    assert_eq!((rows.lobes_x, rows.lobes_y, rows.tile), (8, 8, 16));
+    assert_eq!(rows.data.len(), 8 * 16 * 16);
+    let texels = expand(&rows);
+    let image = envmap::read_image(&exr, &envmap::Limits::default()).unwrap();
+    let exr_texels: Vec<f32> = image.rgb.iter().step_by(3).copied().collect();
+    assert!(texels == exr_texels, "the rows expanded differ from the EXR\n{r}");
     assert!(texels.iter().all(|v| v.is_finite() && *v >= 0.0) && texels.iter().any(|v| *v > 0.0), "{r}");
+    assert_eq!(figure(&r, "stored_kind"), "bandwidth-rows", "{r}");
 
-    // PCA with every component reproduces it.
+    // PCA with every component reproduces it. The model is fitted on the 8 row tiles: one
+    // column, one set of coefficients per row.
     let bin = out.join("bandwidth-atlas.asset");
     let model_dir = tmp.path().join("model");
     let model = model_dir.join("bandwidth-pca.asset");
     let r = bandwidth_pca(&bin, &model_dir, &["--components", "256", "--json"]).expect_code(0);
     assert_eq!(figure(&r, "components"), 256);
+    assert_eq!(figure(&r, "distinct_tiles"), 8);
     assert!(figure(&r, "relative_rmse").as_f64().unwrap() <= 1e-6, "{r}");
     let m = read_model(&model);
-    assert_eq!(m.n_components, 256);
-    assert_eq!((m.mean.len(), m.components.len(), m.coefficients.len()), (256, 256 * 256, 64 * 256));
+    assert_eq!((m.lobes_x, m.lobes_y, m.n_components), (1, 8, 256));
+    assert_eq!((m.mean.len(), m.components.len(), m.coefficients.len()), (256, 256 * 256, 8 * 256));
     png_decode(&model_dir.join("bandwidth-pca.png"));
 
-    // Fewer components: a smaller model, and the report says how far off it is.
-    let r = bandwidth_pca(&bin, &model_dir, &["--components", "4"]).expect_code(0).expect_stdout("components      4");
-    assert!(r.stdout.contains("relative rmse") && r.stdout.contains("compression"), "{r}");
+    // Fewer components: a smaller model, and the report says how far off it is, against the
+    // distinct tiles (8 x 256 floats) and against the full grid (64 x 256 floats), 8 times less.
+    let r = bandwidth_pca(&bin, &model_dir, &["--components", "4", "--json"]).expect_code(0);
+    assert!(r.stderr.contains("components      4") && r.stderr.contains("relative rmse"), "{r}");
+    assert!(r.stderr.contains("of the distinct tiles") && r.stderr.contains("against the full 8 x 8 grid"), "{r}");
     let m = read_model(&model);
-    assert_eq!((m.mean.len(), m.components.len(), m.coefficients.len()), (256, 4 * 256, 64 * 4));
+    assert_eq!((m.mean.len(), m.components.len(), m.coefficients.len()), (256, 4 * 256, 8 * 4));
+    let stored = (256 + 4 * 256 + 8 * 4) as f64;
+    let (ratio, ratio_full) =
+        (figure(&r, "size_ratio").as_f64().unwrap(), figure(&r, "size_ratio_full_grid").as_f64().unwrap());
+    assert!((ratio - stored / (8.0 * 256.0)).abs() < 1e-12 && (ratio_full - stored / (64.0 * 256.0)).abs() < 1e-12);
 }
 
 #[test]
@@ -132,7 +159,7 @@ fn a_lambertian_atlas_is_flat() {
     let out = tmp.path().join("atlas");
     let r = brdf_bandwidth(&material, &out, &["--lobes", "8", "--json"]).expect_code(0);
     assert_eq!(lobes_at_limit(&r), 0, "{r}");
-    let texels = read_atlas(&out.join("bandwidth-atlas.asset")).data;
+    let texels = read_rows(&out.join("bandwidth-atlas.asset")).data;
     let nonzero = texels.iter().filter(|v| **v != 0.0).count();
     assert_eq!(nonzero, 0, "{nonzero} texels of a Lambertian atlas read a frequency\n{r}");
     assert_eq!(figure(&r, "flat_texels"), 128 * 128, "the figures agree with the asset\n{r}");
@@ -155,9 +182,10 @@ fn bad_inputs_exit_2_naming_the_file() {
         .expect_code(2)
         .expect_error(&truncated, "not an asset file");
     let golden = root().join("fixtures").join("assets").join("golden-v1-material-info.asset");
-    bandwidth_pca(&golden, &model, &["--components", "1"])
-        .expect_code(2)
-        .expect_error(&golden, "expected a bandwidth-atlas asset (from brdf-bandwidth), found material-info");
+    bandwidth_pca(&golden, &model, &["--components", "1"]).expect_code(2).expect_error(
+        &golden,
+        "expected a bandwidth-atlas or bandwidth-rows asset (from brdf-bandwidth), found material-info",
+    );
     let material = write_table(tmp.path(), "phong.binary", Analytic::Phong { n: 10.0, ks: [1.0; 3] });
     brdf_bandwidth(&material, &out, &["--lobes", "2"]).expect_code(0);
     let mut bytes = std::fs::read(out.join("bandwidth-atlas.asset")).unwrap();
@@ -179,12 +207,13 @@ fn bad_inputs_exit_2_naming_the_file() {
 
 #[test]
 fn pca_of_the_shared_materials() {
-    // For each material, the atlas (64 x 64 lobes of 16 x 16, analysed at 64 x 64) and the fewest PCA
-    // components whose relative RMSE is at most 2%. Asserted: such a K exists and its measured
-    // error is within 2%. The table is printed.
+    // For each material, the atlas (64 x 64 lobes of 16 x 16, analysed at 64 x 64; stored as its
+    // 64 row tiles) and the fewest PCA components whose relative RMSE is at most 2%. Asserted:
+    // such a K exists and its measured error is within 2%. The table is printed: the model's size
+    // against the 64 distinct tiles and against the full 64 x 64 grid (64 times less).
     let tmp = temp_dir();
     let mut table = String::from(
-        "material                    K   rel. rmse   max error (cycles/rad)   model/atlas   compression\n",
+        "material                    K   rel. rmse   max error (cycles/rad)   model/rows   compression   vs full grid\n",
     );
     let mut failures = Vec::new();
     for name in MATERIALS {
@@ -195,17 +224,19 @@ fn pca_of_the_shared_materials() {
         brdf_bandwidth(&material, &out, &["--analysis-size", "64"]).expect_code(1);
         let r =
             bandwidth_pca(&out.join("bandwidth-atlas.asset"), &out, &["--max-error", "0.02", "--json"]).expect_code(0);
-        let (k, rmse, max_error, ratio) = (
+        let (k, rmse, max_error, ratio, ratio_full) = (
             figure(&r, "components").as_u64().unwrap(),
             figure(&r, "relative_rmse").as_f64().unwrap(),
             figure(&r, "max_abs_error").as_f64().unwrap(),
             figure(&r, "size_ratio").as_f64().unwrap(),
+            figure(&r, "size_ratio_full_grid").as_f64().unwrap(),
         );
         table += &format!(
-            "{name:<24} {k:>5} {:>10.3}% {max_error:>18.3} {:>14.1}% {:>12.1}:1\n",
+            "{name:<24} {k:>5} {:>10.3}% {max_error:>18.3} {:>13.1}% {:>12.2}:1 {:>12.1}:1\n",
             100.0 * rmse,
             100.0 * ratio,
-            1.0 / ratio
+            1.0 / ratio,
+            1.0 / ratio_full
         );
         if !(k <= 256 && rmse <= 0.02) {
             failures.push(format!("{name}: K {k}, relative rmse {rmse}"));

@@ -14,8 +14,8 @@ use sha2::{Digest, Sha256};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::types::{
-    Asset, AssetKind, BandwidthAtlas, BandwidthPca, ImportanceSamples, LayerSelection, MaterialInfo, Payload,
-    PrefilteredEnvmap, Provenance,
+    Asset, AssetKind, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection, MaterialInfo,
+    Payload, PrefilteredEnvmap, Provenance,
 };
 
 /// The first eight bytes of every asset file.
@@ -124,6 +124,7 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
         Payload::BandwidthAtlas(atlas) => encode_section(atlas),
         Payload::BandwidthPca(pca) => encode_section(pca),
         Payload::LayerSelection(selection) => encode_section(selection),
+        Payload::BandwidthRows(rows) => encode_section(rows),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -174,6 +175,7 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
         AssetKind::BandwidthAtlas => Payload::BandwidthAtlas(decode_section::<BandwidthAtlas>("payload", payload)?),
         AssetKind::BandwidthPca => Payload::BandwidthPca(decode_section::<BandwidthPca>("payload", payload)?),
         AssetKind::LayerSelection => Payload::LayerSelection(decode_section::<LayerSelection>("payload", payload)?),
+        AssetKind::BandwidthRows => Payload::BandwidthRows(decode_section::<BandwidthRows>("payload", payload)?),
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;
     Ok((header, Asset { provenance, payload }))

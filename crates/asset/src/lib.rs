@@ -63,6 +63,6 @@ pub use manifest::{
     BakeManifest, FileFormat, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool,
 };
 pub use types::{
-    Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LayerSelection, LinkedFile,
-    MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
+    Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples,
+    LayerSelection, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
 };

@@ -59,17 +59,21 @@ pub enum AssetKind {
     /// [`LayerSelection`]: which Phong layer of a pre-convolved environment serves each view of a
     /// material.
     LayerSelection = 6,
+    /// [`BandwidthRows`]: a bandwidth atlas whose tiles repeat along each row (an isotropic
+    /// material), stored one tile per row.
+    BandwidthRows = 7,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 6] = [
+    pub const ALL: [AssetKind; 7] = [
         AssetKind::MaterialInfo,
         AssetKind::ImportanceSamples,
         AssetKind::PrefilteredEnvmap,
         AssetKind::BandwidthAtlas,
         AssetKind::BandwidthPca,
         AssetKind::LayerSelection,
+        AssetKind::BandwidthRows,
     ];
 
     /// The number stored in the header.
@@ -91,6 +95,7 @@ impl AssetKind {
             AssetKind::BandwidthAtlas => "bandwidth-atlas",
             AssetKind::BandwidthPca => "bandwidth-pca",
             AssetKind::LayerSelection => "layer-selection",
+            AssetKind::BandwidthRows => "bandwidth-rows",
         }
     }
 }
@@ -366,6 +371,46 @@ impl BandwidthAtlas {
     }
 }
 
+/// A bandwidth atlas whose every tile equals the first tile of its row, stored once per row
+/// (payload of [`AssetKind::BandwidthRows`], written by `brdf-bandwidth` for an isotropic
+/// material): the atlas it stands for has `lobes_x x lobes_y` tiles of `tile x tile` texels, and
+/// lobe `(i, j)` is row `j`'s tile for every column `i`. `data` holds the `lobes_y` row tiles one
+/// after another, each `tile x tile` texels row-major, in cycles per radian; this is the layout of
+/// a [`BandwidthAtlas`] one lobe wide.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BandwidthRows {
+    /// The columns of the atlas it stands for: every row's tile serves each of them.
+    pub lobes_x: u32,
+    pub lobes_y: u32,
+    pub tile: u32,
+    pub analysis: BandwidthAnalysis,
+    pub data: Vec<f32>,
+}
+
+impl BandwidthRows {
+    fn check(&self) -> Result<(), String> {
+        // Sizes come from the file: a product that overflows is a size no file can hold. The
+        // full grid (`lobes_x` times the stored texels) is not allocated here; a reader that
+        // expands the rows bounds it first.
+        let stored =
+            u64::from(self.tile).checked_mul(u64::from(self.tile)).and_then(|t| t.checked_mul(u64::from(self.lobes_y)));
+        if stored.is_none_or(|s| s == 0 || s != self.data.len() as u64) {
+            return Err(format!(
+                "bandwidth rows of {} tiles of {} x {} texels hold {} values, expected {} (and at least one)",
+                self.lobes_y,
+                self.tile,
+                self.tile,
+                self.data.len(),
+                stored.map_or("more than any file holds".to_string(), |s| s.to_string())
+            ));
+        }
+        if self.lobes_x == 0 {
+            return Err("bandwidth rows stand for an atlas of 0 columns: expected at least one".to_string());
+        }
+        Ok(())
+    }
+}
+
 /// A bandwidth atlas compressed by PCA (payload of [`AssetKind::BandwidthPca`], written by
 /// `bandwidth-pca`; Bagher et al. 2011, Fig. 8): tile `l` is `mean + sum_k coefficients[l][k]
 /// components[k]`, each tile a row-major `tile x tile` vector of `tile_len = tile^2` values.
@@ -472,6 +517,7 @@ pub enum Payload {
     BandwidthAtlas(BandwidthAtlas),
     BandwidthPca(BandwidthPca),
     LayerSelection(LayerSelection),
+    BandwidthRows(BandwidthRows),
 }
 
 impl Payload {
@@ -483,6 +529,7 @@ impl Payload {
             Payload::BandwidthAtlas(_) => AssetKind::BandwidthAtlas,
             Payload::BandwidthPca(_) => AssetKind::BandwidthPca,
             Payload::LayerSelection(_) => AssetKind::LayerSelection,
+            Payload::BandwidthRows(_) => AssetKind::BandwidthRows,
         }
     }
 
@@ -495,6 +542,7 @@ impl Payload {
             Payload::BandwidthAtlas(atlas) => atlas.check(),
             Payload::BandwidthPca(pca) => pca.check(),
             Payload::LayerSelection(selection) => selection.check(),
+            Payload::BandwidthRows(rows) => rows.check(),
         }
     }
 }
@@ -514,6 +562,12 @@ impl From<ImportanceSamples> for Payload {
 impl From<BandwidthAtlas> for Payload {
     fn from(atlas: BandwidthAtlas) -> Payload {
         Payload::BandwidthAtlas(atlas)
+    }
+}
+
+impl From<BandwidthRows> for Payload {
+    fn from(rows: BandwidthRows) -> Payload {
+        Payload::BandwidthRows(rows)
     }
 }
 

@@ -117,7 +117,7 @@ fn the_unknown_kind_message_names_the_number() {
     assert_eq!(
         decode(&bytes).unwrap_err().to_string(),
         "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples), 3 (prefiltered-envmap), \
-         4 (bandwidth-atlas), 5 (bandwidth-pca), 6 (layer-selection)"
+         4 (bandwidth-atlas), 5 (bandwidth-pca), 6 (layer-selection), 7 (bandwidth-rows)"
     );
 }
 
@@ -248,5 +248,59 @@ fn prefiltered_envmap_invariants_are_refused_on_write_and_read() {
         let message = decode(&encode(&asset)).unwrap_err().to_string();
         assert!(message.starts_with("invalid payload: prefiltered envmap"), "{message}");
         assert!(message.contains(expected), "{expected}: {message}");
+    }
+}
+
+/// Rows of a bandwidth atlas (kind 7) with the sizes and stored values given.
+fn rows_asset(lobes_x: u32, lobes_y: u32, tile: u32, values: usize) -> Asset {
+    Asset {
+        provenance: small_asset().provenance,
+        payload: asset::BandwidthRows {
+            lobes_x,
+            lobes_y,
+            tile,
+            analysis: asset::BandwidthAnalysis { parameterization: "p".into(), analysis_size: 64, eps: 0.01, c: 0.25 },
+            data: vec![0.5; values],
+        }
+        .into(),
+    }
+}
+
+/// The sizes of a rows asset come from the file and are multiplied with overflow checks: claims
+/// whose product exceeds 64 bits, or would wrap to the number of values stored in 32-bit
+/// arithmetic (`954437177 x 3^2 = 2^33 + 1`), are refused on write and on read, like plainly
+/// inconsistent ones; consistent sizes with one value pass.
+#[test]
+fn bandwidth_rows_sizes_are_multiplied_without_overflow() {
+    let refused = [
+        (
+            1 << 31,
+            1 << 31,
+            1,
+            1,
+            "bandwidth rows of 2147483648 tiles of 1 x 1 texels hold 1 values, expected 2147483648",
+        ),
+        (1, u32::MAX, u32::MAX, 1, "hold 1 values, expected more than any file holds"),
+        (1, 954_437_177, 3, 1, "hold 1 values, expected 8589934593"),
+        (1 << 31, 1 << 16, 1 << 16, 1, "hold 1 values, expected 281474976710656"),
+        (2, 1, 1, 0, "hold 0 values, expected 1"),
+        (1, 0, 1, 0, "hold 0 values, expected 0 (and at least one)"),
+        (0, 1, 1, 1, "an atlas of 0 columns"),
+    ];
+    for (lobes_x, lobes_y, tile, values, message) in refused {
+        let asset = rows_asset(lobes_x, lobes_y, tile, values);
+        let written = asset::encode_checked(&asset).unwrap_err().to_string();
+        assert!(
+            written.starts_with("refusing to write an invalid payload: ") && written.contains(message),
+            "{written}"
+        );
+        let read = decode(&encode(&asset)).unwrap_err().to_string();
+        assert!(read.starts_with("invalid payload: ") && read.contains(message), "{read}");
+    }
+    // Two billion columns of one row of one texel: consistent (what they expand to is the
+    // reader's limit to enforce).
+    for (lobes_x, lobes_y, tile, values) in [(1 << 31, 1, 1, 1), (u32::MAX, 2, 3, 18)] {
+        let asset = rows_asset(lobes_x, lobes_y, tile, values);
+        assert_eq!(decode(&asset::encode_checked(&asset).unwrap()).unwrap(), asset);
     }
 }

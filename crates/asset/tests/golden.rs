@@ -235,13 +235,26 @@ fn golden_kinds() -> Vec<(&'static str, Asset)> {
             Asset {
                 provenance: provenance("brdf-bake"),
                 payload: Payload::LayerSelection(asset::LayerSelection {
-                    analysis,
+                    analysis: analysis.clone(),
                     rows: 3,
                     reduction: "band-0.99".into(),
                     exponents: vec![1, 64],
                     layer_bandwidth: vec![0.25, 1.5],
                     view_bandwidth: vec![0.3, 1.0, 2.0],
                     view_layer: vec![0, 1, 1],
+                }),
+            },
+        ),
+        (
+            "assets/golden-v1-bandwidth-rows.asset",
+            Asset {
+                provenance: provenance("brdf-bandwidth"),
+                payload: Payload::BandwidthRows(asset::BandwidthRows {
+                    lobes_x: 3,
+                    lobes_y: 2,
+                    tile: 2,
+                    analysis,
+                    data: vec![0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5],
                 }),
             },
         ),

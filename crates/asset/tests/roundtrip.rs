@@ -1,8 +1,8 @@
 //! read(write(a)) = a for random assets, in memory and through files.
 
 use asset::{
-    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, ImportanceSamples, LinkedFile, MaterialInfo, Payload,
-    PrefilteredEnvmap, Provenance, decode, encode, read_file, write_file,
+    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LinkedFile, MaterialInfo,
+    Payload, PrefilteredEnvmap, Provenance, decode, encode, read_file, write_file,
 };
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -49,7 +49,7 @@ fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
 
 fn random_asset(rng: &mut StdRng) -> Asset {
     let angles = random_len(rng);
-    let payload = match rng.random_range(0..5) {
+    let payload = match rng.random_range(0..6) {
         0 => Payload::MaterialInfo(MaterialInfo {
             dims: rng.random(),
             no_data_cells: rng.random(),
@@ -65,6 +65,7 @@ fn random_asset(rng: &mut StdRng) -> Asset {
         1 => random_importance_samples(rng),
         2 => random_prefiltered_envmap(rng),
         3 => random_bandwidth_atlas(rng),
+        4 => random_bandwidth_rows(rng),
         _ => random_bandwidth_pca(rng),
     };
     Asset {
@@ -94,6 +95,21 @@ fn random_bandwidth_atlas(rng: &mut StdRng) -> Payload {
     let (lobes_x, lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32), rng.random_range(1..4u32));
     let n = (lobes_x * lobes_y * tile * tile) as usize;
     Payload::BandwidthAtlas(BandwidthAtlas {
+        lobes_x,
+        lobes_y,
+        tile,
+        analysis: random_analysis(rng),
+        data: (0..n).map(|_| random_f64(rng) as f32).collect(),
+    })
+}
+
+/// Consistent sizes (the payload's invariant), random contents; the columns the rows stand for
+/// range over all of `u32` (they size nothing that is stored).
+fn random_bandwidth_rows(rng: &mut StdRng) -> Payload {
+    let (lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32));
+    let lobes_x = if rng.random_bool(0.5) { rng.random_range(1..4u32) } else { rng.random_range(1..=u32::MAX) };
+    let n = (lobes_y * tile * tile) as usize;
+    Payload::BandwidthRows(BandwidthRows {
         lobes_x,
         lobes_y,
         tile,

@@ -147,7 +147,8 @@ impl Atlas {
 
     /// Checks that the sizes agree with each other and every value is finite and non-negative.
     pub fn check(&self) -> Result<(), Error> {
-        let texels = self.lobes_x.checked_mul(self.tile).and_then(|w| w.checked_mul(self.lobes_y * self.tile));
+        let height = self.lobes_y.checked_mul(self.tile);
+        let texels = self.lobes_x.checked_mul(self.tile).and_then(|w| height.and_then(|h| w.checked_mul(h)));
         if self.lobes_x == 0 || self.lobes_y == 0 || self.tile == 0 || texels.is_none_or(|t| t > MAX_TEXELS) {
             return Err(Error::Invalid(format!(
                 "atlas of {} x {} lobes of {} x {} texels is empty or too large",
@@ -203,6 +204,60 @@ impl Atlas {
             let start = (j * t + y) * width + i * t;
             self.data[start..start + t].copy_from_slice(row);
         }
+    }
+
+    /// Whether every tile of every row equals the row's first tile, bit for bit: the atlas of an
+    /// isotropic material (every MERL table), whose rows [`Self::rows`] hold all of it. Bits, not
+    /// `==`, so that expanding the rows again gives back exactly these texels.
+    pub fn is_isotropic(&self) -> bool {
+        let (t, width) = (self.tile, self.width());
+        if t == 0 || width == 0 {
+            return true;
+        }
+        self.data.chunks_exact(width).all(|row| {
+            let (first, rest) = row.split_at(t);
+            rest.chunks_exact(t).all(|tile_row| tile_row.iter().zip(first).all(|(a, b)| a.to_bits() == b.to_bits()))
+        })
+    }
+
+    /// The first column as an atlas one lobe wide (`lobes_x = 1`): row `j`'s first tile is lobe
+    /// `j`, and `data` holds the tiles one after another, each row-major (the payload of asset
+    /// kind 7, `bandwidth-rows`). For an isotropic atlas ([`Self::is_isotropic`]) these are its
+    /// distinct tiles and [`Self::expand_rows`] gives the atlas back.
+    pub fn rows(&self) -> Atlas {
+        let (t, width) = (self.tile, self.width());
+        let mut data = Vec::with_capacity(self.lobes_y * self.tile_len());
+        if t > 0 {
+            for row in self.data.chunks_exact(width) {
+                data.extend_from_slice(&row[..t]);
+            }
+        }
+        Atlas { lobes_x: 1, data, ..*self }
+    }
+
+    /// The atlas `lobes_x` lobes wide whose every column is this atlas of one column (each row's
+    /// tile serves every column of its row): the inverse of [`Self::rows`] for an isotropic
+    /// atlas. Checks the size before allocating: `lobes_x` may come from a file.
+    pub fn expand_rows(&self, lobes_x: usize) -> Result<Atlas, Error> {
+        self.check()?;
+        if self.lobes_x != 1 {
+            return Err(Error::Invalid(format!("expanding rows needs an atlas one lobe wide, not {}", self.lobes_x)));
+        }
+        let texels = lobes_x.checked_mul(self.data.len());
+        if lobes_x == 0 || texels.is_none_or(|t| t > MAX_TEXELS) {
+            return Err(Error::Invalid(format!(
+                "an atlas of {} x {} lobes of {} x {} texels is empty or exceeds the limit of {MAX_TEXELS} texels",
+                lobes_x, self.lobes_y, self.tile, self.tile
+            )));
+        }
+        let t = self.tile;
+        let mut data = Vec::with_capacity(lobes_x * self.data.len());
+        for row in self.data.chunks_exact(t) {
+            for _ in 0..lobes_x {
+                data.extend_from_slice(row);
+            }
+        }
+        Ok(Atlas { lobes_x, data, ..*self })
     }
 }
 

@@ -3,7 +3,7 @@
 //! tiles a direct analysis of each lobe gives.
 
 use brdf_atlas::{
-    Analyser, Atlas, Config, Error, IncidentGrid, LobeMap, LuminanceTable, Parameterization, build_atlas,
+    Analyser, Atlas, Config, Error, IncidentGrid, LobeMap, LuminanceTable, MAX_TEXELS, Parameterization, build_atlas,
     lobe_image_from_fn, to_incidence_frame,
 };
 use glam::DVec3;
@@ -122,4 +122,76 @@ fn tiles_round_trip_through_the_layout() {
     assert!(atlas.check().unwrap_err().to_string().contains("texel (5, 0)"));
     atlas.data.pop();
     assert!(atlas.check().unwrap_err().to_string().contains("holds 95 values"));
+}
+
+/// An atlas of `lobes_x x lobes_y` tiles of 4 x 4 whose texel `(tx, ty)` of lobe `(i, j)` is
+/// `value(i, j, t)` with `t = ty * 4 + tx`.
+fn atlas_of(lobes_x: usize, lobes_y: usize, value: impl Fn(usize, usize, usize) -> f32) -> Atlas {
+    let mut atlas = Atlas {
+        lobes_x,
+        lobes_y,
+        tile: 4,
+        data: vec![0.0; lobes_x * lobes_y * 16],
+        parameterization: Parameterization::IncidencePlaneEquidistant,
+        analysis_size: 16,
+        eps: 0.01,
+        c: bandwidth::DEFAULT_C,
+    };
+    for j in 0..lobes_y {
+        for i in 0..lobes_x {
+            let tile: Vec<f32> = (0..16).map(|t| value(i, j, t)).collect();
+            atlas.set_tile(atlas.lobe_index(i, j), &tile);
+        }
+    }
+    atlas
+}
+
+/// Rows hold an isotropic atlas whole: `rows` keeps each row's first tile, one after another
+/// (the layout of asset kind 7, checked against `tile_of` of the full grid), and `expand_rows`
+/// gives back the full grid bit for bit.
+#[test]
+fn an_isotropic_atlas_is_its_rows_expanded() {
+    let atlas = atlas_of(5, 3, |_, j, t| (10 * j + t) as f32 * 0.25);
+    assert!(atlas.is_isotropic());
+    let rows = atlas.rows();
+    assert_eq!((rows.lobes_x, rows.lobes_y, rows.tile), (1, 3, 4));
+    rows.check().unwrap();
+    for j in 0..3 {
+        assert_eq!(rows.data[j * 16..(j + 1) * 16], atlas.tile_of(atlas.lobe_index(0, j)));
+    }
+    let expanded = rows.expand_rows(5).unwrap();
+    assert_eq!(expanded, atlas);
+    // One column is its own rows.
+    assert_eq!(rows.rows(), rows);
+    assert!(rows.is_isotropic());
+}
+
+/// One texel of one tile away from its row's first tile makes an atlas anisotropic, wherever it
+/// is; so does a zero of the other sign (the rows could not give those bits back).
+#[test]
+fn one_different_texel_makes_an_atlas_anisotropic() {
+    let isotropic = atlas_of(4, 3, |_, j, t| (j + t) as f32);
+    for (i, j, t) in [(1, 0, 0), (3, 2, 15), (2, 1, 7)] {
+        let mut atlas = isotropic.clone();
+        let mut tile = atlas.tile_of(atlas.lobe_index(i, j));
+        tile[t] += 0.5;
+        atlas.set_tile(atlas.lobe_index(i, j), &tile);
+        assert!(!atlas.is_isotropic(), "lobe ({i}, {j}) texel {t}");
+    }
+    let mut signed = atlas_of(2, 1, |_, _, _| 0.0);
+    signed.data[4] = -0.0;
+    assert!(!signed.is_isotropic());
+}
+
+/// The columns to expand to may come from a file: a grid above `MAX_TEXELS` (or one whose size
+/// overflows) is refused before anything is allocated, and only an atlas one lobe wide expands.
+#[test]
+fn expanding_rows_checks_the_size_first() {
+    let rows = atlas_of(1, 2, |_, _, t| t as f32);
+    for lobes_x in [0, MAX_TEXELS / 32 + 1, usize::MAX] {
+        let err = rows.expand_rows(lobes_x).unwrap_err().to_string();
+        assert!(err.contains("is empty or exceeds the limit"), "{lobes_x}: {err}");
+    }
+    let err = atlas_of(2, 2, |_, _, _| 1.0).expand_rows(3).unwrap_err().to_string();
+    assert!(err.contains("one lobe wide, not 2"), "{err}");
 }

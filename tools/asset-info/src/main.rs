@@ -98,6 +98,13 @@ fn print_text(report: &Report) {
                     cli::outln!("  components       {}", pca.n_components);
                 }
                 Payload::LayerSelection(selection) => print_layer_selection(selection),
+                Payload::BandwidthRows(rows) => {
+                    cli::outln!("payload: bandwidth rows (an isotropic bandwidth atlas, one tile per row)");
+                    print_tiles(rows.lobes_x, rows.lobes_y, rows.tile, &rows.analysis);
+                    cli::outln!("  stored           {} row tiles: row j's tile serves every column", rows.lobes_y);
+                    let max = rows.data.iter().fold(0.0f32, |m, v| m.max(*v));
+                    cli::outln!("  max bandwidth    {max} cycles per radian");
+                }
             }
         }
     }
@@ -305,6 +312,13 @@ fn to_json(report: &Report) -> Value {
                 Payload::LayerSelection(selection) => {
                     serde_json::to_value(selection).expect("layer selection serializes to json")
                 }
+                Payload::BandwidthRows(rows) => json!({
+                    "lobes_x": rows.lobes_x,
+                    "lobes_y": rows.lobes_y,
+                    "tile": rows.tile,
+                    "stored_tiles": rows.lobes_y,
+                    "analysis": serde_json::to_value(&rows.analysis).expect("analysis serializes to json"),
+                }),
             };
             json!({
                 "header": header_json,

@@ -9,19 +9,23 @@ use bake::{Program, Source};
 use brdf_atlas::Components;
 use clap::{ArgGroup, Parser};
 
-/// Compress a bandwidth atlas (from brdf-bandwidth) by PCA: each lobe's tile is one vector; the
-/// model is the mean tile, K principal components and K coefficients per lobe, and a tile is
-/// reconstructed as mean + sum_k coefficient_k component_k. Reports the relative RMSE
-/// (|reconstruction - atlas| / |atlas| over all texels), the largest error of a texel and the
-/// size of the model against the atlas. Writes, in DIR: bandwidth-pca.asset (the model) and
-/// bandwidth-pca.png (the absolute error in the atlas's layout, log scale).
+/// Compress a bandwidth atlas (from brdf-bandwidth) by PCA: each distinct tile is one vector; the
+/// model is the mean tile, K principal components and K coefficients per tile, and a tile is
+/// reconstructed as mean + sum_k coefficient_k component_k. For an isotropic atlas (kind
+/// bandwidth-rows, or any atlas whose tiles repeat along each row) the distinct tiles are the
+/// rows: the model has one column and each row's coefficients serve every column. Reports the
+/// relative RMSE (|reconstruction - atlas| / |atlas| over all texels), the largest error of a
+/// texel, and the size of the model against the distinct tiles (size_ratio) and against the full
+/// lobes x lobes grid (size_ratio_full_grid). Writes, in DIR: bandwidth-pca.asset (the model)
+/// and bandwidth-pca.png (the absolute error in the full atlas's layout, log scale).
 ///
 /// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about)]
 #[command(group(ArgGroup::new("k").required(true).args(["components", "max_error"])))]
 struct Args {
-    /// The atlas (bandwidth-atlas.asset written by brdf-bandwidth).
+    /// The atlas (bandwidth-atlas.asset written by brdf-bandwidth: kind bandwidth-rows or
+    /// bandwidth-atlas).
     atlas: PathBuf,
 
     /// The folder to write into (created if missing).
@@ -63,11 +67,7 @@ fn run(args: Args) -> Result<ExitCode> {
     Ok(cli::finish(args.json, &staged.json(dir)?, &staged.report, &staged.problems, &staged.written(dir)))
 }
 
-/// The `bandwidth-atlas` asset written by `brdf-bandwidth`.
+/// The full atlas of the asset `brdf-bandwidth` wrote (either kind).
 fn read_atlas(bytes: &[u8]) -> Result<brdf_atlas::Atlas> {
-    let asset = asset::decode(bytes)?;
-    let asset::Payload::BandwidthAtlas(a) = asset.payload else {
-        return Err(anyhow!("expected a bandwidth-atlas asset (from brdf-bandwidth), found {}", asset.payload.kind()));
-    };
-    bake::stage::atlas::from_asset(a).map_err(|e| anyhow!(e))
+    bake::stage::atlas::from_payload(asset::decode(bytes)?.payload).map_err(|e| anyhow!(e))
 }

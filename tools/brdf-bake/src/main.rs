@@ -12,7 +12,8 @@ use serde_json::json;
 
 /// Bake a MERL material (and, with --env, an environment map) for real-time rendering. Writes,
 /// in DIR: the importance samples (importance.asset, importance.png), the bandwidth atlas
-/// (bandwidth-atlas.asset/.exr/.png), with --pca-max-error its PCA model (bandwidth-pca.asset,
+/// (bandwidth-atlas.asset: once per row for an isotropic table, kind bandwidth-rows; .exr: the
+/// full 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset,
 /// .png), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
 /// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png);
 /// then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool

@@ -16,9 +16,11 @@ use clap::Parser;
 /// reduced to a tile x tile tile by taking the maximum over the pixels of the hemisphere each
 /// texel covers. A MERL table is isotropic: the lobes of a row are one image, analysed once.
 /// Reports how many lobes reach the analysis grid's limit. Writes, in DIR:
-/// bandwidth-atlas.asset (the atlas, for bandwidth-pca and brdf-bake), bandwidth-atlas.exr (one
-/// float channel Y) and bandwidth-atlas.png (false colour, log scale). Parameterizations and
-/// layout: data-schema/brdf-atlas.md.
+/// bandwidth-atlas.asset (the atlas, for bandwidth-pca and brdf-bake: kind bandwidth-rows, one
+/// tile per row, when every tile of a row is the same, as for every MERL table; else kind
+/// bandwidth-atlas, every tile), bandwidth-atlas.exr (the full lobes tile x lobes tile texture
+/// for renderers, one float channel Y) and bandwidth-atlas.png (false colour, log scale).
+/// Parameterizations and layout: data-schema/brdf-atlas.md.
 ///
 /// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]

@@ -1,6 +1,12 @@
 //! The bandwidth atlas of a material (`brdf-bandwidth`; `000` section 2.4): every lobe's wavelet
-//! bandwidth reduced to a tile, as an asset of kind `bandwidth-atlas`, a float EXR and a
-//! false-colour picture.
+//! bandwidth reduced to a tile, as an asset, a float EXR and a false-colour picture.
+//!
+//! The asset stores each distinct tile once: an isotropic atlas (every tile of a row equal to the
+//! row's first, always the case for a MERL table, and checked, not assumed) is written as kind
+//! `bandwidth-rows`, one tile per row, 1/`lobes` of the full grid; any other as kind
+//! `bandwidth-atlas`, the full grid. [`from_payload`] reads either back into the full grid. The
+//! EXR is always the full `lobes tile x lobes tile` texture: the export for renderers that index
+//! the atlas by `wi` directly.
 
 pub(crate) mod picture;
 
@@ -52,13 +58,13 @@ pub fn run(
         ("tile", config.tile.to_string()),
         ("analysis_size", config.analysis_size.to_string()),
     ];
-    let asset = asset::encode_checked(&asset::Asset {
-        provenance: source.provenance(program, &parameters),
-        payload: to_asset(atlas).into(),
-    })
-    .map_err(|e| Error::Internal(format!("encoding {ASSET}: {e}")))?;
+    let payload: asset::Payload =
+        if atlas.is_isotropic() { to_rows_asset(atlas).into() } else { to_asset(atlas).into() };
+    let stored_kind = payload.kind();
+    let asset = asset::encode_checked(&asset::Asset { provenance: source.provenance(program, &parameters), payload })
+        .map_err(|e| Error::Internal(format!("encoding {ASSET}: {e}")))?;
 
-    let (figures, report) = describe(config, &build, range);
+    let (figures, report) = describe(config, &build, range, stored_kind);
     let staged = Staged {
         name: "bandwidth-atlas",
         parameters: object([
@@ -112,8 +118,11 @@ fn describe(
     config: &Config,
     build: &AtlasBuild,
     range: (f64, f64),
+    stored_kind: asset::AssetKind,
 ) -> (serde_json::Map<String, serde_json::Value>, Vec<String>) {
     let atlas = &build.atlas;
+    let rows = stored_kind == asset::AssetKind::BandwidthRows;
+    let stored_texels = if rows { atlas.lobes_y * atlas.tile_len() } else { atlas.data.len() };
     let stats = &build.stats;
     let mut sorted: Vec<f32> = atlas.data.clone();
     sorted.sort_by(f32::total_cmp);
@@ -133,6 +142,9 @@ fn describe(
         ("texels_at_limit", json!(stats.nyquist_texels)),
         ("limit_at_centre", json!(limit_at_centre(config))),
         ("filled_pixels", json!(stats.filled_pixels)),
+        ("isotropic", json!(rows)),
+        ("stored_kind", json!(stored_kind.name())),
+        ("stored_texels", json!(stored_texels)),
     ]);
     let mut report = vec![
         format!(
@@ -168,6 +180,28 @@ fn describe(
             }
         ),
     ];
+    report.push(if rows {
+        format!(
+            "stored        {ASSET}: kind {} ({}), each row's tile once ({} of {} texels: every tile of a row equals \
+             the row's first); {EXR} holds the full {} x {} texture for renderers",
+            stored_kind.code(),
+            stored_kind.name(),
+            stored_texels,
+            atlas.data.len(),
+            atlas.width(),
+            atlas.height()
+        )
+    } else {
+        format!(
+            "stored        {ASSET}: kind {} ({}), every tile ({} texels: the tiles of a row differ); {EXR} holds \
+             the same {} x {} texture",
+            stored_kind.code(),
+            stored_kind.name(),
+            stored_texels,
+            atlas.width(),
+            atlas.height()
+        )
+    });
     if stats.filled_pixels > 0 {
         report.push(format!(
             "filled        {} lobe pixels had no table data around them: filled from their neighbours",
@@ -184,7 +218,8 @@ fn describe(
     (figures, report)
 }
 
-/// The asset's payload (`data-schema/README.md`), the input of `bandwidth-pca`.
+/// The full grid as an asset's payload (kind `bandwidth-atlas`, `data-schema/README.md`): what
+/// the stage writes for an atlas whose tiles differ within a row.
 pub fn to_asset(atlas: &Atlas) -> asset::BandwidthAtlas {
     asset::BandwidthAtlas {
         lobes_x: atlas.lobes_x as u32,
@@ -192,6 +227,19 @@ pub fn to_asset(atlas: &Atlas) -> asset::BandwidthAtlas {
         tile: atlas.tile as u32,
         analysis: analysis_of(atlas),
         data: atlas.data.clone(),
+    }
+}
+
+/// The rows of an isotropic atlas as an asset's payload (kind `bandwidth-rows`): each row's
+/// first tile ([`Atlas::rows`]) and the number of columns they serve. The caller checks
+/// [`Atlas::is_isotropic`]; otherwise the other columns are lost.
+pub fn to_rows_asset(atlas: &Atlas) -> asset::BandwidthRows {
+    asset::BandwidthRows {
+        lobes_x: atlas.lobes_x as u32,
+        lobes_y: atlas.lobes_y as u32,
+        tile: atlas.tile as u32,
+        analysis: analysis_of(atlas),
+        data: atlas.rows().data,
     }
 }
 
@@ -205,15 +253,51 @@ pub fn analysis_of(atlas: &Atlas) -> asset::BandwidthAnalysis {
     }
 }
 
-/// An atlas read back from its asset, checked.
-pub fn from_asset(a: asset::BandwidthAtlas) -> Result<Atlas, String> {
-    let name = a.analysis.parameterization.as_str();
-    let Some(parameterization) = brdf_atlas::Parameterization::from_name(name) else {
-        return Err(format!(
+/// The full atlas an atlas asset of either kind stands for, checked: kind `bandwidth-atlas` as
+/// it is, kind `bandwidth-rows` expanded (row `j`'s tile in every column), its size bounded before
+/// anything is allocated. Any other payload is an error naming its kind.
+pub fn from_payload(payload: asset::Payload) -> Result<Atlas, String> {
+    match payload {
+        asset::Payload::BandwidthAtlas(a) => from_asset(a),
+        asset::Payload::BandwidthRows(r) => from_rows_asset(r),
+        other => Err(format!(
+            "expected a bandwidth-atlas or bandwidth-rows asset (from brdf-bandwidth), found {}",
+            other.kind()
+        )),
+    }
+}
+
+fn parameterization_of(analysis: &asset::BandwidthAnalysis) -> Result<brdf_atlas::Parameterization, String> {
+    let name = analysis.parameterization.as_str();
+    brdf_atlas::Parameterization::from_name(name).ok_or_else(|| {
+        format!(
             "unknown parameterization {name:?}: this build knows {:?}",
             brdf_atlas::Parameterization::IncidencePlaneEquidistant.name()
-        ));
+        )
+    })
+}
+
+/// The full atlas of a rows asset: the rows checked as an atlas one lobe wide, then expanded to
+/// `lobes_x` columns ([`Atlas::expand_rows`] refuses a grid above [`brdf_atlas::MAX_TEXELS`]
+/// before allocating it).
+fn from_rows_asset(r: asset::BandwidthRows) -> Result<Atlas, String> {
+    let parameterization = parameterization_of(&r.analysis)?;
+    let rows = Atlas {
+        lobes_x: 1,
+        lobes_y: r.lobes_y as usize,
+        tile: r.tile as usize,
+        data: r.data,
+        parameterization,
+        analysis_size: r.analysis.analysis_size as usize,
+        eps: r.analysis.eps,
+        c: r.analysis.c,
     };
+    rows.expand_rows(r.lobes_x as usize).map_err(|e| e.to_string())
+}
+
+/// An atlas read back from its full-grid asset, checked.
+pub fn from_asset(a: asset::BandwidthAtlas) -> Result<Atlas, String> {
+    let parameterization = parameterization_of(&a.analysis)?;
     let texels = u64::from(a.lobes_x)
         .checked_mul(u64::from(a.tile))
         .and_then(|w| u64::from(a.lobes_y).checked_mul(u64::from(a.tile)).and_then(|h| w.checked_mul(h)));
