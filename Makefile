@@ -9,7 +9,7 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python build install test demo bake lint bench clean-demo
+.PHONY: setup setup-gpu setup-python build install test test-data demo bake lint bench clean-demo
 
 ## setup: everything the tests need (setup-gpu and setup-python). Idempotent.
 setup: setup-gpu setup-python
@@ -37,11 +37,24 @@ install: build
 	install -d $(PREFIX)/bin
 	install -m 755 $(addprefix $(BIN)/,$(TOOLS)) $(PREFIX)/bin/
 
-## test: every unit, property, GPU (lavapipe) and end-to-end test. The tools are built first, once,
-## and the end-to-end tests run those binaries.
-test: setup
+## test: every unit, property, GPU (lavapipe) and end-to-end test. The test data is made first
+## (test-data), the tools are built once, and the end-to-end tests run those binaries.
+test: setup test-data
 	$(CARGO) build --workspace --bins
 	$(CARGO) test --workspace
+
+## test-data: the 20 real-derived MERL tables the tests read, made once under target/merl/ from
+## ../shared/data/nbrdf (35 MB and about a second each; kept between runs).
+MATERIALS := color-changing-paint3 gold-paint red-metallic-paint green-metallic-paint blue-rubber \
+  white-marble white-paint chrome nickel pink-fabric brass blue-acrylic gray-plastic yellow-paint \
+  steel alum-bronze black-obsidian cherry-235 teflon silver-metallic-paint
+MERL_TABLES := $(addprefix target/merl/,$(addsuffix .binary,$(MATERIALS)))
+test-data: setup-python $(MERL_TABLES)
+
+target/merl/%.binary:
+	@test -f ../shared/tools/nbrdf2merl.py || { echo "error: ../shared is missing: the tests need the project's shared/ folder beside this checkout"; exit 2; }
+	@echo "making $@ (nbrdf2merl.py)"
+	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
 
 ## bench: timings against baselines measured in the same run (benchmarks, not tests).
 bench:
