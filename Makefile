@@ -38,10 +38,12 @@ install: build
 	install -m 755 $(addprefix $(BIN)/,$(TOOLS)) $(PREFIX)/bin/
 
 ## test: every unit, property, GPU (lavapipe) and end-to-end test. The test data is made first
-## (test-data), the tools are built once, and the end-to-end tests run those binaries.
+## (test-data), the tools are built once, and the end-to-end tests run those binaries. Without
+## incremental compilation (a clean run gains nothing from it and it costs a gigabyte of disk;
+## set CARGO_INCREMENTAL=1 to keep it).
 test: setup test-data
-	$(CARGO) build --workspace --bins
-	$(CARGO) test --workspace
+	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) build --workspace --bins
+	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) test --workspace
 
 ## test-data: the 20 real-derived MERL tables the tests read, made once under target/merl/ from
 ## ../shared/data/nbrdf (35 MB and about a second each; kept between runs).

@@ -17,7 +17,7 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 
 use crate::support::{
-    ReferenceBake, bake_command, bake_env, copy_dir, ggx_copper, png_decode, reference_bake, root, run, temp_dir,
+    ReferenceBake, bake_command, bake_env, copy_dir, ggx_copper, png_decode, reference_bake, root, run, temp_dir, tool,
 };
 
 const MANIFEST: &str = "manifest.json";
@@ -330,4 +330,30 @@ fn bad_inputs_and_settings_exit_2_with_one_line() {
         assert!(r.stdout.is_empty(), "{r}");
     }
     assert!(!out.join(MANIFEST).exists());
+}
+
+/// A bake whose validation found a problem (here: at 64 x 64 most of the GGX's lobes reach the
+/// analysis grid's limit) exits 1, records the problem in its manifest, and a rerun that finds it
+/// up to date reports the same problem and exits 1 again: a pipeline sees the same status either
+/// way.
+#[test]
+fn validation_problems_survive_an_up_to_date_rerun() {
+    let tmp = temp_dir();
+    let dir = tmp.path().join("bake");
+    let command = || {
+        let mut cmd = tool("brdf-bake");
+        cmd.arg(ggx_copper()).arg("--env").arg(bake_env()).arg("--out-dir").arg(&dir);
+        cmd.args(["--analysis-size", "64"]);
+        cmd
+    };
+    let first = run(command(), "").expect_code(1);
+    assert!(first.stdout.contains("problem: bandwidth-atlas:") && first.stdout.contains("grid's limit"), "{first}");
+    let manifest = checked_manifest(&dir);
+    let atlas = manifest["stages"].as_array().unwrap().iter().find(|s| s["name"] == "bandwidth-atlas").unwrap();
+    assert_eq!(atlas["figures"]["problems"].as_array().map(Vec::len), Some(1), "{manifest:#}");
+    let before = snapshot(&dir);
+    let again = run(command(), "").expect_code(1);
+    assert!(again.stdout.contains("up to date"), "{again}");
+    assert!(again.stdout.contains("problem: bandwidth-atlas:"), "{again}");
+    assert_eq!(snapshot(&dir), before, "an up-to-date rerun wrote something");
 }

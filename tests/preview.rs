@@ -44,7 +44,10 @@ fn bake(material: &str, environment: &str) -> PathBuf {
         .arg(&dir)
         // The atlas does not enter these modes' checks; the smallest analysis keeps the bake quick.
         .args(["--vectors", VECTORS, "--analysis-size", "64", "--quiet"]);
-    run(cmd, "").expect_code(0);
+    // At 64 x 64 most lobes of these materials reach the grid's limit, which the bake reports as
+    // a validation problem (exit 1) and writes anyway; anything else is an error here.
+    let r = run(cmd, "");
+    assert!(matches!(r.code, Some(0 | 1)), "the bake failed\n{r}");
     done.lock().unwrap().push(dir.clone());
     dir
 }

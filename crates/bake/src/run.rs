@@ -161,12 +161,8 @@ pub fn run_bake(
         && is_same_bake(previous, &manifest)
         && all_files_match(previous, out)?
     {
-        return Ok(BakeOutcome {
-            manifest: previous.clone(),
-            up_to_date: true,
-            reports: Vec::new(),
-            problems: Vec::new(),
-        });
+        let problems = recorded_problems(previous);
+        return Ok(BakeOutcome { manifest: previous.clone(), up_to_date: true, reports: Vec::new(), problems });
     }
 
     // Both inputs are read before the folder is touched: a bake that cannot run leaves the
@@ -193,7 +189,13 @@ pub fn run_bake(
         next += 1;
     };
     let mut record = |staged: Staged, manifest: &mut BakeManifest| -> Result<(), Error> {
-        manifest.stages.push(staged.write(out)?);
+        let mut stage = staged.write(out)?;
+        // The manifest keeps what validation found, so that a rerun that finds the bake up to
+        // date reports (and exits with) the same.
+        if !staged.problems.is_empty() {
+            stage.figures.insert("problems".into(), json!(staged.problems));
+        }
+        manifest.stages.push(stage);
         problems.extend(staged.problems.iter().map(|p| format!("{}: {p}", staged.name)));
         reports.push((staged.name, staged.report));
         Ok(())
@@ -248,6 +250,19 @@ pub fn run_bake(
     }
     asset::write_atomic(&manifest_path, manifest.to_json().as_bytes()).map_err(|e| Error::write(&manifest_path, e))?;
     Ok(BakeOutcome { manifest, up_to_date: false, reports, problems })
+}
+
+/// The problems the stages of a manifest recorded (`figures.problems`), as `run_bake` reports
+/// them.
+fn recorded_problems(manifest: &BakeManifest) -> Vec<String> {
+    manifest
+        .stages
+        .iter()
+        .flat_map(|stage| {
+            let listed = stage.figures.get("problems").and_then(serde_json::Value::as_array);
+            listed.into_iter().flatten().filter_map(|p| p.as_str()).map(move |p| format!("{}: {p}", stage.name))
+        })
+        .collect()
 }
 
 /// The stages `run_bake` will announce, in order.

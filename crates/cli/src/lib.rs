@@ -68,6 +68,14 @@ macro_rules! outln {
     ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
 }
 
+/// Parses a `WIDTHxHEIGHT` argument (`x` or `X`), as clap's `value_parser` wants it. Sizes are
+/// checked by whoever uses them; this only reads the two numbers.
+pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
+    let parse = |s: &str| s.trim().parse::<usize>().map_err(|e| format!("{s:?}: {e}"));
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
+    Ok((parse(w)?, parse(h)?))
+}
+
 /// Prints a tool's outcome the way every tool does and returns its exit status. With `json`,
 /// stdout gets exactly `value` (one JSON object, which lists the files written) and the report
 /// goes to stderr; without, the report and the problems go to stdout. Either way the files written
@@ -155,7 +163,17 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::lower_case_start;
+    use super::{lower_case_start, parse_size};
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("64x32"), Ok((64, 32)));
+        assert_eq!(parse_size("64X32"), Ok((64, 32)));
+        assert_eq!(parse_size(" 8 x 4 "), Ok((8, 4)));
+        assert!(parse_size("64").is_err());
+        assert!(parse_size("ax32").is_err());
+        assert!(parse_size("-1x2").is_err());
+    }
 
     #[test]
     fn only_plain_capitalized_first_words_are_lowered() {

@@ -24,9 +24,7 @@ fn material() -> &'static Material {
         let table = Analytic::Ggx { alpha: 0.2, f0: [0.95, 0.64, 0.54] }.table(Dims::MERL);
         let config = importance::Config { n_theta_o: 16, n_vectors: 4, n_samples: 64, ..Default::default() };
         let tables = importance::build(&table, &config).expect("a valid config");
-        let texels =
-            tables.all_samples().iter().map(|s| [s.wi.x as f32, s.wi.y as f32, s.wi.z as f32, s.pdf as f32]).collect();
-        let samples = SampleSet { n_slices: 16, n_vectors: 4, n_samples: 64, texels };
+        let samples = SampleSet { n_slices: 16, n_vectors: 4, n_samples: 64, texels: tables.sample_texels() };
         Material { table, samples, view_layers: vec![0, 0, 1, 1, 2, 2] }
     })
 }

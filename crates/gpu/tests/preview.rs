@@ -46,17 +46,7 @@ const SIZE: usize = 64;
 
 fn sample_set(tables: &ImportanceTables) -> SampleSet {
     let c = tables.config();
-    SampleSet {
-        n_slices: c.n_theta_o,
-        n_vectors: c.n_vectors,
-        n_samples: c.n_samples,
-        // The texel layout of `merl-importance`'s asset (kind 2).
-        texels: tables
-            .all_samples()
-            .iter()
-            .map(|s| [s.wi.x as f32, s.wi.y as f32, s.wi.z as f32, s.pdf as f32])
-            .collect(),
-    }
+    SampleSet { n_slices: c.n_theta_o, n_vectors: c.n_vectors, n_samples: c.n_samples, texels: tables.sample_texels() }
 }
 
 /// A bake of an analytic table: 90 slices of 8 vectors of 64 samples. The view-layer table picks

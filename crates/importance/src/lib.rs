@@ -322,6 +322,12 @@ impl ImportanceTables {
     pub fn all_samples(&self) -> &[DirectionSample] {
         &self.samples
     }
+
+    /// Every sample as the renderers and the asset (kind 2) store it: an RGBA32F texel
+    /// `(wi.x, wi.y, wi.z, pdf)`, in the order of [`ImportanceTables::all_samples`].
+    pub fn sample_texels(&self) -> Vec<[f32; 4]> {
+        self.all_samples().iter().map(|s| [s.wi.x as f32, s.wi.y as f32, s.wi.z as f32, s.pdf as f32]).collect()
+    }
 }
 
 /// Builds the importance-sampling tables of `table`.

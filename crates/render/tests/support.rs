@@ -15,16 +15,7 @@ use render::{Camera, Lighting, Material, Mesh, SampleSet, Scene};
 /// The samples of a bake as the renderers read them (the layout of `merl-importance`'s asset).
 pub fn sample_set(tables: &ImportanceTables) -> SampleSet {
     let c = tables.config();
-    SampleSet {
-        n_slices: c.n_theta_o,
-        n_vectors: c.n_vectors,
-        n_samples: c.n_samples,
-        texels: tables
-            .all_samples()
-            .iter()
-            .map(|s| [s.wi.x as f32, s.wi.y as f32, s.wi.z as f32, s.pdf as f32])
-            .collect(),
-    }
+    SampleSet { n_slices: c.n_theta_o, n_vectors: c.n_vectors, n_samples: c.n_samples, texels: tables.sample_texels() }
 }
 
 /// The bakes: 16 vectors of 512 samples per slice (8192 per slice: the renderer's expectation is

@@ -141,9 +141,7 @@ impl From<ModeArg> for Mode {
 }
 
 fn parse_size(text: &str) -> Result<(usize, usize), String> {
-    let parse = |s: &str| s.trim().parse::<usize>().map_err(|e| format!("{s:?}: {e}"));
-    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
-    let (w, h) = (parse(w)?, parse(h)?);
+    let (w, h) = cli::parse_size(text)?;
     if w == 0 || h == 0 || w > 8192 || h > 8192 {
         return Err(format!("{w}x{h}: each side must be between 1 and 8192"));
     }

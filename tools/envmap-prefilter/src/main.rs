@@ -34,7 +34,7 @@ struct Args {
     exponents: Vec<u32>,
 
     /// Size of every layer, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT.
-    #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = cli::parse_size)]
     size: (usize, usize),
 
     /// How the layers are computed: auto picks the cheaper per layer.
@@ -71,12 +71,6 @@ impl From<MethodArg> for Method {
             MethodArg::Window => Method::Window,
         }
     }
-}
-
-fn parse_size(text: &str) -> Result<(usize, usize), String> {
-    let parse = |s: &str| s.trim().parse::<usize>().map_err(|e| format!("{s:?}: {e}"));
-    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
-    Ok((parse(w)?, parse(h)?))
 }
 
 const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
@@ -123,13 +117,5 @@ mod tests {
         let config = prefilter::Config::default();
         assert_eq!(args.exponents, config.exponents);
         assert_eq!(args.size, (config.width, config.height));
-    }
-
-    #[test]
-    fn sizes_parse() {
-        assert_eq!(super::parse_size("64x32"), Ok((64, 32)));
-        assert_eq!(super::parse_size("64X32"), Ok((64, 32)));
-        assert!(super::parse_size("64").is_err());
-        assert!(super::parse_size("ax32").is_err());
     }
 }

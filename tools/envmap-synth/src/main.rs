@@ -22,8 +22,8 @@ struct Args {
     out: PathBuf,
 
     /// Width and height, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT.
-    #[arg(long, value_name = "WxH", default_value = "1024x512")]
-    size: String,
+    #[arg(long, value_name = "WxH", default_value = "1024x512", value_parser = cli::parse_size)]
+    size: (usize, usize),
 
     /// Print one JSON object (the file written, its size) on stdout.
     #[arg(long)]
@@ -35,11 +35,7 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    let Some((w, h)) = args.size.split_once(['x', 'X']) else {
-        bail!("--size {:?}: expected WIDTHxHEIGHT", args.size);
-    };
-    let (w, h): (usize, usize) =
-        (w.trim().parse().context("--size width")?, h.trim().parse().context("--size height")?);
+    let (w, h) = args.size;
     if h > 8192 {
         bail!("--size {w}x{h}: at most 16384x8192");
     }

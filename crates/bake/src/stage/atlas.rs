@@ -281,44 +281,33 @@ fn parameterization_of(analysis: &asset::BandwidthAnalysis) -> Result<brdf_atlas
 /// `lobes_x` columns ([`Atlas::expand_rows`] refuses a grid above [`brdf_atlas::MAX_TEXELS`]
 /// before allocating it).
 fn from_rows_asset(r: asset::BandwidthRows) -> Result<Atlas, String> {
-    let parameterization = parameterization_of(&r.analysis)?;
-    let rows = Atlas {
-        lobes_x: 1,
-        lobes_y: r.lobes_y as usize,
-        tile: r.tile as usize,
-        data: r.data,
-        parameterization,
-        analysis_size: r.analysis.analysis_size as usize,
-        eps: r.analysis.eps,
-        c: r.analysis.c,
-    };
+    let rows = atlas_of(1, r.lobes_y, r.tile, r.data, &r.analysis)?;
     rows.expand_rows(r.lobes_x as usize).map_err(|e| e.to_string())
 }
 
 /// An atlas read back from its full-grid asset, checked.
 pub fn from_asset(a: asset::BandwidthAtlas) -> Result<Atlas, String> {
-    let parameterization = parameterization_of(&a.analysis)?;
-    let texels = u64::from(a.lobes_x)
-        .checked_mul(u64::from(a.tile))
-        .and_then(|w| u64::from(a.lobes_y).checked_mul(u64::from(a.tile)).and_then(|h| w.checked_mul(h)));
-    match texels {
-        Some(t) if t <= brdf_atlas::MAX_TEXELS as u64 => {}
-        _ => {
-            return Err(format!(
-                "an atlas of {} x {} tiles of {} texels exceeds the limit",
-                a.lobes_x, a.lobes_y, a.tile
-            ));
-        }
-    }
+    atlas_of(a.lobes_x, a.lobes_y, a.tile, a.data, &a.analysis)
+}
+
+/// The in-memory atlas of an asset's fields, checked (`Atlas::check`: sizes with overflow checks,
+/// the texel limit, finite values).
+fn atlas_of(
+    lobes_x: u32,
+    lobes_y: u32,
+    tile: u32,
+    data: Vec<f32>,
+    analysis: &asset::BandwidthAnalysis,
+) -> Result<Atlas, String> {
     let atlas = Atlas {
-        lobes_x: a.lobes_x as usize,
-        lobes_y: a.lobes_y as usize,
-        tile: a.tile as usize,
-        data: a.data,
-        parameterization,
-        analysis_size: a.analysis.analysis_size as usize,
-        eps: a.analysis.eps,
-        c: a.analysis.c,
+        lobes_x: lobes_x as usize,
+        lobes_y: lobes_y as usize,
+        tile: tile as usize,
+        data,
+        parameterization: parameterization_of(analysis)?,
+        analysis_size: analysis.analysis_size as usize,
+        eps: analysis.eps,
+        c: analysis.c,
     };
     atlas.check().map_err(|e| e.to_string())?;
     Ok(atlas)

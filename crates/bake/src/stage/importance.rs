@@ -182,12 +182,6 @@ fn provenance_parameters(config: &Config) -> [(&'static str, String); 8] {
     ]
 }
 
-/// The samples as the asset stores them and the renderers read them: `(wi.x, wi.y, wi.z, pdf)` in
-/// `f32`, slice-major, then vector, then sample.
-pub fn sample_texels(tables: &ImportanceTables) -> Vec<[f32; 4]> {
-    tables.all_samples().iter().map(|s| [s.wi.x as f32, s.wi.y as f32, s.wi.z as f32, s.pdf as f32]).collect()
-}
-
 /// The tables' samples as the renderers read them (what `crate::load` makes of the asset).
 pub fn sample_set(tables: &ImportanceTables) -> render::SampleSet {
     let config = tables.config();
@@ -195,7 +189,7 @@ pub fn sample_set(tables: &ImportanceTables) -> render::SampleSet {
         n_slices: config.n_theta_o,
         n_vectors: config.n_vectors,
         n_samples: config.n_samples,
-        texels: sample_texels(tables),
+        texels: tables.sample_texels(),
     }
 }
 
@@ -213,7 +207,7 @@ fn payload(config: &Config, tables: &ImportanceTables) -> asset::ImportanceSampl
             h_density.extend((0..d.nu()).map(|iu| slice.h_density([iu, iv]) as f32));
         }
     }
-    let samples = sample_texels(tables);
+    let samples = tables.sample_texels();
     asset::ImportanceSamples {
         theta_o: tables.slices().iter().map(|s| s.theta_o()).collect(),
         n_vectors: config.n_vectors as u32,
