@@ -139,17 +139,18 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
     assert_eq!(lobes_at_limit(&r), 0, "{r}");
 }
 
-/// The default analysis (512 x 512) resolves Phong n = 1000 wherever the lobe lies above the
-/// horizon: only the grazing rows, where the lobe straddles the horizon and the analysis's
-/// continuation below it turns the lobe's cut into an edge, read the limit (measured: the last 5
-/// of 64 rows, theta_i above 84 degrees; at 256 every lobe reads it, at 1024 the last row does).
+/// The default analysis (512 x 512) resolves Phong n = 1000 at every incident direction (the
+/// `brdf-atlas` test `phong_1000_across_the_horizon_is_resolved_at_the_default_size`); what a
+/// table of it still reads at the limit is the table's no-data edge at the horizon, on the
+/// horizon's last pixel in three of the most grazing rows (measured: 192 lobes, theta_i above
+/// 86 degrees; 320 before the analysis continued the lobe with its curvature; 4096 at 256).
 #[test]
-fn the_default_analysis_resolves_phong_1000_above_the_horizon() {
+fn the_default_analysis_resolves_phong_1000() {
     let tmp = temp_dir();
     let table = write_table(tmp.path(), "phong1000.binary", Analytic::Phong { n: 1000.0, ks: [1.0; 3] });
     let r = brdf_bandwidth(&table, &tmp.path().join("atlas"), &["--json"]).expect_code(0);
     let at_limit = lobes_at_limit(&r);
-    assert!(at_limit <= 5 * 64 && at_limit.is_multiple_of(64), "{at_limit} lobes at the limit\n{r}");
+    assert!(at_limit <= 3 * 64 && at_limit.is_multiple_of(64), "{at_limit} lobes at the limit\n{r}");
 }
 
 #[test]

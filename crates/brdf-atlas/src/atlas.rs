@@ -20,9 +20,12 @@ pub struct Config {
     /// two from 16 to 4096, at least `tile`. The highest bandwidth it can report is
     /// [`DEFAULT_C`](bandwidth::DEFAULT_C)` / 2` cycles per pixel, `0.088 size / pi` cycles per
     /// radian at the centre of the lobe image (1.8 for 64, 14.4 for 512). The default, 512,
-    /// resolves normalized Phong lobes up to n = 1000 wherever their lobe lies above the horizon
-    /// (at 256 every lobe of n = 1000 reaches the limit); the lobes that straddle the horizon at
-    /// the grazing rows still read the limit there (320 of 4096 lobes for n = 1000, 64 at 1024).
+    /// resolves normalized Phong lobes up to n = 1000 at every incident direction, the grazing
+    /// ones whose lobe straddles the horizon included (at 256 every lobe of n = 1000 reaches
+    /// the limit). A table of such a lobe made by `merl-synth` reads the limit in 192 of 4096
+    /// lobes (theta_i above 86 degrees, 128 at 1024), on the horizon's last pixel, where the
+    /// trilinear lookup leaves out the cells beyond the horizon, which hold no data (crate docs,
+    /// "Lobe images").
     /// It costs about 2.5 s for a real-derived material in a release build on two cores.
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).
@@ -83,7 +86,7 @@ impl Config {
 pub enum Parameterization {
     /// Incident directions in rows of equal `cos(theta_i)` steps and columns of `phi_i`
     /// ([`IncidentGrid`]); lobe images in the azimuthal equidistant projection of `wo` in the
-    /// frame of the plane of incidence, continued below the horizon by an odd reflection
+    /// frame of the plane of incidence, continued below the horizon by extrapolation
     /// ([`crate::LobeMap`]); a texel holds the largest bandwidth of the analysis pixels of the
     /// hemisphere it covers, in cycles per radian (crate docs).
     IncidencePlaneEquidistant,

@@ -9,7 +9,7 @@
 //! 1. The MERL table becomes one Rec. 709 luminance per cell ([`LuminanceTable`]), read by
 //!    `merl`'s trilinear interpolation (equal to `merl::luminance` of the RGB lookup to 1e-12).
 //! 2. For each row of the incident grid (one `theta_i`), the lobe image: `n x n` pixels
-//!    (`Config::analysis_size`, default 64) of the hemisphere of `wo` ([`LobeMap`]).
+//!    (`Config::analysis_size`, default 512) of the hemisphere of `wo` ([`LobeMap`]).
 //! 3. The image is continued to a periodic `2n x 2n` image by mirroring ([`extend_periodic`])
 //!    and handed to [`bandwidth::local_bandwidth`]: D4, `eps = 0.01`, `c = 2^-2.5`, the noise
 //!    floor scaled to the lobe's peak, [`analysis_levels`] levels. The estimate of the image's
@@ -66,21 +66,48 @@
 //! (a parabola in `ln f`) would read the same bandwidth for every exponent.
 //!
 //! The corners of the square (`r > 1`, 21% of the pixels, up to `theta_o = 127` degrees) are
-//! below the horizon, where the BRDF does not exist. They hold the lobe's odd reflection across
-//! the horizon along the radius, `2 f(theta_o = pi / 2) - f(pi - theta_o)` ([`Sample`]), which
-//! continues the image with its slope: D4 has two vanishing moments and ignores a linear trend,
-//! so the horizon reads neither as a jump nor as a kink. (An even reflection leaves a kink where
-//! the lobe is steep at the horizon: at 64 x 64, broad Phong lobes (n = 2) then read the grid's
-//! limit on the rim.) Pixels with no table data around them (all eight trilinear corners empty,
-//! which happens only near the horizon) are filled with the mean of their neighbours
-//! ([`lobe_image`]); on the 20 shared materials none is.
+//! below the horizon, where the BRDF does not exist. They hold the lobe continued along the
+//! radius ([`Sample`]): at depth `t` below the horizon, `6 f(-t) - 8 f(-2t) + 3 f(-3t)` of the
+//! values at heights `t`, `2t`, `3t` above it on the same great circle, exact for every
+//! quadratic, so the image meets the horizon with its value, slope and curvature and the
+//! wavelets (D4 has two vanishing moments) see no edge there. Three pixels down
+//! ([`param::CONTINUATION_REACH`]) it has blended into the odd reflection `2 f(0) - f(-t)`,
+//! which stays within the lobe's range and reads no further than `t` above the horizon (the
+//! three-point rule reads `3t` in, where a narrow lobe is no longer a quadratic, and, 37
+//! degrees deep, past the zenith). Lesser continuations leave an edge: an even reflection a kink
+//! where the lobe is steep at the horizon (at 64 x 64, broad Phong lobes (n = 2) read the
+//! grid's limit on the rim), the odd reflection alone a jump in curvature, which reads the
+//! limit where a narrow lobe straddles the horizon (Phong n = 1000 at 512 x 512: 320 of 4096
+//! lobes, the last five rows; now none).
+//!
+//! Pixels with no table data around them (all eight trilinear corners empty, which happens only
+//! near the horizon) are filled with the mean of their neighbours ([`lobe_image`]); on the 20
+//! shared materials none is.
+//!
+//! What remains at the horizon is the table's own: MERL tables hold no data for configurations
+//! below it, and the trilinear lookup leaves those corners out and renormalizes, which bends
+//! the lobe within a cell of the horizon. Where a narrow lobe meets the horizon nearly opposite
+//! `wi` (grazing incidence, where the half vector swings fast with `wo` and a cell is small in
+//! `wo`) that reads the limit on the horizon's last pixel at any analysis size: `merl-synth
+//! phong -n 1000` reads it in 192 of 4096 lobes at 512 and 128 at 1024, while the same lobe
+//! analytically, or tabulated with values beyond the horizon, reads it in none (test
+//! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`).
 //!
 //! # Boundaries
 //!
 //! The periodic transform would wrap the square's left edge onto its right edge, i.e. one side
-//! of the horizon onto the other. [`extend_periodic`] analyses instead the `2n x 2n` image made
-//! of the lobe image, its mirror image to the right and both mirrored below: periodic and
-//! continuous everywhere. Only the estimate of the top-left `n x n` pixels is kept.
+//! of the horizon onto the other. [`extend_periodic`] analyses instead a `2n x 2n` image, the
+//! lobe image in its top-left quarter, continued across each of its borders the way the
+//! corners continue it below the horizon: the three-point rule for the first pixels, blended
+//! into the odd reflection about the border, which carries the slope across; half way to the
+//! next border that has blended into the plain mirror image, so that the continuations of
+//! opposite borders never meet. Periodic and smooth everywhere. This matters where the
+//! square's edge touches the horizon (`phi = 0, 90, 180, 270` degrees): a plain mirror there
+//! leaves a kink wherever the lobe is steep, as at grazing
+//! incidence, where the mirror direction lies on the `-a` edge. Only the estimate of the
+//! top-left `n x n` pixels is kept. (The layer selection's energy shares read the plain mirror
+//! tiling instead, [`mirror_tiling`]: there the continuation's ramps would count as the lobe's
+//! energy.)
 //!
 //! # Levels
 //!
@@ -143,10 +170,10 @@
 //!
 //! # Performance
 //!
-//! One analysis per row: 64 lobe images of 4096 trilinear lookups and 64 estimates of 128 x 128
-//! images, in parallel over rows, each thread with its own buffers (only the `bandwidth` crate
-//! allocates per lobe). The default atlas of a real-derived material takes about 0.1 s in a
-//! release build on two cores, 0.3 s for the whole tool with reading and writing.
+//! One analysis per row: 64 lobe images of `n^2` trilinear lookups (three per pixel below the
+//! horizon) and 64 estimates of `2n x 2n` images, in parallel over rows, each thread with its
+//! own buffers (only the `bandwidth` crate allocates per lobe). At the default `n = 512` the
+//! atlas of a real-derived material takes about 2.5 s in a release build on two cores.
 
 mod analysis;
 mod atlas;
@@ -156,7 +183,7 @@ pub mod param;
 pub mod pca;
 pub mod view;
 
-pub use analysis::{Analyser, LobeBandwidth, TileReduction, analysis_levels, extend_periodic};
+pub use analysis::{Analyser, LobeBandwidth, TileReduction, analysis_levels, extend_periodic, mirror_tiling};
 pub use atlas::{Atlas, AtlasBuild, BuildStats, Config, MAX_TEXELS, Parameterization, build_atlas};
 pub use error::Error;
 pub use lobe::{LuminanceTable, lobe_image, lobe_image_from_fn};

@@ -2,7 +2,7 @@
 //! images"): the grid of
 //! incident directions (rows of equal solid angle in `theta_i`, columns in `phi_i`) and the
 //! image of an outgoing lobe (an azimuthal equidistant projection of the hemisphere of `wo` in
-//! the frame of the plane of incidence, continued below the horizon by an odd reflection),
+//! the frame of the plane of incidence, continued below the horizon by extrapolation),
 //! with the Jacobian that turns cycles per pixel into cycles per radian.
 //!
 //! Both images are seen from `+z`, looking down at the surface; normalized coordinates
@@ -75,25 +75,39 @@ pub fn to_incidence_frame(w: DVec3, phi_i: f64) -> DVec3 {
 /// point `(a, b) = r (cos phi, sin phi)` is the direction `theta_o = (pi / 2) r`,
 /// `phi_o - phi_i = phi`; column `x` grows with `a`, row `y` with `-b`. The corners (`r > 1`, up to
 /// `theta_o = 127` degrees) are below the horizon, where the BRDF does not exist: a corner pixel
-/// holds the odd reflection of the lobe across the horizon along its radius,
-/// `2 f(pi / 2) - f(pi - theta_o)` ([`Sample::Reflected`]), which continues the image with its
-/// slope, so that the wavelets (D4 ignores linear trends) see neither a jump nor a kink at the
-/// horizon (crate docs, "Lobe images").
+/// holds the lobe continued along its radius from points above the horizon
+/// ([`Sample::Continued`]): with its value, slope and curvature at the horizon, so that the
+/// wavelets see no edge there, blending into the odd reflection `2 f(0) - f(-t)` deeper down
+/// (crate docs, "Lobe images").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LobeMap {
     pub size: usize,
 }
 
 /// What one pixel of a lobe image holds: the BRDF at one direction, or, below the horizon, a
-/// combination of two.
+/// combination of three.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sample {
     /// `f(wo)`.
     Direct(DVec3),
-    /// `2 f(horizon) - f(mirrored)`: `horizon` is the direction of the pixel's azimuth on the
-    /// horizon, `mirrored` its direction reflected across the horizon (`wo.z -> -wo.z`).
-    Reflected { horizon: DVec3, mirrored: DVec3 },
+    /// `sum_k weights[k] f(points[k])`: the lobe continued below the horizon from directions
+    /// above it on the pixel's great circle through the zenith ([`LobeMap::sample`]).
+    Continued { points: [DVec3; 4], weights: [f64; 4] },
 }
+
+/// The weights of the three-point continuation in [`LobeMap::sample`]: `c_1 + c_2 + c_3 = 1`,
+/// `-c_1 - 2 c_2 - 3 c_3 = 1`, `c_1 + 4 c_2 + 9 c_3 = 1` (the continuation of `1`, `t` and `t^2`
+/// is `1`, `t`, `t^2`).
+pub const CONTINUATION_WEIGHTS: [f64; 3] = [6.0, -8.0, 3.0];
+
+/// Pixels (samples) over which the three-point continuation blends into the odd reflection,
+/// below the horizon ([`LobeMap::sample`], along the radius) and past the square's edges
+/// (`extend_periodic`). The three-point rule reads three times as far in, where a lobe narrower
+/// than that is no longer a quadratic: blending over more pixels lets its misfit show (on a lobe
+/// 16 samples wide with its inflection on the border, the finest wavelets read 1.9 times the
+/// lobe's own finest detail over 3 samples, 5 times over 8), over fewer the blend's own turn
+/// shows (at 64 x 64, a broad Phong lobe then reads the limit on the rim).
+pub const CONTINUATION_REACH: usize = 3;
 
 impl Sample {
     /// The pixel's value for a BRDF `f` (luminance of `f(wi, wo)` at fixed `wi`); `None` where
@@ -101,7 +115,15 @@ impl Sample {
     pub fn eval(&self, mut f: impl FnMut(DVec3) -> Option<f64>) -> Option<f64> {
         match *self {
             Sample::Direct(wo) => f(wo),
-            Sample::Reflected { horizon, mirrored } => Some(2.0 * f(horizon)? - f(mirrored)?),
+            Sample::Continued { points, weights } => {
+                let mut sum = 0.0;
+                for (w, c) in points.into_iter().zip(weights) {
+                    if c != 0.0 {
+                        sum += c * f(w)?;
+                    }
+                }
+                Some(sum)
+            }
         }
     }
 }
@@ -137,8 +159,24 @@ impl LobeMap {
         if w.z >= 0.0 {
             return Sample::Direct(w);
         }
-        let rho = w.x.hypot(w.y);
-        Sample::Reflected { horizon: DVec3::new(w.x / rho, w.y / rho, 0.0), mirrored: DVec3::new(w.x, w.y, -w.z) }
+        let (a, b) = self.square(x, y);
+        let depth = self.theta(x, y) - FRAC_PI_2;
+        let at = |k: f64| direction_from_disk(a, b, FRAC_PI_2 - k * depth);
+        // The blend's weight: 1 on the horizon, 0 from CONTINUATION_REACH pixels (of pi / size
+        // radians along the radius) on, flat at both ends.
+        let s = (depth / self.continuation_depth()).min(1.0);
+        let w = 1.0 - s * s * (3.0 - 2.0 * s);
+        let [c1, c2, c3] = CONTINUATION_WEIGHTS.map(|c| c * w);
+        Sample::Continued {
+            points: [at(0.0), at(1.0), at(2.0), at(3.0)],
+            weights: [2.0 * (1.0 - w), c1 - (1.0 - w), c2, c3],
+        }
+    }
+
+    /// The depth below the horizon, in radians, from which [`Self::sample`] holds the plain odd
+    /// reflection: [`CONTINUATION_REACH`] pixels along the radius.
+    pub fn continuation_depth(&self) -> f64 {
+        CONTINUATION_REACH as f64 * PI / self.size as f64
     }
 
     /// Whether the centre of pixel `(x, y)` lies on the hemisphere (`theta_o <= pi / 2`).
@@ -217,10 +255,24 @@ mod tests {
                             (u * 16.0 - (x as f64 + 0.5)).abs() < 1e-9 && (v * 16.0 - (y as f64 + 0.5)).abs() < 1e-9
                         );
                     }
-                    Sample::Reflected { horizon, mirrored } => {
-                        assert!(!map.inside(x, y) && horizon.z == 0.0 && mirrored.z > 0.0);
-                        assert!((map.theta(x, y) - (PI - merl::coords::theta_of(mirrored))).abs() < 1e-12);
-                        assert!((horizon.x * mirrored.y - horizon.y * mirrored.x).abs() < 1e-12);
+                    Sample::Continued { points, weights } => {
+                        // k times the pixel's depth above the horizon on the pixel's great
+                        // circle through the zenith, on the pixel's side wherever weighted.
+                        assert!(!map.inside(x, y));
+                        assert!((weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                        let depth = map.theta(x, y) - FRAC_PI_2;
+                        for (k, (w, c)) in points.into_iter().zip(weights).enumerate() {
+                            assert!((w.length() - 1.0).abs() < 1e-12);
+                            assert!((w.x * wo.y - w.y * wo.x).abs() < 1e-12);
+                            if c != 0.0 {
+                                let elevation = FRAC_PI_2 - merl::coords::theta_of(w);
+                                assert!(w.x * wo.x + w.y * wo.y > 0.0, "{x} {y} {k}");
+                                assert!((elevation - k as f64 * depth).abs() < 1e-12, "{x} {y} {k}");
+                            }
+                        }
+                        if depth >= map.continuation_depth() {
+                            assert_eq!(weights, [2.0, -1.0, 0.0, 0.0]);
+                        }
                     }
                 }
             }
@@ -246,5 +298,40 @@ mod tests {
             assert!((radial - r_expect).abs() < 1e-6 * r_expect, "{radial} {r_expect}");
             assert!((tangential - t_expect).abs() < 1e-6 * t_expect, "{tangential} {t_expect}");
         }
+    }
+
+    #[test]
+    fn the_continuation_is_exact_for_linear_and_keeps_the_curvature() {
+        // Along each pixel's great circle, f = alpha + beta e + gamma e^2 of the elevation e
+        // (negative below the horizon). A linear f is continued exactly at every depth; a
+        // quadratic one to O(t^4) near the horizon (the three-point continuation), and by the
+        // odd reflection (exact for linear only) from the continuation depth on.
+        let map = LobeMap::new(512);
+        let elevation = |w: DVec3| FRAC_PI_2 - merl::coords::theta_of(w);
+        let (alpha, beta, gamma) = (0.7, -1.3, 2.1);
+        let mut checked = 0;
+        for y in 0..512 {
+            for x in 0..512 {
+                let Sample::Continued { .. } = map.sample(x, y) else { continue };
+                let t = map.theta(x, y) - FRAC_PI_2;
+                let direction = map.direction(x, y);
+                // Elevation measured on the pixel's side of the zenith.
+                let e = |w: DVec3| {
+                    if w.x * direction.x + w.y * direction.y >= 0.0 { elevation(w) } else { PI - elevation(w) }
+                };
+                let linear = map.sample(x, y).eval(|w| Some(alpha + beta * e(w))).unwrap();
+                assert!((linear - (alpha - beta * t)).abs() < 1e-12, "{x} {y}");
+                let blend = map.continuation_depth();
+                if t < blend / 2.0 {
+                    let q = map.sample(x, y).eval(|w| Some(alpha + beta * e(w) + gamma * e(w).powi(2))).unwrap();
+                    let exact = alpha - beta * t + gamma * t * t;
+                    // The blend's weight departs from 1 as 3 s^2, s = t / blend: error 6 gamma t^2 s^2.
+                    let bound = 6.0 * gamma * t * t * (t / blend).powi(2) + 1e-12;
+                    assert!((q - exact).abs() <= bound, "{x} {y}: {q} {exact} {bound}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 100, "{checked}");
     }
 }

@@ -10,8 +10,8 @@
 //! - [`ViewReduction::Max`]: the largest texel of the row's tile, the papers' "maximum
 //!   frequency" read literally.
 //! - [`ViewReduction::BandQuantile`]: the frequency below which a share `q` of the lobe image's
-//!   wavelet detail energy lies ([`band_quantile`]): the same D4 decomposition of the same
-//!   periodic continuation the estimator reads, its energy per level accumulated from the
+//!   wavelet detail energy lies ([`band_quantile`]): the same D4 decomposition, of the lobe
+//!   image's mirror tiling ([`crate::mirror_tiling`]), its energy per level accumulated from the
 //!   coarsest, the crossing interpolated within its level, level `j` read as `c 2^-j` cycles per
 //!   pixel as the estimator reads it, converted at the lobe map's centre (`n / pi` pixels per
 //!   radian).
@@ -33,7 +33,7 @@
 
 use merl::MerlTable;
 
-use crate::analysis::{Analyser, analysis_levels, extend_periodic};
+use crate::analysis::{Analyser, analysis_levels, mirror_tiling};
 use crate::atlas::{AtlasBuild, Config};
 use crate::error::Error;
 use crate::lobe::lobe_image_from_fn;
@@ -80,10 +80,11 @@ impl ViewReduction {
 }
 
 /// The energy of each detail level of a lobe image's wavelet decomposition: the periodic
-/// continuation the estimator reads ([`extend_periodic`]), D4, [`analysis_levels`] levels;
+/// image's mirror tiling ([`mirror_tiling`]: four copies of the image, so the shares are the
+/// image's own), D4, [`analysis_levels`] levels;
 /// finest first, the three orientations of a level summed.
 pub fn band_energy(image: &[f64], n: usize) -> Vec<f64> {
-    let decomposition = wavelet::wavedec2(&extend_periodic(image, n), wavelet::Wavelet::D4, analysis_levels(n))
+    let decomposition = wavelet::wavedec2(&mirror_tiling(image, n), wavelet::Wavelet::D4, analysis_levels(n))
         .expect("lobe images have a power-of-two size of at least 16");
     decomposition.details.iter().map(|level| level.iter().map(wavelet::Image::energy).sum()).collect()
 }

@@ -96,3 +96,45 @@ fn the_atlas_counts_the_lobes_at_the_limit() {
         }
     }
 }
+
+/// The lobes of Phong n = 1000 at the eight most grazing rows of the default 64-row grid, where
+/// the mirror direction lies within 8 degrees of the horizon and the lobe (1/e half width 2.6
+/// degrees) straddles it: analysed at the default 512 x 512, the pixels at the grid's limit of
+/// each, (a) for the analytic lobe and (b) for a table holding the lobe in every cell, beyond
+/// the horizon too.
+///
+/// Both must read none: the continuation below the horizon (three-point extrapolation) and
+/// across the square's edges (odd reflection) carry the lobe's value, slope and curvature, so
+/// the cut reads as no edge. Before them, (a) read 12 to 50 pixels at the limit in rows 60 to
+/// 63 (the odd reflection `2 f(0) - f(-t)` flips the curvature, the square's mirrored edge
+/// makes a kink). A table made by `merl-synth` still reads the limit in three of these rows
+/// (192 of 4096 lobes), on the horizon's last pixel: its cells beyond the horizon hold no
+/// data, and the trilinear lookup, which leaves those corners out, has an edge there; (b)
+/// shows that the lobe itself is resolved.
+#[test]
+fn phong_1000_across_the_horizon_is_resolved_at_the_default_size() {
+    use merl::{Dims, MerlTable};
+    let config = Config::default();
+    assert_eq!(config.analysis_size, 512);
+    let analyser = Analyser::new(&config);
+    let n = 1000.0;
+    let lobe = |wi: DVec3, wo: DVec3| {
+        let r = DVec3::new(-wi.x, -wi.y, wi.z);
+        (n + 2.0) / std::f64::consts::TAU * wo.dot(r).max(0.0).powf(n)
+    };
+    let full = MerlTable::from_fn(Dims::MERL, |hd| {
+        let (wi, wo) = hd.to_dirs();
+        Some([lobe(wi, wo); 3])
+    });
+    let full = LuminanceTable::new(&full);
+    let grid = IncidentGrid::new(64);
+    for j in 56..64 {
+        let theta_i = grid.theta_i(j);
+        let wi = merl::spherical_dir(theta_i, 0.0);
+        let analytic = analyser.analyse_image(brdf_atlas::lobe_image_from_fn(analyser.map(), |wo| Some(lobe(wi, wo))));
+        let tabulated = analyser.analyse(&full, theta_i);
+        let counts = (analytic.nyquist_count(), tabulated.nyquist_count());
+        println!("row {j}, theta_i {:.2} deg: {counts:?} pixels at the limit", theta_i.to_degrees());
+        assert_eq!(counts, (0, 0), "row {j}, theta_i {:.2} deg", theta_i.to_degrees());
+    }
+}
