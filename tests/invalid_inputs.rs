@@ -77,3 +77,31 @@ fn full_size_damaged_merl_files_are_rejected() {
     std::fs::write(&nan, &bytes).unwrap();
     check("merl-info", &nan, 2, "infinite value in the blue channel");
 }
+
+/// Count options take a whole number from 1 up and say so: zero (`bandwidth-pca --components 0`
+/// was accepted) and negative numbers (clap read `-1` as an unknown flag, "unexpected argument
+/// '-1' found") are errors that name the option and what it accepts, before any input is read.
+#[test]
+fn count_options_say_what_they_accept() {
+    let missing = Path::new("no-such-input");
+    for (name, option) in [
+        ("bandwidth-pca", "--components"),
+        ("brdf-bandwidth", "--lobes"),
+        ("brdf-bandwidth", "--analysis-size"),
+        ("merl-importance", "--samples"),
+        ("merl-importance", "--theta-o"),
+        ("brdf-bake", "--vectors"),
+        ("envmap-bandwidth", "--levels"),
+    ] {
+        for value in ["0", "-1", "2.5"] {
+            let mut cmd = tool(name);
+            cmd.arg(missing).args([option, value, "--out-dir", "unused"]);
+            let r = run(cmd, "").expect_code(2);
+            let says = format!("invalid value '{value}' for '{option}");
+            assert!(
+                r.stderr.contains(&says) && r.stderr.contains("expected a whole number from 1 up"),
+                "{name} {option} {value}: {r}"
+            );
+        }
+    }
+}

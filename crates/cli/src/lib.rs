@@ -76,6 +76,16 @@ pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
+/// Parses a count option (samples, sizes, components), as clap's `value_parser` wants it: a
+/// whole number from 1 up. Tools set `allow_negative_numbers` on their commands, so `-1`
+/// reaches this parser and the message says what the option accepts.
+pub fn parse_count(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("expected a whole number from 1 up".to_string()),
+    }
+}
+
 /// Prints a tool's outcome the way every tool does and returns its exit status. With `json`,
 /// stdout gets exactly `value` (one JSON object, which lists the files written) and the report
 /// goes to stderr; without, the report and the problems go to stdout. Either way the files written

@@ -19,7 +19,7 @@ use serde_json::{Value, json};
 /// still shown); 2 the file cannot be read, is not an asset, or is of a version or kind this
 /// build does not know.
 #[derive(Debug, Parser)]
-#[command(version)]
+#[command(version, allow_negative_numbers = true)]
 struct Args {
     /// The asset file to inspect
     file: PathBuf,

@@ -21,7 +21,7 @@ use clap::{ArgGroup, Parser};
 ///
 /// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 #[command(group(ArgGroup::new("k").required(true).args(["components", "max_error"])))]
 struct Args {
     /// The atlas (bandwidth-atlas.asset written by brdf-bandwidth: kind bandwidth-rows or
@@ -33,7 +33,7 @@ struct Args {
     out_dir: PathBuf,
 
     /// Keep exactly K components.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = cli::parse_count)]
     components: Option<usize>,
 
     /// Keep the fewest components whose relative RMSE is at most E (e.g. 0.02).

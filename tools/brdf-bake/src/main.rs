@@ -27,7 +27,7 @@ use serde_json::json;
 /// Exit status: 0 ok, 1 a stage's validation found a problem (the bake is written and says so),
 /// 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
@@ -48,17 +48,17 @@ struct Args {
     /// Vectors of importance samples per view elevation (each of --samples samples): the
     /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
     /// needs tens of vectors for percent-level agreement).
-    #[arg(long, value_name = "V", default_value_t = importance::Config::default().n_vectors)]
+    #[arg(long, value_name = "V", default_value_t = importance::Config::default().n_vectors, value_parser = cli::parse_count)]
     vectors: usize,
 
     /// Importance samples per vector (a power of two).
-    #[arg(long, value_name = "N", default_value_t = importance::Config::default().n_samples)]
+    #[arg(long, value_name = "N", default_value_t = importance::Config::default().n_samples, value_parser = cli::parse_count)]
     samples: usize,
 
     /// Pixels per side of the images each lobe is analysed on, for the bandwidth atlas and the
     /// layer selection (a power of two from 16 to 4096; 256 or more tells the default layers
     /// apart, and 512 resolves Phong lobes up to n = 1000).
-    #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size)]
+    #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 
     /// Bake even when the folder's manifest is up to date.

@@ -24,7 +24,7 @@ use clap::Parser;
 ///
 /// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
@@ -34,16 +34,16 @@ struct Args {
     out_dir: PathBuf,
 
     /// Incident directions per side of the grid.
-    #[arg(long, value_name = "N", default_value_t = Config::default().lobes)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().lobes, value_parser = cli::parse_count)]
     lobes: usize,
 
     /// Texels per side of each lobe's tile (a power of two).
-    #[arg(long, value_name = "T", default_value_t = Config::default().tile)]
+    #[arg(long, value_name = "T", default_value_t = Config::default().tile, value_parser = cli::parse_count)]
     tile: usize,
 
     /// Pixels per side of the image each lobe is analysed on (a power of two from 16, >= the
     /// tile); the highest bandwidth it resolves grows with it.
-    #[arg(long = "analysis-size", value_name = "N", default_value_t = Config::default().analysis_size)]
+    #[arg(long = "analysis-size", value_name = "N", default_value_t = Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 
     /// Print one JSON object (parameters, figures, files written) on stdout; the report goes to

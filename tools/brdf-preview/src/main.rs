@@ -39,7 +39,7 @@ mod window;
 ///
 /// Exit status: 0 ok, 1 --min-psnr was not met, 2 error (including no GPU adapter).
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The bake's folder (made by brdf-bake, with --env for rendering).
     bake: PathBuf,

@@ -30,7 +30,7 @@ use clap::Parser;
 /// Exit status: 0 ok, 2 error (unreadable input, a map that is not 2:1 without --spatial, a size
 /// the estimator cannot analyse, bad arguments).
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The map: OpenEXR or Radiance HDR (told apart by their first bytes). Without --spatial it
     /// must be a 2:1 lat-long map.
@@ -70,7 +70,7 @@ struct Args {
     eps: f64,
 
     /// Number of wavelet levels; by default as many as the size allows.
-    #[arg(long)]
+    #[arg(long, value_parser = cli::parse_count)]
     levels: Option<usize>,
 }
 

@@ -20,7 +20,7 @@ use prefilter::{Config, Method};
 ///
 /// Exit status: 0 ok, 1 --verify found a file that does not read back as written, 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The environment map (.exr or .hdr, lat-long, width = 2 x height).
     env: PathBuf,

@@ -15,7 +15,7 @@ use serde_json::json;
 ///
 /// Exit status: 0 ok, 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The map to write (OpenEXR).
     #[arg(long, short, value_name = "FILE.exr")]

@@ -18,7 +18,7 @@ use importance::Config;
 ///
 /// Exit status: 0 ok, 1 --report found a slice whose relative variance exceeds 0.1, 2 error.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
@@ -28,19 +28,19 @@ struct Args {
     out_dir: PathBuf,
 
     /// Outgoing elevations: theta_o = k / N * 90 degrees, k = 0 .. N-1.
-    #[arg(long = "theta-o", value_name = "N", default_value_t = Config::default().n_theta_o)]
+    #[arg(long = "theta-o", value_name = "N", default_value_t = Config::default().n_theta_o, value_parser = cli::parse_count)]
     n_theta_o: usize,
 
     /// Vectors of samples per elevation.
-    #[arg(long, value_name = "V", default_value_t = Config::default().n_vectors)]
+    #[arg(long, value_name = "V", default_value_t = Config::default().n_vectors, value_parser = cli::parse_count)]
     vectors: usize,
 
     /// Samples per vector (a power of two keeps each vector stratified).
-    #[arg(long, value_name = "S", default_value_t = Config::default().n_samples)]
+    #[arg(long, value_name = "S", default_value_t = Config::default().n_samples, value_parser = cli::parse_count)]
     samples: usize,
 
     /// Sectors of phi_h.
-    #[arg(long, value_name = "N", default_value_t = Config::default().n_phi_h)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().n_phi_h, value_parser = cli::parse_count)]
     phi_h: usize,
 
     /// Seed of the scrambled Sobol' points the samples come from.

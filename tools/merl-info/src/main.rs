@@ -1,6 +1,7 @@
 //! `merl-info`: validate a MERL BRDF table and summarize it, or evaluate it at directions read
 //! from stdin. A thin layer over the `merl` crate: argument parsing, one library call, reporting.
 
+use std::f64::consts::{PI, TAU};
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -18,7 +19,7 @@ use serde_json::json;
 /// Exit status: 0 the table is valid, 1 it loaded but validation found a problem (albedo above
 /// 1, or a noticeable part of the hemisphere without data), 2 it could not be read.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
     /// The MERL table to read.
     file: PathBuf,
@@ -159,10 +160,15 @@ fn parse_angles(line: &str) -> Result<[f64; 4]> {
         bail!("expected 4 numbers (theta_i phi_i theta_o phi_o), found {}", fields.len());
     }
     let mut out = [0.0; 4];
-    for (o, f) in out.iter_mut().zip(&fields) {
+    for (k, (o, f)) in out.iter_mut().zip(&fields).enumerate() {
         *o = f.parse::<f64>().with_context(|| format!("{f:?} is not a number"))?;
-        if !o.is_finite() {
-            bail!("{f:?} is not a finite angle");
+        // Polar angles in [0, pi], azimuths in [-2 pi, 2 pi]: a direction has no other
+        // reading, and an angle like 1e308 is a mistake, not a direction.
+        let (name, limit, low) =
+            [("theta_i", PI, 0.0), ("phi_i", TAU, -TAU), ("theta_o", PI, 0.0), ("phi_o", TAU, -TAU)][k];
+        if !(o.is_finite() && *o >= low && *o <= limit) {
+            let range = if low == 0.0 { "[0, pi]" } else { "[-2 pi, 2 pi]" };
+            bail!("{name} {f} is outside {range} (angles are in radians)");
         }
     }
     Ok(out)
