@@ -151,12 +151,13 @@ fn bad_arguments() {
     let input = shared().join("data/env/quarry_01_1k.hdr");
     let dir = temp_dir();
     let out = dir.path().join("bw");
-    let usage: [(&[&str], &str); 7] = [
+    let usage: [(&[&str], &str); 8] = [
         (&[], "--out-dir"),
         (&["--pad", "--out-dir", "x"], "--spatial"),
         (&["--out-dir", "x", "--frobnicate"], "--frobnicate"),
         (&["--out-dir", "x", "--levels", "many"], "--levels"),
         (&["--out-dir", "x", "--eps", "2"], "2 is not in (0, 1]"),
+        (&["--out-dir", "x", "--levels", "0"], "expected a whole number from 1 up"),
         (&["--out-dir", "x", "--eps", "NaN"], "NaN is not in (0, 1]"),
         // The options that no longer exist are refused, not ignored.
         (&["--out-dir", "x", "--png", "x.png"], "--png"),
@@ -168,8 +169,9 @@ fn bad_arguments() {
         assert!(r.stderr.contains(needle), "stderr should mention {needle}\n{r}");
         assert!(r.stdout.is_empty(), "{r}");
     }
-    // Values that only the estimator refuses: one line naming the file.
-    for levels in ["0", "11"] {
+    // Values that only the estimator refuses: one line naming the file. (`--levels 0` is a usage
+    // error: a count takes a whole number from 1 up.)
+    for levels in ["11"] {
         let r = envmap_bandwidth(&input, &out, &["--levels", levels]).expect_code(2);
         let names_the_file = r.stderr.contains(&input.display().to_string());
         assert!(r.stderr.starts_with("error: ") && names_the_file && r.stderr.lines().count() == 1, "{r}");

@@ -178,6 +178,11 @@ fn merl_importance_refuses_bad_settings() {
     let mut cmd = tool("merl-importance");
     cmd.arg(&material).arg("--out-dir").arg(dir.path().join("x")).args(["--samples", "0"]);
     let r = run(cmd, "").expect_code(2);
-    assert!(r.stderr.contains("invalid setting: samples per vector must be at least 1"), "{r}");
+    assert!(r.stderr.contains("invalid value '0' for '--samples <S>': expected a whole number from 1 up"), "{r}");
+    // A count the option takes but the tables cannot hold is the library's to refuse.
+    let mut cmd = tool("merl-importance");
+    cmd.arg(&material).arg("--out-dir").arg(dir.path().join("x")).args(["--vectors", "2000"]);
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("invalid setting: vectors 2000 exceeds the limit of 1024"), "{r}");
     assert!(!dir.path().join("x").exists(), "nothing is written for a bad setting\n{r}");
 }

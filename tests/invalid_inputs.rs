@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::support::{root, run, temp_dir, tool};
+use crate::support::{root, run, shared, temp_dir, tool};
 
 /// Runs `tool FILE`, expects exit `code` and a single `error: reading FILE: ...` line holding
 /// `problem`.
@@ -104,4 +104,37 @@ fn count_options_say_what_they_accept() {
             );
         }
     }
+}
+
+/// A 98 KB old-RLE Radiance file declaring 16384 x 8192 (exactly the size limit) made the
+/// environment tools decode it and then abort on a 1.4 GB (prefilter) or 0.5 GB (bandwidth)
+/// allocation under a 4 GB address-space limit. Now each tool estimates its need from the header
+/// and refuses it over the budget (4 GiB by default), in one line, with exit 2 and no output;
+/// with the budget raised past what the system gives (`ulimit -v`), the estimate cannot be
+/// reserved, which is the same kind of error, not an abort.
+#[test]
+fn a_small_file_declaring_a_huge_map_is_refused_within_the_memory_budget() {
+    let hostile = shared().join("data/hostile/repro-oldrle-16384x8192-abort.hdr");
+    let tmp = temp_dir();
+    for (name, need) in [("envmap-prefilter", "needs about 6 GiB"), ("envmap-bandwidth", "needs about 10 GiB")] {
+        let out = tmp.path().join(name);
+        let mut cmd = tool(name);
+        cmd.arg(&hostile).arg("--out-dir").arg(&out);
+        run(cmd, "").expect_code(2).expect_error(&hostile, need).expect_error(&hostile, "memory budget of 4 GiB");
+        assert!(!out.exists(), "{name} wrote {}", out.display());
+    }
+    let mut cmd = std::process::Command::new("sh");
+    let prefilter = tool("envmap-prefilter");
+    cmd.arg("-c").arg(r#"ulimit -v 4000000 && exec "$0" "$@""#).arg(prefilter.get_program()).arg(&hostile);
+    cmd.args(["--max-memory", "64G", "--out-dir"]).arg(tmp.path().join("raised"));
+    run(cmd, "").expect_code(2).expect_error(&hostile, "the system cannot provide it");
+    // The budget applies to small maps too, and --max-memory says what it accepts.
+    let map = shared().join("data/env/quarry_01_1k.hdr");
+    let mut cmd = tool("envmap-bandwidth");
+    cmd.arg(&map).args(["--max-memory", "16M", "--out-dir"]).arg(tmp.path().join("small"));
+    run(cmd, "").expect_code(2).expect_error(&map, "a 1024 x 512 map needs about 40 MiB for this job");
+    let mut cmd = tool("envmap-bandwidth");
+    cmd.arg(&map).args(["--max-memory", "lots", "--out-dir"]).arg(tmp.path().join("small"));
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("expected a size such as 4G, 512M"), "{r}");
 }

@@ -168,8 +168,17 @@ pub fn run_bake(
     // Both inputs are read before the folder is touched: a bake that cannot run leaves the
     // previous one as it was.
     let table = merl::read_file(&config.material).map_err(|e| Error::read(&config.material, e))?;
-    let map =
-        config.environment.as_deref().map(|path| envmap::load(path).map_err(|e| Error::read(path, e))).transpose()?;
+    // The map is held through both environment stages: the larger of their needs per texel,
+    // under the budget less the layers.
+    let limits = envmap::Limits {
+        bytes_per_texel: env_bandwidth::BYTES_PER_TEXEL.max(prefilter::BYTES_PER_TEXEL),
+        ..prefilter::limits(&config.prefilter, config.env_bandwidth.max_memory)
+    };
+    let map = config
+        .environment
+        .as_deref()
+        .map(|path| envmap::load_with_limits(path, &limits).map_err(|e| Error::read(path, e)))
+        .transpose()?;
 
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     // From here on the folder's files change: first make sure no manifest can name them.

@@ -86,6 +86,19 @@ pub fn parse_count(text: &str) -> Result<usize, String> {
     }
 }
 
+/// Parses a memory size (`--max-memory`): a whole number of bytes, or of KiB, MiB or GiB with the
+/// suffix `K`, `M`, `G` (or `KiB`, `MiB`, `GiB`; any case).
+pub fn parse_bytes(text: &str) -> Result<u64, String> {
+    let lower = text.trim().to_ascii_lowercase();
+    let (number, shift) = [("gib", 30), ("g", 30), ("mib", 20), ("m", 20), ("kib", 10), ("k", 10)]
+        .iter()
+        .find_map(|&(suffix, shift)| lower.strip_suffix(suffix).map(|n| (n.trim(), shift)))
+        .unwrap_or((lower.as_str(), 0));
+    let bad = || format!("expected a size such as 4G, 512M or 1048576 (bytes), found {text:?}");
+    let value: u64 = number.parse().map_err(|_| bad())?;
+    value.checked_mul(1 << shift).filter(|&v| v > 0).ok_or_else(bad)
+}
+
 /// Prints a tool's outcome the way every tool does and returns its exit status. With `json`,
 /// stdout gets exactly `value` (one JSON object, which lists the files written) and the report
 /// goes to stderr; without, the report and the problems go to stdout. Either way the files written
@@ -173,7 +186,7 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::{lower_case_start, parse_size};
+    use super::{lower_case_start, parse_bytes, parse_count, parse_size};
 
     #[test]
     fn sizes_parse() {
@@ -183,6 +196,22 @@ mod tests {
         assert!(parse_size("64").is_err());
         assert!(parse_size("ax32").is_err());
         assert!(parse_size("-1x2").is_err());
+    }
+
+    #[test]
+    fn counts_and_memory_sizes_parse() {
+        assert_eq!(parse_count("3"), Ok(3));
+        for bad in ["0", "-1", "2.5", "x", ""] {
+            assert!(parse_count(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_bytes("4G"), Ok(4 << 30));
+        assert_eq!(parse_bytes("4gib"), Ok(4 << 30));
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("64 KiB"), Ok(64 << 10));
+        assert_eq!(parse_bytes("1048576"), Ok(1 << 20));
+        for bad in ["0", "-1G", "1.5G", "4T", "G", "99999999999G"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -26,15 +26,19 @@
 //! - Radiance HDR (via `image`): `#?` signature (any program name), `FORMAT=32-bit_rle_rgbe`,
 //!   `-Y H +X W` orientation, new and old run-length schemes. `EXPOSURE` is not divided out.
 //! - The format is recognised by its first bytes, never the extension.
-//! - A map must be non-empty, within [`Limits`] (16384 x 8192 by default; checked from the header
-//!   before decoding), exactly 2:1 (`width == 2 * height`; a 512 x 768 file is "not a lat-long
+//! - A map must be non-empty, within [`Limits`] (16384 x 8192 and a memory budget of 4 GiB for
+//!   the job by default: the job's need, its bytes per texel times the texels, is estimated from
+//!   the header, refused over the budget and reserved once, fallibly, before decoding; an OpenEXR
+//!   payload is also checked against the file's size first), exactly 2:1 (`width == 2 * height`; a 512 x 768 file is "not a lat-long
 //!   map"), and every value finite and non-negative. Negative radiance is rejected, not clamped:
 //!   it is a damaged or wrongly converted file, and silently clamping would change its mean. The
 //!   error names the first bad texel (x, y, channel).
 //! - [`read_image`] reads the same files without the 2:1 requirement; `*_from_memory` read bytes.
 //!
 //! Errors are split by who is at fault ([`Error`]): invalid input (a short read included),
-//! unsupported feature, limit exceeded, IO. No input makes the readers panic.
+//! unsupported feature, limit exceeded, IO. No input makes the readers panic. (The `exr` crate's
+//! B44 decompressor can panic on damaged data when overflow checks are on; B44 files are decoded
+//! on the calling thread, where such a panic is caught and reported as damaged data.)
 //!
 //! # Example
 //!
@@ -65,7 +69,10 @@ pub use error::Error;
 pub use geometry::{direction, texel_solid_angle, uv};
 pub use map::EnvMap;
 pub use mip::MipChain;
-pub use read::{HdrImage, Limits, load, load_from_memory, load_with_limits, read_image, read_image_from_memory};
+pub use read::{
+    DEFAULT_MAX_MEMORY, HdrImage, Limits, READ_BYTES_PER_TEXEL, format_bytes, load, load_from_memory, load_with_limits,
+    read_image, read_image_from_memory,
+};
 pub use write::{Preview, SampleType, ToneMap, encode_exr, encode_png_rgb8, tonemap_rgb8, write_exr, write_png_rgb8};
 
 /// Rec. 709 luminance of a linear RGB triple (weights 0.2126, 0.7152, 0.0722).

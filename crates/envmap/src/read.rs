@@ -8,18 +8,91 @@ use std::path::Path;
 use crate::error::Error;
 use crate::map::{EnvMap, check_latlong_shape, check_not_empty, check_radiance};
 
-/// The largest map the readers accept, checked against the header before decoding.
+/// The largest map the readers accept and the memory the job reading it may use, both checked
+/// against the header before anything the size of the image is allocated or decoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     pub max_width: usize,
     pub max_height: usize,
+    /// The memory budget of the job, in bytes ([`DEFAULT_MAX_MEMORY`]).
+    pub max_memory: u64,
+    /// What the job needs per texel of the map, in bytes: its peak memory is estimated as
+    /// `width x height x bytes_per_texel`. [`READ_BYTES_PER_TEXEL`] covers reading alone; a tool
+    /// that holds more per texel says so (the `bake` crate's stages do).
+    pub bytes_per_texel: u64,
 }
 
+/// The default memory budget of a job: 4 GiB.
+pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
+/// The peak memory of reading a map, per texel, in bytes: the decoded `f32` RGB image (12)
+/// and what the decoders hold beside it at their peak (the `exr` crate's channels, 12, the
+/// `image` crate's Radiance pixels and their conversion, 16), with room to spare.
+pub const READ_BYTES_PER_TEXEL: u64 = 32;
+
 impl Default for Limits {
-    /// 16384 x 8192: a 16k lat-long map, 1.5 GiB of `f32` RGB.
+    /// 16384 x 8192 (a 16k lat-long map, 1.5 GiB of `f32` RGB), [`DEFAULT_MAX_MEMORY`],
+    /// [`READ_BYTES_PER_TEXEL`].
     fn default() -> Self {
-        Limits { max_width: 16384, max_height: 8192 }
+        Limits {
+            max_width: 16384,
+            max_height: 8192,
+            max_memory: DEFAULT_MAX_MEMORY,
+            bytes_per_texel: READ_BYTES_PER_TEXEL,
+        }
     }
+}
+
+impl Limits {
+    /// The default limits for a job that needs `bytes_per_texel` per texel of the map and may
+    /// use `max_memory` bytes.
+    pub fn for_job(bytes_per_texel: u64, max_memory: u64) -> Limits {
+        Limits { max_memory, bytes_per_texel, ..Limits::default() }
+    }
+
+    /// Checks a map's size from its header: within the largest size, and the job's estimated
+    /// memory within the budget. The estimate is then reserved once, fallibly, and released:
+    /// where the system cannot give that much (an address-space limit, `ulimit -v`), the job
+    /// stops here with an error instead of aborting on an allocation later.
+    pub fn check(&self, width: usize, height: usize) -> Result<(), Error> {
+        if width > self.max_width || height > self.max_height {
+            return Err(Error::LimitExceeded(format!(
+                "{width} x {height} is larger than the limit of {} x {}",
+                self.max_width, self.max_height
+            )));
+        }
+        let need = (width as u64).saturating_mul(height as u64).saturating_mul(self.bytes_per_texel);
+        if need > self.max_memory {
+            return Err(Error::LimitExceeded(format!(
+                "a {width} x {height} map needs about {} for this job ({} bytes per texel), more than the memory \
+                 budget of {} (--max-memory)",
+                format_bytes(need),
+                self.bytes_per_texel,
+                format_bytes(self.max_memory)
+            )));
+        }
+        let mut probe: Vec<u8> = Vec::new();
+        probe.try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX)).map_err(|_| {
+            Error::LimitExceeded(format!(
+                "a {width} x {height} map needs about {} for this job and the system cannot provide it",
+                format_bytes(need)
+            ))
+        })?;
+        Ok(())
+    }
+}
+
+/// A size for people: bytes, KiB, MiB or GiB with up to one decimal (`1.5 GiB`, `4 GiB`).
+pub fn format_bytes(bytes: u64) -> String {
+    let units = [("GiB", 1u64 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
+    for (name, size) in units {
+        if bytes >= size {
+            let value = bytes as f64 / size as f64;
+            let text = format!("{value:.1}");
+            return format!("{} {name}", text.strip_suffix(".0").unwrap_or(&text));
+        }
+    }
+    format!("{bytes} bytes")
 }
 
 /// An RGB radiance image of any shape: what [`read_image`] returns for files that need not be
@@ -101,16 +174,6 @@ fn decode<R: BufRead + Seek>(
     Ok(image)
 }
 
-fn check_size(width: usize, height: usize, limits: &Limits) -> Result<(), Error> {
-    if width > limits.max_width || height > limits.max_height {
-        return Err(Error::LimitExceeded(format!(
-            "{width} x {height} is larger than the limit of {} x {}",
-            limits.max_width, limits.max_height
-        )));
-    }
-    Ok(())
-}
-
 /// Radiance HDR through the `image` crate: the new (per-component) and the old run-length
 /// schemes and flat pixels; `FORMAT=32-bit_rle_rgbe` only, `-Y H +X W` orientation only.
 /// `EXPOSURE` and `COLORCORR` are not applied: the values are the pixels as stored, like every
@@ -131,7 +194,7 @@ fn decode_hdr<R: BufRead>(
     let decoder = image::codecs::hdr::HdrDecoder::new((&b"#?RADIANCE\n"[..]).chain(reader)).map_err(hdr_error)?;
     let (width, height) = image::ImageDecoder::dimensions(&decoder);
     let (width, height) = (width as usize, height as usize);
-    check_size(width, height, limits)?;
+    limits.check(width, height)?;
     check_shape(width, height)?;
     let rgb = image::DynamicImage::from_decoder(decoder).map_err(hdr_error)?.into_rgb32f().into_raw();
     check_radiance(width, &["R", "G", "B"], &rgb)?;
@@ -147,8 +210,12 @@ fn decode_exr<R: BufRead + Seek>(
     limits: &Limits,
     check_shape: fn(usize, usize) -> Result<(), Error>,
 ) -> Result<HdrImage, Error> {
+    use exr::compression::Compression;
     use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 
+    let mut reader = reader;
+    let file_len = reader.seek(SeekFrom::End(0))?;
+    reader.seek(SeekFrom::Start(0))?;
     // Headers only; the offset tables and the pixels are read by `from_chunks` below.
     let chunks = exr::block::read(reader, false)?;
     let header = chunks
@@ -157,18 +224,21 @@ fn decode_exr<R: BufRead + Seek>(
         .find(|header| !header.deep)
         .ok_or_else(|| Error::Unsupported("openexr: deep data only, no flat image".into()))?;
     let (width, height) = (header.layer_size.0, header.layer_size.1);
-    check_size(width, height, limits)?;
+    limits.check(width, height)?;
     check_shape(width, height)?;
     let names = pick_exr_channels(header)?;
+    check_exr_payload(header, width, height, file_len)?;
 
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .pedantic()
-        .from_chunks(chunks)?;
+    let read = exr::prelude::read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer();
+    let read = read.all_attributes().pedantic();
+    // The `exr` crate's B44 decompressor overflows on some damaged data (1.74.2,
+    // `compression/b44/mod.rs`); with overflow checks on (debug and test builds) that is a
+    // panic, which inside the crate's thread pool aborts the process. B44 files are decoded on
+    // this thread instead, and a panic of the decoder becomes an error.
+    let b44 = chunks.headers().iter().any(|h| matches!(h.compression, Compression::B44 | Compression::B44A));
+    let read = if b44 { read.non_parallel() } else { read };
+    let image = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read.from_chunks(chunks)))
+        .map_err(|_| Error::Invalid("openexr: the decoder failed on damaged data".into()))??;
     let layer = image.layer_data;
     if (layer.size.0, layer.size.1) != (width, height) {
         return Err(Error::Invalid("openexr: the decoded layer is not the one whose header was checked".into()));
@@ -196,6 +266,33 @@ fn decode_exr<R: BufRead + Seek>(
         ExrChannels::Y => channel("Y")?.iter().flat_map(|&y| [y, y, y]).collect(),
     };
     Ok(HdrImage { width, height, rgb })
+}
+
+/// Checks that the file can hold the payload its header declares before anything the size of the
+/// image is allocated: every chunk has an entry in the offset table (8 bytes) and at least a
+/// 4-byte coordinate, a 4-byte size and one byte of data; an uncompressed part holds every
+/// sample. An 808-byte header declaring a 16384 x 8192 image is truncated, not a reason to
+/// allocate 1.5 GiB.
+fn check_exr_payload(
+    header: &exr::meta::header::Header,
+    width: usize,
+    height: usize,
+    file_len: u64,
+) -> Result<(), Error> {
+    let chunks = header.chunk_count as u64;
+    let mut least = chunks.saturating_mul(8 + 9);
+    if header.compression == exr::compression::Compression::Uncompressed {
+        let sample_bytes: u64 = header.channels.list.iter().map(|c| c.sample_type.bytes_per_sample() as u64).sum();
+        let samples = (width as u64).saturating_mul(height as u64).saturating_mul(sample_bytes);
+        least = least.max(samples);
+    }
+    if file_len < least {
+        return Err(Error::Invalid(format!(
+            "openexr: truncated: a {width} x {height} image in {chunks} chunks needs at least {least} bytes, the \
+             file has {file_len}"
+        )));
+    }
+    Ok(())
 }
 
 enum ExrChannels {

@@ -83,14 +83,88 @@ fn a_missing_file_is_an_io_error() {
 #[test]
 fn limits_come_from_the_header() {
     let path = crate::shared_env().join("potsdamer_platz_1k.hdr");
-    let small = envmap::Limits { max_width: 1023, max_height: 8192 };
+    let small = envmap::Limits { max_width: 1023, max_height: 8192, ..Default::default() };
     let error = envmap::load_with_limits(&path, &small).expect_err("over the limit");
     assert_eq!(error.to_string(), "limit exceeded: 1024 x 512 is larger than the limit of 1023 x 8192");
-    let exact = envmap::Limits { max_width: 1024, max_height: 512 };
+    let exact = envmap::Limits { max_width: 1024, max_height: 512, ..Default::default() };
     assert!(envmap::load_with_limits(&path, &exact).is_ok());
     let exr = crate::shared_env().join("KernerEnvLatLong.exr");
-    let error = envmap::load_with_limits(&exr, &envmap::Limits { max_width: 1024, max_height: 511 }).expect_err("exr");
+    let error =
+        envmap::load_with_limits(&exr, &envmap::Limits { max_width: 1024, max_height: 511, ..Default::default() })
+            .expect_err("exr");
     assert_eq!(crate::kind(&error), Kind::Limit, "{error}");
+}
+
+/// The memory a job needs is estimated from the header and refused over the budget, before any
+/// decoding (issue 9: a 98 KB old-RLE file declaring 16384 x 8192 made `envmap-prefilter`
+/// abort on a 1.4 GB allocation under a 4 GB address-space limit).
+#[test]
+fn the_memory_budget_comes_from_the_header() {
+    let path = crate::shared_env().join("potsdamer_platz_1k.hdr");
+    let error = envmap::load_with_limits(&path, &envmap::Limits::for_job(64, 1 << 20)).expect_err("over budget");
+    assert_eq!(
+        error.to_string(),
+        "limit exceeded: a 1024 x 512 map needs about 32 MiB for this job (64 bytes per texel), more than the \
+         memory budget of 1 MiB (--max-memory)"
+    );
+    assert!(envmap::load_with_limits(&path, &envmap::Limits::for_job(64, 32 << 20)).is_ok());
+
+    let hostile = crate::shared_env().join("../hostile/repro-oldrle-16384x8192-abort.hdr");
+    let job = envmap::Limits::for_job(48, envmap::DEFAULT_MAX_MEMORY);
+    let error = envmap::load_with_limits(&hostile, &job).expect_err("over budget");
+    assert_eq!(crate::kind(&error), Kind::Limit, "{error}");
+    assert!(error.to_string().contains("a 16384 x 8192 map needs about 6 GiB"), "{error}");
+    // The estimate is reserved once, fallibly: more than any system gives is an error, not an
+    // abort.
+    let error = envmap::load_with_limits(&path, &envmap::Limits::for_job(1 << 50, u64::MAX)).expect_err("unreservable");
+    assert!(error.to_string().contains("the system cannot provide it"), "{error}");
+}
+
+/// An OpenEXR header that declares more pixels than the file can hold is truncated, found before
+/// the image is allocated (issue 9: an 808-byte header declaring the size limit reached 790 MB
+/// before "truncated"). Made from a small valid file by widening its data window to 16384 x
+/// 8192 and cutting it after the header.
+#[test]
+fn an_exr_header_at_the_size_limit_is_truncated_before_allocating() {
+    let ramp: Vec<f32> = (0..32 * 16).map(|i| i as f32).collect();
+    let mut bytes =
+        envmap::encode_exr(32, 16, &[("R", &ramp), ("G", &ramp), ("B", &ramp)], envmap::SampleType::F32).expect("exr");
+    let name = b"dataWindow\0box2i\0";
+    let at = bytes.windows(name.len()).position(|w| w == name).expect("a data window") + name.len() + 4;
+    bytes[at + 8..at + 12].copy_from_slice(&16383i32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&8191i32.to_le_bytes());
+    // The chunk count the writer recorded follows the height: 16 rows became 8192.
+    let name = b"chunkCount\0int\0";
+    if let Some(p) = bytes.windows(name.len()).position(|w| w == name) {
+        let at = p + name.len() + 4;
+        let count = i32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        bytes[at..at + 4].copy_from_slice(&(count * 512).to_le_bytes());
+    }
+    let header_end = bytes.windows(3).rposition(|w| w == b"\0\0\0").map_or(bytes.len(), |p| p + 3).min(900);
+    bytes.truncate(header_end);
+    let error = envmap::read_image_from_memory(&bytes, &envmap::Limits::default()).expect_err("truncated");
+    assert_eq!(crate::kind(&error), Kind::Invalid, "{error}");
+    assert!(error.to_string().starts_with("openexr: truncated: a 16384 x 8192 image in "), "{error}");
+}
+
+/// Damaged B44 files that make the `exr` crate (1.74.2) overflow in its B44 decompressor: with
+/// overflow checks on, as in this test build, that panic inside the crate's thread pool aborted
+/// the whole test process; the reader decodes B44 on its own thread and reports the file as
+/// damaged (a release build reports the crate's own error).
+#[test]
+fn damaged_b44_files_are_errors_in_a_debug_build() {
+    let hostile = crate::shared_env().join("../hostile");
+    let mut files: Vec<_> = std::fs::read_dir(&hostile)
+        .expect("the shared hostile inputs")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("b44-overflow-")))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4, "expected the 4 b44-overflow-*.exr files in {}", hostile.display());
+    for path in files {
+        let error = envmap::read_image(&path, &envmap::Limits::default()).expect_err("damaged");
+        println!("{}: {error}", path.display());
+    }
 }
 
 /// Random byte damage (fixed seed) to small valid files of every kind: any outcome but a panic.

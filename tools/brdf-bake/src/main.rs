@@ -65,6 +65,11 @@ struct Args {
     #[arg(long)]
     force: bool,
 
+    /// Memory budget of the environment stages (4G, 512M, ...): a map whose estimated need (80
+    /// bytes per texel, plus the layers) is larger is refused from its header, before decoding.
+    #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
+    max_memory: u64,
+
     /// Print one JSON object on stdout: whether the bake was up to date, the manifest, and the
     /// problems found; the report goes to stderr.
     #[arg(long)]
@@ -93,6 +98,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.importance.n_samples = args.samples;
     config.atlas.analysis_size = args.analysis_size;
     config.force = args.force;
+    config.env_bandwidth.max_memory = args.max_memory;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {
         Progress::Stage { index, count, name } => progress.step(format!("{}/{count} {name}", index + 1)),

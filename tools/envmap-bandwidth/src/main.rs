@@ -72,6 +72,11 @@ struct Args {
     /// Number of wavelet levels; by default as many as the size allows.
     #[arg(long, value_parser = cli::parse_count)]
     levels: Option<usize>,
+
+    /// Memory budget (4G, 512M, ...): a map whose estimated need (80 bytes per texel) is larger
+    /// is refused from its header, before decoding.
+    #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
+    max_memory: u64,
 }
 
 /// `--eps`: checked here because `latlong_bandwidth` does not check its configuration.
@@ -97,6 +102,7 @@ fn run(args: Args) -> Result<ExitCode> {
         mode,
         config: Config { eps: args.eps, levels: args.levels, ..Config::default() },
         fft_diagnostic: args.fft_diagnostic,
+        max_memory: args.max_memory,
     };
     let staged = bake::stage::env_bandwidth::run(&args.input, &settings)?;
     let dir = &args.out_dir;

@@ -37,6 +37,11 @@ struct Args {
     #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = cli::parse_size)]
     size: (usize, usize),
 
+    /// Memory budget (4G, 512M, ...): a map whose estimated need (48 bytes per texel, plus the
+    /// layers) is larger is refused from its header, before decoding.
+    #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
+    max_memory: u64,
+
     /// How the layers are computed: auto picks the cheaper per layer.
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     method: MethodArg,
@@ -89,7 +94,9 @@ fn run(args: Args) -> Result<ExitCode> {
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);
     progress.step("loading".to_string());
-    let map = envmap::load(&args.env).with_context(|| format!("reading {}", args.env.display()))?;
+    let limits = bake::stage::prefilter::limits(&config, args.max_memory);
+    let map =
+        envmap::load_with_limits(&args.env, &limits).with_context(|| format!("reading {}", args.env.display()))?;
     let source = Source::hash(&args.env)?;
     progress.step("prefiltering".to_string());
     let (mut staged, prefiltered) =

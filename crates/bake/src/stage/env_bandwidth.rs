@@ -53,18 +53,33 @@ pub struct Settings {
     pub config: Config,
     /// Also run the windowed FFT and compare.
     pub fft_diagnostic: bool,
+    /// The memory budget, in bytes: a map whose estimated need ([`BYTES_PER_TEXEL`]) exceeds it
+    /// is refused from its header.
+    pub max_memory: u64,
 }
+
+/// The peak memory of this stage per texel of the map, in bytes, reading included: measured 68
+/// (the maximum resident size on 2048 x 1024 and 4096 x 2048 maps, the difference over the
+/// difference in texels: the image, `ln(1 + Y)` in `f64`, the wavelet decomposition and the
+/// estimate), with room to spare.
+pub const BYTES_PER_TEXEL: u64 = 80;
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings { mode: Mode::Angular, config: Config::default(), fft_diagnostic: false }
+        Settings {
+            mode: Mode::Angular,
+            config: Config::default(),
+            fft_diagnostic: false,
+            max_memory: envmap::DEFAULT_MAX_MEMORY,
+        }
     }
 }
 
 /// Reads `input` and estimates its bandwidth. Angular mode loads it as an environment map (2:1,
 /// finite, non-negative); the spatial modes take any image.
 pub fn run(input: &Path, settings: &Settings) -> Result<Staged, Error> {
-    let (width, height, image) = read(input, settings.mode).map_err(|e| Error::read(input, e))?;
+    let limits = envmap::Limits::for_job(BYTES_PER_TEXEL, settings.max_memory);
+    let (width, height, image) = read(input, settings.mode, &limits).map_err(|e| Error::read(input, e))?;
     run_on(input, width, height, image, settings)
 }
 
@@ -143,12 +158,16 @@ struct Stats {
 }
 
 /// Reads the input and returns its size and the image the estimator reads, ln(1 + Y).
-fn read(path: &Path, mode: Mode) -> Result<(usize, usize, Image), Box<dyn std::error::Error + Send + Sync>> {
+fn read(
+    path: &Path,
+    mode: Mode,
+    limits: &envmap::Limits,
+) -> Result<(usize, usize, Image), Box<dyn std::error::Error + Send + Sync>> {
     Ok(if mode == Mode::Angular {
-        let map = envmap::load(path)?;
+        let map = envmap::load_with_limits(path, limits)?;
         (map.width(), map.height(), log1p_luminance(map.width(), map.height(), map.texels())?)
     } else {
-        let image = envmap::read_image(path, &envmap::Limits::default())?;
+        let image = envmap::read_image(path, limits)?;
         (image.width, image.height, log1p_luminance(image.width, image.height, image.rgb.as_chunks::<3>().0)?)
     })
 }

@@ -21,6 +21,20 @@ pub fn layer_exr(n: u32) -> String {
     format!("layer-n{n}.exr")
 }
 
+/// The peak memory of this stage per texel of the input map, in bytes, reading included:
+/// measured 40 (the maximum resident size on 2048 x 1024 and 4096 x 2048 maps, the difference
+/// over the difference in texels: the map, its mip chain in `f32` and in `f16` for the KTX2
+/// file), with room to spare. The layers come on top ([`limits`]).
+pub const BYTES_PER_TEXEL: u64 = 48;
+
+/// The reading limits of this stage under a memory budget of `max_memory` bytes: the layers
+/// (one `f32` RGB map of the configured size per exponent, twice over while they are encoded)
+/// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`].
+pub fn limits(config: &::prefilter::Config, max_memory: u64) -> envmap::Limits {
+    let layers = (config.width as u64 * config.height as u64).saturating_mul(24 * config.exponents.len() as u64);
+    envmap::Limits::for_job(BYTES_PER_TEXEL, max_memory.saturating_sub(layers))
+}
+
 /// Convolves `map` (read from `source`) with the lobes of `config`; `progress(done, total)` is
 /// called as the work advances (a progress bar's hook).
 pub fn run(
