@@ -188,14 +188,18 @@ impl ImportanceSamples {
                 self.n_vectors, self.n_samples
             ));
         }
+        // Counts from the file, multiplied without wrapping: a product past u64 is no file's.
+        let (slices, rows, cols) = (slices as u64, rows as u64, cols as u64);
+        let product = |factors: &[u64]| factors.iter().try_fold(1u64, |p, &f| p.checked_mul(f));
         let expect = [
-            ("samples", self.samples.len(), slices * self.n_vectors as usize * self.n_samples as usize),
-            ("marginal cdf", self.marginal_cdf.len(), slices * (rows + 1)),
-            ("conditional cdf", self.conditional_cdf.len(), slices * rows * (cols + 1)),
-            ("h density", self.h_density.len(), slices * rows * cols),
+            ("samples", self.samples.len(), product(&[slices, self.n_vectors.into(), self.n_samples.into()])),
+            ("marginal cdf", self.marginal_cdf.len(), product(&[slices, rows + 1])),
+            ("conditional cdf", self.conditional_cdf.len(), product(&[slices, rows, cols + 1])),
+            ("h density", self.h_density.len(), product(&[slices, rows, cols])),
         ];
         for (what, found, expected) in expect {
-            if found != expected {
+            if Some(found as u64) != expected {
+                let expected = expected.map_or("more than any file holds".to_string(), |e| e.to_string());
                 return Err(format!("importance samples: {what} has {found} values, expected {expected}"));
             }
         }

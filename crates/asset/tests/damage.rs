@@ -2,7 +2,8 @@
 //! names the problem, never a panic and never an allocation sized by the lie.
 
 use asset::{
-    Asset, Error, HEADER_BYTES, LinkedFile, Payload, PrefilteredEnvmap, decode, encode, read_file, write_file,
+    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, Error, HEADER_BYTES, ImportanceSamples,
+    LinkedFile, Payload, PrefilteredEnvmap, decode, encode, read_file, write_file,
 };
 
 use crate::{reseal, small_asset};
@@ -302,5 +303,79 @@ fn bandwidth_rows_sizes_are_multiplied_without_overflow() {
     for (lobes_x, lobes_y, tile, values) in [(1 << 31, 1, 1, 1), (u32::MAX, 2, 3, 18)] {
         let asset = rows_asset(lobes_x, lobes_y, tile, values);
         assert_eq!(decode(&asset::encode_checked(&asset).unwrap()).unwrap(), asset);
+    }
+}
+
+/// Every size a payload declares is multiplied with checked arithmetic: counts whose product
+/// wraps past 2^64 to the length the file holds must be refused, not accepted (release builds
+/// accepted such files, debug builds panicked: `../shared/data/hostile/repro-pca-wrapped-check.asset`
+/// and its siblings, made here for every kind that multiplies counts from the file).
+#[test]
+fn declared_sizes_that_wrap_are_invalid_not_accepted() {
+    let analysis = || BandwidthAnalysis {
+        parameterization: "incidence-plane-equidistant".into(),
+        analysis_size: 64,
+        eps: 0.01,
+        c: 0.17,
+    };
+    let wrapped = [
+        // 4 x 2^31 x 2^31 = 2^64 samples, stored as 0.
+        (
+            "importance samples",
+            Payload::ImportanceSamples(ImportanceSamples {
+                theta_o: vec![0.0, 0.1, 0.2, 0.3],
+                n_vectors: 1 << 31,
+                n_samples: 1 << 31,
+                theta_h_edges: vec![0.0, 1.0],
+                n_phi_h: 1,
+                samples: vec![],
+                marginal_cdf: vec![0.0; 8],
+                conditional_cdf: vec![0.0; 8],
+                h_density: vec![1.0; 4],
+            }),
+        ),
+        // 2^16 x 2^16 lobes of 2^16 x 2^16 texels = 2^64 texels, stored as 0.
+        (
+            "bandwidth atlas",
+            Payload::BandwidthAtlas(BandwidthAtlas {
+                lobes_x: 1 << 16,
+                lobes_y: 1 << 16,
+                tile: 1 << 16,
+                analysis: analysis(),
+                data: vec![],
+            }),
+        ),
+        // 2^32 rows of 2^16 x 2^16 texels wraps in u64 too: 2^64 stored as 0.
+        (
+            "bandwidth rows",
+            Payload::BandwidthRows(BandwidthRows {
+                lobes_x: 1,
+                lobes_y: u32::MAX,
+                tile: 1 << 16,
+                analysis: analysis(),
+                data: vec![],
+            }),
+        ),
+        // 2^31 x 2^31 lobes x K = 4 coefficients = 2^64, stored as 0 (the hostile file's lie).
+        (
+            "bandwidth pca",
+            Payload::BandwidthPca(BandwidthPca {
+                lobes_x: 1 << 31,
+                lobes_y: 1 << 31,
+                tile: 1,
+                analysis: analysis(),
+                n_components: 4,
+                mean: vec![0.0],
+                components: vec![1.0, 0.0, 0.0, 0.0],
+                coefficients: vec![],
+            }),
+        ),
+    ];
+    for (what, payload) in wrapped {
+        let asset = Asset { provenance: small_asset().provenance, payload };
+        match decode(&encode(&asset)) {
+            Err(Error::Invalid(message)) => assert!(message.starts_with("invalid payload: "), "{what}: {message}"),
+            other => panic!("{what}: expected an invalid payload, got {other:?}"),
+        }
     }
 }

@@ -152,13 +152,16 @@ fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
     let layers = header.layer_count.max(1) as usize;
     let mut out = Vec::new();
     for (l, level) in reader.levels().enumerate() {
-        let (w, h) = ((header.pixel_width >> l).max(1) as usize, (header.pixel_height >> l).max(1) as usize);
-        let texel_bytes = 8 * w * h;
-        if level.data.len() != texel_bytes * layers {
-            return Err(Error::read(
-                path,
-                format!("level {l} holds {} bytes, expected {}", level.data.len(), texel_bytes * layers),
-            ));
+        // Sizes from the file: shifts and products that cannot overflow.
+        let shrink = |size: u32| size.checked_shr(l as u32).unwrap_or(0).max(1) as usize;
+        let (w, h) = (shrink(header.pixel_width), shrink(header.pixel_height));
+        let texel_bytes = 8usize.checked_mul(w).and_then(|b| b.checked_mul(h));
+        let expected = texel_bytes.and_then(|b| b.checked_mul(layers));
+        let (Some(texel_bytes), Some(expected)) = (texel_bytes, expected) else {
+            return Err(Error::read(path, format!("level {l} of {w} x {h} x {layers} texels is larger than any file")));
+        };
+        if level.data.len() != expected {
+            return Err(Error::read(path, format!("level {l} holds {} bytes, expected {expected}", level.data.len())));
         }
         let maps = level
             .data
@@ -176,4 +179,33 @@ fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
         out.push(maps);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A KTX2 file whose header declares more texels than any file holds (2^32 - 1 squared, 2^32
+    /// - 1 layers: the byte count wraps past 2^64) is refused; before, the product wrapped in a
+    /// release build and panicked in a debug one.
+    #[test]
+    fn a_ktx2_header_whose_size_wraps_is_refused() {
+        let rgb = vec![0.5f32; 3 * 4 * 2];
+        let encoded = ::prefilter::ktx::encode_rgba16f(4, 2, 0, &[vec![&rgb[..]]], "test").unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.ktx2");
+        let mut bytes = encoded.bytes;
+        // Header: pixelWidth at 20, pixelHeight at 24, layerCount at 32 (KTX2 specification).
+        for at in [20, 24, 32] {
+            bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        }
+        std::fs::write(&path, &bytes).unwrap();
+        let error = read_ktx2(&path, 1.0).map(|_| ()).unwrap_err();
+        let source = std::error::Error::source(&error).map(|s| s.to_string()).unwrap_or_default();
+        assert!(source.contains("is larger than any file"), "{error}: {source}");
+        // The unpatched file reads.
+        std::fs::write(&path, ::prefilter::ktx::encode_rgba16f(4, 2, 0, &[vec![&rgb[..]]], "test").unwrap().bytes)
+            .unwrap();
+        assert_eq!(read_ktx2(&path, 1.0).unwrap()[0][0].width(), 4);
+    }
 }
