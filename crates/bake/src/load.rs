@@ -185,12 +185,12 @@ fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
 mod tests {
     use super::*;
 
-    /// A KTX2 file whose header declares more texels than any file holds (2^32 - 1 squared, 2^32
-    /// - 1 layers: the byte count wraps past 2^64) is refused; before, the product wrapped in a
-    /// release build and panicked in a debug one.
+    /// A KTX2 file whose header declares more texels than any file holds (`2^32 - 1` squared,
+    /// `2^32 - 1` layers: the byte count wraps past 2^64) is refused; before, the product wrapped
+    /// in a release build and panicked in a debug one.
     #[test]
     fn a_ktx2_header_whose_size_wraps_is_refused() {
-        let rgb = vec![0.5f32; 3 * 4 * 2];
+        let rgb = [0.5f32; 3 * 4 * 2];
         let encoded = ::prefilter::ktx::encode_rgba16f(4, 2, 0, &[vec![&rgb[..]]], "test").unwrap();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("huge.ktx2");
