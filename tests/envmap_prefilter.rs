@@ -218,3 +218,130 @@ fn damaged_inputs_are_refused_with_the_reason() {
     check_refused(&text, "unsupported: unknown file format (starts with 68 65 6c 6c)");
     check_refused(&tmp.path().join("missing.hdr"), "no such file or directory");
 }
+
+/// `asset-info` checks the files a prefiltered asset names: a missing or replaced file is exit 1
+/// naming it (issue 9: a killed rerun could leave `prefiltered.asset` naming a `layers.ktx2`
+/// whose sha256 no longer matched, and `asset-info` said nothing).
+#[test]
+fn asset_info_names_a_stale_or_missing_linked_file() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("out");
+    let mut cmd = tool("envmap-prefilter");
+    cmd.arg(env_dir().join("studio_small_03_1k.hdr")).arg("--out-dir").arg(&out).args(["--size", "32x16"]);
+    run(cmd, "").expect_code(0);
+    let asset_path = out.join("prefiltered.asset");
+    let check = |code: i32| {
+        let mut cmd = tool("asset-info");
+        cmd.arg(&asset_path);
+        run(cmd, "").expect_code(code)
+    };
+    let r = check(0);
+    assert!(r.stdout.contains("layers.ktx2            ok"), "{r}");
+    std::fs::write(out.join("layers.ktx2"), b"another bake's layers").unwrap();
+    std::fs::remove_file(out.join("layer-n4.exr")).unwrap();
+    let r = check(1);
+    assert_eq!(
+        r.stderr.trim_end(),
+        format!(
+            "error: checking {}: linked file layers.ktx2 does not have the sha256 the asset records; layer-n4.exr is \
+             missing",
+            asset_path.display()
+        ),
+        "{r}"
+    );
+    let mut cmd = tool("asset-info");
+    cmd.arg(&asset_path).arg("--json");
+    let r = run(cmd, "").expect_code(1);
+    let statuses: Vec<(String, String)> = r.json()["linked_files"]
+        .as_array()
+        .expect("linked_files")
+        .iter()
+        .map(|f| (f["name"].as_str().unwrap().to_string(), f["status"].as_str().unwrap().to_string()))
+        .collect();
+    assert!(statuses.contains(&("layers.ktx2".into(), "differs".into())), "{statuses:?}");
+    assert!(statuses.contains(&("layer-n4.exr".into(), "missing".into())), "{statuses:?}");
+    assert!(statuses.contains(&("mips.ktx2".into(), "ok".into())), "{statuses:?}");
+}
+
+/// Killed at 20 moments of its writing phase (from its first temporary file to its exit, at
+/// seeded random fractions of the shortest phase measured so far), `envmap-prefilter` leaves
+/// a folder that is consistent every time: where an asset is there, every file it names is there
+/// with the recorded sha256 (`asset-info` exits 0); and the rerun leaves a complete folder with
+/// no temporary file (the killed run's are removed).
+#[test]
+fn killed_while_writing_the_folder_stays_consistent() {
+    use rand::{Rng, SeedableRng};
+    use std::time::{Duration, Instant};
+
+    let tmp = temp_dir();
+    let out = tmp.path().join("out");
+    // A small map keeps the 41 runs short (about 10 s in all in a debug build).
+    let input = tmp.path().join("sky.exr");
+    let mut cmd = tool("envmap-synth");
+    cmd.args(["--size", "256x128", "--out"]).arg(&input);
+    run(cmd, "").expect_code(0);
+    let start = || {
+        let mut cmd = tool("envmap-prefilter");
+        cmd.arg(&input).arg("--out-dir").arg(&out).args(["--size", "256x128", "--quiet"]);
+        cmd.stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null());
+        cmd.spawn().expect("start envmap-prefilter")
+    };
+    let writing = || {
+        std::fs::read_dir(&out).is_ok_and(|d| d.flatten().any(|e| e.file_name().to_string_lossy().ends_with(".tmp")))
+    };
+    // Polls until the run starts writing; `None` if it ended first.
+    let wait_for_writing = |child: &mut std::process::Child| loop {
+        if writing() {
+            return Some(Instant::now());
+        }
+        if child.try_wait().expect("poll").is_some() {
+            return None;
+        }
+        std::thread::sleep(Duration::from_micros(200));
+    };
+    // The length of the writing phase: the shortest seen so far (every rerun is measured too, so
+    // a first run slowed by a busy machine does not send the kills past the end).
+    let measure = || {
+        let mut child = start();
+        let began = wait_for_writing(&mut child).expect("a full run writes");
+        assert!(child.wait().expect("wait").success(), "a full run failed");
+        began.elapsed()
+    };
+    let mut phase = measure();
+    let asset_path = out.join("prefiltered.asset");
+    let asset_info = |code: i32, what: &str| {
+        let mut cmd = tool("asset-info");
+        cmd.arg(&asset_path);
+        let r = run(cmd, "");
+        assert_eq!(r.code, Some(code), "{what}\n{r}");
+    };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(9);
+    let (mut killed, mut with_asset) = (0, 0);
+    for kill in 0..20 {
+        let mut child = start();
+        if wait_for_writing(&mut child).is_some() {
+            std::thread::sleep(phase.mul_f64(rng.random_range(0.0..1.0)));
+            killed += usize::from(child.try_wait().expect("poll").is_none());
+            let _ = child.kill();
+        }
+        let _ = child.wait();
+        if asset_path.exists() {
+            // The asset is removed before any file it names is replaced, and lands last.
+            with_asset += 1;
+            asset_info(0, &format!("kill {kill}: asset-info on the killed state"));
+        }
+        phase = phase.min(measure());
+        asset_info(0, &format!("kill {kill}: asset-info after the rerun"));
+        let temporaries: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        assert!(temporaries.is_empty(), "kill {kill}: the rerun left {temporaries:?}");
+    }
+    println!(
+        "writing takes {phase:?}; 20 runs stopped in it, {killed} killed before they ended, {with_asset} killed \
+         states held an asset, every one consistent"
+    );
+    assert!(killed >= 5, "only {killed} of 20 kills landed while writing: the test no longer tests");
+}

@@ -186,3 +186,43 @@ fn merl_importance_refuses_bad_settings() {
     assert!(r.stderr.contains("invalid setting: vectors 2000 exceeds the limit of 1024"), "{r}");
     assert!(!dir.path().join("x").exists(), "nothing is written for a bad setting\n{r}");
 }
+
+/// A tool's outputs land together or not at all (issue 9: `merl-importance` left the asset
+/// behind when the PNG could not be written, exit 2, and a build system saw a target that looked
+/// done). Here the PNG's name is taken by a folder: exit 2 naming the PNG (not a temporary file),
+/// no asset, no temporary file. Temporaries an interrupted run left for these names are removed
+/// by the next run.
+#[test]
+fn outputs_land_as_a_set_and_stale_temporaries_are_removed() {
+    let dir = temp_dir();
+    let material = dir.path().join("lambert.binary");
+    let mut cmd = tool("merl-synth");
+    cmd.args(["lambertian", "--out"]).arg(&material);
+    run(cmd, "").expect_code(0);
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("importance.png")).unwrap();
+    let importance = || {
+        let mut cmd = tool("merl-importance");
+        cmd.arg(&material).arg("--out-dir").arg(&out).args(["--theta-o", "4", "--vectors", "2", "--samples", "16"]);
+        cmd
+    };
+    let r = run(importance(), "").expect_code(2);
+    let png = out.join("importance.png");
+    assert!(r.stderr.starts_with(&format!("error: writing {}: ", png.display())), "{r}");
+    assert!(!r.stderr.contains("/.importance."), "the error names a temporary file\n{r}");
+    let left: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(left, ["importance.png"], "only the folder in the way remains\n{r}");
+
+    std::fs::remove_dir(&png).unwrap();
+    let stale = [".importance.asset.Ab3dE9.tmp", ".importance.png.x7YqZ2.tmp"];
+    for name in stale {
+        std::fs::write(out.join(name), b"left by a killed run").unwrap();
+    }
+    std::fs::write(out.join(".notes.txt.Ab3dE9.tmp"), b"not ours").unwrap();
+    run(importance(), "").expect_code(0);
+    let mut left: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert_eq!(left, [".notes.txt.Ab3dE9.tmp", "importance.asset", "importance.png"]);
+}

@@ -2,7 +2,7 @@
 //! They know nothing about the asset format.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
@@ -18,30 +18,148 @@ use sha2::{Digest, Sha256};
 ///
 /// A missing parent folder is created first: a bake writes into folders of its own choosing.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let folder = match path.parent() {
+    let folder = folder_of(path);
+    std::fs::create_dir_all(folder)?;
+    let file = temporary(folder, path, bytes)?;
+    file.persist(path).map_err(|e| e.error)?;
+    // The rename itself is durable only once the folder's entry is on disk.
+    sync_folder(folder)
+}
+
+/// Writes several files into `dir` (created if missing) so that they land together or not at
+/// all. Every file is first written in full to a temporary file beside its target and synced;
+/// only then are they renamed into place, in order, with the last of `files` (the one that names
+/// the others, such as an asset that records its linked files' SHA-256) removed first and
+/// renamed last: an interruption at any moment leaves either the old set, or new files that no
+/// index names yet, never an index naming a file that does not match it. If a rename fails, the
+/// files already renamed are removed, so the set is absent rather than partly new. Temporary
+/// files an earlier interrupted run left for these names (`.NAME.XXXXXX.tmp`) are removed first.
+///
+/// Errors name the target file the caller asked for, never a temporary one.
+pub fn write_set(dir: &Path, files: &[(&str, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
+    std::fs::create_dir_all(dir).map_err(|e| (dir.to_path_buf(), e))?;
+    let names: Vec<&str> = files.iter().map(|(name, _)| *name).collect();
+    remove_stale_temporaries(dir, &names).map_err(|e| (dir.to_path_buf(), e))?;
+    let mut staged = Vec::with_capacity(files.len());
+    for (name, bytes) in files {
+        let path = dir.join(name);
+        let file = temporary(dir, &path, bytes).map_err(|e| (path.clone(), e))?;
+        staged.push((path, file));
+    }
+    let Some((index, _)) = staged.last() else { return Ok(()) };
+    match std::fs::remove_file(index) {
+        Ok(()) => sync_folder(dir).map_err(|e| (dir.to_path_buf(), e))?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err((index.clone(), e)),
+    }
+    let mut landed: Vec<PathBuf> = Vec::with_capacity(staged.len());
+    for (path, file) in staged {
+        if let Err(e) = file.persist(&path) {
+            for done in &landed {
+                let _ = std::fs::remove_file(done);
+            }
+            let _ = sync_folder(dir);
+            return Err((path, e.error));
+        }
+        landed.push(path);
+    }
+    sync_folder(dir).map_err(|e| (dir.to_path_buf(), e))
+}
+
+/// Removes the temporary files [`write_atomic`] and [`write_set`] name `.NAME.XXXXXX.tmp` for
+/// each of `names` in `dir`: left by an interrupted run, they are never outputs. Returns how
+/// many were removed.
+pub fn remove_stale_temporaries(dir: &Path, names: &[&str]) -> std::io::Result<usize> {
+    let mut removed = 0;
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let file_name = entry.file_name();
+        let file_name = file_name.to_string_lossy();
+        let ours = names.iter().any(|name| {
+            file_name
+                .strip_prefix('.')
+                .and_then(|rest| rest.strip_prefix(name))
+                .and_then(|rest| rest.strip_prefix('.'))
+                .and_then(|rest| rest.strip_suffix(".tmp"))
+                .is_some_and(|random| {
+                    random.len() == TEMPORARY_RANDOM_CHARS && random.chars().all(|c| c.is_ascii_alphanumeric())
+                })
+        });
+        if ours && entry.file_type()?.is_file() {
+            std::fs::remove_file(entry.path())?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// Random characters in a temporary file's name (`tempfile`'s default).
+const TEMPORARY_RANDOM_CHARS: usize = 6;
+
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
-    };
-    std::fs::create_dir_all(folder)?;
+    }
+}
+
+/// `bytes` in a synced temporary file `.NAME.XXXXXX.tmp` in `folder`, with the permissions
+/// `File::create` would give (0o666 less the umask on Unix), not a temporary file's owner-only
+/// ones. Errors carry no temporary path (the caller names the target); the file is removed
+/// when the handle is dropped unpersisted.
+fn temporary(folder: &Path, target: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
     let mut prefix = std::ffi::OsString::from(".");
-    prefix.push(path.file_name().unwrap_or_default());
+    prefix.push(target.file_name().unwrap_or_default());
     prefix.push(".");
     let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
+    builder.prefix(&prefix).suffix(".tmp").rand_bytes(TEMPORARY_RANDOM_CHARS);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut file = builder.tempfile_in(folder)?;
-    file.write_all(bytes)?;
-    file.flush()?;
-    file.as_file().sync_all()?;
-    file.persist(path).map_err(|e| e.error)?;
-    // The rename itself is durable only once the folder's entry is on disk.
+    // `tempfile` appends "at path ..." to its errors: keep the system's message only.
+    let mut file = builder.tempfile_in(folder).map_err(|e| {
+        let message = e.to_string();
+        let message = message.split(" at path ").next().unwrap_or(&message).to_string();
+        std::io::Error::new(e.kind(), message)
+    })?;
+    let handle = file.as_file_mut();
+    handle.write_all(bytes)?;
+    handle.flush()?;
+    handle.sync_all()?;
+    Ok(file)
+}
+
+fn sync_folder(folder: &Path) -> std::io::Result<()> {
     #[cfg(unix)]
     std::fs::File::open(folder)?.sync_all()?;
+    #[cfg(not(unix))]
+    let _ = folder;
     Ok(())
+}
+
+/// What [`linked_file_status`] found for a file an asset names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum LinkedStatus {
+    /// The file exists and has the SHA-256 the asset records.
+    Matches,
+    /// No such file beside the asset.
+    Missing,
+    /// The file's SHA-256 differs from the recorded one: it belongs to another bake.
+    Differs { found: [u8; 32] },
+    /// The file could not be read.
+    Unreadable(String),
+}
+
+/// Checks a file an asset names (`name`, `sha256`) in the asset's folder `dir`.
+pub fn linked_file_status(dir: &Path, name: &str, sha256: &[u8; 32]) -> LinkedStatus {
+    match sha256_file(&dir.join(name)) {
+        Ok(found) if found == *sha256 => LinkedStatus::Matches,
+        Ok(found) => LinkedStatus::Differs { found },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => LinkedStatus::Missing,
+        Err(e) => LinkedStatus::Unreadable(e.to_string()),
+    }
 }
 
 /// SHA-256 of a file's contents, read in a stream so that any size fits in memory.

@@ -58,7 +58,10 @@ pub use container::{
     decode_with_header, encode, encode_checked, read_file, read_file_with_header, read_header, write_file,
 };
 pub use error::Error;
-pub use files::{hex, sha256, sha256_file, sha256_from_hex, write_atomic};
+pub use files::{
+    LinkedStatus, hex, linked_file_status, remove_stale_temporaries, sha256, sha256_file, sha256_from_hex,
+    write_atomic, write_set,
+};
 pub use manifest::{
     BakeManifest, FileFormat, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool,
 };

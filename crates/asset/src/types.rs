@@ -268,6 +268,12 @@ pub struct PrefilteredEnvmap {
 }
 
 impl PrefilteredEnvmap {
+    /// Every file the asset names: the layers and mips KTX2 files, the contact sheet, the layer
+    /// EXRs.
+    pub fn linked_files(&self) -> Vec<&LinkedFile> {
+        [&self.layers_ktx2, &self.mips_ktx2, &self.contact_sheet_png].into_iter().chain(&self.layer_exrs).collect()
+    }
+
     fn check(&self) -> Result<(), String> {
         let k = self.exponents.len();
         if k == 0 {
@@ -315,8 +321,7 @@ impl PrefilteredEnvmap {
                 return Err(format!("prefiltered envmap {what} radiance scale {scale} outside (0, 1]"));
             }
         }
-        let files: Vec<&LinkedFile> =
-            [&self.layers_ktx2, &self.mips_ktx2, &self.contact_sheet_png].into_iter().chain(&self.layer_exrs).collect();
+        let files = self.linked_files();
         for (i, file) in files.iter().enumerate() {
             file.check().map_err(|problem| format!("prefiltered envmap: {problem}"))?;
             if files[..i].iter().any(|other| other.name == file.name) {
@@ -525,6 +530,14 @@ pub enum Payload {
 }
 
 impl Payload {
+    /// The files next to the asset that it names with their SHA-256 (empty for most kinds).
+    pub fn linked_files(&self) -> Vec<&LinkedFile> {
+        match self {
+            Payload::PrefilteredEnvmap(p) => p.linked_files(),
+            _ => Vec::new(),
+        }
+    }
+
     pub fn kind(&self) -> AssetKind {
         match self {
             Payload::MaterialInfo(_) => AssetKind::MaterialInfo,

@@ -111,14 +111,14 @@ pub struct Staged {
 }
 
 impl Staged {
-    /// Writes every file into `dir` (created if missing), each atomically, in order, and returns
-    /// the stage's manifest entry with the files' paths relative to `dir`.
+    /// Writes the stage's files into `dir` (created if missing) as one set ([`asset::write_set`]):
+    /// all of them or none, the asset, which may name the others, landing last. Returns the
+    /// stage's manifest entry with the files' paths relative to `dir`.
     pub fn write(&self, dir: &Path) -> Result<asset::Stage, Error> {
-        std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
-        for file in &self.files {
-            let path = dir.join(&file.name);
-            asset::write_atomic(&path, &file.bytes).map_err(|e| Error::write(&path, e))?;
-        }
+        let mut files: Vec<&OutFile> = self.files.iter().collect();
+        files.sort_by_key(|f| f.format == asset::FileFormat::Asset);
+        let set: Vec<(&str, &[u8])> = files.iter().map(|f| (f.name.as_str(), &f.bytes[..])).collect();
+        asset::write_set(dir, &set).map_err(|(path, e)| Error::write(&path, e))?;
         self.manifest_stage()
     }
 

@@ -1,13 +1,16 @@
 //! `asset-info`: shows what a baked asset file holds (header, provenance, checksum status and a
-//! summary of the payload) as text or JSON. The exit status tells a script whether the file is
-//! valid (0), readable but damaged (1: the checksum does not match), or unreadable (2).
+//! summary of the payload) as text or JSON, and checks the files it names beside it. The exit
+//! status tells a script whether the file is valid (0), readable but damaged or stale (1: the
+//! checksum does not match, or a file it names is missing or does not have the recorded
+//! SHA-256), or unreadable (2).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
 use asset::{
-    Asset, Error, Header, ImportanceSamples, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance, hex,
+    Asset, Error, Header, ImportanceSamples, LinkedFile, LinkedStatus, MaterialInfo, Payload, PrefilteredEnvmap,
+    Provenance, hex,
 };
 use clap::Parser;
 use serde_json::{Value, json};
@@ -16,7 +19,8 @@ use serde_json::{Value, json};
 /// matches, and a summary of its payload.
 ///
 /// Exit status: 0 the asset is valid; 1 its checksum does not match its contents (the header is
-/// still shown); 2 the file cannot be read, is not an asset, or is of a version or kind this
+/// still shown), or a file it names beside it (the KTX2, EXR and PNG files of a prefiltered
+/// envmap) is missing or does not have the SHA-256 it records; 2 the file cannot be read, is not an asset, or is of a version or kind this
 /// build does not know.
 #[derive(Debug, Parser)]
 #[command(version, allow_negative_numbers = true)]
@@ -51,10 +55,38 @@ fn run() -> anyhow::Result<ExitCode> {
         Err(Error::ChecksumMismatch { header, computed }) => Report { header, computed, asset: None },
         Err(e) => return Err(e).with_context(context),
     };
+    let dir = match args.file.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => std::path::Path::new("."),
+    };
+    let linked: Vec<(&LinkedFile, LinkedStatus)> = report.asset.as_ref().map_or_else(Vec::new, |asset| {
+        asset
+            .payload
+            .linked_files()
+            .into_iter()
+            .map(|f| (f, asset::linked_file_status(dir, &f.name, &f.sha256)))
+            .collect()
+    });
     if args.json {
-        cli::outln!("{:#}", to_json(&report));
+        let mut value = to_json(&report);
+        value["linked_files"] = linked.iter().map(|(f, status)| linked_json(f, status)).collect();
+        cli::outln!("{value:#}");
     } else {
         print_text(&report);
+        print_linked(&linked);
+    }
+    let stale: Vec<String> = linked
+        .iter()
+        .filter_map(|(f, status)| match status {
+            LinkedStatus::Matches => None,
+            LinkedStatus::Missing => Some(format!("{} is missing", f.name)),
+            LinkedStatus::Differs { .. } => Some(format!("{} does not have the sha256 the asset records", f.name)),
+            LinkedStatus::Unreadable(e) => Some(format!("{} cannot be read: {e}", f.name)),
+        })
+        .collect();
+    if !stale.is_empty() {
+        eprintln!("error: checking {}: linked file {}", args.file.display(), stale.join("; "));
+        return Ok(ExitCode::from(1));
     }
     if report.asset.is_some() {
         return Ok(ExitCode::SUCCESS);
@@ -62,6 +94,33 @@ fn run() -> anyhow::Result<ExitCode> {
     let mismatch = Error::ChecksumMismatch { header: report.header, computed: report.computed };
     eprintln!("error: {:#}", anyhow::Error::new(mismatch).context(context()));
     Ok(ExitCode::from(1))
+}
+
+/// The files the asset names, each with what was found beside it.
+fn print_linked(linked: &[(&LinkedFile, LinkedStatus)]) {
+    if linked.is_empty() {
+        return;
+    }
+    cli::outln!("linked files (beside the asset, checked against the sha256 it records)");
+    for (f, status) in linked {
+        let found = match status {
+            LinkedStatus::Matches => "ok".to_string(),
+            LinkedStatus::Missing => "MISSING".to_string(),
+            LinkedStatus::Differs { found } => format!("DIFFERS (found sha256 {})", hex(found)),
+            LinkedStatus::Unreadable(e) => format!("UNREADABLE ({e})"),
+        };
+        cli::outln!("  {:<22} {found}", f.name);
+    }
+}
+
+fn linked_json(f: &LinkedFile, status: &LinkedStatus) -> Value {
+    let (name, found) = match status {
+        LinkedStatus::Matches => ("ok", Some(hex(&f.sha256))),
+        LinkedStatus::Missing => ("missing", None),
+        LinkedStatus::Differs { found } => ("differs", Some(hex(found))),
+        LinkedStatus::Unreadable(_) => ("unreadable", None),
+    };
+    json!({ "name": f.name, "sha256": hex(&f.sha256), "status": name, "found_sha256": found })
 }
 
 fn print_text(report: &Report) {
