@@ -141,9 +141,10 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
 
 /// The default analysis (512 x 512) resolves Phong n = 1000 at every incident direction (the
 /// `brdf-atlas` test `phong_1000_across_the_horizon_is_resolved_at_the_default_size`); what a
-/// table of it still reads at the limit is the table's no-data edge at the horizon, on the
-/// horizon's last pixel in three of the most grazing rows (measured: 192 lobes, theta_i above
-/// 86 degrees; 320 before the analysis continued the lobe with its curvature; 4096 at 256).
+/// table of it still reads at the limit are the table's own edges (its trilinear lookup's):
+/// the no-data edge on the horizon's last pixel at two grazing rows and the `sqrt(theta_h)`
+/// cusp at the mirror direction of one row (measured: 3 rows, 192 lobes; 320 before the
+/// analysis continued the lobe with its curvature; 4096 at 256).
 #[test]
 fn the_default_analysis_resolves_phong_1000() {
     let tmp = temp_dir();

@@ -22,10 +22,11 @@ pub struct Config {
     /// radian at the centre of the lobe image (1.8 for 64, 14.4 for 512). The default, 512,
     /// resolves normalized Phong lobes up to n = 1000 at every incident direction, the grazing
     /// ones whose lobe straddles the horizon included (at 256 every lobe of n = 1000 reaches
-    /// the limit). A table of such a lobe made by `merl-synth` reads the limit in 192 of 4096
-    /// lobes (theta_i above 86 degrees, 128 at 1024), on the horizon's last pixel, where the
-    /// trilinear lookup leaves out the cells beyond the horizon, which hold no data (crate docs,
-    /// "Lobe images").
+    /// the limit). A table of such a lobe made by `merl-synth` reads the limit in 3 of the 64
+    /// rows (192 of 4096 lobes; 128 at 1024), where the table's trilinear lookup has edges of
+    /// its own: on the horizon's last pixel at theta_i 86.9 and 89.6 degrees (the cells beyond
+    /// the horizon hold no data), and at the mirror direction at 21 degrees (cells linear in
+    /// `sqrt(theta_h)`, a cusp at `theta_h = 0`) (crate docs, "Lobe images").
     /// It costs about 2.5 s for a real-derived material in a release build on two cores.
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).

@@ -88,10 +88,13 @@
 //! below it, and the trilinear lookup leaves those corners out and renormalizes, which bends
 //! the lobe within a cell of the horizon. Where a narrow lobe meets the horizon nearly opposite
 //! `wi` (grazing incidence, where the half vector swings fast with `wo` and a cell is small in
-//! `wo`) that reads the limit on the horizon's last pixel at any analysis size: `merl-synth
-//! phong -n 1000` reads it in 192 of 4096 lobes at 512 and 128 at 1024, while the same lobe
-//! analytically, or tabulated with values beyond the horizon, reads it in none (test
-//! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`).
+//! `wo`) that reads the limit on the horizon's last pixel at any analysis size, while the same
+//! lobe analytically, or tabulated with values beyond the horizon, reads it in none (test
+//! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`). The table's other edge is
+//! at the mirror direction: its cells are linear in `sqrt(theta_h)`, a cusp at `theta_h = 0`
+//! that a narrow lobe can show where its peak falls between pixels. `merl-synth phong -n 1000`
+//! reads the limit in 3 of 64 rows at 512 (192 of 4096 lobes: the horizon at theta_i 86.9 and
+//! 89.6 degrees, the mirror direction at 21 degrees) and in 128 lobes at 1024.
 //!
 //! # Boundaries
 //!

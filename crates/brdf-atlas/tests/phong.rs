@@ -107,10 +107,10 @@ fn the_atlas_counts_the_lobes_at_the_limit() {
 /// across the square's edges (odd reflection) carry the lobe's value, slope and curvature, so
 /// the cut reads as no edge. Before them, (a) read 12 to 50 pixels at the limit in rows 60 to
 /// 63 (the odd reflection `2 f(0) - f(-t)` flips the curvature, the square's mirrored edge
-/// makes a kink). A table made by `merl-synth` still reads the limit in three of these rows
-/// (192 of 4096 lobes), on the horizon's last pixel: its cells beyond the horizon hold no
-/// data, and the trilinear lookup, which leaves those corners out, has an edge there; (b)
-/// shows that the lobe itself is resolved.
+/// makes a kink). A table made by `merl-synth` still reads the limit on the horizon's last
+/// pixel in two of these rows: its cells beyond the horizon hold no data, and the trilinear
+/// lookup, which leaves those corners out, has an edge there; (b) shows that the lobe itself is
+/// resolved.
 #[test]
 fn phong_1000_across_the_horizon_is_resolved_at_the_default_size() {
     use merl::{Dims, MerlTable};
