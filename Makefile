@@ -9,7 +9,7 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python build install test test-data demo bake lint bench clean-demo
+.PHONY: setup setup-gpu setup-python build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
 ## setup: everything the tests need (setup-gpu and setup-python). Idempotent.
 setup: setup-gpu setup-python
@@ -97,3 +97,35 @@ lint:
 
 clean-demo:
 	rm -rf $(DEMO)
+
+## fuzz: every fuzz target in fuzz/ (cargo-fuzz, nightly Rust) for FUZZ_SECONDS seconds each
+## (default 60): timeout 2 s per input, 2 GiB RSS, the memory bound of crates/fuzzing. Seeds are
+## read from fuzz/corpus/, new inputs kept in fuzz/work-corpus/, crashes saved in fuzz/artifacts/
+## (copy each into fuzz/regressions/<target>/). Prints each target's executions; exit 1 if any
+## target found a crash. E.g. make fuzz FUZZ_SECONDS=600 FUZZ_TARGETS=asset
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?= merl asset envmap_exr envmap_hdr
+fuzz:
+	@cargo +nightly fuzz --version >/dev/null 2>&1 || { \
+	  echo "error: make fuzz needs nightly Rust and cargo-fuzz; install them with"; \
+	  echo "  rustup toolchain install nightly"; \
+	  echo "  cargo install cargo-fuzz"; \
+	  exit 2; }
+	cargo +nightly fuzz build
+	@failed=""; for t in $(FUZZ_TARGETS); do \
+	  mkdir -p fuzz/work-corpus/$$t fuzz/artifacts/$$t; \
+	  echo "fuzzing $$t for $(FUZZ_SECONDS) s (log: fuzz/artifacts/$$t.log)"; \
+	  cargo +nightly fuzz run $$t fuzz/work-corpus/$$t fuzz/corpus/$$t -- -max_total_time=$(FUZZ_SECONDS) \
+	    -timeout=2 -rss_limit_mb=2048 -print_final_stats=1 >fuzz/artifacts/$$t.log 2>&1 \
+	    || { failed="$$failed $$t"; tail -n 40 fuzz/artifacts/$$t.log; }; \
+	  awk -v t=$$t '/stat::number_of_executed_units/ {n=$$2} /stat::average_exec_per_sec/ {r=$$2} \
+	    /stat::peak_rss_mb/ {m=$$2} /^fuzzing: largest peak so far/ {p=$$6} \
+	    END {printf "%s: %s executions (%s per second), largest reader peak %s bytes, RSS %s MB\n", t, n, r, p, m}' \
+	    fuzz/artifacts/$$t.log; \
+	done; \
+	if [ -n "$$failed" ]; then echo "crashes in:$$failed (inputs in fuzz/artifacts/<target>/)"; exit 1; fi
+
+## fuzz-regressions: replay every reproducer (fuzz/regressions/) and seed (fuzz/corpus/) through the
+## fuzz harnesses on stable Rust, under the memory bound (part of make test).
+fuzz-regressions:
+	$(CARGO) test -p fuzzing

@@ -67,5 +67,5 @@ pub use manifest::{
 };
 pub use types::{
     Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples,
-    LayerSelection, LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
+    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
 };

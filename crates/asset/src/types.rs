@@ -396,6 +396,11 @@ pub struct BandwidthRows {
     pub data: Vec<f32>,
 }
 
+/// The most columns a [`BandwidthRows`] payload may stand for: the largest side of an incident
+/// grid the atlas builder accepts (`brdf_atlas::Config`, 4096). Expanding rows to the full grid
+/// multiplies the stored texels by at most this.
+pub const MAX_ROWS_COLUMNS: u32 = 4096;
+
 impl BandwidthRows {
     fn check(&self) -> Result<(), String> {
         // Sizes come from the file: a product that overflows is a size no file can hold. The
@@ -413,8 +418,15 @@ impl BandwidthRows {
                 stored.map_or("more than any file holds".to_string(), |s| s.to_string())
             ));
         }
-        if self.lobes_x == 0 {
-            return Err("bandwidth rows stand for an atlas of 0 columns: expected at least one".to_string());
+        // The columns the rows stand for are at most an incident grid's side: a reader that
+        // expands the rows holds at most MAX_ROWS_COLUMNS times what the file holds, never a
+        // count the file declares alone (a 321-byte file declaring 7.5 million columns made
+        // `bandwidth-pca` hold 951 MB).
+        if self.lobes_x == 0 || self.lobes_x > MAX_ROWS_COLUMNS {
+            return Err(format!(
+                "bandwidth rows stand for {} columns of lobes: expected 1 to {MAX_ROWS_COLUMNS}",
+                self.lobes_x
+            ));
         }
         Ok(())
     }

@@ -104,10 +104,11 @@ fn random_bandwidth_atlas(rng: &mut StdRng) -> Payload {
 }
 
 /// Consistent sizes (the payload's invariant), random contents; the columns the rows stand for
-/// range over all of `u32` (they size nothing that is stored).
+/// range over all they may (they size nothing that is stored, up to `MAX_ROWS_COLUMNS`).
 fn random_bandwidth_rows(rng: &mut StdRng) -> Payload {
     let (lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32));
-    let lobes_x = if rng.random_bool(0.5) { rng.random_range(1..4u32) } else { rng.random_range(1..=u32::MAX) };
+    let lobes_x =
+        if rng.random_bool(0.5) { rng.random_range(1..4u32) } else { rng.random_range(1..=asset::MAX_ROWS_COLUMNS) };
     let n = (lobes_y * tile * tile) as usize;
     Payload::BandwidthRows(BandwidthRows {
         lobes_x,

@@ -1,0 +1,6 @@
+//! Fuzzes the Radiance HDR environment reader (`fuzzing::envmap_hdr`) under the counting
+//! allocator: a panic, or more memory than `fuzzing::check_memory` allows, is a crash that
+//! libFuzzer reports and saves.
+#![no_main]
+
+fuzzing::fuzz_target_for!(fuzzing::envmap_hdr);
