@@ -233,10 +233,11 @@ fn decode_exr<R: BufRead + Seek>(
     let read = read.all_attributes().pedantic();
     // The `exr` crate's B44 decompressor overflows on some damaged data (1.74.2,
     // `compression/b44/mod.rs`); with overflow checks on (debug and test builds) that is a
-    // panic, which inside the crate's thread pool aborts the process. B44 files are decoded on
-    // this thread instead, and a panic of the decoder becomes an error.
+    // panic, which inside the crate's thread pool aborts the process. B44 files, and every file
+    // in a build with debug assertions (where the crate's own assertions can fire too), are
+    // decoded on this thread instead, and a panic of the decoder becomes an error.
     let b44 = chunks.headers().iter().any(|h| matches!(h.compression, Compression::B44 | Compression::B44A));
-    let read = if b44 { read.non_parallel() } else { read };
+    let read = if b44 || cfg!(debug_assertions) { read.non_parallel() } else { read };
     let image = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read.from_chunks(chunks)))
         .map_err(|_| Error::Invalid("openexr: the decoder failed on damaged data".into()))??;
     let layer = image.layer_data;
