@@ -190,7 +190,6 @@ impl ImportanceSamples {
         }
         // Counts from the file, multiplied without wrapping: a product past u64 is no file's.
         let (slices, rows, cols) = (slices as u64, rows as u64, cols as u64);
-        let product = |factors: &[u64]| factors.iter().try_fold(1u64, |p, &f| p.checked_mul(f));
         let expect = [
             ("samples", self.samples.len(), product(&[slices, self.n_vectors.into(), self.n_samples.into()])),
             ("marginal cdf", self.marginal_cdf.len(), product(&[slices, rows + 1])),
@@ -205,6 +204,13 @@ impl ImportanceSamples {
         }
         Ok(())
     }
+}
+
+/// The product of sizes read from a file, `None` past `u64`: no file holds that many, and a
+/// wrapped product could match what a damaged file holds. Every payload check multiplies sizes
+/// through it.
+fn product(factors: &[u64]) -> Option<u64> {
+    factors.iter().try_fold(1u64, |p, &f| p.checked_mul(f))
 }
 
 /// A file written next to an asset: its name in the asset's folder and its SHA-256, so that a
@@ -361,10 +367,7 @@ pub struct BandwidthAtlas {
 impl BandwidthAtlas {
     fn check(&self) -> Result<(), String> {
         // Sizes come from the file: a product that overflows is a size no file can hold.
-        let texels = u64::from(self.lobes_x)
-            .checked_mul(u64::from(self.lobes_y))
-            .and_then(|n| n.checked_mul(u64::from(self.tile)))
-            .and_then(|n| n.checked_mul(u64::from(self.tile)));
+        let texels = product(&[self.lobes_x, self.lobes_y, self.tile, self.tile].map(u64::from));
         if texels.is_none_or(|t| t == 0 || t != self.data.len() as u64) {
             return Err(format!(
                 "bandwidth atlas of {} x {} tiles of {} x {} texels holds {} values, expected {} (and at least one)",
@@ -406,8 +409,7 @@ impl BandwidthRows {
         // Sizes come from the file: a product that overflows is a size no file can hold. The
         // full grid (`lobes_x` times the stored texels) is not allocated here; a reader that
         // expands the rows bounds it first.
-        let stored =
-            u64::from(self.tile).checked_mul(u64::from(self.tile)).and_then(|t| t.checked_mul(u64::from(self.lobes_y)));
+        let stored = product(&[self.tile, self.tile, self.lobes_y].map(u64::from));
         if stored.is_none_or(|s| s == 0 || s != self.data.len() as u64) {
             return Err(format!(
                 "bandwidth rows of {} tiles of {} x {} texels hold {} values, expected {} (and at least one)",
@@ -454,8 +456,8 @@ pub struct BandwidthPca {
 impl BandwidthPca {
     fn check(&self) -> Result<(), String> {
         // Sizes come from the file: a product that overflows is a size no file can hold.
-        let tile_len = u64::from(self.tile).checked_mul(u64::from(self.tile));
-        let lobes = u64::from(self.lobes_x).checked_mul(u64::from(self.lobes_y));
+        let tile_len = product(&[self.tile, self.tile].map(u64::from));
+        let lobes = product(&[self.lobes_x, self.lobes_y].map(u64::from));
         let k = u64::from(self.n_components);
         let (Some(tile_len), Some(lobes)) = (tile_len, lobes) else {
             return Err("bandwidth pca sizes exceed what any file holds".to_string());
@@ -465,8 +467,8 @@ impl BandwidthPca {
         }
         let expect = [
             ("mean", self.mean.len() as u64, Some(tile_len)),
-            ("components", self.components.len() as u64, k.checked_mul(tile_len)),
-            ("coefficients", self.coefficients.len() as u64, lobes.checked_mul(k)),
+            ("components", self.components.len() as u64, product(&[k, tile_len])),
+            ("coefficients", self.coefficients.len() as u64, product(&[lobes, k])),
         ];
         for (what, found, expected) in expect {
             if Some(found) != expected {

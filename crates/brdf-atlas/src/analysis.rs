@@ -327,9 +327,8 @@ fn extend_line(line: &mut [f64]) {
         let odd = 2.0 * at(0) - at(k);
         let mut value = mirror + (std::f64::consts::PI * k as f64 / n as f64).cos().powi(2) * (odd - mirror);
         if k <= reach {
-            let s = k as f64 / reach as f64;
             let three_point = c1 * at(k) + c2 * at(2 * k) + c3 * at(3 * k);
-            value += (1.0 - s * s * (3.0 - 2.0 * s)) * (three_point - odd);
+            value += crate::param::three_point_share(k as f64 / reach as f64) * (three_point - odd);
         }
         value
     };

@@ -100,6 +100,15 @@ pub enum Sample {
 /// is `1`, `t`, `t^2`).
 pub const CONTINUATION_WEIGHTS: [f64; 3] = [6.0, -8.0, 3.0];
 
+/// The share of the three-point continuation at `s`, the depth in units of the blend
+/// ([`CONTINUATION_REACH`]): 1 at the border, 0 from `s = 1` on, `1 - 3 s^2 + 2 s^3` between,
+/// flat at both ends. The rest is the odd reflection's. Below the horizon and past the square's
+/// edges alike.
+pub(crate) fn three_point_share(s: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    1.0 - s * s * (3.0 - 2.0 * s)
+}
+
 /// Pixels (samples) over which the three-point continuation blends into the odd reflection,
 /// below the horizon ([`LobeMap::sample`], along the radius) and past the square's edges
 /// (`extend_periodic`). The three-point rule reads three times as far in, where a lobe narrower
@@ -162,10 +171,8 @@ impl LobeMap {
         let (a, b) = self.square(x, y);
         let depth = self.theta(x, y) - FRAC_PI_2;
         let at = |k: f64| direction_from_disk(a, b, FRAC_PI_2 - k * depth);
-        // The blend's weight: 1 on the horizon, 0 from CONTINUATION_REACH pixels (of pi / size
-        // radians along the radius) on, flat at both ends.
-        let s = (depth / self.continuation_depth()).min(1.0);
-        let w = 1.0 - s * s * (3.0 - 2.0 * s);
+        // CONTINUATION_REACH pixels of pi / size radians along the radius.
+        let w = three_point_share(depth / self.continuation_depth());
         let [c1, c2, c3] = CONTINUATION_WEIGHTS.map(|c| c * w);
         Sample::Continued {
             points: [at(0.0), at(1.0), at(2.0), at(3.0)],

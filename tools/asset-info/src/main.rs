@@ -313,6 +313,17 @@ fn importance_summary(s: &ImportanceSamples) -> ImportanceSummary {
     }
 }
 
+/// The grid and analysis of a bandwidth payload (kinds 4, 5 and 7) in JSON, as `print_tiles`
+/// prints them.
+fn tiles_json(lobes_x: u32, lobes_y: u32, tile: u32, analysis: &asset::BandwidthAnalysis) -> Value {
+    json!({
+        "lobes_x": lobes_x,
+        "lobes_y": lobes_y,
+        "tile": tile,
+        "analysis": serde_json::to_value(analysis).expect("analysis serializes to json"),
+    })
+}
+
 fn to_json(report: &Report) -> Value {
     let header = &report.header;
     let header_json = json!({
@@ -355,29 +366,20 @@ fn to_json(report: &Report) -> Value {
                     })
                 }
                 Payload::PrefilteredEnvmap(prefiltered) => prefiltered_envmap_json(prefiltered),
-                Payload::BandwidthAtlas(atlas) => json!({
-                    "lobes_x": atlas.lobes_x,
-                    "lobes_y": atlas.lobes_y,
-                    "tile": atlas.tile,
-                    "analysis": serde_json::to_value(&atlas.analysis).expect("analysis serializes to json"),
-                }),
-                Payload::BandwidthPca(pca) => json!({
-                    "lobes_x": pca.lobes_x,
-                    "lobes_y": pca.lobes_y,
-                    "tile": pca.tile,
-                    "n_components": pca.n_components,
-                    "analysis": serde_json::to_value(&pca.analysis).expect("analysis serializes to json"),
-                }),
+                Payload::BandwidthAtlas(atlas) => tiles_json(atlas.lobes_x, atlas.lobes_y, atlas.tile, &atlas.analysis),
+                Payload::BandwidthPca(pca) => {
+                    let mut value = tiles_json(pca.lobes_x, pca.lobes_y, pca.tile, &pca.analysis);
+                    value["n_components"] = pca.n_components.into();
+                    value
+                }
                 Payload::LayerSelection(selection) => {
                     serde_json::to_value(selection).expect("layer selection serializes to json")
                 }
-                Payload::BandwidthRows(rows) => json!({
-                    "lobes_x": rows.lobes_x,
-                    "lobes_y": rows.lobes_y,
-                    "tile": rows.tile,
-                    "stored_tiles": rows.lobes_y,
-                    "analysis": serde_json::to_value(&rows.analysis).expect("analysis serializes to json"),
-                }),
+                Payload::BandwidthRows(rows) => {
+                    let mut value = tiles_json(rows.lobes_x, rows.lobes_y, rows.tile, &rows.analysis);
+                    value["stored_tiles"] = rows.lobes_y.into();
+                    value
+                }
             };
             json!({
                 "header": header_json,
