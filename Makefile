@@ -100,11 +100,15 @@ clean-demo:
 
 ## fuzz: every fuzz target in fuzz/ (cargo-fuzz, nightly Rust) for FUZZ_SECONDS seconds each
 ## (default 60): timeout 2 s per input, 2 GiB RSS, the memory bound of crates/fuzzing. Seeds are
-## read from fuzz/corpus/, new inputs kept in fuzz/work-corpus/, crashes saved in fuzz/artifacts/
+## read from fuzz/corpus/, fuzz/regressions/, fixtures/ and ../shared/data/hostile/, new inputs
+## kept in fuzz/work-corpus/, crashes saved in fuzz/artifacts/
 ## (copy each into fuzz/regressions/<target>/). Prints each target's executions; exit 1 if any
 ## target found a crash. E.g. make fuzz FUZZ_SECONDS=600 FUZZ_TARGETS=asset
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?= merl asset envmap_exr envmap_hdr
+# Seeds every target reads besides its own: the committed fixtures and the shared hostile inputs
+# (crates/fuzzing/tests/regressions.rs replays the same folders).
+FUZZ_SHARED_SEEDS := fixtures ../shared/data/hostile
 fuzz:
 	@cargo +nightly fuzz --version >/dev/null 2>&1 || { \
 	  echo "error: make fuzz needs nightly Rust and cargo-fuzz; install them with"; \
@@ -115,7 +119,8 @@ fuzz:
 	@failed=""; for t in $(FUZZ_TARGETS); do \
 	  mkdir -p fuzz/work-corpus/$$t fuzz/artifacts/$$t; \
 	  echo "fuzzing $$t for $(FUZZ_SECONDS) s (log: fuzz/artifacts/$$t.log)"; \
-	  cargo +nightly fuzz run $$t fuzz/work-corpus/$$t fuzz/corpus/$$t -- -max_total_time=$(FUZZ_SECONDS) \
+	  seeds=""; for d in fuzz/corpus/$$t fuzz/regressions/$$t; do [ -d $$d ] && seeds="$$seeds $$d"; done; \
+	  cargo +nightly fuzz run $$t fuzz/work-corpus/$$t $$seeds $(FUZZ_SHARED_SEEDS) -- -max_total_time=$(FUZZ_SECONDS) \
 	    -timeout=2 -rss_limit_mb=2048 -print_final_stats=1 >fuzz/artifacts/$$t.log 2>&1 \
 	    || { failed="$$failed $$t"; tail -n 40 fuzz/artifacts/$$t.log; }; \
 	  awk -v t=$$t '/stat::number_of_executed_units/ {n=$$2} /stat::average_exec_per_sec/ {r=$$2} \
@@ -125,7 +130,7 @@ fuzz:
 	done; \
 	if [ -n "$$failed" ]; then echo "crashes in:$$failed (inputs in fuzz/artifacts/<target>/)"; exit 1; fi
 
-## fuzz-regressions: replay every reproducer (fuzz/regressions/) and seed (fuzz/corpus/) through the
+## fuzz-regressions: replay every reproducer (fuzz/regressions/, ../shared/data/hostile/) and seed (fuzz/corpus/, fixtures/) through the
 ## fuzz harnesses on stable Rust, under the memory bound (part of make test).
 fuzz-regressions:
 	$(CARGO) test -p fuzzing

@@ -104,7 +104,8 @@ pub fn fuzz_one(harness: Harness, data: &[u8]) {
 pub type Harness = fn(&[u8]);
 
 /// The harnesses by target name, in the order of `fuzz/Cargo.toml`: the replay runs the files
-/// of `fuzz/regressions/<name>/` and `fuzz/corpus/<name>/` through the function named here.
+/// of `fuzz/regressions/<name>/` and `fuzz/corpus/<name>/`, and those every target shares
+/// (`fixtures/`, `../shared/data/hostile/`), through the function named here.
 pub const HARNESSES: [(&str, Harness); 4] =
     [("merl", merl), ("asset", asset), ("envmap_exr", envmap_exr), ("envmap_hdr", envmap_hdr)];
 

@@ -1,6 +1,8 @@
-//! Every reproducer the fuzzers found (`fuzz/regressions/<target>/`) and every seed
-//! (`fuzz/corpus/<target>/`) replayed through its harness on stable Rust, under the counting
-//! allocator: no input may panic or allocate beyond `fuzzing::check_memory`'s bound. Then the
+//! Every reproducer the fuzzers found (`fuzz/regressions/<target>/`), every seed
+//! (`fuzz/corpus/<target>/`), and the inputs every target shares, kept where they already are
+//! (the committed fixtures, `fixtures/`, and the shared hostile files, `../shared/data/hostile/`),
+//! replayed through each harness on stable Rust, under the counting allocator: no input may panic
+//! or allocate beyond `fuzzing::check_memory`'s bound. Then the
 //! same bound on the largest legitimate inputs: the real maps in `../shared/data/env` and a MERL
 //! table of full size.
 
@@ -27,19 +29,31 @@ fn shown(path: &Path) -> String {
     path.strip_prefix(&root).unwrap_or(path).display().to_string()
 }
 
-/// The files of a folder of inputs, sorted; a missing or empty folder fails with what it should
-/// hold.
+/// The files of a folder of inputs and of its subfolders, sorted (`README.md` files are not
+/// inputs); a missing or empty folder fails with what it should hold.
 fn inputs(dir: &Path, what: &str) -> Vec<PathBuf> {
-    let entries = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}: expected the {what} of this target there", shown(dir)));
-    let mut files: Vec<PathBuf> = entries
-        .map(|entry| entry.expect("listing a folder of inputs").path())
-        .filter(|path| path.is_file() && path.file_name().is_some_and(|n| n != "README.md"))
-        .collect();
+    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}: expected {what} there", shown(dir)));
+    let mut files = Vec::new();
+    for path in entries.map(|entry| entry.expect("listing a folder of inputs").path()) {
+        if path.is_dir() {
+            files.extend(inputs(&path, what));
+        } else if path.file_name().is_some_and(|n| n != "README.md") {
+            files.push(path);
+        }
+    }
     files.sort();
-    assert!(!files.is_empty(), "{} is empty: expected the {what} of this target there", shown(dir));
+    assert!(!files.is_empty(), "{} is empty: expected {what} there", shown(dir));
     files
 }
+
+/// The folders every target reads besides its own, as seeds in `make fuzz` (`FUZZ_SHARED_SEEDS`)
+/// and here: the committed fixtures (valid and damaged files of every format) and the shared
+/// hostile files (reproducers found before fuzzing was in the repository). A harness skips or
+/// refuses another format's bytes.
+const SHARED_INPUTS: [(&str, &str); 2] = [
+    ("fixtures", "the committed fixtures"),
+    ("../shared/data/hostile", "the shared hostile inputs (the project's shared/ folder beside the workspace)"),
+];
 
 /// Runs `harness` on `bytes` under the allocator: `Err` when it panics or holds more than the
 /// bound allows, with the peak either way.
@@ -69,8 +83,16 @@ fn run(harness: fuzzing::Harness, bytes: &[u8]) -> (Result<(), String>, usize) {
 fn replay(target: &str) {
     let harness = fuzzing::HARNESSES.iter().find(|(name, _)| *name == target).expect("a harness of that name").1;
     let dir = root().join("fuzz");
-    let mut files = inputs(&dir.join("regressions").join(target), "reproducers");
-    files.extend(inputs(&dir.join("corpus").join(target), "seed inputs"));
+    // A target's own folders exist once it has inputs of its own.
+    let mut files = Vec::new();
+    for own in [dir.join("regressions").join(target), dir.join("corpus").join(target)] {
+        if own.exists() {
+            files.extend(inputs(&own, "the inputs of this target"));
+        }
+    }
+    for (folder, what) in SHARED_INPUTS {
+        files.extend(inputs(&root().join(folder), what));
+    }
     let mut failures = Vec::new();
     let mut largest = (0, String::new());
     for file in &files {
