@@ -39,7 +39,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn write_set(dir: &Path, files: &[(&str, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
     std::fs::create_dir_all(dir).map_err(|e| (dir.to_path_buf(), e))?;
     let names: Vec<&str> = files.iter().map(|(name, _)| *name).collect();
-    remove_stale_temporaries(dir, &names).map_err(|e| (dir.to_path_buf(), e))?;
+    remove_temporaries(dir, |target| names.contains(&target)).map_err(|e| (dir.to_path_buf(), e))?;
     let mut staged = Vec::with_capacity(files.len());
     for (name, bytes) in files {
         let path = dir.join(name);
@@ -66,25 +66,24 @@ pub fn write_set(dir: &Path, files: &[(&str, &[u8])]) -> Result<(), (PathBuf, st
     sync_folder(dir).map_err(|e| (dir.to_path_buf(), e))
 }
 
-/// Removes the temporary files [`write_atomic`] and [`write_set`] name `.NAME.XXXXXX.tmp` for
-/// each of `names` in `dir`: left by an interrupted run, they are never outputs. Returns how
-/// many were removed.
-pub fn remove_stale_temporaries(dir: &Path, names: &[&str]) -> std::io::Result<usize> {
+/// The file a temporary file of [`write_atomic`] or [`write_set`] was for: `NAME` of
+/// `.NAME.XXXXXX.tmp` (six letters or digits); `None` for any other name.
+pub fn temporary_target(file_name: &str) -> Option<&str> {
+    let rest = file_name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (target, random) = rest.rsplit_once('.')?;
+    let ours = !target.is_empty()
+        && random.len() == TEMPORARY_RANDOM_CHARS
+        && random.chars().all(|c| c.is_ascii_alphanumeric());
+    ours.then_some(target)
+}
+
+/// Removes from `dir` the temporary files ([`temporary_target`]) an interrupted run left for the
+/// files `of` accepts: they are never outputs. Returns how many were removed.
+pub fn remove_temporaries(dir: &Path, of: impl Fn(&str) -> bool) -> std::io::Result<usize> {
     let mut removed = 0;
     for entry in std::fs::read_dir(dir)? {
         let entry = entry?;
-        let file_name = entry.file_name();
-        let file_name = file_name.to_string_lossy();
-        let ours = names.iter().any(|name| {
-            file_name
-                .strip_prefix('.')
-                .and_then(|rest| rest.strip_prefix(name))
-                .and_then(|rest| rest.strip_prefix('.'))
-                .and_then(|rest| rest.strip_suffix(".tmp"))
-                .is_some_and(|random| {
-                    random.len() == TEMPORARY_RANDOM_CHARS && random.chars().all(|c| c.is_ascii_alphanumeric())
-                })
-        });
+        let ours = entry.file_name().to_str().and_then(temporary_target).is_some_and(&of);
         if ours && entry.file_type()?.is_file() {
             std::fs::remove_file(entry.path())?;
             removed += 1;

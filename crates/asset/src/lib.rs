@@ -59,7 +59,7 @@ pub use container::{
 };
 pub use error::Error;
 pub use files::{
-    LinkedStatus, hex, linked_file_status, remove_stale_temporaries, sha256, sha256_file, sha256_from_hex,
+    LinkedStatus, hex, linked_file_status, remove_temporaries, sha256, sha256_file, sha256_from_hex, temporary_target,
     write_atomic, write_set,
 };
 pub use manifest::{

@@ -92,3 +92,27 @@ fn missing_parent_folders_are_created() {
     assert_eq!(std::fs::read(&nested).unwrap(), b"new");
     assert_eq!(entries(&dir.path().join("a/b")), ["out.bin"]);
 }
+
+/// The temporary files of `write_atomic` and `write_set` are recognised by their whole name, so
+/// that a cleanup removes only ours: `.NAME.XXXXXX.tmp` with six letters or digits.
+#[test]
+fn temporary_files_are_recognised_by_their_whole_name() {
+    use asset::temporary_target;
+    assert_eq!(temporary_target(".importance.asset.Ab3dE9.tmp"), Some("importance.asset"));
+    assert_eq!(temporary_target(".manifest.json.x7YqZ2.tmp"), Some("manifest.json"));
+    for other in
+        [".x.tmp", ".a.asset.Ab3d.tmp", "a.asset.Ab3dE9.tmp", ".a.asset.Ab3dE9", "..Ab3dE9.tmp", ".a.Ab-dE9.tmp"]
+    {
+        assert_eq!(temporary_target(other), None, "{other}");
+    }
+    // What write_atomic leaves behind while it writes is of that form.
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("x.asset");
+    let file =
+        tempfile::Builder::new().prefix(".x.asset.").suffix(".tmp").rand_bytes(6).tempfile_in(dir.path()).unwrap();
+    let name = file.path().file_name().unwrap().to_str().unwrap().to_string();
+    assert_eq!(temporary_target(&name), Some("x.asset"), "{name}");
+    assert_eq!(asset::remove_temporaries(dir.path(), |t| t == "other.png").unwrap(), 0);
+    assert_eq!(asset::remove_temporaries(dir.path(), |t| t == "x.asset").unwrap(), 1);
+    assert!(!target.exists() && !file.path().exists());
+}

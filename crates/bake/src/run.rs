@@ -187,7 +187,8 @@ pub fn run_bake(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
         Err(e) => return Err(Error::write(&manifest_path, e)),
     }
-    remove_temporaries(out)?;
+    // Temporary files an interrupted bake left, for any file: the folder is the bake's.
+    asset::remove_temporaries(out, |_| true).map_err(|e| Error::write(out, e))?;
 
     let stages = stage_names(config);
     let mut reports = Vec::new();
@@ -318,21 +319,6 @@ fn all_files_match(manifest: &BakeManifest, dir: &Path) -> Result<bool, Error> {
         }
     }
     Ok(true)
-}
-
-/// Removes the temporary files an interrupted atomic write leaves (`asset::write_atomic` names
-/// them `.NAME.XXXXXX.tmp`): they are never outputs.
-fn remove_temporaries(dir: &Path) -> Result<(), Error> {
-    let entries = std::fs::read_dir(dir).map_err(|e| Error::read(dir, e))?;
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::read(dir, e))?;
-        let name = entry.file_name();
-        let name = name.to_string_lossy();
-        if name.starts_with('.') && name.ends_with(".tmp") && entry.file_type().is_ok_and(|t| t.is_file()) {
-            std::fs::remove_file(entry.path()).map_err(|e| Error::write(&entry.path(), e))?;
-        }
-    }
-    Ok(())
 }
 
 /// Makes a removal durable before files are replaced (Unix; a no-op elsewhere).
