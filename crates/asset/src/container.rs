@@ -14,7 +14,7 @@ use sha2::{Digest, Sha256};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::types::{
-    Asset, AssetKind, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection, MaterialInfo,
+    Asset, AssetKind, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection, MaterialInfo, WaveletBrdf,
     Payload, PrefilteredEnvmap, Provenance,
 };
 
@@ -125,6 +125,7 @@ pub fn encode(asset: &Asset) -> Vec<u8> {
         Payload::BandwidthPca(pca) => encode_section(pca),
         Payload::LayerSelection(selection) => encode_section(selection),
         Payload::BandwidthRows(rows) => encode_section(rows),
+        Payload::WaveletBrdf(wavelet) => encode_section(wavelet),
     };
     let checksum: [u8; 32] = Sha256::new().chain_update(&provenance).chain_update(&payload).finalize().into();
 
@@ -176,6 +177,7 @@ pub fn decode_with_header(bytes: &[u8]) -> Result<(Header, Asset), Error> {
         AssetKind::BandwidthPca => Payload::BandwidthPca(decode_section::<BandwidthPca>("payload", payload)?),
         AssetKind::LayerSelection => Payload::LayerSelection(decode_section::<LayerSelection>("payload", payload)?),
         AssetKind::BandwidthRows => Payload::BandwidthRows(decode_section::<BandwidthRows>("payload", payload)?),
+        AssetKind::WaveletBrdf => Payload::WaveletBrdf(decode_section::<WaveletBrdf>("payload", payload)?),
     };
     payload.check().map_err(|problem| Error::Invalid(format!("invalid payload: {problem}")))?;
     Ok((header, Asset { provenance, payload }))

@@ -62,11 +62,14 @@ pub enum AssetKind {
     /// [`BandwidthRows`]: a bandwidth atlas whose tiles repeat along each row (an isotropic
     /// material), stored one tile per row.
     BandwidthRows = 7,
+    /// [`WaveletBrdf`]: a BRDF encoded in Haar wavelets on the sphere, thresholded and optionally
+    /// quantized (Claustres et al. 2007).
+    WaveletBrdf = 8,
 }
 
 impl AssetKind {
     /// Every kind this build knows, in code order.
-    pub const ALL: [AssetKind; 7] = [
+    pub const ALL: [AssetKind; 8] = [
         AssetKind::MaterialInfo,
         AssetKind::ImportanceSamples,
         AssetKind::PrefilteredEnvmap,
@@ -74,6 +77,7 @@ impl AssetKind {
         AssetKind::BandwidthPca,
         AssetKind::LayerSelection,
         AssetKind::BandwidthRows,
+        AssetKind::WaveletBrdf,
     ];
 
     /// The number stored in the header.
@@ -96,6 +100,7 @@ impl AssetKind {
             AssetKind::BandwidthPca => "bandwidth-pca",
             AssetKind::LayerSelection => "layer-selection",
             AssetKind::BandwidthRows => "bandwidth-rows",
+            AssetKind::WaveletBrdf => "wavelet-brdf",
         }
     }
 }
@@ -529,6 +534,102 @@ impl LayerSelection {
     }
 }
 
+/// The largest grid side of a [`WaveletBrdf`]: `2^8` cells per angle, the paper's limit for 16-bit
+/// compression-map indices (section 5.2).
+pub const MAX_WAVELET_SIDE: u32 = 256;
+
+/// A BRDF encoded in Haar wavelets (payload of [`AssetKind::WaveletBrdf`], written by
+/// `brdf-wavelet`; Claustres, Barthe and Paulin 2007, sections 4-5). Crate `haar-brdf`
+/// documents the parameterization, the transform and the reconstruction;
+/// `data-schema/README.md` the bytes.
+///
+/// Directions are on an `n x n` grid of the sphere parameterization (`n = side`) for both
+/// `wo` (the slice) and `wi` (within a slice). Each slice's log-encoded values were transformed by
+/// a 2D non-standard Haar transform into `n^2` coefficient positions. Coefficient position `p`
+/// (row-major in the `n x n` coefficient layout) taken across all `n^2` outgoing cells and the 3
+/// channels is one stored "slice" or none: `map[p]` is `0` for a dropped position (the shared zero
+/// slice) or `k` in `1..=K` for stored slice `k - 1`; the kept positions, in increasing order,
+/// hold slices `1, 2, ..., K`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WaveletBrdf {
+    /// `n`: cells per angle of both direction grids, a power of two in `2..=256`.
+    pub side: u32,
+    /// `eps` of the log encoding `log((f + eps mu) / mu)`.
+    pub epsilon: f64,
+    /// `mu` per channel: the mean of the resampled values, 1/sr, positive.
+    pub channel_mean: [f64; 3],
+    /// `n^2` entries, one per coefficient position.
+    pub map: Vec<u32>,
+    pub coefficients: WaveletCoefficients,
+}
+
+/// The stored slices of a [`WaveletBrdf`]: `K` slices, each `n^2` outgoing cells (row-major) of 3
+/// channels, slice-major: value `(k, o, c)` is entry `(k n^2 + o) 3 + c`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum WaveletCoefficients {
+    /// The coefficients as `f32`.
+    Float(Vec<f32>),
+    /// 8-bit codes: value `(k, o, c)` is `offset[3 k + c] + code step[3 k + c]`, the range of each
+    /// slice and channel cut into 255 equal steps.
+    Quantized { offset: Vec<f32>, step: Vec<f32>, codes: Vec<u8> },
+}
+
+impl WaveletBrdf {
+    /// `K`, the number of stored slices (the map's nonzero entries).
+    pub fn stored_slices(&self) -> usize {
+        self.map.iter().filter(|&&m| m != 0).count()
+    }
+
+    /// The payload's invariants (checked on write and read; public for readers that build a
+    /// payload themselves).
+    pub fn check(&self) -> Result<(), String> {
+        let n = self.side;
+        if !n.is_power_of_two() || !(2..=MAX_WAVELET_SIDE).contains(&n) {
+            return Err(format!("wavelet brdf side {n} is not a power of two in 2..={MAX_WAVELET_SIDE}"));
+        }
+        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
+            return Err(format!("wavelet brdf epsilon {} is not a positive number", self.epsilon));
+        }
+        if !self.channel_mean.iter().all(|m| m.is_finite() && *m > 0.0) {
+            return Err("wavelet brdf channel means must be positive numbers".into());
+        }
+        let cells = u64::from(n) * u64::from(n);
+        if self.map.len() as u64 != cells {
+            return Err(format!("wavelet brdf map has {} entries, expected {cells}", self.map.len()));
+        }
+        let mut next = 1u32;
+        for (p, &m) in self.map.iter().enumerate() {
+            if m != 0 && m != next {
+                return Err(format!(
+                    "wavelet brdf map gives position {p} slice {m}, expected 0 or {next} (kept positions hold slices 1, 2, ... in order)"
+                ));
+            }
+            next += u32::from(m != 0);
+        }
+        let k = u64::from(next - 1);
+        let values = product(&[k, cells, 3]).expect("k and cells are at most 2^16 each");
+        let (what, found, finite) = match &self.coefficients {
+            WaveletCoefficients::Float(v) => ("values", v.len(), v.iter().all(|x| x.is_finite())),
+            WaveletCoefficients::Quantized { offset, step, codes } => {
+                for (what, found) in [("offsets", offset.len()), ("steps", step.len())] {
+                    if found as u64 != 3 * k {
+                        return Err(format!("wavelet brdf has {found} quantization {what}, expected {}", 3 * k));
+                    }
+                }
+                let ranges = offset.iter().all(|x| x.is_finite()) && step.iter().all(|x| x.is_finite() && *x >= 0.0);
+                ("codes", codes.len(), ranges)
+            }
+        };
+        if found as u64 != values {
+            return Err(format!("wavelet brdf holds {found} {what}, expected {values} ({k} slices of {cells} cells x 3)"));
+        }
+        if !finite {
+            return Err("wavelet brdf coefficients must be finite (and quantization steps not negative)".into());
+        }
+        Ok(())
+    }
+}
+
 /// The payload of an asset, one variant per [`AssetKind`].
 ///
 /// Only the variant's content is serialized; the header's kind code says which type follows.
@@ -541,6 +642,7 @@ pub enum Payload {
     BandwidthPca(BandwidthPca),
     LayerSelection(LayerSelection),
     BandwidthRows(BandwidthRows),
+    WaveletBrdf(WaveletBrdf),
 }
 
 impl Payload {
@@ -561,6 +663,7 @@ impl Payload {
             Payload::BandwidthPca(_) => AssetKind::BandwidthPca,
             Payload::LayerSelection(_) => AssetKind::LayerSelection,
             Payload::BandwidthRows(_) => AssetKind::BandwidthRows,
+            Payload::WaveletBrdf(_) => AssetKind::WaveletBrdf,
         }
     }
 
@@ -574,6 +677,7 @@ impl Payload {
             Payload::BandwidthPca(pca) => pca.check(),
             Payload::LayerSelection(selection) => selection.check(),
             Payload::BandwidthRows(rows) => rows.check(),
+            Payload::WaveletBrdf(wavelet) => wavelet.check(),
         }
     }
 }
@@ -611,6 +715,12 @@ impl From<BandwidthPca> for Payload {
 impl From<LayerSelection> for Payload {
     fn from(selection: LayerSelection) -> Payload {
         Payload::LayerSelection(selection)
+    }
+}
+
+impl From<WaveletBrdf> for Payload {
+    fn from(wavelet: WaveletBrdf) -> Payload {
+        Payload::WaveletBrdf(wavelet)
     }
 }
 

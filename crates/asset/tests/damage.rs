@@ -118,7 +118,7 @@ fn the_unknown_kind_message_names_the_number() {
     assert_eq!(
         decode(&bytes).unwrap_err().to_string(),
         "unknown asset kind 9: this build knows 1 (material-info), 2 (importance-samples), 3 (prefiltered-envmap), \
-         4 (bandwidth-atlas), 5 (bandwidth-pca), 6 (layer-selection), 7 (bandwidth-rows)"
+         4 (bandwidth-atlas), 5 (bandwidth-pca), 6 (layer-selection), 7 (bandwidth-rows), 8 (wavelet-brdf)"
     );
 }
 

@@ -258,6 +258,23 @@ fn golden_kinds() -> Vec<(&'static str, Asset)> {
                 }),
             },
         ),
+        (
+            "assets/golden-v1-wavelet-brdf.asset",
+            Asset {
+                provenance: provenance("brdf-wavelet"),
+                payload: Payload::WaveletBrdf(asset::WaveletBrdf {
+                    side: 2,
+                    epsilon: 0.01,
+                    channel_mean: [0.25, 0.5, 0.125],
+                    map: vec![1, 0, 2, 0],
+                    coefficients: asset::WaveletCoefficients::Quantized {
+                        offset: vec![-1.0, -0.5, 0.0, -2.0, -1.0, -0.25],
+                        step: vec![0.25, 0.0, 0.125, 0.5, 0.25, 0.0625],
+                        codes: (0..24).map(|k| (k * 10) as u8).collect(),
+                    },
+                }),
+            },
+        ),
     ]
 }
 

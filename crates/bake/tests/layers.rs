@@ -16,7 +16,7 @@ fn config() -> Config {
 }
 
 fn phong(n: u32) -> merl::MerlTable {
-    Analytic::Phong { n: f64::from(n), ks: [1.0; 3] }.table(merl::Dims::MERL)
+    Analytic::Phong { n: f64::from(n), ks: [1.0; 3], kd: [0.0; 3] }.table(merl::Dims::MERL)
 }
 
 /// `merl-synth phong -n N` for each layer's exponent from 16 up selects that layer at every row:

@@ -11,7 +11,7 @@ use merl::{Dims, MerlTable};
 
 /// A MERL table of energy-normalized Phong of exponent `n`.
 pub fn phong(n: f64) -> MerlTable {
-    Analytic::Phong { n, ks: [1.0; 3] }.table(Dims::MERL)
+    Analytic::Phong { n, ks: [1.0; 3], kd: [0.0; 3] }.table(Dims::MERL)
 }
 
 /// Least-squares slope of `ys` against `xs`.

@@ -47,7 +47,7 @@ fn ggx() -> &'static MerlTable {
 
 fn phong() -> &'static MerlTable {
     static TABLE: OnceLock<MerlTable> = OnceLock::new();
-    cached(&TABLE, Analytic::Phong { n: 30.0, ks: [0.8, 0.6, 0.3] })
+    cached(&TABLE, Analytic::Phong { n: 30.0, ks: [0.8, 0.6, 0.3], kd: [0.0; 3] })
 }
 
 /// A table whose values name their cell, with a band of no-data cells; instant to build, so it

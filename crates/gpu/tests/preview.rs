@@ -65,7 +65,7 @@ fn lambertian() -> &'static Material {
 
 fn phong() -> &'static Material {
     static MATERIAL: OnceLock<Material> = OnceLock::new();
-    MATERIAL.get_or_init(|| material(Analytic::Phong { n: 50.0, ks: [0.9, 0.7, 0.5] }))
+    MATERIAL.get_or_init(|| material(Analytic::Phong { n: 50.0, ks: [0.9, 0.7, 0.5], kd: [0.0; 3] }))
 }
 
 /// Sharp enough that neighbouring MERL cells differ, so a wrong cell or frame shows.

@@ -19,7 +19,7 @@ fn materials() -> &'static [(&'static str, MerlTable, ImportanceTables)] {
         let config = Config { n_theta_o: 9, ..Config::default() };
         [
             ("lambertian", Analytic::Lambertian { albedo: [0.5; 3] }),
-            ("phong-200", Analytic::Phong { n: 200.0, ks: [0.9; 3] }),
+            ("phong-200", Analytic::Phong { n: 200.0, ks: [0.9; 3], kd: [0.0; 3] }),
             ("ggx-0.05", Analytic::Ggx { alpha: 0.05, f0: [0.9, 0.6, 0.5] }),
         ]
         .into_iter()

@@ -156,7 +156,7 @@ mod tests {
     fn phong_known_answer_at_normal_incidence() {
         // Energy-normalized Phong reflects exactly ks at normal incidence, however sharp.
         for n in [10.0, 1000.0, 100_000.0] {
-            let phong = Analytic::Phong { n, ks: [1.0; 3] };
+            let phong = Analytic::Phong { n, ks: [1.0; 3], kd: [0.0; 3] };
             let a = directional_albedo(|wi, wo| Some(phong.eval(wi, wo)), 0.0, Quadrature::default());
             assert!((a.rgb[0] - 1.0).abs() < 2e-3, "n {n}: {:?}", a.rgb);
         }

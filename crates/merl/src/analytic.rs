@@ -16,10 +16,11 @@ pub const HORIZON_EPS: f64 = 1e-12;
 pub enum Analytic {
     /// `f = albedo / pi`: directional albedo `albedo` at every angle.
     Lambertian { albedo: [f64; 3] },
-    /// Energy-normalized Phong: `f = ks (n + 2) / (2 pi) max(0, wi . r)^n`, `r` the mirror of
-    /// `wo` about the normal. Its directional albedo is exactly `ks` at normal incidence and
-    /// less elsewhere (part of the lobe falls below the horizon).
-    Phong { n: f64, ks: [f64; 3] },
+    /// Energy-normalized Phong with a Lambertian term (Lewis 1994):
+    /// `f = kd / pi + ks (n + 2) / (2 pi) max(0, wi . r)^n`, `r` the mirror of `wo` about the
+    /// normal. Its directional albedo is exactly `kd + ks` at normal incidence and less elsewhere
+    /// (part of the lobe falls below the horizon).
+    Phong { n: f64, ks: [f64; 3], kd: [f64; 3] },
     /// Blinn-Phong with the usual approximate normalization
     /// `f = ks (n + 8) / (8 pi) cos^n theta_h`.
     BlinnPhong { n: f64, ks: [f64; 3] },
@@ -36,10 +37,10 @@ impl Analytic {
         }
         match *self {
             Analytic::Lambertian { albedo } => albedo.map(|a| a / PI),
-            Analytic::Phong { n, ks } => {
+            Analytic::Phong { n, ks, kd } => {
                 let r = DVec3::new(-wo.x, -wo.y, wo.z);
                 let lobe = (n + 2.0) / (2.0 * PI) * wi.dot(r).max(0.0).powf(n);
-                ks.map(|k| k * lobe)
+                [0, 1, 2].map(|c| kd[c] / PI + ks[c] * lobe)
             }
             Analytic::BlinnPhong { n, ks } => {
                 let h = (wi + wo).normalize();
@@ -73,7 +74,8 @@ impl std::fmt::Display for Analytic {
         let rgb = |c: [f64; 3]| format!("{} {} {}", c[0], c[1], c[2]);
         match *self {
             Analytic::Lambertian { albedo } => write!(f, "lambertian albedo {}", rgb(albedo)),
-            Analytic::Phong { n, ks } => write!(f, "normalized phong n {n}, ks {}", rgb(ks)),
+            Analytic::Phong { n, ks, kd } if kd == [0.0; 3] => write!(f, "normalized phong n {n}, ks {}", rgb(ks)),
+            Analytic::Phong { n, ks, kd } => write!(f, "normalized phong n {n}, ks {}, kd {}", rgb(ks), rgb(kd)),
             Analytic::BlinnPhong { n, ks } => write!(f, "blinn-phong n {n}, ks {}", rgb(ks)),
             Analytic::Ggx { alpha, f0 } => write!(f, "ggx alpha {alpha}, f0 {}", rgb(f0)),
         }
@@ -116,7 +118,7 @@ mod tests {
             Analytic::Ggx { alpha: 0.2, f0: [0.95, 0.64, 0.54] }.to_string(),
             "ggx alpha 0.2, f0 0.95 0.64 0.54"
         );
-        assert_eq!(Analytic::Phong { n: 1000.0, ks: [1.0; 3] }.to_string(), "normalized phong n 1000, ks 1 1 1");
+        assert_eq!(Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] }.to_string(), "normalized phong n 1000, ks 1 1 1");
     }
 
     #[test]
@@ -129,19 +131,19 @@ mod tests {
     }
 
     #[test]
-    fn phong_albedo_at_normal_incidence_is_ks() {
-        for n in [1.0, 10.0, 100.0] {
+    fn phong_albedo_at_normal_incidence_is_kd_plus_ks() {
+        for (n, kd) in [(1.0, 0.0), (10.0, 0.0), (100.0, 0.0), (10.0, 0.15)] {
             let wo = DVec3::Z;
-            let phong = Analytic::Phong { n, ks: [0.8, 0.5, 0.2] };
+            let phong = Analytic::Phong { n, ks: [0.8, 0.5, 0.2], kd: [kd; 3] };
             let a = hemisphere(|t| phong.eval(crate::spherical_dir(t, 0.0), wo)[0] * t.cos());
-            assert!((a - 0.8).abs() < 1e-4, "n {n}: {a}");
+            assert!((a - 0.8 - kd).abs() < 1e-4, "n {n}, kd {kd}: {a}");
         }
     }
 
     #[test]
     fn reciprocity() {
         let brdfs = [
-            Analytic::Phong { n: 20.0, ks: [1.0; 3] },
+            Analytic::Phong { n: 20.0, ks: [0.2; 3], kd: [0.8, 0.5, 0.1] },
             Analytic::BlinnPhong { n: 20.0, ks: [1.0; 3] },
             Analytic::Ggx { alpha: 0.3, f0: [0.04, 0.5, 0.9] },
         ];

@@ -83,7 +83,7 @@ mod tests {
         // error (trilinear between lower-edge samples, measured +0.06% at n = 10, +0.8% at
         // n = 1000); 1% covers that and nothing else: a wrong Jacobian is off by far more.
         for n in [1.0, 10.0, 100.0, 1000.0] {
-            let table = Analytic::Phong { n, ks: [1.0; 3] }.table(Dims::MERL);
+            let table = Analytic::Phong { n, ks: [1.0; 3], kd: [0.0; 3] }.table(Dims::MERL);
             let s = summarize(&table, Interp::Trilinear, Quadrature::default());
             for (deg, a) in &s.albedo {
                 assert!(a.rgb[0] <= 1.01, "n {n}, theta_o {deg}: {:?}", a.rgb);

@@ -164,9 +164,28 @@ fn print_text(report: &Report) {
                     let max = rows.data.iter().fold(0.0f32, |m, v| m.max(*v));
                     cli::outln!("  max bandwidth    {max} cycles per radian");
                 }
+                Payload::WaveletBrdf(wavelet) => print_wavelet_brdf(wavelet),
             }
         }
     }
+}
+
+fn print_wavelet_brdf(w: &asset::WaveletBrdf) {
+    let (n, k) = (w.side as usize, w.stored_slices());
+    cli::outln!("payload: wavelet brdf (Haar, Claustres et al. 2007)");
+    cli::outln!("  grid             ({n} x {n})^2 directions: {n} x {n} incoming per outgoing cell");
+    cli::outln!("  log encoding     eps {}, channel means {} {} {} (1/sr)", w.epsilon, w.channel_mean[0], w.channel_mean[1], w.channel_mean[2]);
+    cli::outln!(
+        "  kept             {k} of {} coefficient positions (ratio {}:1), each {} outgoing cells x 3 channels",
+        n * n,
+        (n * n) as f64 / k.max(1) as f64,
+        n * n
+    );
+    let storage = match &w.coefficients {
+        asset::WaveletCoefficients::Float(_) => "32-bit floats",
+        asset::WaveletCoefficients::Quantized { .. } => "8-bit codes, one offset and step per slice and channel",
+    };
+    cli::outln!("  coefficients     {storage}");
 }
 
 fn print_layer_selection(selection: &asset::LayerSelection) {
@@ -380,6 +399,14 @@ fn to_json(report: &Report) -> Value {
                     value["stored_tiles"] = rows.lobes_y.into();
                     value
                 }
+                Payload::WaveletBrdf(w) => json!({
+                    "side": w.side,
+                    "epsilon": w.epsilon,
+                    "channel_mean": w.channel_mean,
+                    "positions": w.map.len(),
+                    "kept_positions": w.stored_slices(),
+                    "quantized": matches!(w.coefficients, asset::WaveletCoefficients::Quantized { .. }),
+                }),
             };
             json!({
                 "header": header_json,

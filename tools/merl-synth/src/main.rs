@@ -45,7 +45,11 @@ enum Brdf {
         #[arg(long, default_value = "0.5", value_delimiter = ',', value_name = "A")]
         albedo: Vec<f64>,
     },
-    /// Energy-normalized Phong, f = ks (n+2)/(2 pi) max(0, wi . reflect(wo))^n.
+    /// Energy-normalized Phong with an optional Lambertian term (Lewis 1994),
+    /// f = kd/pi + ks (n+2)/(2 pi) max(0, wi . reflect(wo))^n.
+    ///
+    /// Example (the Lewis-like material of Claustres et al. 2007, Table 1):
+    /// merl-synth phong -n 10 --ks 0.2 --kd 0.8 --out lewis.binary
     Phong {
         /// Phong exponent n (> 0): larger is sharper.
         #[arg(long, short, value_name = "N")]
@@ -53,6 +57,10 @@ enum Brdf {
         /// Specular reflectance: one value, or three (r,g,b), each in [0, 1].
         #[arg(long, default_value = "1", value_delimiter = ',', value_name = "KS")]
         ks: Vec<f64>,
+        /// Diffuse (Lambertian) reflectance: one value, or three (r,g,b), each in [0, 1]; kd + ks
+        /// at most 1 per channel keeps the material energy-conserving.
+        #[arg(long, default_value = "0", value_delimiter = ',', value_name = "KD")]
+        kd: Vec<f64>,
     },
     /// Blinn-Phong, f = ks (n+8)/(8 pi) cos^n theta_h.
     BlinnPhong {
@@ -110,9 +118,9 @@ fn run(args: Args) -> Result<ExitCode> {
             let albedo = rgb("albedo", albedo, 1.0)?;
             (Analytic::Lambertian { albedo }, "lambertian", json!({ "albedo": albedo }))
         }
-        Brdf::Phong { n, ks } => {
-            let (n, ks) = (positive("n", *n)?, rgb("ks", ks, 1.0)?);
-            (Analytic::Phong { n, ks }, "phong", json!({ "n": n, "ks": ks }))
+        Brdf::Phong { n, ks, kd } => {
+            let (n, ks, kd) = (positive("n", *n)?, rgb("ks", ks, 1.0)?, rgb("kd", kd, 1.0)?);
+            (Analytic::Phong { n, ks, kd }, "phong", json!({ "n": n, "ks": ks, "kd": kd }))
         }
         Brdf::BlinnPhong { n, ks } => {
             let (n, ks) = (positive("n", *n)?, rgb("ks", ks, 1.0)?);

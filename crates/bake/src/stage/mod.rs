@@ -7,3 +7,4 @@ pub mod importance;
 pub mod layers;
 pub mod pca;
 pub mod prefilter;
+pub mod wavelet;
