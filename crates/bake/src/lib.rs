@@ -31,7 +31,7 @@ pub mod stage;
 use std::path::{Path, PathBuf};
 
 pub use error::Error;
-pub use load::{Loaded, load};
+pub use load::{Loaded, load, wavelet as load_wavelet};
 pub use run::{BakeConfig, BakeOutcome, MANIFEST, Progress, run_bake};
 
 use asset::{FileFormat, StageOutput};

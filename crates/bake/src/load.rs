@@ -100,9 +100,30 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     Ok(Loaded {
         dir: dir.to_path_buf(),
         manifest,
-        material: render::Material { table, samples, view_layers },
+        material: render::Material { table, samples, view_layers, wavelet: None },
         lighting,
     })
+}
+
+/// Reads a `wavelet-brdf` asset (`brdf-wavelet`) for the material of a loaded bake: it must have
+/// been made from the same MERL table (same SHA-256).
+pub fn wavelet(path: &Path, loaded: &Loaded) -> Result<haar_brdf::WaveletBrdf, Error> {
+    let asset = asset::read_file(path).map_err(|e| Error::read(path, e))?;
+    let Payload::WaveletBrdf(payload) = &asset.payload else {
+        return Err(Error::read(path, format!("expected a wavelet-brdf asset, found {}", asset.kind())));
+    };
+    if asset::hex(&asset.provenance.source_sha256) != loaded.manifest.material.source_sha256 {
+        return Err(Error::read(
+            path,
+            format!(
+                "made from {} (sha256 {}), not from the bake's material {}",
+                asset.provenance.source_name,
+                asset::hex(&asset.provenance.source_sha256),
+                loaded.manifest.material.name
+            ),
+        ));
+    }
+    haar_brdf::WaveletBrdf::from_payload(payload).map_err(|e| Error::read(path, e.to_string()))
 }
 
 /// A path as the bake was given it: absolute, relative to the working folder, or relative to the

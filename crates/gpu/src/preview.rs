@@ -43,6 +43,41 @@ pub const PREVIEW_RASTER_WGSL: &str = include_str!("preview_raster.wgsl");
 /// The shading pass, compiled after [`MERL_LOOKUP_WGSL`]: entry point `shade_frame`.
 pub const PREVIEW_SHADE_WGSL: &str = include_str!("preview_shade.wgsl");
 
+/// The wavelet BRDF decoder (`haar_brdf::WaveletBrdf::eval` in WGSL) and `material_brdf`, the BRDF
+/// the shading pass reads.
+pub const BRDF_WAVELET_WGSL: &str = include_str!("brdf_wavelet.wgsl");
+
+/// `WaveletParams` of `brdf_wavelet.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct WaveletUniform {
+    side: u32,
+    levels: u32,
+    enabled: u32,
+    lod: f32,
+    mean: [f32; 3],
+    epsilon: f32,
+}
+
+impl WaveletUniform {
+    fn new(wavelet: Option<&render::Wavelet>) -> WaveletUniform {
+        match wavelet {
+            Some(w) => {
+                let grid = w.brdf.grid();
+                WaveletUniform {
+                    side: grid.side() as u32,
+                    levels: grid.levels() as u32,
+                    enabled: 1,
+                    lod: w.lod as f32,
+                    mean: w.brdf.channel_mean().map(|m| m as f32),
+                    epsilon: w.brdf.epsilon() as f32,
+                }
+            }
+            None => WaveletUniform { side: 2, levels: 1, enabled: 0, lod: 0.0, mean: [1.0; 3], epsilon: 0.01 },
+        }
+    }
+}
+
 /// Must equal `SHADE_WORKGROUP` in the WGSL (checked by a test below).
 const SHADE_WORKGROUP: u32 = 8;
 
@@ -233,6 +268,9 @@ impl Renderer {
 
         let table = &material.table;
         check_buffer_fits(&limits, info, table_bytes(table.dims()), "the MERL table")?;
+        if let Some(w) = &material.wavelet {
+            check_buffer_fits(&limits, info, 4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
+        }
         let samples = &material.samples;
         check_buffer_fits(&limits, info, 16 * samples.texels.len() as u64, "the importance samples")?;
         let (env_maps, env_texels) = env_buffers(lighting);
@@ -321,7 +359,13 @@ impl Renderer {
             let compute = wgpu::ShaderStages::COMPUTE;
             let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("merl table"),
-                entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
+                entries: &[
+                    uniform_entry(0, compute, false),
+                    storage_entry(1, compute, true),
+                    uniform_entry(2, compute, false),
+                    storage_entry(3, compute, true),
+                    storage_entry(4, compute, true),
+                ],
             });
             let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview bake"),
@@ -347,7 +391,9 @@ impl Renderer {
             });
             let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_shade.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(format!("{MERL_LOOKUP_WGSL}\n{PREVIEW_SHADE_WGSL}").into()),
+                source: wgpu::ShaderSource::Wgsl(
+                    format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}").into(),
+                ),
             });
             let shade_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("shade_frame"),
@@ -368,12 +414,28 @@ impl Renderer {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             let table_buffer = storage("merl table", bytemuck::cast_slice(&gpu_table_values(table)));
+            let wavelet = WaveletUniform::new(material.wavelet.as_ref());
+            let wavelet_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("wavelet params"),
+                contents: bytemuck::bytes_of(&wavelet),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            // Without a wavelet the shader never reads these; a binding cannot be empty.
+            let (map, slices) = match &material.wavelet {
+                Some(w) => (w.brdf.map(), w.brdf.slices()),
+                None => (&[0u32][..], &[0f32][..]),
+            };
+            let wavelet_map_buffer = storage("wavelet map", bytemuck::cast_slice(map));
+            let wavelet_slices_buffer = storage("wavelet slices", bytemuck::cast_slice(slices));
             let table_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("merl table"),
                 layout: &table_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: dims_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: table_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: wavelet_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: wavelet_map_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: wavelet_slices_buffer.as_entire_binding() },
                 ],
             });
             let samples_buffer = storage("preview samples", bytemuck::cast_slice(&samples.texels));

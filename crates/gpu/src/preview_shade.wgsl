@@ -1,7 +1,8 @@
 //! The previewer's shading pass: one frame of the estimators of the `render` crate (its crate
 //! documentation is the specification), per pixel of the triangle-index G-buffer that
 //! `preview_raster.wgsl` drew, added into an accumulation buffer. Compiled after
-//! `merl_lookup.wgsl`, whose nearest lookup (`merl_lookup_nearest`, group 0) is the BRDF.
+//! `merl_lookup.wgsl` and `brdf_wavelet.wgsl`, whose `material_brdf` (group 0: the MERL table's
+//! nearest lookup, or the wavelet reconstruction) is the BRDF.
 //!
 //! Every step is a function named after the CPU's (`render::raster`, `render::shade`, `envmap`),
 //! in the same order and with the same branches, so that the two images differ by f32 rounding
@@ -406,9 +407,9 @@ fn estimate(frame: ShadingFrame, pixel: u32, f: u32) -> vec3<f32> {
         if (!(pdf > 0.0 && wi_local.z > 0.0)) {
             continue;
         }
-        let brdf = merl_lookup_nearest(wi_local, frame.wo_local);
-        // No data (negative) counts as 0; the CPU skips zeros too.
-        if (!merl_has_data(brdf) || all(brdf == vec3<f32>(0.0))) {
+        let brdf = material_brdf(wi_local, frame.wo_local);
+        // No data counts as 0; the CPU skips zeros too.
+        if (all(brdf == vec3<f32>(0.0))) {
             continue;
         }
         let radiance = incident_radiance(map, to_world(frame, wi_local), pdf);

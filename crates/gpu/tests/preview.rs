@@ -55,7 +55,7 @@ fn material(brdf: Analytic) -> Material {
     let table = brdf.table(Dims::MERL);
     let config = importance::Config { n_theta_o: 90, n_vectors: 8, n_samples: 64, ..Default::default() };
     let tables = importance::build(&table, &config).expect("a valid config");
-    Material { samples: sample_set(&tables), table, view_layers: vec![0, 0, 1, 1, 2, 2, 3, 3] }
+    Material { samples: sample_set(&tables), table, view_layers: vec![0, 0, 1, 1, 2, 2, 3, 3], wavelet: None }
 }
 
 fn lambertian() -> &'static Material {
@@ -234,6 +234,44 @@ fn ggx_fis_matches_the_cpu() {
 #[test]
 fn ggx_prefiltered_matches_the_cpu() {
     check_against_cpu("ggx", ggx(), Mode::Prefiltered);
+}
+
+/// The GGX material with its BRDF read from a Haar wavelet encoding of its table (16 x 16 grid,
+/// 4:1, 8-bit codes) at a fractional level of detail, so that the WGSL decoder's every step
+/// (bilinear cells, synthesis, level blend, dequantized codes) is held to `haar_brdf`.
+fn ggx_wavelet() -> &'static Material {
+    static MATERIAL: OnceLock<Material> = OnceLock::new();
+    MATERIAL.get_or_init(|| {
+        let material = ggx();
+        let grid = haar_brdf::Grid::new(16).expect("a power of two");
+        let resampled = haar_brdf::resample_table(grid, &material.table);
+        let config = haar_brdf::Config { keep: haar_brdf::Keep::Ratio(4), quantize: true, ..Default::default() };
+        let encoded = haar_brdf::encode(&resampled, config).expect("a valid config");
+        let brdf = haar_brdf::WaveletBrdf::from_payload(&encoded.payload).expect("a valid payload");
+        Material { wavelet: Some(render::Wavelet { brdf, lod: 0.5 }), ..material.clone() }
+    })
+}
+
+#[test]
+fn wavelet_reference_matches_the_cpu() {
+    check_against_cpu("ggx-wavelet", ggx_wavelet(), Mode::Reference);
+}
+
+#[test]
+fn wavelet_prefiltered_matches_the_cpu() {
+    check_against_cpu("ggx-wavelet", ggx_wavelet(), Mode::Prefiltered);
+}
+
+/// The wavelet render is not the table's: the comparison sees the encoding's error.
+#[test]
+fn a_wavelet_render_differs_from_the_table_render() {
+    let scene = sphere_scene(SIZE);
+    let settings = settings(Mode::Reference);
+    let wavelet = render_gpu(&mut renderer(&scene, ggx_wavelet(), sky_lighting()), &settings);
+    let table = render_cpu(&scene, ggx(), sky_lighting(), &settings);
+    let (psnr, relative) = compare(&wavelet, &table);
+    log(&format!("ggx wavelet against the table: psnr {psnr:.1} dB, relative error {relative:.2e}"));
+    assert!(psnr < MIN_PSNR_DB && relative > MAX_RELATIVE_ERROR, "psnr {psnr:.1} dB, relative error {relative:.2e}");
 }
 
 /// The comparison can fail: the same render with another seed draws other samples, and the

@@ -14,9 +14,10 @@ pub fn direction(theta: f64, phi: f64) -> DVec3 {
 }
 
 /// The angles `(theta, phi)` of a unit direction with `z >= 0` (the inverse of [`direction`]):
-/// `theta = atan2(z, x)`, `phi = acos(y)`.
+/// `theta = atan2(z, x)`, `phi = atan2(sqrt(x^2 + z^2), y)` (`acos y`, by `atan2` because GPUs
+/// compute `acos` coarsely, and the WGSL port must agree with this to rounding).
 pub fn angles(w: DVec3) -> (f64, f64) {
-    (w.z.atan2(w.x), w.y.clamp(-1.0, 1.0).acos())
+    (w.z.atan2(w.x), (w.x * w.x + w.z * w.z).sqrt().atan2(w.y))
 }
 
 /// An `n x n` grid over `(theta, phi)` in `[0, pi]^2`: cell `(row, col)` (index `row n + col`)

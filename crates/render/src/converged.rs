@@ -181,7 +181,7 @@ fn estimate(
         if wi_local.z.is_nan() || wi_local.z <= 0.0 {
             return;
         }
-        let f = brdf(&material.table, wi_local, wo);
+        let f = brdf(material, wi_local, wo);
         if f == [0.0; 3] {
             return;
         }

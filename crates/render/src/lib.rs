@@ -70,9 +70,13 @@
 //! ```
 //!
 //! over the pixel's `spp` samples, where a sample with `pdf <= 0` or `wi_local.z <= 0`
-//! contributes 0, `f` is the table's nearest lookup (`merl::MerlTable::lookup` with
-//! `Interp::Nearest`, the lookup the WGSL ports) at `(wi_local, wo_local)`, 0 where the table
-//! holds no data, and `cos(theta_j) = wi_local.z`. The modes differ in `L`:
+//! contributes 0, `f` is the BRDF at `(wi_local, wo_local)` and `cos(theta_j) = wi_local.z`. The
+//! BRDF is the table's nearest lookup (`merl::MerlTable::lookup` with `Interp::Nearest`, the
+//! lookup the WGSL ports), 0 where the table holds no data; or, when the material carries a
+//! [`Wavelet`], its reconstruction at the wavelet's level of detail
+//! (`haar_brdf::WaveletBrdf::eval`: bilinear over the 4 x 4 surrounding cell pairs of the sphere
+//! grid, Haar synthesis of each, in the log domain; the WGSL `brdf_wavelet.wgsl` ports it). The
+//! modes differ in `L`:
 //!
 //! - [`Mode::Reference`]: the environment's level 0, bilinear (`envmap::EnvMap::lookup`).
 //! - [`Mode::Fis`] (filtered importance sampling, `002`): the mip chain, trilinear
@@ -168,6 +172,18 @@ pub struct Material {
     /// of `R` view elevations in equal steps of `cos theta_o` (row `r` covers
     /// `1 - cos theta_o` in `[r / R, (r + 1) / R)`).
     pub view_layers: Vec<u32>,
+    /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
+    /// the table (`brdf-preview --brdf wavelet`): see "The BRDF" in the crate docs.
+    pub wavelet: Option<Wavelet>,
+}
+
+/// A wavelet encoding of the material (asset kind `wavelet-brdf`, crate `haar_brdf`) and the
+/// level of detail it is read at.
+#[derive(Clone, Debug)]
+pub struct Wavelet {
+    pub brdf: haar_brdf::WaveletBrdf,
+    /// In `[0, log2 n]`: 0 is full resolution (`haar_brdf::WaveletBrdf::eval`).
+    pub lod: f64,
 }
 
 /// A distant environment with what a bake made of it.

@@ -5,7 +5,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use envmap::{EnvMap, MipChain};
 use glam::DVec3;
-use merl::{Interp, MerlTable};
+use merl::Interp;
 use rayon::prelude::*;
 
 use crate::error::Error;
@@ -121,9 +121,13 @@ pub(crate) fn slice_of(theta_o: f64, n_slices: usize) -> usize {
     ((theta_o / FRAC_PI_2 * n_slices as f64 + 0.5).floor().max(0.0) as usize).min(n_slices - 1)
 }
 
-/// `f(wi, wo)` by the table's nearest lookup, 0 where it holds no data.
-pub(crate) fn brdf(table: &MerlTable, wi_local: DVec3, wo_local: DVec3) -> [f64; 3] {
-    table.lookup(wi_local, wo_local, Interp::Nearest).unwrap_or([0.0; 3])
+/// `f(wi, wo)`: the wavelet reconstruction when the material has one, else the table's nearest
+/// lookup, 0 where it holds no data.
+pub(crate) fn brdf(material: &Material, wi_local: DVec3, wo_local: DVec3) -> [f64; 3] {
+    match &material.wavelet {
+        Some(w) => w.brdf.eval(wi_local, wo_local, w.lod),
+        None => material.table.lookup(wi_local, wo_local, Interp::Nearest).unwrap_or([0.0; 3]),
+    }
 }
 
 /// Where a mode reads `L`.
@@ -160,7 +164,7 @@ fn shade(frame: &ShadingFrame, pixel: u32, material: &Material, lighting: &Light
             if !(pdf > 0.0 && wi_local.z > 0.0) {
                 continue;
             }
-            let f = brdf(&material.table, wi_local, frame.wo_local);
+            let f = brdf(material, wi_local, frame.wo_local);
             if f == [0.0; 3] {
                 continue;
             }

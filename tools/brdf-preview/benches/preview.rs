@@ -86,7 +86,7 @@ fn main() {
         let samples = bake::stage::importance::sample_set(&tables);
         for (env, lighting, preview) in &environments {
             let start = Instant::now();
-            let material = Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0] };
+            let material = Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
             let converged =
                 render::converged::converged(&scene, &material, lighting, converged_samples, 1).expect("converged");
             let converged_picture = metrics::tonemap(&converged, preview);
@@ -159,7 +159,7 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
 
 /// PSNR of one CPU render against the case's converged estimate.
 fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<u32>, mode: Mode, spp: u32, frames: u32) -> f64 {
-    let material = Material { table: case.table.clone(), samples: case.samples.clone(), view_layers };
+    let material = Material { table: case.table.clone(), samples: case.samples.clone(), view_layers, wavelet: None };
     let image =
         render::render(scene, &material, &case.lighting, &Settings { mode, spp, frames, seed: 0 }).expect("render");
     metrics::psnr_db(&metrics::tonemap(&image, &case.preview), &case.converged_picture)
@@ -183,6 +183,7 @@ fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
                 table: case.table.clone(),
                 samples: case.samples.clone(),
                 view_layers: selection.view_layer.clone(),
+                wavelet: None,
             };
             let mut renderer = gpu::preview::Renderer::new(&gpu, scene, &material, &case.lighting).expect("renderer");
             let runs = [

@@ -29,6 +29,11 @@ mod window;
 /// luminance to 0.18), Reinhard's x / (1 + x) per channel, then the sRGB transfer function to 8
 /// bits; a caption strip below the image says what was rendered.
 ///
+/// --brdf wavelet evaluates the BRDF from a Haar wavelet encoding of the table (brdf-wavelet),
+/// decoded per sample on the GPU, and also renders the same image from the table itself: it
+/// reports the PSNR and relative error of the wavelet image against it and writes
+/// OUT-table.png.
+///
 /// --validate renders the same image on the CPU (crate render: the same estimator, the same
 /// samples) and reports the PSNR of the two 8-bit pictures and the relative error of their linear
 /// radiance, and writes OUT-difference.png (|GPU - CPU| x 4). --converged N also renders an
@@ -51,6 +56,21 @@ struct Args {
     /// The MERL table, when it is no longer where the bake read it (its sha256 must match).
     #[arg(long, value_name = "FILE")]
     material: Option<PathBuf>,
+
+    /// Which BRDF the estimators evaluate: the MERL table (nearest lookup), or its Haar wavelet
+    /// encoding (brdf-wavelet; Claustres et al. 2007), decoded on the GPU at --wavelet-lod.
+    #[arg(long, value_enum, default_value_t = BrdfArg::Table)]
+    brdf: BrdfArg,
+
+    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default:
+    /// BAKE/wavelet-brdf.asset (brdf-wavelet MATERIAL --out-dir BAKE writes it there).
+    #[arg(long, value_name = "FILE")]
+    wavelet: Option<PathBuf>,
+
+    /// Level of detail of the wavelet reconstruction, from 0 (full resolution) to log2 of the
+    /// grid side (the hemisphere's mean); fractions blend two levels.
+    #[arg(long, value_name = "L", default_value_t = 0.0)]
+    wavelet_lod: f64,
 
     /// The mesh: sphere, torus, or a Wavefront OBJ file (scaled to the unit sphere).
     #[arg(long, default_value = "sphere", value_name = "sphere|torus|FILE.obj")]
@@ -123,6 +143,12 @@ struct Args {
     json: bool,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum BrdfArg {
+    Table,
+    Wavelet,
+}
+
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum ModeArg {
     Reference,
@@ -159,7 +185,18 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    let loaded = bake::load(&args.bake, args.material.as_deref())?;
+    let mut loaded = bake::load(&args.bake, args.material.as_deref())?;
+    if args.brdf == BrdfArg::Wavelet {
+        let path = args.wavelet.clone().unwrap_or_else(|| args.bake.join(bake::stage::wavelet::ASSET));
+        let brdf = bake::load_wavelet(&path, &loaded)?;
+        let levels = brdf.grid().levels() as f64;
+        if !(0.0..=levels).contains(&args.wavelet_lod) {
+            bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", args.wavelet_lod, path.display());
+        }
+        loaded.material.wavelet = Some(render::Wavelet { brdf, lod: args.wavelet_lod });
+    } else if args.wavelet.is_some() {
+        bail!("--wavelet names the asset for --brdf wavelet; add --brdf wavelet to render with it");
+    }
     // (path, role, PNG bytes): every output is encoded before any is written.
     let mut files: Vec<(PathBuf, &'static str, Vec<u8>)> = Vec::new();
     let mut report = Vec::new();
@@ -205,8 +242,12 @@ fn run(args: Args) -> Result<ExitCode> {
         let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
         let picture = metrics::tonemap(&image, &preview);
         let names = names(&loaded.manifest);
+        let brdf = match &loaded.material.wavelet {
+            Some(w) => format!("wavelet {}:1, lod {}", wavelet_ratio(&w.brdf), w.lod),
+            None => "table".to_string(),
+        };
         let caption = format!(
-            "{} | {} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+            "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
             names,
             mode.name(),
             settings.spp,
@@ -228,6 +269,7 @@ fn run(args: Args) -> Result<ExitCode> {
         value = json!({
             "bake": args.bake.display().to_string(),
             "mode": mode.name(),
+            "brdf": match args.brdf { BrdfArg::Table => "table", BrdfArg::Wavelet => "wavelet" },
             "spp": settings.spp,
             "frames": settings.frames,
             "width": scene.width,
@@ -238,6 +280,20 @@ fn run(args: Args) -> Result<ExitCode> {
             "mean_luminance": metrics::mean_luminance(&image),
         });
 
+        if loaded.material.wavelet.is_some() {
+            // What the compression costs: the same render from the table itself.
+            let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
+            let table = gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
+            let table_picture = metrics::tonemap(&table, &preview);
+            let psnr = metrics::psnr_db(&picture, &table_picture);
+            let relative = metrics::relative_error(&image.rgb, &table.rgb);
+            files.push((sibling(out, "table"), "table", png(&table_picture, scene.width, scene.height)?));
+            report.push(format!(
+                "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB,                  relative error {relative:.3}",
+                db(psnr)
+            ));
+            value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
+        }
         if args.validate {
             let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
             let cpu_picture = metrics::tonemap(&cpu, &preview);
@@ -296,6 +352,12 @@ fn run(args: Args) -> Result<ExitCode> {
         })
         .collect();
     Ok(cli::finish(args.json, &value, &report, &problems, &written))
+}
+
+/// The compression ratio of a wavelet BRDF: coefficient positions per stored slice.
+fn wavelet_ratio(brdf: &haar_brdf::WaveletBrdf) -> String {
+    let stored = brdf.map().iter().filter(|&&m| m != 0).count().max(1);
+    picture::format_number(brdf.map().len() as f64 / stored as f64)
 }
 
 /// An 8-bit RGB picture as PNG bytes.
