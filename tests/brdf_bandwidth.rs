@@ -70,7 +70,7 @@ fn lobes_at_limit(r: &Run) -> u64 {
 #[test]
 fn tools_end_to_end() {
     let tmp = temp_dir();
-    let material = write_table(tmp.path(), "phong30.binary", Analytic::Phong { n: 30.0, ks: [0.9, 0.6, 0.3] });
+    let material = write_table(tmp.path(), "phong30.binary", Analytic::Phong { n: 30.0, ks: [0.9, 0.6, 0.3], kd: [0.0; 3] });
     let out = tmp.path().join("atlas");
     let r = brdf_bandwidth(&material, &out, &["--lobes", "8", "--json"]).expect_code(0);
     assert!(r.stderr.contains("8 x 8 lobes of 16 x 16") && r.stderr.contains("kind 7 (bandwidth-rows)"), "{r}");
@@ -123,7 +123,7 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
     // Phong of exponent 1000 is 2 pixels wide at a 64 x 64 analysis: every lobe reaches the
     // limit; exponent 6 (19 pixels wide) is resolved everywhere.
     let tmp = temp_dir();
-    let sharp = write_table(tmp.path(), "sharp.binary", Analytic::Phong { n: 1000.0, ks: [1.0; 3] });
+    let sharp = write_table(tmp.path(), "sharp.binary", Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] });
     let args = ["--lobes", "8", "--analysis-size", "64", "--json"];
     // Most lobes at the limit is a validation problem (exit 1) that says what to do; the atlas is
     // still written.
@@ -134,7 +134,7 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
     let problems = r.json()["problems"].to_string();
     assert!(problems.contains("64 of 64 lobes") && problems.contains("--analysis-size"), "{r}");
     assert!(tmp.path().join("sharp/bandwidth-atlas.asset").exists(), "{r}");
-    let broad = write_table(tmp.path(), "broad.binary", Analytic::Phong { n: 6.0, ks: [1.0; 3] });
+    let broad = write_table(tmp.path(), "broad.binary", Analytic::Phong { n: 6.0, ks: [1.0; 3], kd: [0.0; 3] });
     let r = brdf_bandwidth(&broad, &tmp.path().join("broad"), &args).expect_code(0);
     assert_eq!(lobes_at_limit(&r), 0, "{r}");
 }
@@ -148,7 +148,7 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
 #[test]
 fn the_default_analysis_resolves_phong_1000() {
     let tmp = temp_dir();
-    let table = write_table(tmp.path(), "phong1000.binary", Analytic::Phong { n: 1000.0, ks: [1.0; 3] });
+    let table = write_table(tmp.path(), "phong1000.binary", Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] });
     let r = brdf_bandwidth(&table, &tmp.path().join("atlas"), &["--json"]).expect_code(0);
     let at_limit = lobes_at_limit(&r);
     assert!(at_limit <= 3 * 64 && at_limit.is_multiple_of(64), "{at_limit} lobes at the limit\n{r}");
@@ -188,7 +188,7 @@ fn bad_inputs_exit_2_naming_the_file() {
         &golden,
         "expected a bandwidth-atlas or bandwidth-rows asset (from brdf-bandwidth), found material-info",
     );
-    let material = write_table(tmp.path(), "phong.binary", Analytic::Phong { n: 10.0, ks: [1.0; 3] });
+    let material = write_table(tmp.path(), "phong.binary", Analytic::Phong { n: 10.0, ks: [1.0; 3], kd: [0.0; 3] });
     brdf_bandwidth(&material, &out, &["--lobes", "2"]).expect_code(0);
     let mut bytes = std::fs::read(out.join("bandwidth-atlas.asset")).unwrap();
     bytes.truncate(bytes.len() - 4);

@@ -94,7 +94,7 @@ fn every_tool_prints_one_json_object_listing_the_files_it_wrote() {
     assert_eq!(files_under(tmp.path()), before);
 
     // The stage tools, on small settings.
-    let small: [(&str, Vec<std::ffi::OsString>); 5] = [
+    let small: [(&str, Vec<std::ffi::OsString>); 6] = [
         (
             "merl-importance",
             vec![
@@ -115,6 +115,7 @@ fn every_tool_prints_one_json_object_listing_the_files_it_wrote() {
             "bandwidth-pca",
             vec![os(&dir("brdf-bandwidth").join("bandwidth-atlas.asset")), "--components".into(), "2".into()],
         ),
+        ("brdf-wavelet", vec![os(&table), "--side".into(), "8".into(), "--ratio".into(), "16".into()]),
         (
             "envmap-bandwidth",
             vec![os(&shared().join("data/env/decoder/imagers_rgbr4x4.hdr")), "--spatial".into(), "--pad".into()],

@@ -6,6 +6,7 @@ mod support;
 mod asset_info;
 mod brdf_bake;
 mod brdf_bandwidth;
+mod brdf_wavelet;
 mod envmap_bandwidth;
 mod envmap_prefilter;
 mod importance;
