@@ -65,6 +65,7 @@ bench:
 	$(CARGO) bench -p bandwidth --bench bandwidth
 	$(CARGO) bench -p prefilter --bench prefilter
 	$(CARGO) bench -p brdf-atlas --bench atlas
+	$(CARGO) bench -p haar-brdf --bench table1
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
 ## procedural calibration sky), then render previews (pre-convolved; reference, validated against

@@ -70,7 +70,8 @@ fn lobes_at_limit(r: &Run) -> u64 {
 #[test]
 fn tools_end_to_end() {
     let tmp = temp_dir();
-    let material = write_table(tmp.path(), "phong30.binary", Analytic::Phong { n: 30.0, ks: [0.9, 0.6, 0.3], kd: [0.0; 3] });
+    let material =
+        write_table(tmp.path(), "phong30.binary", Analytic::Phong { n: 30.0, ks: [0.9, 0.6, 0.3], kd: [0.0; 3] });
     let out = tmp.path().join("atlas");
     let r = brdf_bandwidth(&material, &out, &["--lobes", "8", "--json"]).expect_code(0);
     assert!(r.stderr.contains("8 x 8 lobes of 16 x 16") && r.stderr.contains("kind 7 (bandwidth-rows)"), "{r}");

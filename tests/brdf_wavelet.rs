@@ -36,7 +36,8 @@ fn the_lewis_material_meets_table_1_through_the_tools() {
         let relative = figures["mean_relative_error"].as_f64().unwrap();
         assert!(relative <= paper, "{ratio}:1: mean relative error {relative} above {paper}\n{r}");
         assert_eq!(figures["ratio"].as_f64(), Some(ratio.parse().unwrap()), "{r}");
-        let (kept, total) = (figures["kept_coefficients"].as_u64().unwrap(), figures["total_coefficients"].as_u64().unwrap());
+        let (kept, total) =
+            (figures["kept_coefficients"].as_u64().unwrap(), figures["total_coefficients"].as_u64().unwrap());
         assert_eq!(kept * ratio.parse::<u64>().unwrap(), total, "{r}");
         assert!(figures["bytes"].as_u64().unwrap() < 4 * total / ratio.parse::<u64>().unwrap() + 10_000, "{r}");
         assert!(r.stderr.contains("relative error    mean"), "{r}");

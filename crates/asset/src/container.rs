@@ -14,8 +14,8 @@ use sha2::{Digest, Sha256};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::types::{
-    Asset, AssetKind, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection, MaterialInfo, WaveletBrdf,
-    Payload, PrefilteredEnvmap, Provenance,
+    Asset, AssetKind, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection, MaterialInfo,
+    Payload, PrefilteredEnvmap, Provenance, WaveletBrdf,
 };
 
 /// The first eight bytes of every asset file.

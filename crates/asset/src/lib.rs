@@ -67,6 +67,6 @@ pub use manifest::{
 };
 pub use types::{
     Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples,
-    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MAX_WAVELET_SIDE, MaterialInfo, Payload, PrefilteredEnvmap, Provenance,
-    WaveletBrdf, WaveletCoefficients,
+    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MAX_WAVELET_SIDE, MaterialInfo, Payload, PrefilteredEnvmap,
+    Provenance, WaveletBrdf, WaveletCoefficients,
 };

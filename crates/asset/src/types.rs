@@ -621,7 +621,9 @@ impl WaveletBrdf {
             }
         };
         if found as u64 != values {
-            return Err(format!("wavelet brdf holds {found} {what}, expected {values} ({k} slices of {cells} cells x 3)"));
+            return Err(format!(
+                "wavelet brdf holds {found} {what}, expected {values} ({k} slices of {cells} cells x 3)"
+            ));
         }
         if !finite {
             return Err("wavelet brdf coefficients must be finite (and quantization steps not negative)".into());

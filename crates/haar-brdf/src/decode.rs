@@ -88,6 +88,12 @@ impl WaveletBrdf {
         sum
     }
 
+    /// `eps mu` per channel: below it the log encoding's precision is relative to `eps mu`
+    /// rather than to `f` (`errors`).
+    pub fn floor(&self) -> [f64; 3] {
+        self.channel_mean.map(|m| self.epsilon * m)
+    }
+
     /// `f = mu (exp(value) - eps)`, clamped at 0: the log encoding undone.
     pub fn from_log(&self, log: [f64; 3]) -> [f64; 3] {
         [0, 1, 2].map(|c| (self.channel_mean[c] * (log[c].exp() - self.epsilon)).max(0.0))

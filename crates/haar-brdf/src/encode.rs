@@ -144,7 +144,7 @@ impl Coefficients {
         match keep {
             Keep::All => Ok(vec![true; positions]),
             Keep::Ratio(ratio) => {
-                if ratio == 0 || positions % ratio as usize != 0 {
+                if ratio == 0 || !positions.is_multiple_of(ratio as usize) {
                     return Err(Error::Invalid(format!(
                         "a ratio of {ratio}:1 does not divide the {positions} coefficient positions of a {0} x {0} grid: \
                          use a power of two up to {positions}",

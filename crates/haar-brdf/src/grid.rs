@@ -66,7 +66,7 @@ impl Grid {
     /// = 0` and `theta = pi` are opposite sides of the horizon, `phi = 0` and `phi = pi` opposite
     /// poles). `None` below the horizon (`w.z < 0`).
     pub fn bilinear(&self, w: DVec3) -> Option<[(usize, f64); 4]> {
-        if !(w.z >= 0.0) {
+        if w.z.is_nan() || w.z < 0.0 {
             return None;
         }
         let (theta, phi) = angles(w);

@@ -44,7 +44,11 @@
 //!
 //! As in the paper's Table 1, over the resampled samples (all pairs of cell centres and all three
 //! channels): `rms`, the root mean square of `f - f'` in 1/sr, and `mean_relative_error`, the
-//! mean of `|f - f'| / f` over the samples with `f > 0`, as a fraction.
+//! mean of `|f - f'| / f` over the samples with `f > 0`, as a fraction. Tables with values many
+//! decades below their mean (mirror-like materials, or real-derived tables whose fits reach
+//! `1e-15`) make the second unbounded: the log encoding is relative to `f + eps mu`, so a value far
+//! below `eps mu` comes back as a value near `eps mu`. `mean_relative_error_above_floor` takes the
+//! same mean over the samples with `f >= eps mu` only, where the encoding is relative to `f`.
 //!
 //! Without compression or quantisation the only loss is the `f32` storage of coefficients: the
 //! log-encoded values are exact to about `1e-7` of the coefficients' size, so `|f - f'|` stays
@@ -141,12 +145,21 @@ pub struct Errors {
     pub mean_value: f64,
     /// Samples and channels with `f > 0`, of which the relative errors are taken.
     pub positive: usize,
+    /// Mean of `|f - f'| / f` over the samples and channels with `f >= floor` (`floor` =
+    /// `eps mu`, 1% of the channel's mean by default): where the log encoding is relative to
+    /// `f`. Below it the encoding is relative to `eps mu` instead, and a value of `1e-15` read
+    /// back as `1e-4` is a relative error of `1e11` that says nothing about the picture.
+    pub mean_relative_error_above_floor: f64,
+    /// Samples and channels with `f >= floor`.
+    pub above_floor: usize,
 }
 
-/// The errors of `decoded` against `original` (same layout).
-pub fn errors(original: &[[f64; 3]], decoded: &[[f64; 3]]) -> Errors {
+/// The errors of `decoded` against `original` (same layout); `floor` per channel is usually
+/// `eps mu` ([`WaveletBrdf::floor`]).
+pub fn errors(original: &[[f64; 3]], decoded: &[[f64; 3]], floor: [f64; 3]) -> Errors {
     assert_eq!(original.len(), decoded.len(), "two tables of one grid");
     let (mut squares, mut sum, mut relative, mut max_relative, mut positive) = (0.0, 0.0, 0.0, 0.0f64, 0usize);
+    let (mut relative_above, mut above) = (0.0, 0usize);
     for (f, g) in original.iter().zip(decoded) {
         for c in 0..3 {
             let d = f[c] - g[c];
@@ -157,6 +170,10 @@ pub fn errors(original: &[[f64; 3]], decoded: &[[f64; 3]]) -> Errors {
                 relative += r;
                 max_relative = max_relative.max(r);
                 positive += 1;
+                if f[c] >= floor[c] {
+                    relative_above += r;
+                    above += 1;
+                }
             }
         }
     }
@@ -167,5 +184,7 @@ pub fn errors(original: &[[f64; 3]], decoded: &[[f64; 3]]) -> Errors {
         max_relative_error: max_relative,
         mean_value: sum / n,
         positive,
+        mean_relative_error_above_floor: relative_above / above.max(1) as f64,
+        above_floor: above,
     }
 }

@@ -70,9 +70,7 @@ pub fn inverse(grid: Grid, layout: &[f64], lod: usize) -> Vec<f64> {
         let keep = level > lod;
         Image::from_fn(s, s, |kx, ky| if keep { layout[position(n, level, band, ky, kx)] } else { 0.0 })
     };
-    let details = (1..=grid.levels())
-        .map(|j| Orientation::ALL.map(|band| band_image(j, band)))
-        .collect();
+    let details = (1..=grid.levels()).map(|j| Orientation::ALL.map(|band| band_image(j, band))).collect();
     let approx = Image::new(1, 1, vec![layout[0]]).expect("one value");
     let d = Decomposition2 { wavelet: Wavelet::Haar, approx, details };
     wavelet::waverec2(&d).expect("a whole decomposition of finite values").into_data()

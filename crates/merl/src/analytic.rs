@@ -118,7 +118,10 @@ mod tests {
             Analytic::Ggx { alpha: 0.2, f0: [0.95, 0.64, 0.54] }.to_string(),
             "ggx alpha 0.2, f0 0.95 0.64 0.54"
         );
-        assert_eq!(Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] }.to_string(), "normalized phong n 1000, ks 1 1 1");
+        assert_eq!(
+            Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] }.to_string(),
+            "normalized phong n 1000, ks 1 1 1"
+        );
     }
 
     #[test]

@@ -36,7 +36,8 @@ pub fn lambertian(bake_seed: u64) -> &'static Material {
 /// Normalized Phong, ks 1, n 100, baked with seed 0 or 1.
 pub fn phong(bake_seed: u64) -> &'static Material {
     static MATERIALS: [OnceLock<Material>; 2] = [OnceLock::new(), OnceLock::new()];
-    MATERIALS[bake_seed as usize].get_or_init(|| material(Analytic::Phong { n: 100.0, ks: [1.0; 3], kd: [0.0; 3] }, bake_seed))
+    MATERIALS[bake_seed as usize]
+        .get_or_init(|| material(Analytic::Phong { n: 100.0, ks: [1.0; 3], kd: [0.0; 3] }, bake_seed))
 }
 
 /// Radiance of the constant environments.

@@ -174,7 +174,13 @@ fn print_wavelet_brdf(w: &asset::WaveletBrdf) {
     let (n, k) = (w.side as usize, w.stored_slices());
     cli::outln!("payload: wavelet brdf (Haar, Claustres et al. 2007)");
     cli::outln!("  grid             ({n} x {n})^2 directions: {n} x {n} incoming per outgoing cell");
-    cli::outln!("  log encoding     eps {}, channel means {} {} {} (1/sr)", w.epsilon, w.channel_mean[0], w.channel_mean[1], w.channel_mean[2]);
+    cli::outln!(
+        "  log encoding     eps {}, channel means {} {} {} (1/sr)",
+        w.epsilon,
+        w.channel_mean[0],
+        w.channel_mean[1],
+        w.channel_mean[2]
+    );
     cli::outln!(
         "  kept             {k} of {} coefficient positions (ratio {}:1), each {} outgoing cells x 3 channels",
         n * n,

@@ -86,7 +86,8 @@ fn main() {
         let samples = bake::stage::importance::sample_set(&tables);
         for (env, lighting, preview) in &environments {
             let start = Instant::now();
-            let material = Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
+            let material =
+                Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
             let converged =
                 render::converged::converged(&scene, &material, lighting, converged_samples, 1).expect("converged");
             let converged_picture = metrics::tonemap(&converged, preview);

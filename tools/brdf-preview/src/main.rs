@@ -283,7 +283,8 @@ fn run(args: Args) -> Result<ExitCode> {
         if loaded.material.wavelet.is_some() {
             // What the compression costs: the same render from the table itself.
             let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
-            let table = gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
+            let table =
+                gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
             let table_picture = metrics::tonemap(&table, &preview);
             let psnr = metrics::psnr_db(&picture, &table_picture);
             let relative = metrics::relative_error(&image.rgb, &table.rgb);

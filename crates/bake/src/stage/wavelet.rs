@@ -48,7 +48,7 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
     let encoded = haar_brdf::encode(&resampled, settings.config).map_err(|e| Error::Invalid(e.to_string()))?;
     let brdf = WaveletBrdf::from_payload(&encoded.payload).map_err(|e| Error::Internal(e.to_string()))?;
     let decoded = brdf.decode(0);
-    let errors = haar_brdf::errors(&resampled.values, &decoded);
+    let errors = haar_brdf::errors(&resampled.values, &decoded, brdf.floor());
 
     let config = settings.config;
     let keep = match config.keep {
@@ -81,6 +81,8 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
         ("rms", json!(errors.rms)),
         ("mean_relative_error", json!(errors.mean_relative_error)),
         ("max_relative_error", json!(errors.max_relative_error)),
+        ("mean_relative_error_above_floor", json!(errors.mean_relative_error_above_floor)),
+        ("floor", json!(brdf.floor())),
         ("mean_value", json!(errors.mean_value)),
         ("log_squared_error_dropped", json!(encoded.dropped_energy)),
         ("no_data_samples", json!(resampled.no_data)),
@@ -93,7 +95,8 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
             "grid              ({n} x {n})^2 direction pairs of the sphere parameterization, {} samples x 3 channels",
             n.pow(4)
         ),
-        format!("kept              {} of {} coefficient positions ({keep}): {} of {} coefficients, ratio {}:1",
+        format!(
+            "kept              {} of {} coefficient positions ({keep}): {} of {} coefficients, ratio {}:1",
             encoded.kept_positions,
             n * n,
             encoded.kept_coefficients,
@@ -105,12 +108,24 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
             if config.quantize { "8-bit codes" } else { "32-bit floats" },
             asset.len()
         ),
-        format!("rms               {:.5} (root mean square of f - f', 1/sr; mean value {:.4})", errors.rms, errors.mean_value),
+        format!(
+            "rms               {:.5} (root mean square of f - f', 1/sr; mean value {:.4})",
+            errors.rms, errors.mean_value
+        ),
         format!(
             "relative error    mean {:.3}%, max {:.2}% (|f - f'| / f over the {} samples and channels with f > 0)",
             100.0 * errors.mean_relative_error,
             100.0 * errors.max_relative_error,
             errors.positive
+        ),
+        format!(
+            "                  mean {:.3}% over the {} with f >= eps mu ({} {} {} 1/sr; below it the log encoding is \
+             relative to eps mu, not to f)",
+            100.0 * errors.mean_relative_error_above_floor,
+            errors.above_floor,
+            format_number(brdf.floor()[0]),
+            format_number(brdf.floor()[1]),
+            format_number(brdf.floor()[2])
         ),
         format!("log-domain error  {} (sum of squares of the dropped coefficients)", encoded.dropped_energy),
     ];
@@ -157,20 +172,24 @@ fn picture(name: &str, original: &Resampled, decoded: &[[f64; 3]], ratio: f64) -
     let value_scale = Scale::log(peak * 1e-4, peak);
     let error_scale = Scale::log(1e-4, 1.0);
     let zoom = (192 / n).max(1);
-    let axes = (
-        Axis::new("theta, degrees", 0.0, 180.0),
-        Axis::new("phi, degrees", 0.0, 180.0),
-    );
+    let axes = (Axis::new("theta, degrees", 0.0, 180.0), Axis::new("phi, degrees", 0.0, 180.0));
     let mut panels = Panels::new(3);
-    panels.title(format!("wavelet encoding of {name} at {}:1: slices of wi for three view directions", format_number(ratio)));
+    panels.title(format!(
+        "wavelet encoding of {name} at {}:1: slices of wi for three view directions",
+        format_number(ratio)
+    ));
     let (mut below, mut above) = (false, false);
     for degrees in [10.0f64, 45.0, 75.0] {
         let o = outgoing_cell(grid, degrees.to_radians().min(FRAC_PI_2));
-        let slice = |values: &[[f64; 3]]| -> Vec<f64> { (0..cells).map(|i| luminance(&values[o * cells + i])).collect() };
+        let slice =
+            |values: &[[f64; 3]]| -> Vec<f64> { (0..cells).map(|i| luminance(&values[o * cells + i])).collect() };
         let (before, after) = (slice(&original.values), slice(decoded));
-        let shade = |v: f64, scale: &Scale, map: fn(f64) -> [u8; 3]| if v > 0.0 { map(scale.position(v).clamp(0.0, 1.0)) } else { [0, 0, 0] };
+        let shade = |v: f64, scale: &Scale, map: fn(f64) -> [u8; 3]| {
+            if v > 0.0 { map(scale.position(v).clamp(0.0, 1.0)) } else { [0, 0, 0] }
+        };
         let image = |values: &[f64]| Canvas::from_fn(n, n, |x, y| shade(values[y * n + x], &value_scale, inferno));
-        let relative: Vec<f64> = before.iter().zip(&after).map(|(a, b)| if *a > 0.0 { (a - b).abs() / a } else { 0.0 }).collect();
+        let relative: Vec<f64> =
+            before.iter().zip(&after).map(|(a, b)| if *a > 0.0 { (a - b).abs() / a } else { 0.0 }).collect();
         let (lo, hi) = error_scale.clipping(&relative.iter().copied().filter(|r| *r > 0.0).collect::<Vec<_>>());
         below |= lo;
         above |= hi;
