@@ -90,14 +90,14 @@ fn bad_settings_and_damaged_assets_are_refused() {
 #[test]
 fn the_previewer_renders_from_the_wavelet_and_measures_it_against_the_table() {
     let tmp = temp_dir();
-    let bake = &reference_bake().dir;
     let material = crate::support::ggx_copper();
-    let out = tmp.path().join("wavelet");
-    encode(material, &out, &["--side", "16", "--ratio", "4"]).expect_code(0);
-    let asset = out.join("wavelet-brdf.asset");
+    // brdf-wavelet into a copy of the bake: the previewer finds the asset there by default.
+    let bake = tmp.path().join("bake");
+    crate::support::copy_dir(&reference_bake().dir, &bake);
+    encode(material, &bake, &["--side", "16", "--ratio", "4"]).expect_code(0);
     let picture = tmp.path().join("preview.png");
     let mut cmd = tool("brdf-preview");
-    cmd.arg(bake).arg("--out").arg(&picture).args(["--brdf", "wavelet", "--wavelet"]).arg(&asset);
+    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet"]);
     cmd.args(["--size", "48x48", "--frames", "2", "--spp", "16", "--validate", "--json"]);
     let r = run(cmd, "").expect_code(0);
     let json = r.json();
@@ -113,8 +113,34 @@ fn the_previewer_renders_from_the_wavelet_and_measures_it_against_the_table() {
     let other = tmp.path().join("other");
     encode(&lewis(tmp.path()), &other, &["--side", "4"]).expect_code(0);
     let mut cmd = tool("brdf-preview");
-    cmd.arg(bake).arg("--out").arg(&picture).args(["--brdf", "wavelet", "--wavelet"]);
+    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet", "--wavelet"]);
     cmd.arg(other.join("wavelet-brdf.asset")).args(["--size", "16x16"]);
     let r = run(cmd, "").expect_code(2);
     assert!(r.stderr.contains("not from the bake's material") && r.stderr.contains("wavelet-brdf.asset"), "{r}");
+}
+
+#[test]
+fn brdf_bake_encodes_the_wavelet_with_the_other_material_stages() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("bake");
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(crate::support::ggx_copper()).arg("--out-dir").arg(&out);
+    cmd.args(["--analysis-size", "64", "--wavelet-ratio", "16", "--wavelet-quantize", "--json", "--quiet"]);
+    let r = run(cmd, "");
+    assert!(r.code == Some(0) || r.code == Some(1), "{r}");
+    let json = r.json();
+    let stage = json["manifest"]["stages"].as_array().unwrap().iter().find(|s| s["name"] == "wavelet-brdf");
+    let stage = stage.unwrap_or_else(|| panic!("no wavelet stage\n{r}"));
+    assert_eq!(stage["parameters"]["keep"], "ratio 16", "{r}");
+    assert_eq!(stage["parameters"]["quantize"], true, "{r}");
+    assert_eq!(stage["figures"]["ratio"], 16.0, "{r}");
+    let roles: Vec<&str> = stage["outputs"].as_array().unwrap().iter().map(|o| o["role"].as_str().unwrap()).collect();
+    assert_eq!(roles, ["wavelet-brdf", "wavelet-brdf-picture"], "{r}");
+    assert!(out.join("wavelet-brdf.asset").exists());
+    // A ratio that does not divide the grid is refused before anything is written.
+    let refused = tmp.path().join("refused");
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(crate::support::ggx_copper()).arg("--out-dir").arg(&refused).args(["--wavelet-ratio", "3"]);
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("does not divide") && !refused.exists(), "{r}");
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use asset::{BakeManifest, SourceFile, Tool};
 use serde_json::json;
 
-use crate::stage::{atlas, env_bandwidth, importance, layers, pca, prefilter};
+use crate::stage::{atlas, env_bandwidth, importance, layers, pca, prefilter, wavelet};
 use crate::{Error, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
@@ -25,6 +25,8 @@ pub struct BakeConfig {
     pub atlas: brdf_atlas::Config,
     /// Fit a PCA model of the atlas with the fewest components within this relative RMSE.
     pub pca_max_error: Option<f64>,
+    /// Encode the material in Haar wavelets (`brdf-wavelet`) with these settings.
+    pub wavelet: Option<wavelet::Settings>,
     pub env_bandwidth: env_bandwidth::Settings,
     pub prefilter: ::prefilter::Config,
     /// How a view's lobe and a layer's lobe become the numbers the layer selection compares.
@@ -43,6 +45,7 @@ impl BakeConfig {
             importance: ::importance::Config::default(),
             atlas: brdf_atlas::Config::default(),
             pca_max_error: None,
+            wavelet: None,
             env_bandwidth: env_bandwidth::Settings::default(),
             prefilter: ::prefilter::Config::default(),
             layer_reduction: layers::DEFAULT_REDUCTION,
@@ -68,6 +71,9 @@ impl BakeConfig {
             return Err(Error::Invalid(format!("the pca's largest relative rmse {e} is not in (0, 1)")));
         }
         self.prefilter.check().map_err(|e| Error::stage("prefilter", e))?;
+        if let Some(w) = &self.wavelet {
+            w.check()?;
+        }
         Ok(())
     }
 
@@ -94,6 +100,10 @@ impl BakeConfig {
                 }),
             ),
             ("pca_max_error", json!(self.pca_max_error)),
+            (
+                "wavelet",
+                self.wavelet.as_ref().map_or(serde_json::Value::Null, |w| serde_json::Value::Object(w.parameters())),
+            ),
             (
                 "environment_bandwidth",
                 json!({
@@ -230,6 +240,10 @@ pub fn run_bake(
         let components = brdf_atlas::Components::MaxRelativeRmse(max_error);
         record(pca::run(&atlas_build.atlas, &source, program, components)?, &mut manifest)?;
     }
+    if let Some(settings) = config.wavelet {
+        begin("wavelet encoding");
+        record(wavelet::run(&table, &material_source, program, settings)?, &mut manifest)?;
+    }
     drop(table);
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
@@ -280,6 +294,9 @@ fn stage_names(config: &BakeConfig) -> Vec<&'static str> {
     let mut names = vec!["importance samples", "bandwidth atlas"];
     if config.pca_max_error.is_some() {
         names.push("bandwidth pca");
+    }
+    if config.wavelet.is_some() {
+        names.push("wavelet encoding");
     }
     if config.environment.is_some() {
         names.extend(["environment bandwidth", "phong layers and mip chain", "layer selection"]);

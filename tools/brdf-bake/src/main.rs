@@ -14,7 +14,8 @@ use serde_json::json;
 /// in DIR: the importance samples (importance.asset, importance.png), the bandwidth atlas
 /// (bandwidth-atlas.asset: once per row for an isotropic table, kind bandwidth-rows; .exr: the
 /// full 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset,
-/// .png), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
+/// .png), with --wavelet-ratio its Haar wavelet encoding (wavelet-brdf.asset, .png; what
+/// brdf-preview --brdf wavelet reads), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
 /// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png);
 /// then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool
 /// version and each stage's validation figures), written last.
@@ -44,6 +45,15 @@ struct Args {
     /// is at most E (e.g. 0.02).
     #[arg(long, value_name = "E")]
     pca_max_error: Option<f64>,
+
+    /// Also encode the material in Haar wavelets (as brdf-wavelet does, on its default (32 x 32)^2
+    /// grid), keeping 1/R of the coefficients (4, 16 and 32 are the paper's Table 1).
+    #[arg(long, value_name = "R", value_parser = cli::parse_count)]
+    wavelet_ratio: Option<usize>,
+
+    /// With --wavelet-ratio, store the kept coefficients as 8-bit codes.
+    #[arg(long, requires = "wavelet_ratio")]
+    wavelet_quantize: bool,
 
     /// Vectors of importance samples per view elevation (each of --samples samples): the
     /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
@@ -94,6 +104,15 @@ fn run(args: Args) -> Result<ExitCode> {
     }
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;
+    if let Some(ratio) = args.wavelet_ratio {
+        let ratio = u32::try_from(ratio).map_err(|_| anyhow::anyhow!("--wavelet-ratio {ratio} is too large"))?;
+        let config_w = haar_brdf::Config {
+            keep: haar_brdf::Keep::Ratio(ratio),
+            quantize: args.wavelet_quantize,
+            ..Default::default()
+        };
+        config.wavelet = Some(bake::stage::wavelet::Settings { config: config_w, ..Default::default() });
+    }
     config.importance.n_vectors = args.vectors;
     config.importance.n_samples = args.samples;
     config.atlas.analysis_size = args.analysis_size;

@@ -30,19 +30,61 @@ impl Default for Settings {
     }
 }
 
+impl Settings {
+    /// Refuses settings the stage cannot run, before any work.
+    pub fn check(&self) -> Result<(), Error> {
+        if self.side > MAX_SIDE {
+            return Err(Error::Invalid(format!(
+                "a {0} x {0} grid needs {1:.1} GB of working memory: use a side of at most {MAX_SIDE}",
+                self.side,
+                (self.side as f64).powi(4) * 3.0 * 8.0 * 3.0 / 1e9
+            )));
+        }
+        let grid = Grid::new(self.side).map_err(|e| Error::Invalid(e.to_string()))?;
+        let c = &self.config;
+        if !(c.epsilon.is_finite() && c.epsilon > 0.0) {
+            return Err(Error::Invalid(format!("the log encoding's epsilon must be positive, found {}", c.epsilon)));
+        }
+        match c.keep {
+            Keep::Ratio(r) if r == 0 || !grid.cells().is_multiple_of(r as usize) => Err(Error::Invalid(format!(
+                "a ratio of {r}:1 does not divide the {} coefficient positions of a {1} x {1} grid: use a power of \
+                 two up to {0}",
+                grid.cells(),
+                self.side
+            ))),
+            Keep::Threshold(t) if !(t.is_finite() && t >= 0.0) => {
+                Err(Error::Invalid(format!("the threshold must be a number >= 0, found {t}")))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The settings as the stage's manifest entry records them.
+    pub fn parameters(&self) -> serde_json::Map<String, serde_json::Value> {
+        object([
+            ("side", json!(self.side)),
+            ("epsilon", json!(self.config.epsilon)),
+            ("keep", json!(keep_name(self.config.keep))),
+            ("quantize", json!(self.config.quantize)),
+        ])
+    }
+}
+
+fn keep_name(keep: Keep) -> String {
+    match keep {
+        Keep::All => "all".to_string(),
+        Keep::Ratio(r) => format!("ratio {r}"),
+        Keep::Threshold(t) => format!("threshold {t}"),
+    }
+}
+
 /// The largest grid side the stage accepts: `(64 x 64)^2` samples already hold 1.2 GB of `f64`
 /// working values (three copies of `3 n^4` values); the paper used 32.
 pub const MAX_SIDE: usize = 64;
 
 /// Resamples `table`, encodes it and measures the reconstruction (module docs).
 pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Settings) -> Result<Staged, Error> {
-    if settings.side > MAX_SIDE {
-        return Err(Error::Invalid(format!(
-            "a {0} x {0} grid needs {1} GB of working memory: use a side of at most {MAX_SIDE}",
-            settings.side,
-            (settings.side as f64).powi(4) * 3.0 * 8.0 * 3.0 / 1e9
-        )));
-    }
+    settings.check()?;
     let grid = Grid::new(settings.side).map_err(|e| Error::Invalid(e.to_string()))?;
     let resampled = haar_brdf::resample_table(grid, table);
     let encoded = haar_brdf::encode(&resampled, settings.config).map_err(|e| Error::Invalid(e.to_string()))?;
@@ -51,11 +93,7 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
     let errors = haar_brdf::errors(&resampled.values, &decoded, brdf.floor());
 
     let config = settings.config;
-    let keep = match config.keep {
-        Keep::All => "all".to_string(),
-        Keep::Ratio(r) => format!("ratio {r}"),
-        Keep::Threshold(t) => format!("threshold {t}"),
-    };
+    let keep = keep_name(config.keep);
     let parameters = [
         ("side", settings.side.to_string()),
         ("epsilon", config.epsilon.to_string()),
@@ -139,12 +177,7 @@ pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Sett
     }
     Ok(Staged {
         name: "wavelet-brdf",
-        parameters: object([
-            ("side", json!(settings.side)),
-            ("epsilon", json!(config.epsilon)),
-            ("keep", json!(keep)),
-            ("quantize", json!(config.quantize)),
-        ]),
+        parameters: settings.parameters(),
         figures,
         files: vec![
             OutFile { name: ASSET.into(), format: asset::FileFormat::Asset, role: "wavelet-brdf", bytes: asset },
