@@ -254,7 +254,8 @@ pub struct PrefilteredEnvmap {
     pub layer_size: [u32; 2],
     /// Levels of the mip chain in `mips_ktx2`, level 0 being the source.
     pub mip_levels: u32,
-    /// Texels of `layers_ktx2` are radiance times this (a power of two, at most 1).
+    /// Texels of `layers_ktx2` are radiance times this (a power of two, at most 1); 1 in files
+    /// written since the KTX2 files switch to single floats where half floats overflow.
     pub layers_radiance_scale: f64,
     /// Texels of `mips_ktx2` are radiance times this (a power of two, at most 1).
     pub mips_radiance_scale: f64,
@@ -268,11 +269,13 @@ pub struct PrefilteredEnvmap {
     /// Each layer's solid-angle-weighted mean radiance (equal to the source's up to rounding and
     /// sampling: the lobes integrate to 1).
     pub layer_mean_radiance: Vec<[f64; 3]>,
-    /// The layers as a KTX2 2D array texture, RGBA16F, one layer per exponent.
+    /// The layers as a KTX2 2D array texture, RGBA16F (RGBA32F when a texel exceeds half floats),
+    /// one layer per exponent.
     pub layers_ktx2: LinkedFile,
     /// The layers as OpenEXR files (RGB, 32-bit float), one per exponent.
     pub layer_exrs: Vec<LinkedFile>,
-    /// The source's mip chain as a KTX2 2D texture, RGBA16F.
+    /// The source's mip chain as a KTX2 2D texture, RGBA16F (RGBA32F when a texel exceeds half
+    /// floats).
     pub mips_ktx2: LinkedFile,
     /// The source and the layers side by side, tone mapped (PNG, for people).
     pub contact_sheet_png: LinkedFile,

@@ -161,72 +161,29 @@ fn sample_set(s: asset::ImportanceSamples) -> Result<render::SampleSet, String> 
     })
 }
 
-/// The texels of an RGBA16F KTX2 file as maps: `[level][layer]` (a plain 2D texture has one
-/// layer), radiance divided by `scale`.
+/// The texels of a KTX2 file of ours (`prefilter::ktx`: RGBA16F or RGBA32F) as maps:
+/// `[level][layer]` (a plain 2D texture has one layer), radiance divided by `scale` (1 since the
+/// files hold radiance as it is; older bakes stored some at a power of two below 1).
 fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
-    let reader = ktx2::Reader::new(&bytes[..]).map_err(|e| Error::read(path, format!("not a ktx2 file: {e:?}")))?;
-    let header = reader.header();
-    if header.format != Some(ktx2::Format::R16G16B16A16_SFLOAT) || header.face_count != 1 {
-        return Err(Error::read(path, format!("expected an rgba16f 2d texture, found {:?}", header.format)));
+    let decoded = ::prefilter::ktx::decode(&bytes).map_err(|e| Error::read(path, e))?;
+    if decoded.shape.faces != 1 {
+        return Err(Error::read(path, "expected a lat-long 2d texture, found a cube map"));
     }
-    let layers = header.layer_count.max(1) as usize;
-    let mut out = Vec::new();
-    for (l, level) in reader.levels().enumerate() {
-        // Sizes from the file: shifts and products that cannot overflow.
-        let shrink = |size: u32| size.checked_shr(l as u32).unwrap_or(0).max(1) as usize;
-        let (w, h) = (shrink(header.pixel_width), shrink(header.pixel_height));
-        let texel_bytes = 8usize.checked_mul(w).and_then(|b| b.checked_mul(h));
-        let expected = texel_bytes.and_then(|b| b.checked_mul(layers));
-        let (Some(texel_bytes), Some(expected)) = (texel_bytes, expected) else {
-            return Err(Error::read(path, format!("level {l} of {w} x {h} x {layers} texels is larger than any file")));
-        };
-        if level.data.len() != expected {
-            return Err(Error::read(path, format!("level {l} holds {} bytes, expected {expected}", level.data.len())));
-        }
-        let maps = level
-            .data
-            .chunks_exact(texel_bytes)
-            .map(|layer| {
-                let rgb: Vec<f32> = layer
-                    .chunks_exact(8)
-                    .flat_map(|t| {
-                        (0..3).map(move |c| half::f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32() / scale)
-                    })
-                    .collect();
-                EnvMap::new(w, h, rgb).map_err(|e| Error::read(path, format!("level {l}: {e}")))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        out.push(maps);
-    }
-    Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A KTX2 file whose header declares more texels than any file holds (`2^32 - 1` squared,
-    /// `2^32 - 1` layers: the byte count wraps past 2^64) is refused; before, the product wrapped
-    /// in a release build and panicked in a debug one.
-    #[test]
-    fn a_ktx2_header_whose_size_wraps_is_refused() {
-        let rgb = [0.5f32; 3 * 4 * 2];
-        let encoded = ::prefilter::ktx::encode_rgba16f(4, 2, 0, &[vec![&rgb[..]]], "test").unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("huge.ktx2");
-        let mut bytes = encoded.bytes;
-        // Header: pixelWidth at 20, pixelHeight at 24, layerCount at 32 (KTX2 specification).
-        for at in [20, 24, 32] {
-            bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
-        }
-        std::fs::write(&path, &bytes).unwrap();
-        let error = read_ktx2(&path, 1.0).map(|_| ()).unwrap_err();
-        let source = std::error::Error::source(&error).map(|s| s.to_string()).unwrap_or_default();
-        assert!(source.contains("is larger than any file"), "{error}: {source}");
-        // The unpatched file reads.
-        std::fs::write(&path, ::prefilter::ktx::encode_rgba16f(4, 2, 0, &[vec![&rgb[..]]], "test").unwrap().bytes)
-            .unwrap();
-        assert_eq!(read_ktx2(&path, 1.0).unwrap()[0][0].width(), 4);
-    }
+    let shape = decoded.shape;
+    decoded
+        .levels
+        .into_iter()
+        .enumerate()
+        .map(|(l, images)| {
+            let (w, h) = shape.level_size(l);
+            images
+                .into_iter()
+                .map(|mut rgb| {
+                    rgb.iter_mut().for_each(|v| *v /= scale);
+                    EnvMap::new(w, h, rgb).map_err(|e| Error::read(path, format!("level {l}: {e}")))
+                })
+                .collect()
+        })
+        .collect()
 }

@@ -43,8 +43,20 @@ pub fn encode_exr(
     channels: &[(&str, &[f32])],
     sample_type: SampleType,
 ) -> Result<Vec<u8>, Error> {
-    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec};
-    use exr::prelude::{WritableImage, f16};
+    encode_exr_image(width, height, channels, sample_type, false)
+}
+
+/// [`encode_exr`], with OpenEXR's standard `envmap` attribute set to latlong when `latlong`.
+fn encode_exr_image(
+    width: usize,
+    height: usize,
+    channels: &[(&str, &[f32])],
+    sample_type: SampleType,
+    latlong: bool,
+) -> Result<Vec<u8>, Error> {
+    use exr::meta::attribute::EnvironmentMap;
+    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes};
+    use exr::prelude::{SmallVec, WritableImage, f16};
 
     if width == 0 || height == 0 {
         return Err(Error::Invalid(format!("empty image: {width} x {height}")));
@@ -92,8 +104,11 @@ pub fn encode_exr(
         };
         list.push(AnyChannel::new(text, samples));
     }
-    let layer =
-        Layer::new((width, height), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, AnyChannels::sort(list));
+    let attributes = LayerAttributes {
+        environment_map: latlong.then_some(EnvironmentMap::LatitudeLongitude),
+        ..LayerAttributes::default()
+    };
+    let layer = Layer::new((width, height), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(list));
     let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer).write().non_parallel().to_buffered(&mut bytes)?;
     Ok(bytes.into_inner())
@@ -198,10 +213,17 @@ fn srgb_encode(x: f64) -> f64 {
 }
 
 impl EnvMap {
-    /// Writes the map as an RGB float OpenEXR (channels R, G, B); see [`write_exr`].
+    /// Writes the map as an RGB float OpenEXR (channels R, G, B) with the standard `envmap`
+    /// attribute set to latlong; see [`write_exr`].
     pub fn write_exr(&self, path: &Path, sample_type: SampleType) -> Result<(), Error> {
+        asset::write_atomic(path, &self.encode_exr(sample_type)?)?;
+        Ok(())
+    }
+
+    /// [`EnvMap::write_exr`] to memory.
+    pub fn encode_exr(&self, sample_type: SampleType) -> Result<Vec<u8>, Error> {
         let [r, g, b] = self.planes();
-        write_exr(path, self.width(), self.height(), &[("R", &r), ("G", &g), ("B", &b)], sample_type)
+        encode_exr_image(self.width(), self.height(), &[("R", &r), ("G", &g), ("B", &b)], sample_type, true)
     }
 
     /// Writes a tone-mapped 8-bit sRGB PNG preview of the map.

@@ -1,39 +1,41 @@
-//! A KTX2 writer for uncompressed RGBA16F textures (`VK_FORMAT_R16G16B16A16_SFLOAT`): 2D, 2D
-//! arrays, mip chains. No maintained crate writes KTX2, and the subset needed is small; the
-//! tests read every file back with the maintained `ktx2` reader.
+//! A KTX2 writer for uncompressed float RGBA textures (`VK_FORMAT_R16G16B16A16_SFLOAT` or
+//! `VK_FORMAT_R32G32B32A32_SFLOAT`): 2D, 2D arrays, cube maps, mip chains; and the reader the
+//! toolchain reads them back with ([`decode`], on the maintained `ktx2` crate). No maintained
+//! crate writes KTX2, and the subset needed is small; the tests read every file back with `ktx2`.
 //!
 //! Layout (KTX 2.0 specification, all little-endian), for `K` levels:
 //!
 //! | Offset | Size | Field |
 //! |-------:|-----:|-------|
 //! | 0 | 12 | identifier `AB 4B 54 58 20 32 30 BB 0D 0A 1A 0A` ("«KTX 20»\r\n\x1A\n") |
-//! | 12 | 4 | `vkFormat` = 97 (`R16G16B16A16_SFLOAT`) |
-//! | 16 | 4 | `typeSize` = 2 |
+//! | 12 | 4 | `vkFormat`: 97 (`R16G16B16A16_SFLOAT`) or 109 (`R32G32B32A32_SFLOAT`) |
+//! | 16 | 4 | `typeSize`: 2 or 4 |
 //! | 20 | 8 | `pixelWidth`, `pixelHeight` of level 0 |
 //! | 28 | 4 | `pixelDepth` = 0 (2D) |
-//! | 32 | 4 | `layerCount`: 0 for a plain 2D texture, the number of layers of an array |
-//! | 36 | 4 | `faceCount` = 1 |
+//! | 32 | 4 | `layerCount`: 0 for a plain 2D texture or cube map, the number of layers of an array |
+//! | 36 | 4 | `faceCount`: 1, or 6 for a cube map |
 //! | 40 | 4 | `levelCount` = `K` |
 //! | 44 | 4 | `supercompressionScheme` = 0 (none) |
 //! | 48 | 16 | `dfdByteOffset`, `dfdByteLength`, `kvdByteOffset`, `kvdByteLength` (u32 each) |
 //! | 64 | 16 | `sgdByteOffset`, `sgdByteLength` = 0, 0 (u64 each) |
 //! | 80 | 24 K | level index, level 0 first: `byteOffset`, `byteLength`, `uncompressedByteLength` (u64 each; the lengths are equal) |
 //! | 80 + 24 K | 92 | data format descriptor, below |
-//! | 172 + 24 K | | key/value data: `KTXorientation` = `rd`, `KTXwriter`, `radiance_scale` (each `u32` length, key, NUL, value, NUL, padding to 4 bytes; sorted by key) |
-//! | aligned to 8 | | the levels' texels, **smallest level first**; per level, layer after layer, rows top to bottom, 8 bytes per texel: R, G, B, A as IEEE half floats |
+//! | 172 + 24 K | | key/value data: `KTXorientation` = `rd` (not for cube maps, whose face orientation the specification fixes), `KTXwriter` (each `u32` length, key, NUL, value, NUL, padding to 4 bytes; sorted by key): only keys the specification defines |
+//! | aligned to 16 | | the levels' texels, **smallest level first**; per level, layer after layer, within a layer face after face (`+X, -X, +Y, -Y, +Z, -Z`), rows top to bottom, 8 or 16 bytes per texel: R, G, B, A as IEEE half or single floats |
 //!
 //! The data format descriptor (Khronos Data Format 1.3, one basic block, 4 samples):
 //! `dfdTotalSize` 92; block header: vendor 0 and type 0 (word `0`), version 2 and block size 88
 //! (word `0x0058_0002`); model RGBSDA (1), primaries BT.709 (1), transfer linear (1), flags 0
-//! (straight alpha); texel block `1 x 1 x 1 x 1` (stored as 0); `bytesPlane0` = 8. Samples R, G,
-//! B, A at bit offsets 0, 16, 32, 48, 16 bits (stored as 15), channels 0, 1, 2, 15, qualifiers
-//! float and signed (`0xC0`), positions 0, `sampleLower` = -1.0f (`0xBF800000`), `sampleUpper` =
-//! 1.0f (`0x3F800000`): the values `libktx` writes for this format.
+//! (straight alpha); texel block `1 x 1 x 1 x 1` (stored as 0); `bytesPlane0` = 8 or 16. Samples
+//! R, G, B, A at bit offsets `0, b, 2b, 3b` for `b` = 16 or 32 bits (the length stored as `b -
+//! 1`), channels 0, 1, 2, 15, qualifiers float and signed (`0xC0`), positions 0, `sampleLower` =
+//! -1.0f (`0xBF800000`), `sampleUpper` = 1.0f (`0x3F800000`): the values `libktx` writes for these
+//! formats.
 //!
-//! Radiance above the largest half float (65504, e.g. a sun's texels) would become infinite;
-//! instead every texel of the file is multiplied by a power of two `radiance_scale <= 1` chosen
-//! so that the largest fits (1 when it already does; exact in binary, so only values that become
-//! subnormal lose bits). Readers divide by it.
+//! **No hidden scale.** Texels are radiance as it is. [`Storage::Auto`] writes half floats when
+//! every value fits them (at most 65504) and single floats otherwise (a sun's texels), so that an
+//! engine that loads the file sees the radiance the tool computed; [`Storage::ClampHalf`] writes
+//! half floats and clamps larger values to 65504, and says how many it clamped.
 
 use envmap::{EnvMap, MipChain};
 use half::f16;
@@ -43,19 +45,101 @@ use crate::error::Error;
 /// `VK_FORMAT_R16G16B16A16_SFLOAT`.
 pub const VK_FORMAT_R16G16B16A16_SFLOAT: u32 = 97;
 
+/// `VK_FORMAT_R32G32B32A32_SFLOAT`.
+pub const VK_FORMAT_R32G32B32A32_SFLOAT: u32 = 109;
+
 /// The 12-byte KTX2 file identifier.
 pub const IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
 
-/// A KTX2 file in memory and the scale its texels were stored with.
+/// The largest finite half float.
+pub const HALF_MAX: f32 = 65504.0;
+
+/// The texel formats the writer knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TexelFormat {
+    /// `R16G16B16A16_SFLOAT`.
+    Rgba16f,
+    /// `R32G32B32A32_SFLOAT`.
+    Rgba32f,
+}
+
+impl TexelFormat {
+    pub fn vk_format(self) -> u32 {
+        match self {
+            TexelFormat::Rgba16f => VK_FORMAT_R16G16B16A16_SFLOAT,
+            TexelFormat::Rgba32f => VK_FORMAT_R32G32B32A32_SFLOAT,
+        }
+    }
+
+    /// Bytes of one channel.
+    pub fn type_size(self) -> usize {
+        match self {
+            TexelFormat::Rgba16f => 2,
+            TexelFormat::Rgba32f => 4,
+        }
+    }
+
+    /// The name in reports: `rgba16f`, `rgba32f`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TexelFormat::Rgba16f => "rgba16f",
+            TexelFormat::Rgba32f => "rgba32f",
+        }
+    }
+}
+
+/// How radiance is stored (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Storage {
+    /// Half floats when every value fits, single floats otherwise.
+    #[default]
+    Auto,
+    /// Half floats, values above 65504 clamped to it.
+    ClampHalf,
+}
+
+impl Storage {
+    pub fn name(self) -> &'static str {
+        match self {
+            Storage::Auto => "auto",
+            Storage::ClampHalf => "clamp-half",
+        }
+    }
+}
+
+/// A texture's shape: level 0's size, its array layers (0: not an array) and faces (1, or 6 for
+/// a cube map).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shape {
+    pub width: usize,
+    pub height: usize,
+    pub layers: usize,
+    pub faces: usize,
+}
+
+impl Shape {
+    /// The images of one level: `max(1, layers) faces`.
+    pub fn images(&self) -> usize {
+        self.layers.max(1) * self.faces
+    }
+
+    /// The size of level `l`.
+    pub fn level_size(&self, l: usize) -> (usize, usize) {
+        ((self.width >> l).max(1), (self.height >> l).max(1))
+    }
+}
+
+/// A KTX2 file in memory and how its texels were stored.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Encoded {
     pub bytes: Vec<u8>,
-    /// Stored texel = radiance times this (a power of two, at most 1).
-    pub radiance_scale: f32,
+    pub format: TexelFormat,
+    /// Values clamped to 65504 ([`Storage::ClampHalf`] only).
+    pub clamped: usize,
 }
 
 /// A 2D array texture of one level, one layer per map. The maps must all have the same size.
-pub fn encode_array(layers: &[&EnvMap], writer: &str) -> Result<Encoded, Error> {
+pub fn encode_array(layers: &[&EnvMap], storage: Storage, writer: &str) -> Result<Encoded, Error> {
     let Some(first) = layers.first() else { return Err(Error::InvalidConfig("an array needs a layer".into())) };
     let (w, h) = (first.width(), first.height());
     if let Some(other) = layers.iter().find(|l| (l.width(), l.height()) != (w, h)) {
@@ -66,50 +150,53 @@ pub fn encode_array(layers: &[&EnvMap], writer: &str) -> Result<Encoded, Error> 
         )));
     }
     let level: Vec<&[f32]> = layers.iter().map(|l| l.rgb()).collect();
-    encode_rgba16f(w, h, layers.len(), &[level], writer)
+    encode(Shape { width: w, height: h, layers: layers.len(), faces: 1 }, &[level], storage, writer)
 }
 
 /// A 2D texture with the levels of a mip chain (`envmap`'s chain stops at the first odd height,
 /// so it may hold fewer levels than a full chain down to 1 x 1; KTX2 allows that).
-pub fn encode_mip_chain(chain: &MipChain, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Encoded, Error> {
     let level0 = chain.level(0);
     let levels: Vec<Vec<&[f32]>> = chain.levels().iter().map(|level| vec![level.rgb()]).collect();
-    encode_rgba16f(level0.width(), level0.height(), 0, &levels, writer)
+    encode(Shape { width: level0.width(), height: level0.height(), layers: 0, faces: 1 }, &levels, storage, writer)
 }
 
-/// The general writer: `levels[l][layer]` holds level `l` of each layer (`max(1, layer_count)`
-/// of them) as interleaved RGB, `max(1, width >> l) x max(1, height >> l)` texels; alpha is 1.
-pub fn encode_rgba16f(
-    width: usize,
-    height: usize,
-    layer_count: usize,
-    levels: &[Vec<&[f32]>],
-    writer: &str,
-) -> Result<Encoded, Error> {
+/// The general writer: `levels[l]` holds the [`Shape::images`] images of level `l` (layer-major,
+/// then face) as interleaved RGB of [`Shape::level_size`]; alpha is 1.
+pub fn encode(shape: Shape, levels: &[Vec<&[f32]>], storage: Storage, writer: &str) -> Result<Encoded, Error> {
     let invalid = |message: String| Err(Error::InvalidConfig(message));
+    let Shape { width, height, layers: layer_count, faces } = shape;
     if width == 0 || height == 0 || levels.is_empty() {
         return invalid(format!("empty texture: {width} x {height}, {} levels", levels.len()));
+    }
+    if faces != 1 && !(faces == 6 && width == height) {
+        return invalid(format!("{faces} faces of {width} x {height}: a cube map has 6 square faces"));
     }
     if u32::try_from(width.max(height)).is_err() || (width.max(height) >> (levels.len() - 1)) == 0 {
         return invalid(format!("{} levels do not fit a {width} x {height} texture", levels.len()));
     }
-    let layers = layer_count.max(1);
     for (l, level) in levels.iter().enumerate() {
-        let texels = (width >> l).max(1) * (height >> l).max(1);
-        if level.len() != layers || level.iter().any(|rgb| rgb.len() != 3 * texels) {
-            return invalid(format!("level {l} needs {layers} images of {texels} rgb texels"));
+        let (w, h) = shape.level_size(l);
+        if level.len() != shape.images() || level.iter().any(|rgb| rgb.len() != 3 * w * h) {
+            return invalid(format!("level {l} needs {} images of {} rgb texels", shape.images(), w * h));
         }
     }
-    let max = levels.iter().flatten().flat_map(|rgb| rgb.iter()).fold(0.0f32, |m, &v| m.max(v.abs()));
-    if !max.is_finite() {
+    let values = || levels.iter().flatten().flat_map(|rgb| rgb.iter());
+    if values().any(|v| !v.is_finite()) {
         return Err(Error::Overflow("a texel is not finite".into()));
     }
-    let radiance_scale = half_scale(max);
+    let beyond_half = values().filter(|v| v.abs() > HALF_MAX).count();
+    let (format, clamped) = match storage {
+        Storage::Auto if beyond_half > 0 => (TexelFormat::Rgba32f, 0),
+        Storage::Auto => (TexelFormat::Rgba16f, 0),
+        Storage::ClampHalf => (TexelFormat::Rgba16f, beyond_half),
+    };
 
-    // Key/value data, sorted by key.
-    let scale_text = format!("{radiance_scale}");
+    // Key/value data, sorted by key: only keys the specification defines. A cube map's faces
+    // have the orientation the specification fixes for them, so it carries no KTXorientation.
     let mut kvd = Vec::new();
-    for (key, value) in [("KTXorientation", "rd"), ("KTXwriter", writer), ("radiance_scale", scale_text.as_str())] {
+    let orientation = (faces == 1).then_some(("KTXorientation", "rd"));
+    for (key, value) in orientation.into_iter().chain([("KTXwriter", writer)]) {
         let length = key.len() + 1 + value.len() + 1;
         kvd.extend_from_slice(&(length as u32).to_le_bytes());
         kvd.extend_from_slice(key.as_bytes());
@@ -118,15 +205,21 @@ pub fn encode_rgba16f(
         kvd.push(0);
         kvd.resize(kvd.len().next_multiple_of(4), 0);
     }
-    let dfd = data_format_descriptor();
+    let dfd = data_format_descriptor(format);
 
+    let texel_bytes = 4 * format.type_size();
     let n_levels = levels.len();
     let dfd_offset = 80 + 24 * n_levels;
     let kvd_offset = dfd_offset + dfd.len();
-    let data_start = (kvd_offset + kvd.len()).next_multiple_of(8);
-    let level_bytes: Vec<usize> =
-        (0..n_levels).map(|l| 8 * layers * (width >> l).max(1) * (height >> l).max(1)).collect();
-    // Smallest level first; every level a multiple of 8 bytes, so each starts aligned to 8.
+    let data_start = (kvd_offset + kvd.len()).next_multiple_of(16);
+    let level_bytes: Vec<usize> = (0..n_levels)
+        .map(|l| {
+            let (w, h) = shape.level_size(l);
+            texel_bytes * shape.images() * w * h
+        })
+        .collect();
+    // Smallest level first; every level a multiple of the texel size (8 or 16 bytes, the
+    // alignment the specification asks for), so each starts aligned.
     let mut offsets = vec![0usize; n_levels];
     let mut at = data_start;
     for l in (0..n_levels).rev() {
@@ -137,13 +230,13 @@ pub fn encode_rgba16f(
     let mut bytes = Vec::with_capacity(at);
     bytes.extend_from_slice(&IDENTIFIER);
     for value in [
-        VK_FORMAT_R16G16B16A16_SFLOAT,
-        2,
+        format.vk_format(),
+        format.type_size() as u32,
         width as u32,
         height as u32,
         0,
         layer_count as u32,
-        1,
+        faces as u32,
         n_levels as u32,
         0,
         dfd_offset as u32,
@@ -163,33 +256,95 @@ pub fn encode_rgba16f(
     bytes.extend_from_slice(&dfd);
     bytes.extend_from_slice(&kvd);
     bytes.resize(data_start, 0);
-    let one = f16::ONE.to_le_bytes();
     for level in levels.iter().rev() {
         for rgb in level {
             for texel in rgb.chunks_exact(3) {
-                for &v in texel {
-                    bytes.extend_from_slice(&f16::from_f32(v * radiance_scale).to_le_bytes());
+                for v in [texel[0], texel[1], texel[2], 1.0] {
+                    match format {
+                        TexelFormat::Rgba16f => {
+                            bytes.extend_from_slice(&f16::from_f32(v.clamp(-HALF_MAX, HALF_MAX)).to_le_bytes())
+                        }
+                        TexelFormat::Rgba32f => bytes.extend_from_slice(&v.to_le_bytes()),
+                    }
                 }
-                bytes.extend_from_slice(&one);
             }
         }
     }
     debug_assert_eq!(bytes.len(), at);
-    Ok(Encoded { bytes, radiance_scale })
+    Ok(Encoded { bytes, format, clamped })
 }
 
-/// The largest power of two `s <= 1` with `max * s <= 65504`, the largest finite half float.
-pub fn half_scale(max: f32) -> f32 {
-    let mut scale = 1.0f32;
-    while max * scale > f16::MAX.to_f32() {
-        scale *= 0.5;
+/// A KTX2 file of ours read back: its shape and format, and `levels[l][image]` as interleaved
+/// RGB `f32` (alpha dropped), images layer-major then face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decoded {
+    pub shape: Shape,
+    pub format: TexelFormat,
+    pub levels: Vec<Vec<Vec<f32>>>,
+}
+
+/// Reads a float RGBA KTX2 file (either format, any shape [`encode`] writes) with the `ktx2`
+/// crate, checking every size against the bytes before allocating. The error says what is wrong.
+pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
+    let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a ktx2 file: {e:?}"))?;
+    let header = reader.header();
+    let format = match header.format {
+        Some(ktx2::Format::R16G16B16A16_SFLOAT) => TexelFormat::Rgba16f,
+        Some(ktx2::Format::R32G32B32A32_SFLOAT) => TexelFormat::Rgba32f,
+        other => return Err(format!("expected an rgba16f or rgba32f texture, found {other:?}")),
+    };
+    if header.pixel_depth > 1 || !(header.face_count == 1 || header.face_count == 6) {
+        return Err(format!(
+            "expected a 2d texture or cube map, found depth {} and {} faces",
+            header.pixel_depth, header.face_count
+        ));
     }
-    scale
+    let shape = Shape {
+        width: header.pixel_width as usize,
+        height: header.pixel_height.max(1) as usize,
+        layers: header.layer_count as usize,
+        faces: header.face_count as usize,
+    };
+    let texel_bytes = 4 * format.type_size();
+    let mut levels = Vec::new();
+    for (l, level) in reader.levels().enumerate() {
+        // Sizes from the file: shifts and products that cannot overflow.
+        let shrink = |size: usize| size.checked_shr(l as u32).unwrap_or(0).max(1);
+        let (w, h) = (shrink(shape.width), shrink(shape.height));
+        let image_bytes = texel_bytes.checked_mul(w).and_then(|b| b.checked_mul(h));
+        let expected = image_bytes.and_then(|b| b.checked_mul(shape.images()));
+        let (Some(image_bytes), Some(expected)) = (image_bytes, expected) else {
+            return Err(format!("level {l} of {w} x {h} x {} texels is larger than any file", shape.images()));
+        };
+        if level.data.len() != expected {
+            return Err(format!("level {l} holds {} bytes, expected {expected}", level.data.len()));
+        }
+        let images = level
+            .data
+            .chunks_exact(image_bytes)
+            .map(|image| {
+                image
+                    .chunks_exact(texel_bytes)
+                    .flat_map(|t| {
+                        (0..3).map(move |c| match format {
+                            TexelFormat::Rgba16f => f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32(),
+                            TexelFormat::Rgba32f => {
+                                f32::from_le_bytes([t[4 * c], t[4 * c + 1], t[4 * c + 2], t[4 * c + 3]])
+                            }
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        levels.push(images);
+    }
+    Ok(Decoded { shape, format, levels })
 }
 
-/// The 92-byte data format descriptor of `R16G16B16A16_SFLOAT` (see the module documentation).
-fn data_format_descriptor() -> Vec<u8> {
+/// The 92-byte data format descriptor of `format` (see the module documentation).
+fn data_format_descriptor(format: TexelFormat) -> Vec<u8> {
     const SAMPLES: u32 = 4;
+    let bits = 8 * format.type_size() as u32;
     let block_size = 24 + 16 * SAMPLES;
     let mut words: Vec<u32> = vec![
         4 + block_size,           // dfdTotalSize
@@ -197,13 +352,13 @@ fn data_format_descriptor() -> Vec<u8> {
         2 | (block_size << 16),   // versionNumber 2 (KDF 1.3), descriptorBlockSize
         1 | (1 << 8) | (1 << 16), // colorModel RGBSDA, colorPrimaries BT709, transferFunction linear, flags 0
         0,                        // texelBlockDimension0..3 (value - 1): 1 x 1 x 1 x 1
-        8,                        // bytesPlane0 = 8, bytesPlane1..3 = 0
+        4 * bits / 8,             // bytesPlane0 = 8 or 16, bytesPlane1..3 = 0
         0,                        // bytesPlane4..7
     ];
     const FLOAT_SIGNED: u32 = 0x80 | 0x40;
     for (i, channel) in [0u32, 1, 2, 15].into_iter().enumerate() {
-        let bit_offset = 16 * i as u32;
-        words.push(bit_offset | (15 << 16) | ((FLOAT_SIGNED | channel) << 24));
+        let bit_offset = bits * i as u32;
+        words.push(bit_offset | ((bits - 1) << 16) | ((FLOAT_SIGNED | channel) << 24));
         words.push(0); // samplePosition0..3
         words.push((-1.0f32).to_bits()); // sampleLower
         words.push(1.0f32.to_bits()); // sampleUpper

@@ -154,12 +154,20 @@ pub struct Config {
     pub width: usize,
     pub height: usize,
     pub method: Method,
+    /// How the KTX2 files store radiance (no effect on the layers themselves).
+    pub storage: ktx::Storage,
 }
 
 impl Default for Config {
-    /// The 7 default exponents, 256 x 128 layers, [`Method::Auto`].
+    /// The 7 default exponents, 256 x 128 layers, [`Method::Auto`], [`ktx::Storage::Auto`].
     fn default() -> Self {
-        Config { exponents: DEFAULT_EXPONENTS.to_vec(), width: 256, height: 128, method: Method::Auto }
+        Config {
+            exponents: DEFAULT_EXPONENTS.to_vec(),
+            width: 256,
+            height: 128,
+            method: Method::Auto,
+            storage: ktx::Storage::Auto,
+        }
     }
 }
 

@@ -68,7 +68,7 @@ fn check_method(
     exponents: &[u32],
     report: &mut Vec<LayerError>,
 ) {
-    let config = Config { exponents: exponents.to_vec(), width: W, height: H, method };
+    let config = Config { exponents: exponents.to_vec(), width: W, height: H, method, ..Config::default() };
     let layers: Prefiltered = prefilter(map, &config).unwrap();
     for layer in &layers.layers {
         let column = DEFAULT_EXPONENTS.iter().position(|&n| n == layer.exponent).expect("a default exponent");
@@ -168,7 +168,7 @@ fn a_constant_map_is_a_fixed_point() {
     for (method, exponents) in
         [(Method::SphericalHarmonics, &DEFAULT_EXPONENTS[..]), (Method::Window, &DEFAULT_EXPONENTS[3..])]
     {
-        let config = Config { exponents: exponents.to_vec(), width: 32, height: 16, method };
+        let config = Config { exponents: exponents.to_vec(), width: 32, height: 16, method, ..Config::default() };
         for layer in prefilter(&map, &config).unwrap().layers {
             for texel in layer.map.texels() {
                 for c in 0..3 {

@@ -43,7 +43,7 @@ fn tiny_maps_and_layers() {
     let map = EnvMap::new(2, 1, vec![1.0, 2.0, 3.0, 3.0, 2.0, 1.0]).unwrap();
     for method in [Method::Auto, Method::SphericalHarmonics, Method::Window] {
         for (width, height) in [(2, 1), (6, 3)] {
-            let config = Config { exponents: vec![1, 100], width, height, method };
+            let config = Config { exponents: vec![1, 100], width, height, method, ..Config::default() };
             let layers = prefilter(&map, &config).unwrap();
             assert_eq!(layers.layers.len(), 2);
             assert!(layers.layers.iter().all(|l| (l.map.width(), l.map.height()) == (width, height)));

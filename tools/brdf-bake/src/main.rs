@@ -71,6 +71,11 @@ struct Args {
     #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 
+    /// Store the environment's KTX2 files as half floats even where texels exceed 65504, clamping
+    /// them (the default stores such a file as single floats).
+    #[arg(long)]
+    clamp_half: bool,
+
     /// Bake even when the folder's manifest is up to date.
     #[arg(long)]
     force: bool,
@@ -117,6 +122,9 @@ fn run(args: Args) -> Result<ExitCode> {
     config.importance.n_samples = args.samples;
     config.atlas.analysis_size = args.analysis_size;
     config.force = args.force;
+    if args.clamp_half {
+        config.prefilter.storage = prefilter::ktx::Storage::ClampHalf;
+    }
     config.env_bandwidth.max_memory = args.max_memory;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {

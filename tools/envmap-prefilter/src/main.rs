@@ -12,11 +12,15 @@ use prefilter::{Config, Method};
 
 /// Convolve a lat-long environment map (OpenEXR or Radiance HDR, 2:1) with the normalized Phong
 /// lobe (n + 1) / (2 pi) max(0, w . r)^n for each exponent n, around every direction r of a
-/// lat-long grid. Writes, in DIR: layers.ktx2 (RGBA16F 2D array, one layer per exponent),
-/// layer-n<N>.exr (RGB float, one per exponent), mips.ktx2 (RGBA16F 2D texture with the source's
-/// mip chain, for filtered importance sampling), layers.png (the source and the layers, tone
+/// lat-long grid. Writes, in DIR: layers.ktx2 (2D array, one layer per exponent),
+/// layer-n<N>.exr (RGB float, one per exponent, tagged envmap = latlong), mips.ktx2 (2D texture
+/// with the source's mip chain, for filtered importance sampling), layers.png (the source and the layers, tone
 /// mapped) and prefiltered.asset (kind prefiltered-envmap: exponents, bandwidths, the
 /// bandwidth-to-layer thresholds, file names and hashes; layout in data-schema/README.md).
+///
+/// The KTX2 files hold radiance as it is, with no scale an engine would have to know of: RGBA16F
+/// (half floats) when every texel fits them, RGBA32F when some exceed 65504 (a sun), or, with
+/// --clamp-half, RGBA16F with those texels clamped to 65504 (the report says how many).
 ///
 /// Exit status: 0 ok, 1 --verify found a file that does not read back as written, 2 error.
 #[derive(Debug, Parser)]
@@ -37,7 +41,7 @@ struct Args {
     #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = cli::parse_size)]
     size: (usize, usize),
 
-    /// Memory budget (4G, 512M, ...): a map whose estimated need (48 bytes per texel, plus the
+    /// Memory budget (4G, 512M, ...): a map whose estimated need (60 bytes per texel, plus the
     /// layers) is larger is refused from its header, before decoding.
     #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
     max_memory: u64,
@@ -46,8 +50,13 @@ struct Args {
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     method: MethodArg,
 
+    /// Store the KTX2 files as half floats even when some texels exceed 65504, clamping those
+    /// (smaller files; the default stores such a file as single floats).
+    #[arg(long)]
+    clamp_half: bool,
+
     /// Read the KTX2 files back (with the `ktx2` crate) and check that they hold the EXR layers
-    /// and the mip chain up to half-float rounding.
+    /// and the mip chain (up to half-float rounding when stored as half floats).
     #[arg(long)]
     verify: bool,
 
@@ -90,6 +99,7 @@ fn run(args: Args) -> Result<ExitCode> {
         width: args.size.0,
         height: args.size.1,
         method: args.method.into(),
+        storage: if args.clamp_half { prefilter::ktx::Storage::ClampHalf } else { prefilter::ktx::Storage::Auto },
     };
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);

@@ -24,8 +24,9 @@ pub fn layer_exr(n: u32) -> String {
 /// The peak memory of this stage per texel of the input map, in bytes, reading included:
 /// measured 40 (the maximum resident size on 2048 x 1024 and 4096 x 2048 maps, the difference
 /// over the difference in texels: the map, its mip chain in `f32` and in `f16` for the KTX2
-/// file), with room to spare. The layers come on top ([`limits`]).
-pub const BYTES_PER_TEXEL: u64 = 48;
+/// file), plus 11 for a mip chain stored as `f32` (a map brighter than half floats), with room to
+/// spare. The layers come on top ([`limits`]).
+pub const BYTES_PER_TEXEL: u64 = 60;
 
 /// The reading limits of this stage under a memory budget of `max_memory` bytes: the layers
 /// (one `f32` RGB map of the configured size per exponent, twice over while they are encoded)
@@ -67,19 +68,18 @@ fn outputs(
         file
     };
     let layer_maps: Vec<&EnvMap> = prefiltered.layers.iter().map(|layer| &layer.map).collect();
-    let layers = prefilter::ktx::encode_array(&layer_maps, &writer).map_err(|e| encoding(LAYERS_KTX2, &e))?;
+    let layers =
+        prefilter::ktx::encode_array(&layer_maps, config.storage, &writer).map_err(|e| encoding(LAYERS_KTX2, &e))?;
     let layers_ktx2 = linked(LAYERS_KTX2.into(), asset::FileFormat::Ktx2, "phong-layers", layers.bytes);
     let chain = MipChain::new(map);
-    let mips = prefilter::ktx::encode_mip_chain(&chain, &writer).map_err(|e| encoding(MIPS_KTX2, &e))?;
+    let mips =
+        prefilter::ktx::encode_mip_chain(&chain, config.storage, &writer).map_err(|e| encoding(MIPS_KTX2, &e))?;
+    let (layers_format, mips_format, clamped) = (layers.format, mips.format, layers.clamped + mips.clamped);
     let mips_ktx2 = linked(MIPS_KTX2.into(), asset::FileFormat::Ktx2, "environment-mips", mips.bytes);
     let mut layer_exrs = Vec::new();
     for layer in &prefiltered.layers {
         let name = layer_exr(layer.exponent);
-        let texels = layer.map.texels();
-        let planes: [Vec<f32>; 3] = std::array::from_fn(|c| texels.iter().map(|t| t[c]).collect());
-        let channels = [("R", planes[0].as_slice()), ("G", &planes[1]), ("B", &planes[2])];
-        let bytes = envmap::encode_exr(layer.map.width(), layer.map.height(), &channels, SampleType::F32)
-            .map_err(|e| encoding(&name, &e))?;
+        let bytes = layer.map.encode_exr(SampleType::F32).map_err(|e| encoding(&name, &e))?;
         layer_exrs.push(linked(name, asset::FileFormat::Exr, "phong-layer-exr", bytes));
     }
     let exponents_and_maps: Vec<(u32, &EnvMap)> =
@@ -96,8 +96,10 @@ fn outputs(
         source_mean_radiance: source_mean,
         layer_size: [config.width as u32, config.height as u32],
         mip_levels: chain.n_levels() as u32,
-        layers_radiance_scale: f64::from(layers.radiance_scale),
-        mips_radiance_scale: f64::from(mips.radiance_scale),
+        // Texels are radiance as it is (no scale since the KTX2 files went to rgba32f where half
+        // floats cannot hold them); the fields stay for the readers of older files.
+        layers_radiance_scale: 1.0,
+        mips_radiance_scale: 1.0,
         exponents: config.exponents.clone(),
         lobe_bandwidth: prefiltered.mapping.bandwidths().to_vec(),
         bandwidth_thresholds: prefiltered.mapping.thresholds().to_vec(),
@@ -145,22 +147,28 @@ fn outputs(
         "layer means   within {:.2e} of the source's mean radiance (relative, worst channel and layer)",
         mean_error
     ));
-    for (what, scale) in [("layers", layers.radiance_scale), ("mips", mips.radiance_scale)] {
-        if scale != 1.0 {
-            report.push(format!("note: {what} texels are radiance x {scale} (the brightest exceed half floats)"));
+    report.push(format!(
+        "ktx2          {LAYERS_KTX2} {}, {MIPS_KTX2} {} ({})",
+        layers_format.name(),
+        mips_format.name(),
+        match config.storage {
+            prefilter::ktx::Storage::Auto => "half floats where every texel fits them, else single floats".to_string(),
+            prefilter::ktx::Storage::ClampHalf => format!("half floats, {clamped} values clamped to 65504"),
         }
-    }
+    ));
     Ok(Staged {
         name: "prefilter",
         parameters: object([
             ("exponents", json!(config.exponents)),
             ("size", json!([config.width, config.height])),
             ("method", json!(config.method.name())),
+            ("storage", json!(config.storage.name())),
         ]),
         figures: object([
             ("mip_levels", json!(chain.n_levels())),
-            ("layers_radiance_scale", json!(layers.radiance_scale)),
-            ("mips_radiance_scale", json!(mips.radiance_scale)),
+            ("layers_format", json!(layers_format.name())),
+            ("mips_format", json!(mips_format.name())),
+            ("clamped_values", json!(clamped)),
             ("layer_mean_max_relative_error", json!(mean_error)),
             ("layers", json!(methods)),
         ]),
@@ -175,6 +183,7 @@ fn provenance_parameters(config: &Config, prefiltered: &Prefiltered) -> Vec<(&'s
         ("exponents", join(&config.exponents)),
         ("size", format!("{}x{}", config.width, config.height)),
         ("method", Method::name(config.method).to_string()),
+        ("storage", config.storage.name().to_string()),
     ];
     for layer in &prefiltered.layers {
         let how = match layer.degree {
@@ -193,9 +202,9 @@ fn join(exponents: &[u32]) -> String {
 
 /// Half-float rounding: round to nearest keeps 11 significant bits (relative error at most
 /// `2^-11`), and below the smallest normal half (`2^-14`) the spacing is `2^-24`, so the absolute
-/// error there is at most `2^-25`. Stored values are radiance times the file's scale.
-fn half_tolerance(value: f32, scale: f32) -> f32 {
-    value.abs() * 2f32.powi(-11) + 2f32.powi(-25) / scale
+/// error there is at most `2^-25`.
+fn half_tolerance(value: f32) -> f32 {
+    value.abs() * 2f32.powi(-11) + 2f32.powi(-25)
 }
 
 /// What [`verify`] found.
@@ -219,6 +228,15 @@ pub fn verify(dir: &Path, map: &EnvMap, prefiltered: &Prefiltered) -> Result<Ver
     };
     let mut problems = Vec::new();
     let mut report = Vec::new();
+    if payload.layers_radiance_scale != 1.0 || payload.mips_radiance_scale != 1.0 {
+        problems.push(format!(
+            "{}: the KTX2 texels are stored scaled (radiance x {} and x {}), as versions before rgba32f did: bake \
+             again",
+            asset_path.display(),
+            payload.layers_radiance_scale,
+            payload.mips_radiance_scale
+        ));
+    }
     let exrs: Vec<Vec<f32>> = prefiltered
         .layers
         .iter()
@@ -232,9 +250,8 @@ pub fn verify(dir: &Path, map: &EnvMap, prefiltered: &Prefiltered) -> Result<Ver
     let layers_path = dir.join(LAYERS_KTX2);
     let worst = compare_ktx2(
         &layers_path,
-        (first.width(), first.height(), prefiltered.layers.len() as u32),
+        (first.width(), first.height(), prefiltered.layers.len()),
         &[exrs.iter().map(Vec::as_slice).collect()],
-        payload.layers_radiance_scale as f32,
         &mut problems,
     )?;
     report.push(format!(
@@ -246,13 +263,7 @@ pub fn verify(dir: &Path, map: &EnvMap, prefiltered: &Prefiltered) -> Result<Ver
     let mips_path = dir.join(MIPS_KTX2);
     let level0 = chain.level(0);
     let levels: Vec<Vec<&[f32]>> = chain.levels().iter().map(|level| vec![level.rgb()]).collect();
-    let worst = compare_ktx2(
-        &mips_path,
-        (level0.width(), level0.height(), 0),
-        &levels,
-        payload.mips_radiance_scale as f32,
-        &mut problems,
-    )?;
+    let worst = compare_ktx2(&mips_path, (level0.width(), level0.height(), 0), &levels, &mut problems)?;
     report.push(format!(
         "{}: {} mip levels match the source's mip chain within half-float rounding (largest relative difference \
          {worst:.2e})",
@@ -263,51 +274,44 @@ pub fn verify(dir: &Path, map: &EnvMap, prefiltered: &Prefiltered) -> Result<Ver
 }
 
 /// Checks one KTX2 file's header and texels against `expected[level][layer]` (interleaved RGB),
-/// returning the largest relative difference; mismatches go to `problems`.
+/// returning the largest relative difference; mismatches go to `problems`. Half floats are held to
+/// their rounding, single floats must be exact.
 fn compare_ktx2(
     path: &Path,
-    (width, height, layer_count): (usize, usize, u32),
+    (width, height, layer_count): (usize, usize, usize),
     expected: &[Vec<&[f32]>],
-    scale: f32,
     problems: &mut Vec<String>,
 ) -> Result<f32, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
-    let reader = ktx2::Reader::new(&bytes[..]).map_err(|e| Error::read(path, format!("{e:?}")))?;
-    let header = reader.header();
-    let found = (header.format, header.pixel_width, header.pixel_height, header.layer_count, header.level_count);
-    let wanted =
-        (Some(ktx2::Format::R16G16B16A16_SFLOAT), width as u32, height as u32, layer_count, expected.len() as u32);
-    if found != wanted {
-        problems.push(format!("{}: header {found:?}, expected {wanted:?}", path.display()));
+    let decoded = prefilter::ktx::decode(&bytes).map_err(|e| Error::read(path, e))?;
+    let wanted = prefilter::ktx::Shape { width, height, layers: layer_count, faces: 1 };
+    if decoded.shape != wanted || decoded.levels.len() != expected.len() {
+        problems.push(format!(
+            "{}: {:?} with {} levels, expected {wanted:?} with {}",
+            path.display(),
+            decoded.shape,
+            decoded.levels.len(),
+            expected.len()
+        ));
         return Ok(f32::INFINITY);
     }
+    let half = decoded.format == prefilter::ktx::TexelFormat::Rgba16f;
     let mut worst = 0.0f32;
-    for (l, (level, images)) in reader.levels().zip(expected).enumerate() {
-        let texels: Vec<f32> =
-            level.data.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect();
-        let per_layer = texels.len() / images.len().max(1);
-        for (layer, image) in images.iter().enumerate() {
-            let stored = &texels[layer * per_layer..(layer + 1) * per_layer];
-            if stored.len() != image.len() / 3 * 4 {
-                problems.push(format!("{}: level {l} layer {layer} has {} values", path.display(), stored.len()));
-                continue;
-            }
-            for (i, (rgba, rgb)) in stored.chunks_exact(4).zip(image.chunks_exact(3)).enumerate() {
-                for c in 0..3 {
-                    let (got, want) = (rgba[c] / scale, rgb[c]);
-                    let difference = (got - want).abs();
-                    if difference > half_tolerance(want, scale) {
-                        problems.push(format!(
-                            "{}: level {l} layer {layer} texel {i} channel {c}: {got}, expected {want}",
-                            path.display()
-                        ));
-                    }
-                    if want > 0.0 {
-                        worst = worst.max(difference / want);
-                    }
+    for (l, (images, wanted)) in decoded.levels.iter().zip(expected).enumerate() {
+        for (layer, (stored, image)) in images.iter().zip(wanted).enumerate() {
+            for (i, (&got, &want)) in stored.iter().zip(image.iter()).enumerate() {
+                let difference = (got - want).abs();
+                let tolerance = if half { half_tolerance(want) } else { 0.0 };
+                if difference > tolerance {
+                    problems.push(format!(
+                        "{}: level {l} layer {layer} texel {} channel {}: {got}, expected {want}",
+                        path.display(),
+                        i / 3,
+                        i % 3
+                    ));
                 }
-                if rgba[3] != 1.0 {
-                    problems.push(format!("{}: level {l} layer {layer} texel {i}: alpha {}", path.display(), rgba[3]));
+                if want > 0.0 {
+                    worst = worst.max(difference / want);
                 }
             }
         }
