@@ -9,10 +9,10 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
+.PHONY: setup setup-gpu setup-python setup-node build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
-## setup: everything the tests need (setup-gpu and setup-python). Idempotent.
-setup: setup-gpu setup-python
+## setup: everything the tests need (setup-gpu, setup-python and setup-node). Idempotent.
+setup: setup-gpu setup-python setup-node
 
 ## setup-gpu: the software Vulkan driver (lavapipe), for brdf-preview and the GPU tests on machines
 ## without a GPU driver. Installed only when missing; quiet.
@@ -27,6 +27,17 @@ setup-gpu:
 ## setup-python: numpy, for ../shared/tools/nbrdf2merl.py (the real-derived test materials).
 setup-python:
 	@python3 -c 'import numpy' 2>/dev/null || { echo "installing numpy (for ../shared/tools/nbrdf2merl.py)"; python3 -m pip install --quiet numpy; }
+
+## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
+## tests run on the KTX2 files with node. Installs node and npm from Debian when missing.
+setup-node:
+	@if ! command -v npm >/dev/null 2>&1; then \
+	  echo "installing nodejs and npm (to read the KTX2 outputs with ktx-parse in the tests)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
+	fi
+	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
 
 ## build: every tool, optimized, into target/release/.
 build:

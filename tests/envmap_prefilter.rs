@@ -345,3 +345,55 @@ fn killed_while_writing_the_folder_stays_consistent() {
     );
     assert!(killed >= 5, "only {killed} of 20 kills landed while writing: the test no longer tests");
 }
+
+/// The KTX2 files as three.js reads them: `ktx-parse` (the parser of its KTX2Loader), run by
+/// node on `tests/ktx-parse/check.mjs`, parses every file `--cube` writes, and finds the shape,
+/// format, level sizes, descriptor and only the specification's keys. `make setup` installs it.
+#[test]
+fn ktx_parse_reads_the_lat_long_and_cube_files() {
+    let script = crate::support::root().join("tests").join("ktx-parse").join("check.mjs");
+    let modules = crate::support::root().join("tests").join("ktx-parse").join("node_modules").join("ktx-parse");
+    assert!(
+        modules.is_dir(),
+        "ktx-parse is not installed: run `make setup` (npm ci in tests/ktx-parse; needs node and npm)"
+    );
+    let tmp = temp_dir();
+    let out = tmp.path().join("prefiltered");
+    let mut cmd = tool("envmap-prefilter");
+    cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out-dir").arg(&out);
+    cmd.args(["--size", "64x32", "--exponents", "1,64", "--cube", "--quiet"]);
+    run(cmd, "").expect_code(0);
+    let names = ["layers.ktx2", "mips.ktx2", "layers-cube.ktx2", "mips-cube.ktx2"];
+    let mut node = std::process::Command::new("node");
+    node.arg(&script).args(names.map(|n| out.join(n)));
+    let r = run(node, "").expect_code(0);
+    let parsed: Vec<serde_json::Value> =
+        r.stdout.lines().map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}\n{r}"))).collect();
+    assert_eq!(parsed.len(), 4, "{r}");
+    // (faces, layers, width, height, levels) of each file.
+    let shapes = [(1, 2, 64, 32, 1), (1, 0, 1024, 512, 10), (6, 2, 16, 16, 1), (6, 0, 256, 256, 9)];
+    for (json, (name, (faces, layers, width, height, levels))) in parsed.iter().zip(names.iter().zip(shapes)) {
+        let found = (&json["faceCount"], &json["layerCount"], &json["pixelWidth"], &json["pixelHeight"]);
+        assert_eq!(found, (&faces.into(), &layers.into(), &width.into(), &height.into()), "{name}\n{r}");
+        assert_eq!(json["levelCount"], levels, "{name}\n{r}");
+        let format = json["vkFormat"].as_u64().unwrap();
+        assert!(format == 97 || format == 109, "{name}: vkFormat {format}");
+        let texel = if format == 97 { 8 } else { 16 };
+        assert_eq!(json["bytesPlane0"], texel, "{name}\n{r}");
+        for (l, bytes) in json["levelBytes"].as_array().unwrap().iter().enumerate() {
+            let (w, h) = ((width >> l).max(1), (height >> l).max(1));
+            assert_eq!(bytes.as_u64().unwrap(), (texel * w * h * faces * layers.max(1)) as u64, "{name} level {l}");
+        }
+        // Only keys the KTX2 specification defines: no custom key for a validator to warn about.
+        for key in json["keys"].as_array().unwrap() {
+            assert!(key.as_str().unwrap().starts_with("KTX"), "{name}: custom key {key}");
+        }
+        // RGBSDA, BT.709, linear.
+        assert_eq!(
+            (&json["colorModel"], &json["colorPrimaries"], &json["transferFunction"]),
+            (&1.into(), &1.into(), &1.into())
+        );
+    }
+    // Quarry's sun does not fit half floats: the lat-long mip chain is single floats.
+    assert_eq!(parsed[1]["vkFormat"], 109, "{r}");
+}

@@ -82,6 +82,7 @@
 //! (`benches/prefilter.rs` prints the table). Memory: the row spectra and coefficients, a few tens
 //! of megabytes at `L = 411`.
 
+pub mod cube;
 mod error;
 pub mod ktx;
 pub mod lobe;
@@ -156,6 +157,8 @@ pub struct Config {
     pub method: Method,
     /// How the KTX2 files store radiance (no effect on the layers themselves).
     pub storage: ktx::Storage,
+    /// Also write the layers and the mip chain as KTX2 cube maps ([`cube`]).
+    pub cube: bool,
 }
 
 impl Default for Config {
@@ -167,6 +170,7 @@ impl Default for Config {
             height: 128,
             method: Method::Auto,
             storage: ktx::Storage::Auto,
+            cube: false,
         }
     }
 }

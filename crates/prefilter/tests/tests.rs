@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod config;
+mod cube;
 mod ktx;
 mod lobe;
 mod sheet;

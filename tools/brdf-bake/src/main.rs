@@ -71,6 +71,11 @@ struct Args {
     #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 
+    /// Also write the environment's layers and mip chain as KTX2 cube maps for engines
+    /// (layers-cube.ktx2, mips-cube.ktx2; see envmap-prefilter --help).
+    #[arg(long, requires = "env")]
+    cube: bool,
+
     /// Store the environment's KTX2 files as half floats even where texels exceed 65504, clamping
     /// them (the default stores such a file as single floats).
     #[arg(long)]
@@ -125,6 +130,7 @@ fn run(args: Args) -> Result<ExitCode> {
     if args.clamp_half {
         config.prefilter.storage = prefilter::ktx::Storage::ClampHalf;
     }
+    config.prefilter.cube = args.cube;
     config.env_bandwidth.max_memory = args.max_memory;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {

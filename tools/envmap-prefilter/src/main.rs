@@ -50,6 +50,13 @@ struct Args {
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     method: MethodArg,
 
+    /// Also write the layers and the mip chain as KTX2 cube maps for engines: layers-cube.ktx2 (a
+    /// cube-map array, one cube per exponent, faces of WIDTH / 4) and mips-cube.ktx2 (a cube map
+    /// with the mip chain). Vulkan/KTX2 face order and orientation, +Y up: the world's +z (the
+    /// map's top row) is the +Y face (data-schema/README.md has the picture).
+    #[arg(long)]
+    cube: bool,
+
     /// Store the KTX2 files as half floats even when some texels exceed 65504, clamping those
     /// (smaller files; the default stores such a file as single floats).
     #[arg(long)]
@@ -100,6 +107,7 @@ fn run(args: Args) -> Result<ExitCode> {
         height: args.size.1,
         method: args.method.into(),
         storage: if args.clamp_half { prefilter::ktx::Storage::ClampHalf } else { prefilter::ktx::Storage::Auto },
+        cube: args.cube,
     };
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);

@@ -15,6 +15,8 @@ pub const ASSET: &str = "prefiltered.asset";
 pub const LAYERS_KTX2: &str = "layers.ktx2";
 pub const MIPS_KTX2: &str = "mips.ktx2";
 pub const CONTACT_SHEET: &str = "layers.png";
+pub const LAYERS_CUBE_KTX2: &str = "layers-cube.ktx2";
+pub const MIPS_CUBE_KTX2: &str = "mips-cube.ktx2";
 
 /// The EXR file of the layer of exponent `n`.
 pub fn layer_exr(n: u32) -> String {
@@ -30,11 +32,18 @@ pub const BYTES_PER_TEXEL: u64 = 60;
 
 /// The reading limits of this stage under a memory budget of `max_memory` bytes: the layers
 /// (one `f32` RGB map of the configured size per exponent, twice over while they are encoded)
-/// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`].
+/// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`], plus [`CUBE_BYTES_PER_TEXEL`] with
+/// cube maps.
 pub fn limits(config: &::prefilter::Config, max_memory: u64) -> envmap::Limits {
     let layers = (config.width as u64 * config.height as u64).saturating_mul(24 * config.exponents.len() as u64);
-    envmap::Limits::for_job(BYTES_PER_TEXEL, max_memory.saturating_sub(layers))
+    let per_texel = BYTES_PER_TEXEL + if config.cube { CUBE_BYTES_PER_TEXEL } else { 0 };
+    envmap::Limits::for_job(per_texel, max_memory.saturating_sub(layers))
 }
+
+/// What the cube mip chain adds per texel of the map: its faces hold 3/4 of the map's texels (six
+/// faces of `(w / 4)^2` for `w^2 / 2`), 4/3 of that with the levels, as `f32` RGB (12 bytes) and in
+/// the KTX2 file (up to 16 bytes): 28, rounded up.
+pub const CUBE_BYTES_PER_TEXEL: u64 = 32;
 
 /// Convolves `map` (read from `source`) with the lobes of `config`; `progress(done, total)` is
 /// called as the work advances (a progress bar's hook).
@@ -74,7 +83,22 @@ fn outputs(
     let chain = MipChain::new(map);
     let mips =
         prefilter::ktx::encode_mip_chain(&chain, config.storage, &writer).map_err(|e| encoding(MIPS_KTX2, &e))?;
-    let (layers_format, mips_format, clamped) = (layers.format, mips.format, layers.clamped + mips.clamped);
+    let (layers_format, mips_format, mut clamped) = (layers.format, mips.format, layers.clamped + mips.clamped);
+    // Cube maps for engines (not linked from the asset: the previewer reads the lat-long files).
+    let mut cube_files = Vec::new();
+    if config.cube {
+        let cube_layers = prefilter::cube::encode_layers(&layer_maps, config.storage, &writer)
+            .map_err(|e| encoding(LAYERS_CUBE_KTX2, &e))?;
+        let cube_mips = prefilter::cube::encode_mip_chain(&chain, config.storage, &writer)
+            .map_err(|e| encoding(MIPS_CUBE_KTX2, &e))?;
+        clamped += cube_layers.clamped + cube_mips.clamped;
+        for (name, role, bytes) in [
+            (LAYERS_CUBE_KTX2, "phong-layers-cube", cube_layers.bytes),
+            (MIPS_CUBE_KTX2, "environment-mips-cube", cube_mips.bytes),
+        ] {
+            cube_files.push(OutFile { name: name.into(), format: asset::FileFormat::Ktx2, role, bytes });
+        }
+    }
     let mips_ktx2 = linked(MIPS_KTX2.into(), asset::FileFormat::Ktx2, "environment-mips", mips.bytes);
     let mut layer_exrs = Vec::new();
     for layer in &prefiltered.layers {
@@ -116,6 +140,7 @@ fn outputs(
     .map_err(|e| encoding(ASSET, &e))?;
     // The asset names the other files with their hashes, so it comes last: a reader that finds it
     // finds them.
+    files.extend(cube_files);
     files.push(OutFile {
         name: ASSET.into(),
         format: asset::FileFormat::Asset,
@@ -163,6 +188,7 @@ fn outputs(
             ("size", json!([config.width, config.height])),
             ("method", json!(config.method.name())),
             ("storage", json!(config.storage.name())),
+            ("cube", json!(config.cube)),
         ]),
         figures: object([
             ("mip_levels", json!(chain.n_levels())),
