@@ -84,6 +84,7 @@
 
 pub mod cube;
 mod error;
+pub mod ggx;
 pub mod ktx;
 pub mod lobe;
 pub mod reference;
@@ -97,7 +98,7 @@ use envmap::EnvMap;
 use rayon::prelude::*;
 
 pub use error::Error;
-pub use lobe::{LayerMapping, legendre_coefficients, lobe, lobe_bandwidth};
+pub use lobe::{LayerMapping, Lobe, legendre_coefficients, lobe, lobe_bandwidth};
 pub use reference::Reference;
 pub use sheet::{COLUMNS, ContactSheet, MIN_PANEL_WIDTH, contact_sheet, panel_titles, signed};
 
@@ -237,13 +238,44 @@ pub fn prefilter_with_progress(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Prefiltered, Error> {
     config.check()?;
+    let lobes: Vec<Lobe> = config.exponents.iter().map(|&n| Lobe::Phong(n)).collect();
+    let sizes = vec![(config.width, config.height); lobes.len()];
+    let layers = convolve_lobes(map, &lobes, &sizes, config.method, progress)?
+        .into_iter()
+        .zip(&config.exponents)
+        .map(|(c, &exponent)| Layer { exponent, method: c.method, degree: c.degree, map: c.map })
+        .collect();
+    Ok(Prefiltered { layers, mapping: LayerMapping::new(&config.exponents) })
+}
+
+/// One convolution of [`convolve_lobes`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Convolved {
+    /// The method that computed it (never `Auto`).
+    pub method: Method,
+    /// The truncation degree, for [`Method::SphericalHarmonics`].
+    pub degree: Option<usize>,
+    pub map: EnvMap,
+}
+
+/// `map` convolved with each lobe, layer `k` on a lat-long grid of `sizes[k]` (`width = 2
+/// height`), by `method` (per layer the cheaper one for `Auto`). The map's harmonics are analysed
+/// once for every layer that uses them.
+pub fn convolve_lobes(
+    map: &EnvMap,
+    lobes: &[Lobe],
+    sizes: &[(usize, usize)],
+    method: Method,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Vec<Convolved>, Error> {
+    assert_eq!(lobes.len(), sizes.len(), "one size per lobe");
     let plan: Vec<(Method, Option<usize>)> =
-        config.exponents.par_iter().map(|&n| plan_layer(n, map, config)).collect::<Result<_, _>>()?;
+        lobes.par_iter().zip(sizes).map(|(lobe, &size)| plan_layer(lobe, map, size, method)).collect::<Result<_, _>>()?;
     let sh_degree = plan.iter().filter_map(|&(_, degree)| degree).max();
-    let n_window = plan.iter().filter(|(method, _)| *method == Method::Window).count() as u64;
-    let n_sh = plan.len() as u64 - n_window;
-    let h = config.height as u64;
-    let total = sh_degree.map_or(0, |l| 2 * (l as u64 + 1) + n_sh * h) + n_window * h;
+    let rows = |k: usize| sizes[k].1 as u64;
+    let sh_rows: u64 = (0..plan.len()).filter(|&k| plan[k].1.is_some()).map(rows).sum();
+    let window_rows: u64 = (0..plan.len()).filter(|&k| plan[k].0 == Method::Window).map(rows).sum();
+    let total = sh_degree.map_or(0, |l| 2 * (l as u64 + 1) + sh_rows) + window_rows;
     let done = AtomicU64::new(0);
     let tick = || {
         let done = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -253,54 +285,66 @@ pub fn prefilter_with_progress(
     let mut rgb: Vec<Option<Vec<f32>>> = vec![None; plan.len()];
     if let Some(l_max) = sh_degree {
         let coefficients = sh::analyse(map, l_max, &tick);
-        let specs: Vec<sh::LayerSpec> = plan
-            .iter()
-            .zip(&config.exponents)
-            .filter_map(|(&(_, degree), &n)| degree.map(|l| sh::LayerSpec { k: legendre_coefficients(n, l) }))
-            .collect();
-        let mut layers = sh::synthesize(&coefficients, &specs, config.width, config.height, &tick).into_iter();
-        for (slot, (_, degree)) in rgb.iter_mut().zip(&plan) {
+        // The layers of one size share the synthesis's recurrence: one pass per size.
+        let mut by_size: Vec<((usize, usize), Vec<usize>)> = Vec::new();
+        for (k, &(_, degree)) in plan.iter().enumerate() {
             if degree.is_some() {
-                *slot = layers.next();
+                match by_size.iter_mut().find(|(size, _)| *size == sizes[k]) {
+                    Some((_, ks)) => ks.push(k),
+                    None => by_size.push((sizes[k], vec![k])),
+                }
+            }
+        }
+        for ((width, height), ks) in by_size {
+            let specs: Vec<sh::LayerSpec> = ks
+                .iter()
+                .map(|&k| sh::LayerSpec { k: lobes[k].legendre_coefficients(plan[k].1.expect("harmonics")) })
+                .collect();
+            for (k, layer) in ks.into_iter().zip(sh::synthesize(&coefficients, &specs, width, height, &tick)) {
+                rgb[k] = Some(layer);
             }
         }
     }
-    for ((slot, (method, _)), &n) in rgb.iter_mut().zip(&plan).zip(&config.exponents) {
+    for (k, (method, _)) in plan.iter().enumerate() {
         if *method == Method::Window {
-            *slot = Some(window::convolve(map, n, config.width, config.height, &tick));
+            let (width, height) = sizes[k];
+            rgb[k] = Some(window::convolve(map, &lobes[k], width, height, &tick));
         }
     }
-    let layers = rgb
-        .into_iter()
+    rgb.into_iter()
         .zip(plan)
-        .zip(&config.exponents)
-        .map(|((rgb, (method, degree)), &exponent)| {
+        .zip(lobes.iter().zip(sizes))
+        .map(|((rgb, (method, degree)), (lobe, &(width, height)))| {
             let rgb = rgb.expect("every layer was computed");
-            let map = EnvMap::new(config.width, config.height, rgb)
-                .map_err(|e| Error::Overflow(format!("layer of exponent {exponent}: {e}")))?;
-            Ok(Layer { exponent, method, degree, map })
+            let map = EnvMap::new(width, height, rgb)
+                .map_err(|e| Error::Overflow(format!("layer of the {}: {e}", lobe.name())))?;
+            Ok(Convolved { method, degree, map })
         })
-        .collect::<Result<_, Error>>()?;
-    Ok(Prefiltered { layers, mapping: LayerMapping::new(&config.exponents) })
+        .collect()
 }
 
-/// The method and, for harmonics, the degree of the layer of exponent `n`.
-fn plan_layer(n: u32, map: &EnvMap, config: &Config) -> Result<(Method, Option<usize>), Error> {
-    let (width, height) = (config.width, config.height);
-    let degree = sh_degree(n);
-    match config.method {
+/// The method and, for harmonics, the degree of a layer of `lobe` of `(width, height)`.
+fn plan_layer(
+    lobe: &Lobe,
+    map: &EnvMap,
+    (width, height): (usize, usize),
+    method: Method,
+) -> Result<(Method, Option<usize>), Error> {
+    let degree = lobe_degree(lobe);
+    match method {
         Method::Auto => {
             // One step of the recurrence for one row pair costs about what one texel visit of the
             // direct sum does (about 3 ns each on 2 cores, measured for n = 4096 on quarry).
             let steps = sh::steps(degree, map.height(), height);
-            if degree > sh::MAX_DEGREE || window::visits(n, map.width(), map.height(), width, height) < steps {
+            if degree > sh::MAX_DEGREE || window::visits(lobe, map.width(), map.height(), width, height) < steps {
                 Ok((Method::Window, None))
             } else {
                 Ok((Method::SphericalHarmonics, Some(degree)))
             }
         }
         Method::SphericalHarmonics if degree > sh::MAX_DEGREE => Err(Error::InvalidConfig(format!(
-            "exponent {n} needs spherical harmonics of degree {degree}, above the limit of {}",
+            "the {} needs spherical harmonics of degree {degree}, above the limit of {}",
+            lobe.name(),
             sh::MAX_DEGREE
         ))),
         Method::SphericalHarmonics => Ok((Method::SphericalHarmonics, Some(degree))),
@@ -315,12 +359,22 @@ fn plan_layer(n: u32, map: &EnvMap, config: &Config) -> Result<(Method, Option<u
 /// there only far beyond it (the kink of `max(0, t)^n` at the horizon slows the series for small
 /// `n`). Above [`MAX_SH_DEGREE`] when the lobe is too narrow for harmonics.
 pub fn sh_degree(n: u32) -> usize {
-    // A smooth lobe's coefficients fall like exp(-l^2 / (2 n)): below 1e-13 beyond 8 sqrt(n).
-    let wanted = (8.0 * f64::from(n).sqrt()).ceil() as usize + 16;
+    lobe_degree(&Lobe::Phong(n))
+}
+
+/// [`sh_degree`] for any lobe. A Phong lobe's coefficients fall like `exp(-l^2 / (2 n))`: below
+/// 1e-13 beyond `8 sqrt(n)`. GGX's tails fall like `t^-4` in angle, so its spectrum falls only
+/// exponentially, like `exp(-2 alpha l)` roughly: below 1e-9 of its peak beyond about `12 /
+/// alpha`.
+pub fn lobe_degree(lobe: &Lobe) -> usize {
+    let wanted = match lobe {
+        Lobe::Phong(n) => (8.0 * f64::from(*n).sqrt()).ceil() as usize + 16,
+        Lobe::Ggx(g) => (12.0 / g.alpha).ceil() as usize + 16,
+    };
     if wanted > sh::MAX_DEGREE {
         return wanted;
     }
     let l_top = wanted.max(KINK_DEGREE);
-    let errors = lobe::truncation_errors(n, l_top);
+    let errors = lobe.truncation_errors(l_top);
     errors.iter().rposition(|&e| e > SH_EPSILON).map_or(0, |l| (l + 1).min(l_top))
 }

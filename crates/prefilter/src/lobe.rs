@@ -5,6 +5,8 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
+use crate::ggx::GgxLobe;
+
 /// `(n + 1) / (2 pi)`: the lobe's value at its peak, and the factor that makes it integrate to 1
 /// over the sphere. Only the hemisphere around `r` contributes (the `max(0, .)`), and there
 /// `int cos^n theta d omega = 2 pi int_0^1 t^n dt = 2 pi / (n + 1)`.
@@ -60,9 +62,59 @@ pub fn legendre_coefficients(n: u32, l_max: usize) -> Vec<f64> {
 /// angles spread evenly over `[0, pi]` (every `P_l`, `l <= l_top`, sampled at least 8 times per
 /// oscillation, so the largest error between samples is missed by a few percent at most).
 pub fn truncation_errors(n: u32, l_top: usize) -> Vec<f64> {
-    let k = legendre_coefficients(n, l_top);
-    let c: Vec<f64> = k.iter().enumerate().map(|(l, k)| (2 * l + 1) as f64 / (4.0 * PI) * k).collect();
-    let peak = normalization(n);
+    Lobe::Phong(n).truncation_errors(l_top)
+}
+
+/// A zonal lobe the map is convolved with: a function of `t = w . r` alone that integrates to 1
+/// over the sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lobe {
+    /// The normalized Phong lobe of exponent `n` ([`lobe`]).
+    Phong(u32),
+    /// The GGX lobe of the split-sum approximation ([`crate::ggx`]).
+    Ggx(GgxLobe),
+}
+
+impl Lobe {
+    /// The lobe at `t = w . r`.
+    pub fn eval(&self, t: f64) -> f64 {
+        match self {
+            Lobe::Phong(n) => lobe(*n, t),
+            Lobe::Ggx(g) => g.eval(t),
+        }
+    }
+
+    /// Its value at `t = 1`, the largest.
+    pub fn peak(&self) -> f64 {
+        match self {
+            Lobe::Phong(n) => normalization(*n),
+            Lobe::Ggx(g) => g.peak(),
+        }
+    }
+
+    /// `k_0 ..= k_{l_max}`: the Legendre coefficients (see [`legendre_coefficients`]).
+    pub fn legendre_coefficients(&self, l_max: usize) -> Vec<f64> {
+        match self {
+            Lobe::Phong(n) => legendre_coefficients(*n, l_max),
+            Lobe::Ggx(g) => g.legendre_coefficients(l_max),
+        }
+    }
+
+    /// A name for reports: `phong n 64`, `ggx alpha 0.25`.
+    pub fn name(&self) -> String {
+        match self {
+            Lobe::Phong(n) => format!("phong n {n}"),
+            Lobe::Ggx(g) => format!("ggx alpha {}", g.alpha),
+        }
+    }
+
+    /// [`truncation_errors`] of this lobe.
+    pub fn truncation_errors(&self, l_top: usize) -> Vec<f64> {
+        let k = self.legendre_coefficients(l_top);
+        let c: Vec<f64> = k.iter().enumerate().map(|(l, k)| (2 * l + 1) as f64 / (4.0 * PI) * k).collect();
+        let peak = self.peak();
+        let n = *self;
+        let lobe = move |t: f64| n.eval(t);
     let n_angles = 8 * l_top + 8;
     let max = |a: Vec<f64>, b: Vec<f64>| a.iter().zip(&b).map(|(a, b)| a.max(*b)).collect::<Vec<f64>>();
     (0..n_angles)
@@ -71,7 +123,7 @@ pub fn truncation_errors(n: u32, l_top: usize) -> Vec<f64> {
             || vec![0.0f64; l_top + 1],
             |mut errors, i| {
                 let t = (PI * (i as f64 + 0.5) / n_angles as f64).cos();
-                let exact = lobe(n, t);
+                let exact = lobe(t);
                 let (mut p0, mut p1) = (1.0, t);
                 let mut sum = c[0];
                 errors[0] = errors[0].max((exact - sum).abs() / peak);
@@ -87,6 +139,7 @@ pub fn truncation_errors(n: u32, l_top: usize) -> Vec<f64> {
             },
         )
         .reduce(|| vec![0.0f64; l_top + 1], max)
+    }
 }
 
 /// The angular bandwidth of the lobe of exponent `n`, in cycles per radian (the units of

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 use envmap::EnvMap;
 use rayon::prelude::*;
 
-use crate::lobe::normalization;
+use crate::lobe::{Lobe, normalization};
 
 /// The fraction of its peak below which the lobe is cut off. A source texel of power `P`
 /// (radiance times solid angle) just outside the cap would have added at most
@@ -21,15 +21,19 @@ use crate::lobe::normalization;
 /// `2e-6`, far below the darkest texels of a real map's layers.
 pub(crate) const WINDOW_EPSILON: f64 = 1e-9;
 
-/// The cosine of the cap's angular radius for exponent `n`: `eps^(1/n)`.
-pub(crate) fn cap_cos(n: u32) -> f64 {
-    (WINDOW_EPSILON.ln() / f64::from(n)).exp()
+/// The cosine of the cap's angular radius: `eps^(1/n)` for the Phong lobe of exponent `n`, found
+/// by bisection for GGX.
+pub(crate) fn cap_cos(lobe: &Lobe) -> f64 {
+    match lobe {
+        Lobe::Phong(n) => (WINDOW_EPSILON.ln() / f64::from(*n)).exp(),
+        Lobe::Ggx(g) => g.cap_cos(WINDOW_EPSILON),
+    }
 }
 
-/// How many source texels [`convolve`] visits for exponent `n`, a `source_width x source_height`
-/// map and a `width x height` layer (the spans' lengths, averaged over `phi_r`): its cost.
-pub(crate) fn visits(n: u32, source_width: usize, source_height: usize, width: usize, height: usize) -> f64 {
-    let cos_a = cap_cos(n);
+/// How many source texels [`convolve`] visits for `lobe`, a `source_width x source_height` map and
+/// a `width x height` layer (the spans' lengths, averaged over `phi_r`): its cost.
+pub(crate) fn visits(lobe: &Lobe, source_width: usize, source_height: usize, width: usize, height: usize) -> f64 {
+    let cos_a = cap_cos(lobe);
     let a = cos_a.acos();
     let (sw, sh) = (source_width as f64, source_height as f64);
     let mut total = 0.0;
@@ -50,11 +54,11 @@ pub(crate) fn visits(n: u32, source_width: usize, source_height: usize, width: u
     total
 }
 
-/// The convolution of `map` with the lobe of exponent `n` at the texel centres of a `width x
-/// height` lat-long grid, as interleaved RGB. Calls `tick` once per row done.
-pub(crate) fn convolve(map: &EnvMap, n: u32, width: usize, height: usize, tick: &(dyn Fn() + Sync)) -> Vec<f32> {
+/// The convolution of `map` with `lobe` at the texel centres of a `width x height` lat-long grid,
+/// as interleaved RGB. Calls `tick` once per row done.
+pub(crate) fn convolve(map: &EnvMap, lobe: &Lobe, width: usize, height: usize, tick: &(dyn Fn() + Sync)) -> Vec<f32> {
     let (sw, sh) = (map.width(), map.height());
-    let cos_a = cap_cos(n);
+    let cos_a = cap_cos(lobe);
     let a = cos_a.acos();
     let texels = map.texels();
     let phi: Vec<(f64, f64)> = (0..sw).map(|x| (2.0 * PI * (x as f64 + 0.5) / sw as f64).sin_cos()).collect();
@@ -64,7 +68,11 @@ pub(crate) fn convolve(map: &EnvMap, n: u32, width: usize, height: usize, tick: 
             (cos, sin, map.texel_solid_angle(y))
         })
         .collect();
-    let norm = normalization(n);
+    // The Phong lobe's weights are `norm t^n`, built by squaring; GGX's are the lobe itself.
+    let norm = match lobe {
+        Lobe::Phong(n) => normalization(*n),
+        Lobe::Ggx(_) => 1.0,
+    };
 
     let mut rgb = vec![0.0f32; 3 * width * height];
     rgb.par_chunks_mut(3 * width).enumerate().for_each(|(j, out_row)| {
@@ -117,7 +125,10 @@ pub(crate) fn convolve(map: &EnvMap, n: u32, width: usize, height: usize, tick: 
                     let segment = from..from + len;
                     ts.clear();
                     ts.extend(phi[segment.clone()].iter().map(|&(s, c)| aa + bc * c + bs * s));
-                    pow_n_in_place(&mut ts, &mut base, n, cos_a);
+                    match lobe {
+                        Lobe::Phong(n) => pow_n_in_place(&mut ts, &mut base, *n, cos_a),
+                        Lobe::Ggx(g) => ts.iter_mut().for_each(|t| *t = if *t >= cos_a { g.eval(*t) } else { 0.0 }),
+                    }
                     for (&weight, texel) in ts.iter().zip(&row[segment]) {
                         for (s, &v) in row_sum.iter_mut().zip(texel) {
                             *s += weight * f64::from(v);
