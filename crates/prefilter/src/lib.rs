@@ -269,8 +269,11 @@ pub fn convolve_lobes(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Convolved>, Error> {
     assert_eq!(lobes.len(), sizes.len(), "one size per lobe");
-    let plan: Vec<(Method, Option<usize>)> =
-        lobes.par_iter().zip(sizes).map(|(lobe, &size)| plan_layer(lobe, map, size, method)).collect::<Result<_, _>>()?;
+    let plan: Vec<(Method, Option<usize>)> = lobes
+        .par_iter()
+        .zip(sizes)
+        .map(|(lobe, &size)| plan_layer(lobe, map, size, method))
+        .collect::<Result<_, _>>()?;
     let sh_degree = plan.iter().filter_map(|&(_, degree)| degree).max();
     let rows = |k: usize| sizes[k].1 as u64;
     let sh_rows: u64 = (0..plan.len()).filter(|&k| plan[k].1.is_some()).map(rows).sum();

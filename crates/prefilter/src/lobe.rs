@@ -115,30 +115,30 @@ impl Lobe {
         let peak = self.peak();
         let n = *self;
         let lobe = move |t: f64| n.eval(t);
-    let n_angles = 8 * l_top + 8;
-    let max = |a: Vec<f64>, b: Vec<f64>| a.iter().zip(&b).map(|(a, b)| a.max(*b)).collect::<Vec<f64>>();
-    (0..n_angles)
-        .into_par_iter()
-        .fold(
-            || vec![0.0f64; l_top + 1],
-            |mut errors, i| {
-                let t = (PI * (i as f64 + 0.5) / n_angles as f64).cos();
-                let exact = lobe(t);
-                let (mut p0, mut p1) = (1.0, t);
-                let mut sum = c[0];
-                errors[0] = errors[0].max((exact - sum).abs() / peak);
-                for l in 1..=l_top {
-                    sum += c[l] * p1;
-                    errors[l] = errors[l].max((exact - sum).abs() / peak);
-                    let lf = l as f64;
-                    let p2 = ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0);
-                    p0 = p1;
-                    p1 = p2;
-                }
-                errors
-            },
-        )
-        .reduce(|| vec![0.0f64; l_top + 1], max)
+        let n_angles = 8 * l_top + 8;
+        let max = |a: Vec<f64>, b: Vec<f64>| a.iter().zip(&b).map(|(a, b)| a.max(*b)).collect::<Vec<f64>>();
+        (0..n_angles)
+            .into_par_iter()
+            .fold(
+                || vec![0.0f64; l_top + 1],
+                |mut errors, i| {
+                    let t = (PI * (i as f64 + 0.5) / n_angles as f64).cos();
+                    let exact = lobe(t);
+                    let (mut p0, mut p1) = (1.0, t);
+                    let mut sum = c[0];
+                    errors[0] = errors[0].max((exact - sum).abs() / peak);
+                    for l in 1..=l_top {
+                        sum += c[l] * p1;
+                        errors[l] = errors[l].max((exact - sum).abs() / peak);
+                        let lf = l as f64;
+                        let p2 = ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0);
+                        p0 = p1;
+                        p1 = p2;
+                    }
+                    errors
+                },
+            )
+            .reduce(|| vec![0.0f64; l_top + 1], max)
     }
 }
 

@@ -93,6 +93,25 @@ impl Reference {
         sums.iter().zip(exponents).map(|(sum, &n)| sum.map(|s| s * normalization(n))).collect()
     }
 
+    /// The convolution with any zonal lobe at the unit direction `r`, RGB: the same sum with
+    /// `lobe.eval(w_j . r)` as the weight (one lobe at a time; the Phong exponents have the faster
+    /// [`Reference::at`]).
+    pub fn at_lobe(&self, r: DVec3, lobe: &crate::Lobe) -> [f64; 3] {
+        let [dx, dy, dz] = &self.direction;
+        let mut sum = [0.0f64; 3];
+        for j in 0..dx.len() {
+            let t = dx[j] * r.x + dy[j] * r.y + dz[j] * r.z;
+            if t <= 0.0 {
+                continue;
+            }
+            let weight = lobe.eval(t);
+            for (c, s) in sum.iter_mut().enumerate() {
+                *s += weight * self.power[c][j];
+            }
+        }
+        sum
+    }
+
     /// [`Reference::at`] at the centre of texel `(x, y)` of a `width x height` lat-long grid.
     pub fn at_texel(&self, x: usize, y: usize, width: usize, height: usize, exponents: &[u32]) -> Vec<[f64; 3]> {
         let (u, v) = envmap::geometry::texel_center_uv(x, y, width, height);
