@@ -45,11 +45,10 @@ pub fn alpha(roughness: f64) -> f64 {
     roughness * roughness
 }
 
-/// The GGX normal distribution `D` at `c = cos^2 theta_h`.
+/// The GGX normal distribution `D` at `c = cos^2 theta_h` (`merl::analytic::ggx_d`, the one the
+/// toolchain's GGX tables use).
 pub fn distribution(alpha: f64, cos2: f64) -> f64 {
-    let a2 = alpha * alpha;
-    let d = cos2 * (a2 - 1.0) + 1.0;
-    a2 / (PI * d * d)
+    merl::analytic::ggx_d(alpha, cos2.sqrt())
 }
 
 /// The GGX lobe of one width, normalized (module docs).

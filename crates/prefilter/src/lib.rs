@@ -83,6 +83,7 @@
 //! of megabytes at `L = 411`.
 
 pub mod cube;
+pub mod dfg;
 mod error;
 pub mod ggx;
 pub mod ktx;

@@ -3,6 +3,7 @@
 mod accuracy;
 mod config;
 mod cube;
+mod dfg;
 mod ggx;
 mod ktx;
 mod lobe;
