@@ -112,8 +112,18 @@ pub fn encode_layers(layers: &[&EnvMap], storage: Storage, writer: &str) -> Resu
 /// chain has, down to faces of one texel.
 pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Encoded, Error> {
     let n = face_size(chain.level(0).width());
-    let levels = chain.n_levels().min(n.ilog2() as usize + 1);
-    let images: Vec<Vec<Vec<f32>>> = (0..levels).map(|l| faces(chain.level(l), (n >> l).max(1))).collect();
+    let levels: Vec<&EnvMap> = chain.levels().iter().take(n.ilog2() as usize + 1).collect();
+    encode_levels(&levels, storage, writer)
+}
+
+/// Lat-long levels (each half the size of the one before) as one KTX2 cube map with a level
+/// each: level `l` has faces of `max(1, n >> l)` texels, `n` the [`face_size`] of level 0's width.
+/// At most `log2 n + 1` levels.
+pub fn encode_levels(levels: &[&EnvMap], storage: Storage, writer: &str) -> Result<Encoded, Error> {
+    let Some(first) = levels.first() else { return Err(Error::InvalidConfig("a cube map needs a level".into())) };
+    let n = face_size(first.width());
+    let images: Vec<Vec<Vec<f32>>> =
+        levels.iter().enumerate().map(|(l, level)| faces(level, (n >> l).max(1))).collect();
     let level_refs: Vec<Vec<&[f32]>> = images.iter().map(|faces| faces.iter().map(Vec::as_slice).collect()).collect();
     ktx::encode(Shape { width: n, height: n, layers: 0, faces: 6 }, &level_refs, storage, writer)
 }

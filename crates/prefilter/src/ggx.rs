@@ -133,3 +133,65 @@ fn gauss_legendre_8() -> ([f64; 8], [f64; 8]) {
     let w = [0.362_683_783_378_362, 0.313_706_645_877_887_3, 0.222_381_034_453_374_5, 0.101_228_536_290_376_3];
     ([-x[3], -x[2], -x[1], -x[0], x[0], x[1], x[2], x[3]], [w[3], w[2], w[1], w[0], w[0], w[1], w[2], w[3]])
 }
+
+/// A GGX pre-filtered chain: level `m` is the map convolved with the GGX lobe of perceptual
+/// roughness `roughness[m] = m / (M - 1)` on a lat-long grid of `(width >> m) x (height >> m)`
+/// (module docs). Level 0, roughness 0, is the mirror: the map itself, box-filtered to the
+/// level's size (`envmap::MipChain`) when the map's width is `width` times a power of two, else
+/// its bilinear lookup at the level's texel centres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chain {
+    pub roughness: Vec<f64>,
+    pub levels: Vec<envmap::EnvMap>,
+    /// The method of each level from 1 on.
+    pub methods: Vec<crate::Method>,
+}
+
+/// The most levels a chain of level-0 width `width` may have: `log2(width) - 1`, so that its
+/// cube map (faces of `width / 4`) ends at faces of one texel and its lat-long grid at 4 x 2.
+pub fn max_levels(width: usize) -> usize {
+    if width < 4 { 0 } else { width.ilog2() as usize - 1 }
+}
+
+/// The GGX chain of `map` with `levels` levels from a `width x width / 2` level 0 (`levels` in
+/// `2..=max_levels(width)`, `width` even).
+pub fn chain(
+    map: &envmap::EnvMap,
+    width: usize,
+    levels: usize,
+    method: crate::Method,
+    progress: &(dyn Fn(crate::Progress) + Sync),
+) -> Result<Chain, crate::Error> {
+    if width < 2 || !width.is_multiple_of(2) || !(2..=max_levels(width)).contains(&levels) {
+        return Err(crate::Error::InvalidConfig(format!(
+            "a ggx chain of {levels} levels from a {width} x {} level 0: need an even width and 2 to {} levels",
+            width / 2,
+            max_levels(width)
+        )));
+    }
+    let roughness: Vec<f64> = (0..levels).map(|m| m as f64 / (levels - 1) as f64).collect();
+    let lobes: Vec<crate::Lobe> =
+        roughness[1..].iter().map(|&r| crate::Lobe::Ggx(GgxLobe::new(alpha(r).max(MIN_ALPHA)))).collect();
+    let sizes: Vec<(usize, usize)> = (1..levels).map(|m| (width >> m, (width / 2) >> m)).collect();
+    let convolved = crate::convolve_lobes(map, &lobes, &sizes, method, progress)?;
+    let mirror = mirror_level(map, width);
+    let methods = convolved.iter().map(|c| c.method).collect();
+    let levels = std::iter::once(mirror).chain(convolved.into_iter().map(|c| c.map)).collect();
+    Ok(Chain { roughness, levels, methods })
+}
+
+/// The map at `width x width / 2` (see [`Chain`]).
+fn mirror_level(map: &envmap::EnvMap, width: usize) -> envmap::EnvMap {
+    let chain = envmap::MipChain::new(map);
+    if let Some(level) = chain.levels().iter().find(|l| l.width() == width) {
+        return level.clone();
+    }
+    let height = width / 2;
+    let rgb = (0..width * height)
+        .flat_map(|k| {
+            let (u, v) = envmap::geometry::texel_center_uv(k % width, k / width, width, height);
+            map.lookup_uv(u, v)
+        })
+        .collect();
+    envmap::EnvMap::new(width, height, rgb).expect("bilinear lookups of a valid map are valid")
+}

@@ -161,6 +161,9 @@ pub struct Config {
     pub storage: ktx::Storage,
     /// Also write the layers and the mip chain as KTX2 cube maps ([`cube`]).
     pub cube: bool,
+    /// Also compute a GGX chain of this many levels from a `width x height` level 0 ([`ggx`]); 0
+    /// for none.
+    pub ggx_levels: usize,
 }
 
 impl Default for Config {
@@ -173,6 +176,7 @@ impl Default for Config {
             method: Method::Auto,
             storage: ktx::Storage::Auto,
             cube: false,
+            ggx_levels: 0,
         }
     }
 }
@@ -194,6 +198,15 @@ impl Config {
             return invalid(format!(
                 "layer size {} x {}: expected width = 2 x height, height 1 ..= {MAX_LAYER_HEIGHT}",
                 self.width, self.height
+            ));
+        }
+        if self.ggx_levels != 0 && !(2..=ggx::max_levels(self.width)).contains(&self.ggx_levels) {
+            return invalid(format!(
+                "{} ggx levels from a {} x {} level 0: 2 to {}",
+                self.ggx_levels,
+                self.width,
+                self.height,
+                ggx::max_levels(self.width)
             ));
         }
         Ok(())

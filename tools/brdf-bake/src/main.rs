@@ -76,6 +76,11 @@ struct Args {
     #[arg(long, requires = "env")]
     cube: bool,
 
+    /// Also write the environment's GGX chain of M levels and the split-sum DFG table (ggx.ktx2,
+    /// dfg.ktx2, dfg.png; see envmap-prefilter --help).
+    #[arg(long, value_name = "M", requires = "env")]
+    ggx_levels: Option<usize>,
+
     /// Store the environment's KTX2 files as half floats even where texels exceed 65504, clamping
     /// them (the default stores such a file as single floats).
     #[arg(long)]
@@ -131,6 +136,7 @@ fn run(args: Args) -> Result<ExitCode> {
         config.prefilter.storage = prefilter::ktx::Storage::ClampHalf;
     }
     config.prefilter.cube = args.cube;
+    config.prefilter.ggx_levels = args.ggx_levels.unwrap_or(0);
     config.env_bandwidth.max_memory = args.max_memory;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {

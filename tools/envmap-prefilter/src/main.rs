@@ -57,6 +57,13 @@ struct Args {
     #[arg(long)]
     cube: bool,
 
+    /// Also write the GGX chain engines read (split sum, n = v = r): ggx.ktx2, M mip levels from
+    /// the --size grid down, level m at perceptual roughness m / (M - 1) (alpha = roughness^2;
+    /// level 0 the mirror), ggx-cube.ktx2 with --cube, and the split-sum DFG table (dfg.ktx2: A
+    /// in red, B in green of F0 A + B; dfg.png). At most log2(WIDTH) - 1 levels (7 for 256x128).
+    #[arg(long, value_name = "M")]
+    ggx_levels: Option<usize>,
+
     /// Store the KTX2 files as half floats even when some texels exceed 65504, clamping those
     /// (smaller files; the default stores such a file as single floats).
     #[arg(long)]
@@ -108,6 +115,7 @@ fn run(args: Args) -> Result<ExitCode> {
         method: args.method.into(),
         storage: if args.clamp_half { prefilter::ktx::Storage::ClampHalf } else { prefilter::ktx::Storage::Auto },
         cube: args.cube,
+        ggx_levels: args.ggx_levels.unwrap_or(0),
     };
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);

@@ -11,6 +11,8 @@ use serde_json::json;
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
+pub mod ggx;
+
 pub const ASSET: &str = "prefiltered.asset";
 pub const LAYERS_KTX2: &str = "layers.ktx2";
 pub const MIPS_KTX2: &str = "mips.ktx2";
@@ -35,7 +37,10 @@ pub const BYTES_PER_TEXEL: u64 = 60;
 /// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`], plus [`CUBE_BYTES_PER_TEXEL`] with
 /// cube maps.
 pub fn limits(config: &::prefilter::Config, max_memory: u64) -> envmap::Limits {
-    let layers = (config.width as u64 * config.height as u64).saturating_mul(24 * config.exponents.len() as u64);
+    // A GGX chain holds 4/3 of a layer in its levels, encoded once more: counted as 2 layers.
+    let ggx = if config.ggx_levels > 0 { 2 } else { 0 };
+    let layers =
+        (config.width as u64 * config.height as u64).saturating_mul(24 * (config.exponents.len() as u64 + ggx));
     let per_texel = BYTES_PER_TEXEL + if config.cube { CUBE_BYTES_PER_TEXEL } else { 0 };
     envmap::Limits::for_job(per_texel, max_memory.saturating_sub(layers))
 }
@@ -57,7 +62,19 @@ pub fn run(
     config.check().map_err(|e| Error::stage("prefilter", e))?;
     let prefiltered = prefilter::prefilter_with_progress(map, config, &|p| progress(p.done, p.total))
         .map_err(|e| Error::stage("prefilter", e))?;
-    let staged = outputs(map, source, program, config, &prefiltered)?;
+    let mut staged = outputs(map, source, program, config, &prefiltered)?;
+    if config.ggx_levels > 0 {
+        let writer = format!("{} {}", program.name, program.version);
+        let ggx = ggx::outputs(map, config, &writer, progress)?;
+        // The manifest entries list the files in order; the asset stays last.
+        let asset = staged.files.pop().expect("the asset");
+        staged.files.extend(ggx.files);
+        staged.files.push(asset);
+        staged.figures.extend(ggx.figures.into_iter().map(|(k, v)| (k.to_string(), v)));
+        let clamped = staged.figures.get("clamped_values").and_then(serde_json::Value::as_u64).unwrap_or(0);
+        staged.figures.insert("clamped_values".into(), json!(clamped + ggx.clamped as u64));
+        staged.report.extend(ggx.report);
+    }
     Ok((staged, prefiltered))
 }
 
@@ -189,6 +206,7 @@ fn outputs(
             ("method", json!(config.method.name())),
             ("storage", json!(config.storage.name())),
             ("cube", json!(config.cube)),
+            ("ggx_levels", json!(config.ggx_levels)),
         ]),
         figures: object([
             ("mip_levels", json!(chain.n_levels())),
