@@ -74,6 +74,83 @@ fn main() {
             p99
         );
     }
+    engine_outputs(dir);
+}
+
+/// The engine outputs (issue 13) against the Phong array, measured in the same run on the same
+/// map: the GGX chain (default 7 levels from 256 x 128) with its accuracy against the brute force
+/// on every 8th texel of every level, the cube maps, the DFG table.
+fn engine_outputs(dir: &std::path::Path) {
+    let config = Config::default();
+    println!();
+    println!("{:<24} {:<40} {:>10} {:>10} {:>16}", "map", "output", "time (med)", "x array", "worst rel. RMSE");
+    for name in MAPS {
+        let map = envmap::load(&dir.join(name)).expect("a shared map");
+        let time = |f: &mut dyn FnMut()| {
+            median(
+                (0..RUNS)
+                    .map(|_| {
+                        let start = Instant::now();
+                        f();
+                        start.elapsed()
+                    })
+                    .collect(),
+            )
+        };
+        let mut layers = None;
+        let array = time(&mut || layers = Some(prefilter(&map, &config).expect("default config")));
+        let layers = layers.expect("ran");
+        let mut chain = None;
+        let ggx = time(&mut || {
+            chain = Some(prefilter::ggx::chain(&map, config.width, 7, Method::Auto, &|_| {}).expect("7 levels"))
+        });
+        let chain = chain.expect("ran");
+        let reference = Reference::new(&map);
+        let mut worst = 0.0f64;
+        for (level, &rho) in chain.levels.iter().zip(&chain.roughness).skip(1) {
+            let lobe = prefilter::Lobe::Ggx(prefilter::ggx::GgxLobe::new(prefilter::ggx::alpha(rho)));
+            let (w, h) = (level.width(), level.height());
+            let step = if w >= 64 { STEP } else { 1 };
+            let texels: Vec<(usize, usize)> =
+                (0..h).step_by(step).flat_map(|y| (0..w).step_by(step).map(move |x| (x, y))).collect();
+            let (num, den) = texels
+                .par_iter()
+                .map(|&(x, y)| {
+                    let (u, v) = envmap::geometry::texel_center_uv(x, y, w, h);
+                    let r = reference.at_lobe(envmap::direction(u, v), &lobe);
+                    let ours = level.texel(x, y);
+                    (0..3).fold((0.0, 0.0), |(n, d), c| (n + (f64::from(ours[c]) - r[c]).powi(2), d + r[c] * r[c]))
+                })
+                .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+            worst = worst.max((num / den).sqrt());
+        }
+        let maps: Vec<&EnvMap> = layers.layers.iter().map(|l| &l.map).collect();
+        let cube_layers = time(&mut || {
+            prefilter::cube::encode_layers(&maps, prefilter::ktx::Storage::Auto, "bench").expect("cube");
+        });
+        let levels: Vec<&EnvMap> = chain.levels.iter().collect();
+        let cube_ggx = time(&mut || {
+            prefilter::cube::encode_levels(&levels, prefilter::ktx::Storage::Auto, "bench").expect("cube");
+        });
+        let dfg = time(&mut || {
+            std::hint::black_box(prefilter::dfg::table(prefilter::dfg::DFG_SIZE));
+        });
+        let row = |what: &str, t: Duration, accuracy: String| {
+            println!(
+                "{:<24} {:<40} {:>7.1} ms {:>10.2} {:>16}",
+                name,
+                what,
+                t.as_secs_f64() * 1e3,
+                t.as_secs_f64() / array.as_secs_f64(),
+                accuracy
+            );
+        };
+        row("baseline: phong array, 7 x 256 x 128", array, "(table above)".into());
+        row("ggx chain, 7 levels from 256 x 128", ggx, format!("{worst:.2e}"));
+        row("phong array as cube maps (+ encoding)", cube_layers, "resampled".into());
+        row("ggx chain as a cube map (+ encoding)", cube_ggx, "resampled".into());
+        row("dfg table 128 x 128, 2048 samples", dfg, "< 1e-3 (tests)".into());
+    }
 }
 
 /// The worst layer's relative RMSE and 99th-percentile relative error (floor 1e-3 of the mean),

@@ -105,8 +105,7 @@ fn a_chain_halves_its_levels_and_keeps_the_mean_radiance() {
     assert_eq!(chain.levels[0], envmap::MipChain::new(&map).levels()[4]);
     // Every lobe integrates to 1: every level keeps the source's solid-angle-weighted mean, up to
     // the midpoint quadrature of the level's own grid (measured: 1.4e-3 at 32 x 16, 4e-3 at 16 x 8,
-    // 6% at 4 x 2, where
-    // eight texel centres stand for the sphere); checked down to 16 x 8.
+    // 6% at 4 x 2, where eight texel centres stand for the sphere); checked down to 16 x 8.
     let source = map.mean_radiance();
     for (m, level) in chain.levels.iter().enumerate().take(3) {
         let mean = level.mean_radiance();
