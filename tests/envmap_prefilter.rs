@@ -347,7 +347,7 @@ fn killed_while_writing_the_folder_stays_consistent() {
 }
 
 /// The KTX2 files as three.js reads them: `ktx-parse` (the parser of its KTX2Loader), run by
-/// node on `tests/ktx-parse/check.mjs`, parses every file `--cube --ggx-levels` writes, and finds the shape,
+/// node on `tests/ktx-parse/check.mjs`, parses every file `--cube --ggx-levels --chain` writes, and finds the shape,
 /// format, level sizes, descriptor and only the specification's keys. `make setup` installs it.
 #[test]
 fn ktx_parse_reads_the_lat_long_and_cube_files() {
@@ -361,10 +361,19 @@ fn ktx_parse_reads_the_lat_long_and_cube_files() {
     let out = tmp.path().join("prefiltered");
     let mut cmd = tool("envmap-prefilter");
     cmd.arg(env_dir().join("quarry_01_1k.hdr")).arg("--out-dir").arg(&out);
-    cmd.args(["--size", "64x32", "--exponents", "1,64", "--cube", "--ggx-levels", "5", "--quiet"]);
+    cmd.args(["--size", "64x32", "--exponents", "1,64", "--cube", "--ggx-levels", "5", "--chain", "--quiet"]);
     run(cmd, "").expect_code(0);
-    let names =
-        ["layers.ktx2", "mips.ktx2", "layers-cube.ktx2", "mips-cube.ktx2", "ggx.ktx2", "ggx-cube.ktx2", "dfg.ktx2"];
+    let names = [
+        "layers.ktx2",
+        "mips.ktx2",
+        "layers-cube.ktx2",
+        "mips-cube.ktx2",
+        "ggx.ktx2",
+        "ggx-cube.ktx2",
+        "dfg.ktx2",
+        "phong-chain.ktx2",
+        "phong-chain-cube.ktx2",
+    ];
     let mut node = std::process::Command::new("node");
     node.arg(&script).args(names.map(|n| out.join(n)));
     let r = run(node, "").expect_code(0);
@@ -380,6 +389,8 @@ fn ktx_parse_reads_the_lat_long_and_cube_files() {
         (1, 0, 64, 32, 5),
         (6, 0, 16, 16, 5),
         (1, 0, 128, 128, 1),
+        (1, 0, 64, 32, 2),
+        (6, 0, 16, 16, 2),
     ];
     for (json, (name, (faces, layers, width, height, levels))) in parsed.iter().zip(names.iter().zip(shapes)) {
         let found = (&json["faceCount"], &json["layerCount"], &json["pixelWidth"], &json["pixelHeight"]);

@@ -115,7 +115,7 @@ impl BakeConfig {
                 "prefilter",
                 json!({
                     "exponents": p.exponents, "size": [p.width, p.height], "method": p.method.name(),
-                    "storage": p.storage.name(), "cube": p.cube, "ggx_levels": p.ggx_levels,
+                    "storage": p.storage.name(), "cube": p.cube, "ggx_levels": p.ggx_levels, "chain": p.chain,
                 }),
             ),
             ("layer_reduction", json!(self.layer_reduction.name())),

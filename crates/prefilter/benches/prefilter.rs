@@ -124,6 +124,9 @@ fn engine_outputs(dir: &std::path::Path) {
                 .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
             worst = worst.max((num / den).sqrt());
         }
+        let phong_chain = time(&mut || {
+            std::hint::black_box(prefilter::phong_chain(&map, &config, &|_| {}).expect("7 levels"));
+        });
         let maps: Vec<&EnvMap> = layers.layers.iter().map(|l| &l.map).collect();
         let cube_layers = time(&mut || {
             prefilter::cube::encode_layers(&maps, prefilter::ktx::Storage::Auto, "bench").expect("cube");
@@ -146,6 +149,7 @@ fn engine_outputs(dir: &std::path::Path) {
             );
         };
         row("baseline: phong array, 7 x 256 x 128", array, "(table above)".into());
+        row("phong chain, 4096..1 from 256 x 128", phong_chain, "as the array".into());
         row("ggx chain, 7 levels from 256 x 128", ggx, format!("{worst:.2e}"));
         row("phong array as cube maps (+ encoding)", cube_layers, "resampled".into());
         row("ggx chain as a cube map (+ encoding)", cube_ggx, "resampled".into());

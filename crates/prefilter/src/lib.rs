@@ -164,6 +164,8 @@ pub struct Config {
     /// Also compute a GGX chain of this many levels from a `width x height` level 0 ([`ggx`]); 0
     /// for none.
     pub ggx_levels: usize,
+    /// Also compute the exponents as one mip chain ([`phong_chain`]).
+    pub chain: bool,
 }
 
 impl Default for Config {
@@ -177,6 +179,7 @@ impl Default for Config {
             storage: ktx::Storage::Auto,
             cube: false,
             ggx_levels: 0,
+            chain: false,
         }
     }
 }
@@ -200,6 +203,9 @@ impl Config {
                 self.width, self.height
             ));
         }
+        if self.chain {
+            self.check_chain()?;
+        }
         if self.ggx_levels != 0 && !(2..=ggx::max_levels(self.width)).contains(&self.ggx_levels) {
             return invalid(format!(
                 "{} ggx levels from a {} x {} level 0: 2 to {}",
@@ -208,6 +214,22 @@ impl Config {
                 self.height,
                 ggx::max_levels(self.width)
             ));
+        }
+        Ok(())
+    }
+}
+
+impl Config {
+    /// The exponents fit one mip chain from the layers' size ([`phong_chain`]).
+    pub fn check_chain(&self) -> Result<(), Error> {
+        if self.exponents.len() > ggx::max_levels(self.width) {
+            return Err(Error::InvalidConfig(format!(
+                "a chain of {} exponents from a {} x {} level 0: at most {} levels",
+                self.exponents.len(),
+                self.width,
+                self.height,
+                ggx::max_levels(self.width)
+            )));
         }
         Ok(())
     }
@@ -260,6 +282,25 @@ pub fn prefilter_with_progress(
         .map(|(c, &exponent)| Layer { exponent, method: c.method, degree: c.degree, map: c.map })
         .collect();
     Ok(Prefiltered { layers, mapping: LayerMapping::new(&config.exponents) })
+}
+
+/// The exponents as one mip chain, the layout engines read (cmft's): level `m` holds the `m`-th
+/// largest exponent on a `(width >> m) x (height >> m)` grid, so the sharpest lobe gets the finest
+/// level and every factor 4 in exponent (a factor 2 in lobe width) costs a level (half the
+/// resolution): the default exponents give cmft's `4096, 1024, ..., 1` from `width x height` down,
+/// the texels per lobe width about constant. Returns `(exponent, level)` pairs, level 0 first.
+pub fn phong_chain(
+    map: &EnvMap,
+    config: &Config,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Vec<(u32, EnvMap)>, Error> {
+    config.check()?;
+    config.check_chain()?;
+    let exponents: Vec<u32> = config.exponents.iter().rev().copied().collect();
+    let lobes: Vec<Lobe> = exponents.iter().map(|&n| Lobe::Phong(n)).collect();
+    let sizes: Vec<(usize, usize)> = (0..lobes.len()).map(|m| (config.width >> m, config.height >> m)).collect();
+    let levels = convolve_lobes(map, &lobes, &sizes, config.method, progress)?;
+    Ok(exponents.into_iter().zip(levels.into_iter().map(|c| c.map)).collect())
 }
 
 /// One convolution of [`convolve_lobes`].

@@ -1,6 +1,7 @@
 //! All integration tests of the `prefilter` crate, one module per topic, in one binary.
 
 mod accuracy;
+mod chain;
 mod config;
 mod cube;
 mod dfg;

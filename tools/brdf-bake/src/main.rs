@@ -76,6 +76,12 @@ struct Args {
     #[arg(long, requires = "env")]
     cube: bool,
 
+    /// Also write the Phong exponents as one mip chain, the layout engines read (cmft's):
+    /// phong-chain.ktx2, level m the m-th sharpest exponent at (WIDTH >> m) x (HEIGHT >> m) (the
+    /// defaults give 4096, 1024, ..., 1 from 256 x 128 down), and phong-chain-cube.ktx2 with --cube.
+    #[arg(long, requires = "env")]
+    chain: bool,
+
     /// Also write the environment's GGX chain of M levels and the split-sum DFG table (ggx.ktx2,
     /// dfg.ktx2, dfg.png; see envmap-prefilter --help).
     #[arg(long, value_name = "M", requires = "env")]
@@ -137,6 +143,7 @@ fn run(args: Args) -> Result<ExitCode> {
     }
     config.prefilter.cube = args.cube;
     config.prefilter.ggx_levels = args.ggx_levels.unwrap_or(0);
+    config.prefilter.chain = args.chain;
     config.env_bandwidth.max_memory = args.max_memory;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {

@@ -57,6 +57,12 @@ struct Args {
     #[arg(long)]
     cube: bool,
 
+    /// Also write the Phong exponents as one mip chain, the layout engines read (cmft's):
+    /// phong-chain.ktx2, level m the m-th sharpest exponent at (WIDTH >> m) x (HEIGHT >> m) (the
+    /// defaults give 4096, 1024, ..., 1 from 256 x 128 down), and phong-chain-cube.ktx2 with --cube.
+    #[arg(long)]
+    chain: bool,
+
     /// Also write the GGX chain engines read (split sum, n = v = r): ggx.ktx2, M mip levels from
     /// the --size grid down, level m at perceptual roughness m / (M - 1) (alpha = roughness^2;
     /// level 0 the mirror), ggx-cube.ktx2 with --cube, and the split-sum DFG table (dfg.ktx2: A
@@ -116,6 +122,7 @@ fn run(args: Args) -> Result<ExitCode> {
         storage: if args.clamp_half { prefilter::ktx::Storage::ClampHalf } else { prefilter::ktx::Storage::Auto },
         cube: args.cube,
         ggx_levels: args.ggx_levels.unwrap_or(0),
+        chain: args.chain,
     };
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);

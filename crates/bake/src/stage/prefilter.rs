@@ -11,7 +11,7 @@ use serde_json::json;
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
-pub mod ggx;
+pub mod engine;
 
 pub const ASSET: &str = "prefiltered.asset";
 pub const LAYERS_KTX2: &str = "layers.ktx2";
@@ -37,8 +37,9 @@ pub const BYTES_PER_TEXEL: u64 = 60;
 /// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`], plus [`CUBE_BYTES_PER_TEXEL`] with
 /// cube maps.
 pub fn limits(config: &::prefilter::Config, max_memory: u64) -> envmap::Limits {
-    // A GGX chain holds 4/3 of a layer in its levels, encoded once more: counted as 2 layers.
-    let ggx = if config.ggx_levels > 0 { 2 } else { 0 };
+    // A chain (GGX or Phong) holds 4/3 of a layer in its levels, encoded once more: counted as 2
+    // layers each.
+    let ggx = 2 * (u64::from(config.ggx_levels > 0) + u64::from(config.chain));
     let layers =
         (config.width as u64 * config.height as u64).saturating_mul(24 * (config.exponents.len() as u64 + ggx));
     let per_texel = BYTES_PER_TEXEL + if config.cube { CUBE_BYTES_PER_TEXEL } else { 0 };
@@ -63,17 +64,17 @@ pub fn run(
     let prefiltered = prefilter::prefilter_with_progress(map, config, &|p| progress(p.done, p.total))
         .map_err(|e| Error::stage("prefilter", e))?;
     let mut staged = outputs(map, source, program, config, &prefiltered)?;
-    if config.ggx_levels > 0 {
+    if config.chain || config.ggx_levels > 0 {
         let writer = format!("{} {}", program.name, program.version);
-        let ggx = ggx::outputs(map, config, &writer, progress)?;
+        let engine = engine::outputs(map, config, &writer, progress)?;
         // The manifest entries list the files in order; the asset stays last.
         let asset = staged.files.pop().expect("the asset");
-        staged.files.extend(ggx.files);
+        staged.files.extend(engine.files);
         staged.files.push(asset);
-        staged.figures.extend(ggx.figures.into_iter().map(|(k, v)| (k.to_string(), v)));
+        staged.figures.extend(engine.figures.into_iter().map(|(k, v)| (k.to_string(), v)));
         let clamped = staged.figures.get("clamped_values").and_then(serde_json::Value::as_u64).unwrap_or(0);
-        staged.figures.insert("clamped_values".into(), json!(clamped + ggx.clamped as u64));
-        staged.report.extend(ggx.report);
+        staged.figures.insert("clamped_values".into(), json!(clamped + engine.clamped as u64));
+        staged.report.extend(engine.report);
     }
     Ok((staged, prefiltered))
 }
@@ -207,6 +208,7 @@ fn outputs(
             ("storage", json!(config.storage.name())),
             ("cube", json!(config.cube)),
             ("ggx_levels", json!(config.ggx_levels)),
+            ("chain", json!(config.chain)),
         ]),
         figures: object([
             ("mip_levels", json!(chain.n_levels())),
