@@ -7,6 +7,7 @@ use std::path::Path;
 
 use envmap::{EnvMap, MipChain, SampleType};
 use prefilter::{Config, Method, Prefiltered};
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
@@ -88,27 +89,54 @@ fn outputs(
 ) -> Result<Staged, Error> {
     let writer = format!("{} {}", program.name, program.version);
     let encoding = |what: &str, e: &dyn std::fmt::Display| Error::Internal(format!("encoding {what}: {e}"));
-    let mut files = Vec::new();
-    let mut linked = |name: String, format, role, bytes: Vec<u8>| -> asset::LinkedFile {
-        let file = asset::LinkedFile { name: name.clone(), sha256: asset::sha256(&bytes) };
-        files.push(OutFile { name, format, role, bytes });
-        file
-    };
     let layer_maps: Vec<&EnvMap> = prefiltered.layers.iter().map(|layer| &layer.map).collect();
-    let layers =
-        prefilter::ktx::encode_array(&layer_maps, config.storage, &writer).map_err(|e| encoding(LAYERS_KTX2, &e))?;
-    let layers_ktx2 = linked(LAYERS_KTX2.into(), asset::FileFormat::Ktx2, "phong-layers", layers.bytes);
     let chain = MipChain::new(map);
-    let mips =
-        prefilter::ktx::encode_mip_chain(&chain, config.storage, &writer).map_err(|e| encoding(MIPS_KTX2, &e))?;
+    // The encoders are serial (the EXR and PNG compressors above all): run them side by side.
+    let ktx =
+        |result: Result<prefilter::ktx::Encoded, prefilter::Error>, name: &str| result.map_err(|e| encoding(name, &e));
+    let ((layers, mips), (exrs, (png, cubes))) = rayon::join(
+        || {
+            rayon::join(
+                || ktx(prefilter::ktx::encode_array(&layer_maps, config.storage, &writer), LAYERS_KTX2),
+                || ktx(prefilter::ktx::encode_mip_chain(&chain, config.storage, &writer), MIPS_KTX2),
+            )
+        },
+        || {
+            let exrs = || {
+                prefiltered
+                    .layers
+                    .par_iter()
+                    .map(|layer| {
+                        let name = layer_exr(layer.exponent);
+                        let bytes = layer.map.encode_exr(SampleType::F32).map_err(|e| encoding(&name, &e))?;
+                        Ok((name, bytes))
+                    })
+                    .collect::<Result<Vec<_>, Error>>()
+            };
+            let png = || {
+                let exponents_and_maps: Vec<(u32, &EnvMap)> =
+                    prefiltered.layers.iter().map(|layer| (layer.exponent, &layer.map)).collect();
+                let sheet = prefilter::contact_sheet(&chain, &exponents_and_maps);
+                envmap::encode_png_rgb8(sheet.width, sheet.height, &sheet.rgb8).map_err(|e| encoding(CONTACT_SHEET, &e))
+            };
+            // Cube maps for engines (not linked from the asset: the previewer reads the lat-long
+            // files).
+            let cubes = || -> Result<Option<_>, Error> {
+                if !config.cube {
+                    return Ok(None);
+                }
+                Ok(Some((
+                    ktx(prefilter::cube::encode_layers(&layer_maps, config.storage, &writer), LAYERS_CUBE_KTX2)?,
+                    ktx(prefilter::cube::encode_mip_chain(&chain, config.storage, &writer), MIPS_CUBE_KTX2)?,
+                )))
+            };
+            rayon::join(exrs, || rayon::join(png, cubes))
+        },
+    );
+    let (layers, mips, exrs, png, cubes) = (layers?, mips?, exrs?, png?, cubes?);
     let (layers_format, mips_format, mut clamped) = (layers.format, mips.format, layers.clamped + mips.clamped);
-    // Cube maps for engines (not linked from the asset: the previewer reads the lat-long files).
     let mut cube_files = Vec::new();
-    if config.cube {
-        let cube_layers = prefilter::cube::encode_layers(&layer_maps, config.storage, &writer)
-            .map_err(|e| encoding(LAYERS_CUBE_KTX2, &e))?;
-        let cube_mips = prefilter::cube::encode_mip_chain(&chain, config.storage, &writer)
-            .map_err(|e| encoding(MIPS_CUBE_KTX2, &e))?;
+    if let Some((cube_layers, cube_mips)) = cubes {
         clamped += cube_layers.clamped + cube_mips.clamped;
         for (name, role, bytes) in [
             (LAYERS_CUBE_KTX2, "phong-layers-cube", cube_layers.bytes),
@@ -117,18 +145,16 @@ fn outputs(
             cube_files.push(OutFile { name: name.into(), format: asset::FileFormat::Ktx2, role, bytes });
         }
     }
+    let mut files = Vec::new();
+    let mut linked = |name: String, format, role, bytes: Vec<u8>| -> asset::LinkedFile {
+        let file = asset::LinkedFile { name: name.clone(), sha256: asset::sha256(&bytes) };
+        files.push(OutFile { name, format, role, bytes });
+        file
+    };
+    let layers_ktx2 = linked(LAYERS_KTX2.into(), asset::FileFormat::Ktx2, "phong-layers", layers.bytes);
     let mips_ktx2 = linked(MIPS_KTX2.into(), asset::FileFormat::Ktx2, "environment-mips", mips.bytes);
-    let mut layer_exrs = Vec::new();
-    for layer in &prefiltered.layers {
-        let name = layer_exr(layer.exponent);
-        let bytes = layer.map.encode_exr(SampleType::F32).map_err(|e| encoding(&name, &e))?;
-        layer_exrs.push(linked(name, asset::FileFormat::Exr, "phong-layer-exr", bytes));
-    }
-    let exponents_and_maps: Vec<(u32, &EnvMap)> =
-        prefiltered.layers.iter().map(|layer| (layer.exponent, &layer.map)).collect();
-    let sheet = prefilter::contact_sheet(&chain, &exponents_and_maps);
-    let png =
-        envmap::encode_png_rgb8(sheet.width, sheet.height, &sheet.rgb8).map_err(|e| encoding(CONTACT_SHEET, &e))?;
+    let layer_exrs: Vec<asset::LinkedFile> =
+        exrs.into_iter().map(|(name, bytes)| linked(name, asset::FileFormat::Exr, "phong-layer-exr", bytes)).collect();
     let contact_sheet_png = linked(CONTACT_SHEET.into(), asset::FileFormat::Png, "phong-layers-picture", png);
 
     let source_mean = map.mean_radiance();
