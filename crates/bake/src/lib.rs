@@ -124,9 +124,11 @@ impl Staged {
 
     /// The stage's manifest entry (paths are the file names).
     pub fn manifest_stage(&self) -> Result<asset::Stage, Error> {
+        // Hashing is most of the work: the files in parallel, in order.
+        use rayon::prelude::*;
         let outputs = self
             .files
-            .iter()
+            .par_iter()
             .map(|f| StageOutput::of_bytes(&f.name, f.format, f.role, &f.bytes))
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| Error::Internal(format!("describing the outputs of stage {}: {e}", self.name)))?;
