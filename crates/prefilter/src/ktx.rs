@@ -21,7 +21,7 @@
 //! | 80 | 24 K | level index, level 0 first: `byteOffset`, `byteLength`, `uncompressedByteLength` (u64 each; the lengths are equal) |
 //! | 80 + 24 K | 92 | data format descriptor, below |
 //! | 172 + 24 K | | key/value data: `KTXorientation` = `rd` (not for cube maps, whose face orientation the specification fixes), `KTXwriter` (each `u32` length, key, NUL, value, NUL, padding to 4 bytes; sorted by key): only keys the specification defines |
-//! | aligned to 16 | | the levels' texels, **smallest level first**; per level, layer after layer, within a layer face after face (`+X, -X, +Y, -Y, +Z, -Z`), rows top to bottom, 8 or 16 bytes per texel: R, G, B, A as IEEE half or single floats |
+//! | aligned to the texel size (8 or 16), no more | | the levels' texels, **smallest level first**; per level, layer after layer, within a layer face after face (`+X, -X, +Y, -Y, +Z, -Z`), rows top to bottom, 8 or 16 bytes per texel: R, G, B, A as IEEE half or single floats |
 //!
 //! The data format descriptor (Khronos Data Format 1.3, one basic block, 4 samples):
 //! `dfdTotalSize` 92; block header: vendor 0 and type 0 (word `0`), version 2 and block size 88
@@ -211,7 +211,9 @@ pub fn encode(shape: Shape, levels: &[Vec<&[f32]>], storage: Storage, writer: &s
     let n_levels = levels.len();
     let dfd_offset = 80 + 24 * n_levels;
     let kvd_offset = dfd_offset + dfd.len();
-    let data_start = (kvd_offset + kvd.len()).next_multiple_of(16);
+    // The specification's mip padding: the least that aligns the first level to lcm(texel block
+    // size, 4), the texel's 8 or 16 bytes; more is an error to Khronos' validator.
+    let data_start = (kvd_offset + kvd.len()).next_multiple_of(texel_bytes);
     let level_bytes: Vec<usize> = (0..n_levels)
         .map(|l| {
             let (w, h) = shape.level_size(l);

@@ -55,11 +55,17 @@ fn check_common(reader: &Reader<&[u8]>, encoded: &Encoded) {
         vec![("KTXorientation", b"rd\0"), ("KTXwriter", b"prefilter tests\0")]
     };
     assert_eq!(pairs, expected);
-    // Levels start at multiples of 16 and are stored smallest first, without gaps.
+    // Levels start at multiples of the texel size and are stored smallest first, without gaps;
+    // the first starts at the least such offset after the key/value data (more padding is an
+    // error to Khronos' validator).
+    let texel = 4 * encoded.format.type_size() as u64;
     let index = level_index(reader.data(), header.level_count as usize);
+    let kvd_end = u64::from(header.index.kvd_byte_offset + header.index.kvd_byte_length);
+    let first = index.iter().map(|l| l.0).min().unwrap();
+    assert_eq!(first, kvd_end.next_multiple_of(texel), "mip padding");
     let mut end = reader.data().len() as u64;
     for &(offset, length, uncompressed) in &index {
-        assert_eq!(offset % 16, 0);
+        assert_eq!(offset % texel, 0);
         assert_eq!(length, uncompressed);
         assert_eq!(offset + length, end, "level data is contiguous, level 0 last");
         end = offset;
@@ -161,8 +167,9 @@ fn sizes_add_up() {
         let reader = Reader::new(&encoded.bytes[..]).unwrap();
         check_common(&reader, &encoded);
         let kvd_length = reader.header().index.kvd_byte_length as usize;
-        // Header and level index, descriptor, key/value data, padding to 16, 2 layers of 8 texels.
-        let data_start = (80 + 24 + 92 + kvd_length).next_multiple_of(16);
+        // Header and level index, descriptor, key/value data, padding to the texel, 2 layers of 8
+        // texels.
+        let data_start = (80 + 24 + 92 + kvd_length).next_multiple_of(texel_bytes);
         assert_eq!(encoded.bytes.len(), data_start + 2 * 8 * texel_bytes);
         let stored = values(reader.levels().next().unwrap().data, format);
         check_texels(&stored, &[map.rgb(), map.rgb()].concat(), format, format.name());
