@@ -9,10 +9,10 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python setup-node build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
+.PHONY: setup setup-gpu setup-python setup-node setup-ktx build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
-## setup: everything the tests need (setup-gpu, setup-python and setup-node). Idempotent.
-setup: setup-gpu setup-python setup-node
+## setup: everything the tests need (setup-gpu, setup-python, setup-node, setup-ktx). Idempotent.
+setup: setup-gpu setup-python setup-node setup-ktx
 
 ## setup-gpu: the software Vulkan driver (lavapipe), for brdf-preview and the GPU tests on machines
 ## without a GPU driver. Installed only when missing; quiet.
@@ -38,6 +38,31 @@ setup-node:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
 	fi
 	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
+
+## setup-ktx: Khronos' KTX2 validator, ktx2check (KTX-Software 4.0.0, whose sources the
+## libktx-rs-sys crate carries: fetched from crates.io by cargo vendor), built with cmake into
+## target/ktx2check/ once (about two minutes on 2 cores); the end-to-end tests run it on every KTX2
+## output. Installs cmake from Debian when missing.
+KTX2CHECK := target/ktx2check/ktx2check
+setup-ktx: $(KTX2CHECK)
+$(KTX2CHECK):
+	@if ! command -v cmake >/dev/null 2>&1; then \
+	  echo "installing cmake (to build Khronos' ktx2check for the tests)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq cmake >/dev/null; \
+	fi
+	@echo "building ktx2check (Khronos' KTX2 validator) into target/ktx2check/"
+	@rm -rf target/ktx2check/vendor target/ktx2check/build && mkdir -p target/ktx2check
+	@$(CARGO) vendor -q --locked --manifest-path tests/ktx2check/Cargo.toml target/ktx2check/vendor >/dev/null
+	@cmake -S target/ktx2check/vendor/libktx-rs-sys/build/KTX-Software -B target/ktx2check/build \
+	  -DCMAKE_BUILD_TYPE=Release -DKTX_FEATURE_TOOLS=ON -DKTX_FEATURE_TESTS=OFF -DKTX_FEATURE_DOC=OFF \
+	  -DKTX_FEATURE_LOADTEST_APPS=OFF -DKTX_FEATURE_STATIC_LIBRARY=ON > target/ktx2check/build.log 2>&1 \
+	  || { tail -20 target/ktx2check/build.log; exit 1; }
+	@cmake --build target/ktx2check/build --target ktx2check -j 2 >> target/ktx2check/build.log 2>&1 \
+	  || { tail -20 target/ktx2check/build.log; exit 1; }
+	@cp target/ktx2check/build/tools/ktx2check/ktx2check $@
+	@rm -rf target/ktx2check/vendor target/ktx2check/build
 
 ## build: every tool, optimized, into target/release/.
 build:

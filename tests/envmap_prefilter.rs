@@ -348,7 +348,8 @@ fn killed_while_writing_the_folder_stays_consistent() {
 
 /// The KTX2 files as three.js reads them: `ktx-parse` (the parser of its KTX2Loader), run by
 /// node on `tests/ktx-parse/check.mjs`, parses every file `--cube --ggx-levels --chain` writes, and finds the shape,
-/// format, level sizes, descriptor and only the specification's keys. `make setup` installs it.
+/// format, level sizes, descriptor and only the specification's keys; and Khronos' validator
+/// `ktx2check` passes every file with warnings as errors. `make setup` installs both.
 #[test]
 fn ktx_parse_reads_the_lat_long_and_cube_files() {
     let script = crate::support::root().join("tests").join("ktx-parse").join("check.mjs");
@@ -416,4 +417,15 @@ fn ktx_parse_reads_the_lat_long_and_cube_files() {
     }
     // Quarry's sun does not fit half floats: the lat-long mip chain is single floats.
     assert_eq!(parsed[1]["vkFormat"], 109, "{r}");
+
+    // Khronos' own validator (ktx2check, KTX-Software 4.0), warnings counted as errors.
+    let ktx2check = crate::support::root().join("target").join("ktx2check").join("ktx2check");
+    assert!(
+        ktx2check.is_file(),
+        "ktx2check is not built: run `make setup` (make setup-ktx; needs cmake and a C++ compiler)"
+    );
+    let mut check = std::process::Command::new(&ktx2check);
+    check.arg("--warn-as-error").args(names.map(|n| out.join(n)));
+    let r = run(check, "");
+    assert_eq!(r.code, Some(0), "ktx2check found problems\n{r}");
 }
