@@ -324,12 +324,14 @@ pub fn convolve_lobes(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Convolved>, Error> {
     assert_eq!(lobes.len(), sizes.len(), "one size per lobe");
-    let plan: Vec<(Method, Option<usize>)> = lobes
+    // Per layer its method and, for harmonics, its degree and Legendre coefficients (GGX's come
+    // from a quadrature: computed once, for the degree search, and kept).
+    let plan: Vec<Plan> = lobes
         .par_iter()
         .zip(sizes)
         .map(|(lobe, &size)| plan_layer(lobe, map, size, method))
         .collect::<Result<_, _>>()?;
-    let sh_degree = plan.iter().filter_map(|&(_, degree)| degree).max();
+    let sh_degree = plan.iter().filter_map(|(_, sh)| sh.as_ref().map(|(degree, _)| *degree)).max();
     let rows = |k: usize| sizes[k].1 as u64;
     let sh_rows: u64 = (0..plan.len()).filter(|&k| plan[k].1.is_some()).map(rows).sum();
     let window_rows: u64 = (0..plan.len()).filter(|&k| plan[k].0 == Method::Window).map(rows).sum();
@@ -345,8 +347,8 @@ pub fn convolve_lobes(
         let coefficients = sh::analyse(map, l_max, &tick);
         // The layers of one size share the synthesis's recurrence: one pass per size.
         let mut by_size: Vec<((usize, usize), Vec<usize>)> = Vec::new();
-        for (k, &(_, degree)) in plan.iter().enumerate() {
-            if degree.is_some() {
+        for (k, (_, sh)) in plan.iter().enumerate() {
+            if sh.is_some() {
                 match by_size.iter_mut().find(|(size, _)| *size == sizes[k]) {
                     Some((_, ks)) => ks.push(k),
                     None => by_size.push((sizes[k], vec![k])),
@@ -354,10 +356,8 @@ pub fn convolve_lobes(
             }
         }
         for ((width, height), ks) in by_size {
-            let specs: Vec<sh::LayerSpec> = ks
-                .iter()
-                .map(|&k| sh::LayerSpec { k: lobes[k].legendre_coefficients(plan[k].1.expect("harmonics")) })
-                .collect();
+            let specs: Vec<sh::LayerSpec> =
+                ks.iter().map(|&k| sh::LayerSpec { k: plan[k].1.as_ref().expect("harmonics").1.clone() }).collect();
             for (k, layer) in ks.into_iter().zip(sh::synthesize(&coefficients, &specs, width, height, &tick)) {
                 rgb[k] = Some(layer);
             }
@@ -372,7 +372,8 @@ pub fn convolve_lobes(
     rgb.into_iter()
         .zip(plan)
         .zip(lobes.iter().zip(sizes))
-        .map(|((rgb, (method, degree)), (lobe, &(width, height)))| {
+        .map(|((rgb, (method, sh)), (lobe, &(width, height)))| {
+            let degree = sh.map(|(degree, _)| degree);
             let rgb = rgb.expect("every layer was computed");
             let map = EnvMap::new(width, height, rgb)
                 .map_err(|e| Error::Overflow(format!("layer of the {}: {e}", lobe.name())))?;
@@ -381,14 +382,16 @@ pub fn convolve_lobes(
         .collect()
 }
 
-/// The method and, for harmonics, the degree of a layer of `lobe` of `(width, height)`.
-fn plan_layer(
-    lobe: &Lobe,
-    map: &EnvMap,
-    (width, height): (usize, usize),
-    method: Method,
-) -> Result<(Method, Option<usize>), Error> {
-    let degree = lobe_degree(lobe);
+/// A layer's method and, for harmonics, its degree and coefficients `k_0 ..= k_degree`.
+type Plan = (Method, Option<(usize, Vec<f64>)>);
+
+/// The [`Plan`] of a layer of `lobe` of `(width, height)`.
+fn plan_layer(lobe: &Lobe, map: &EnvMap, (width, height): (usize, usize), method: Method) -> Result<Plan, Error> {
+    let (degree, coefficients) = degree_and_coefficients(lobe);
+    let harmonics = move || {
+        let k = coefficients.unwrap_or_else(|| lobe.legendre_coefficients(degree));
+        Some((degree, k))
+    };
     match method {
         Method::Auto => {
             // One step of the recurrence for one row pair costs about what one texel visit of the
@@ -397,7 +400,7 @@ fn plan_layer(
             if degree > sh::MAX_DEGREE || window::visits(lobe, map.width(), map.height(), width, height) < steps {
                 Ok((Method::Window, None))
             } else {
-                Ok((Method::SphericalHarmonics, Some(degree)))
+                Ok((Method::SphericalHarmonics, harmonics()))
             }
         }
         Method::SphericalHarmonics if degree > sh::MAX_DEGREE => Err(Error::InvalidConfig(format!(
@@ -405,7 +408,7 @@ fn plan_layer(
             lobe.name(),
             sh::MAX_DEGREE
         ))),
-        Method::SphericalHarmonics => Ok((Method::SphericalHarmonics, Some(degree))),
+        Method::SphericalHarmonics => Ok((Method::SphericalHarmonics, harmonics())),
         Method::Window => Ok((Method::Window, None)),
     }
 }
@@ -425,14 +428,23 @@ pub fn sh_degree(n: u32) -> usize {
 /// exponentially, like `exp(-2 alpha l)` roughly: below 1e-9 of its peak beyond about `12 /
 /// alpha`.
 pub fn lobe_degree(lobe: &Lobe) -> usize {
+    degree_and_coefficients(lobe).0
+}
+
+/// [`lobe_degree`], and the coefficients `k_0 ..= k_degree` when the search computed them (not
+/// for a lobe too narrow for harmonics).
+fn degree_and_coefficients(lobe: &Lobe) -> (usize, Option<Vec<f64>>) {
     let wanted = match lobe {
         Lobe::Phong(n) => (8.0 * f64::from(*n).sqrt()).ceil() as usize + 16,
         Lobe::Ggx(g) => (12.0 / g.alpha).ceil() as usize + 16,
     };
     if wanted > sh::MAX_DEGREE {
-        return wanted;
+        return (wanted, None);
     }
     let l_top = wanted.max(KINK_DEGREE);
-    let errors = lobe.truncation_errors(l_top);
-    errors.iter().rposition(|&e| e > SH_EPSILON).map_or(0, |l| (l + 1).min(l_top))
+    let mut k = lobe.legendre_coefficients(l_top);
+    let errors = lobe.truncation_errors_of(&k);
+    let degree = errors.iter().rposition(|&e| e > SH_EPSILON).map_or(0, |l| (l + 1).min(l_top));
+    k.truncate(degree + 1);
+    (degree, Some(k))
 }

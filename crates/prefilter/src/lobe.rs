@@ -110,7 +110,13 @@ impl Lobe {
 
     /// [`truncation_errors`] of this lobe.
     pub fn truncation_errors(&self, l_top: usize) -> Vec<f64> {
-        let k = self.legendre_coefficients(l_top);
+        self.truncation_errors_of(&self.legendre_coefficients(l_top))
+    }
+
+    /// [`Lobe::truncation_errors`] from this lobe's coefficients `k_0 ..= k_{l_top}`, computed
+    /// once by the caller.
+    pub fn truncation_errors_of(&self, k: &[f64]) -> Vec<f64> {
+        let l_top = k.len() - 1;
         let c: Vec<f64> = k.iter().enumerate().map(|(l, k)| (2 * l + 1) as f64 / (4.0 * PI) * k).collect();
         let peak = self.peak();
         let n = *self;
