@@ -2,7 +2,6 @@
 //! (sections 5.3-5.4), by the same steps the WGSL decoder (`gpu`, `haar_brdf.wgsl`) takes.
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::Error;
 use crate::grid::Grid;
@@ -58,6 +57,11 @@ impl WaveletBrdf {
         self.channel_mean
     }
 
+    /// Coefficient positions per stored slice: the compression ratio `r_c`.
+    pub fn ratio(&self) -> f64 {
+        self.map.len() as f64 / self.map.iter().filter(|&&m| m != 0).count().max(1) as f64
+    }
+
     /// Per coefficient position, its slice in [`WaveletBrdf::slices`] (0: the zero slice).
     pub fn map(&self) -> &[u32] {
         &self.map
@@ -69,9 +73,14 @@ impl WaveletBrdf {
         &self.slices
     }
 
+    /// Where coefficient position `p` of outgoing cell `o` starts in `slices` (3 channels).
+    fn coefficient_at(&self, p: usize, o: usize) -> usize {
+        (self.map[p] as usize * self.grid.cells() + o) * 3
+    }
+
     /// Coefficient position `p` of outgoing cell `o`.
     fn coefficient(&self, p: usize, o: usize) -> [f64; 3] {
-        let at = (self.map[p] as usize * self.grid.cells() + o) * 3;
+        let at = self.coefficient_at(p, o);
         [0, 1, 2].map(|c| f64::from(self.slices[at + c]))
     }
 
@@ -137,24 +146,12 @@ impl WaveletBrdf {
     /// synthesis), in the layout of `Resampled::log_encoded`.
     pub fn decode_log(&self, lod: usize) -> Vec<f64> {
         let cells = self.grid.cells();
-        let slices: Vec<[Vec<f64>; 3]> = (0..cells)
-            .into_par_iter()
-            .map(|o| {
-                [0, 1, 2].map(|c| {
-                    let layout: Vec<f64> = (0..cells).map(|p| self.coefficient(p, o)[c]).collect();
-                    transform::inverse(self.grid, &layout, lod)
-                })
-            })
-            .collect();
-        let mut values = vec![0.0; cells * cells * 3];
-        for (o, channels) in slices.iter().enumerate() {
-            for (c, slice) in channels.iter().enumerate() {
-                for (i, v) in slice.iter().enumerate() {
-                    values[(o * cells + i) * 3 + c] = *v;
-                }
-            }
-        }
-        values
+        transform::map_slices(
+            self.grid,
+            |o, c, p| f64::from(self.slices[self.coefficient_at(p, o) + c]),
+            |layout| transform::inverse(self.grid, layout, lod),
+            |o, c, i| (o * cells + i) * 3 + c,
+        )
     }
 
     /// Every value in 1/sr at the integer level of detail `lod`, in the layout of

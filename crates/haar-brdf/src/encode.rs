@@ -92,29 +92,18 @@ pub struct Coefficients {
 
 /// Log-encodes `resampled` and transforms each slice (one outgoing cell, one channel).
 pub fn coefficients(resampled: &Resampled, epsilon: f64) -> Result<Coefficients, Error> {
-    if !(epsilon.is_finite() && epsilon > 0.0) {
-        return Err(Error::Invalid(format!("epsilon must be a positive number, found {epsilon}")));
-    }
+    check_epsilon(epsilon)?;
     let grid = resampled.grid;
     let cells = grid.cells();
     let log = resampled.log_encoded(epsilon);
-    let slices: Vec<[Vec<f64>; 3]> = (0..cells)
-        .into_par_iter()
-        .map(|o| {
-            [0, 1, 2].map(|c| {
-                let slice: Vec<f64> = (0..cells).map(|i| log[(o * cells + i) * 3 + c]).collect();
-                transform::forward(grid, &slice)
-            })
-        })
-        .collect();
-    let mut values = vec![0.0; cells * cells * 3];
-    for (o, channels) in slices.iter().enumerate() {
-        for (c, layout) in channels.iter().enumerate() {
-            for (p, v) in layout.iter().enumerate() {
-                values[(p * cells + o) * 3 + c] = *v;
-            }
-        }
-    }
+    // Slice (o, c) holds the incoming cells in the table's layout; its coefficients go
+    // position-major.
+    let values = transform::map_slices(
+        grid,
+        |o, c, i| log[(o * cells + i) * 3 + c],
+        |slice| transform::forward(grid, slice),
+        |o, c, p| (p * cells + o) * 3 + c,
+    );
     Ok(Coefficients { grid, epsilon, channel_mean: resampled.channel_mean(), values })
 }
 
@@ -131,6 +120,35 @@ pub enum Keep {
     Threshold(f64),
 }
 
+/// Refuses a log-encoding bias that is not a positive number.
+pub(crate) fn check_epsilon(epsilon: f64) -> Result<(), Error> {
+    if !(epsilon.is_finite() && epsilon > 0.0) {
+        return Err(Error::Invalid(format!("the log encoding's epsilon must be a positive number, found {epsilon}")));
+    }
+    Ok(())
+}
+
+impl Keep {
+    /// Refuses a setting no grid of this side can honour: a ratio that does not divide its `n^2`
+    /// coefficient positions, a threshold that is not a number `>= 0`.
+    pub fn check(self, grid: Grid) -> Result<(), Error> {
+        let positions = grid.cells();
+        match self {
+            Keep::Ratio(ratio) if ratio == 0 || !positions.is_multiple_of(ratio as usize) => {
+                Err(Error::Invalid(format!(
+                    "a ratio of {ratio}:1 does not divide the {positions} coefficient positions of a {0} x {0} grid: \
+                     use a power of two up to {positions}",
+                    grid.side()
+                )))
+            }
+            Keep::Threshold(t) if !(t.is_finite() && t >= 0.0) => {
+                Err(Error::Invalid(format!("the threshold must be a number >= 0, found {t}")))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 impl Coefficients {
     /// The energy (sum of squares) of each position's vector of `n^2 x 3` coefficients.
     pub fn position_energy(&self) -> Vec<f64> {
@@ -139,18 +157,12 @@ impl Coefficients {
 
     /// The positions to keep, as a flag per position. Ties in energy keep the lower position.
     pub fn select(&self, keep: Keep) -> Result<Vec<bool>, Error> {
+        keep.check(self.grid)?;
         let positions = self.grid.cells();
         let energy = self.position_energy();
         match keep {
             Keep::All => Ok(vec![true; positions]),
             Keep::Ratio(ratio) => {
-                if ratio == 0 || !positions.is_multiple_of(ratio as usize) {
-                    return Err(Error::Invalid(format!(
-                        "a ratio of {ratio}:1 does not divide the {positions} coefficient positions of a {0} x {0} grid: \
-                         use a power of two up to {positions}",
-                        self.grid.side()
-                    )));
-                }
                 let mut order: Vec<usize> = (0..positions).collect();
                 order.sort_by(|&a, &b| energy[b].total_cmp(&energy[a]).then(a.cmp(&b)));
                 let mut kept = vec![false; positions];
@@ -160,9 +172,6 @@ impl Coefficients {
                 Ok(kept)
             }
             Keep::Threshold(t) => {
-                if !(t.is_finite() && t >= 0.0) {
-                    return Err(Error::Invalid(format!("the threshold must be a number >= 0, found {t}")));
-                }
                 let entries = (self.grid.cells() * 3) as f64;
                 Ok(energy.iter().map(|e| (e / entries).sqrt() >= t).collect())
             }

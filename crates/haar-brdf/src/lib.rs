@@ -83,6 +83,15 @@ pub struct Config {
     pub quantize: bool,
 }
 
+impl Config {
+    /// Refuses settings that cannot encode a table on `grid` (the checks [`encode`] makes), so
+    /// that a caller can refuse them before reading anything.
+    pub fn check(&self, grid: Grid) -> Result<(), Error> {
+        encode::check_epsilon(self.epsilon)?;
+        self.keep.check(grid)
+    }
+}
+
 impl Default for Config {
     fn default() -> Config {
         Config { epsilon: DEFAULT_EPSILON, keep: Keep::Ratio(4), quantize: false }

@@ -25,6 +25,7 @@
 //! ([`synthesis`]). Reconstruction at level of detail `L` leaves out the levels `j <= L`: the
 //! value is then the mean of the `2^L x 2^L` block around the cell (Haar's approximation).
 
+use rayon::prelude::*;
 use wavelet::{Decomposition2, Image, Orientation, Wavelet};
 
 use crate::grid::Grid;
@@ -95,4 +96,30 @@ pub fn synthesis(grid: Grid, cell: usize, lod: usize) -> impl Iterator<Item = (u
         ]
     });
     approx.chain(details)
+}
+
+/// `f` applied to every slice of a table of `n^2` outgoing cells x 3 channels x `n^2` entries, in
+/// parallel: slice `(o, c)` is gathered by `read(o, c, k)` for `k` in `0..n^2` and entry `k` of
+/// `f`'s result lands at index `write(o, c, k)` of the `3 n^4` values returned. The encoder and the
+/// decoder differ only in the transform and the two layouts.
+pub(crate) fn map_slices(
+    grid: Grid,
+    read: impl Fn(usize, usize, usize) -> f64 + Sync,
+    f: impl Fn(&[f64]) -> Vec<f64> + Sync,
+    write: impl Fn(usize, usize, usize) -> usize,
+) -> Vec<f64> {
+    let cells = grid.cells();
+    let slices: Vec<[Vec<f64>; 3]> = (0..cells)
+        .into_par_iter()
+        .map(|o| [0, 1, 2].map(|c| f(&(0..cells).map(|k| read(o, c, k)).collect::<Vec<f64>>())))
+        .collect();
+    let mut values = vec![0.0; cells * cells * 3];
+    for (o, channels) in slices.iter().enumerate() {
+        for (c, slice) in channels.iter().enumerate() {
+            for (k, v) in slice.iter().enumerate() {
+                values[write(o, c, k)] = *v;
+            }
+        }
+    }
+    values
 }

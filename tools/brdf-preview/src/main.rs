@@ -243,7 +243,7 @@ fn run(args: Args) -> Result<ExitCode> {
         let picture = metrics::tonemap(&image, &preview);
         let names = names(&loaded.manifest);
         let brdf = match &loaded.material.wavelet {
-            Some(w) => format!("wavelet {}:1, lod {}", wavelet_ratio(&w.brdf), w.lod),
+            Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
             None => "table".to_string(),
         };
         let caption = format!(
@@ -353,12 +353,6 @@ fn run(args: Args) -> Result<ExitCode> {
         })
         .collect();
     Ok(cli::finish(args.json, &value, &report, &problems, &written))
-}
-
-/// The compression ratio of a wavelet BRDF: coefficient positions per stored slice.
-fn wavelet_ratio(brdf: &haar_brdf::WaveletBrdf) -> String {
-    let stored = brdf.map().iter().filter(|&&m| m != 0).count().max(1);
-    picture::format_number(brdf.map().len() as f64 / stored as f64)
 }
 
 /// An 8-bit RGB picture as PNG bytes.

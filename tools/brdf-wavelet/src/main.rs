@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
-use bake::stage::wavelet::{MAX_SIDE, Settings};
+use bake::stage::wavelet::Settings;
 use bake::{Program, Source};
 use clap::Parser;
 use haar_brdf::{Config, DEFAULT_EPSILON, DEFAULT_SIDE, Keep};
@@ -82,10 +82,9 @@ fn run(args: Args) -> Result<ExitCode> {
         Some(8) => true,
         Some(bits) => bail!("--quantize supports 8 bits only, found {bits}"),
     };
-    if args.side > MAX_SIDE {
-        bail!("--side {} is larger than {MAX_SIDE}: its working memory is too large", args.side);
-    }
     let settings = Settings { side: args.side, config: Config { epsilon: args.epsilon, keep, quantize } };
+    // Before the table is read: a refused setting costs nothing.
+    settings.check()?;
     let table = merl::read_file(&args.material).with_context(|| format!("reading {}", args.material.display()))?;
     let source = Source::hash(&args.material)?;
     let staged = bake::stage::wavelet::run(&table, &source, &PROGRAM, settings)?;

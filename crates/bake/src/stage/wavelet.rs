@@ -41,22 +41,7 @@ impl Settings {
             )));
         }
         let grid = Grid::new(self.side).map_err(|e| Error::Invalid(e.to_string()))?;
-        let c = &self.config;
-        if !(c.epsilon.is_finite() && c.epsilon > 0.0) {
-            return Err(Error::Invalid(format!("the log encoding's epsilon must be positive, found {}", c.epsilon)));
-        }
-        match c.keep {
-            Keep::Ratio(r) if r == 0 || !grid.cells().is_multiple_of(r as usize) => Err(Error::Invalid(format!(
-                "a ratio of {r}:1 does not divide the {} coefficient positions of a {1} x {1} grid: use a power of \
-                 two up to {0}",
-                grid.cells(),
-                self.side
-            ))),
-            Keep::Threshold(t) if !(t.is_finite() && t >= 0.0) => {
-                Err(Error::Invalid(format!("the threshold must be a number >= 0, found {t}")))
-            }
-            _ => Ok(()),
-        }
+        self.config.check(grid).map_err(|e| Error::Invalid(e.to_string()))
     }
 
     /// The settings as the stage's manifest entry records them.

@@ -32,12 +32,13 @@ pub(super) struct Outputs {
 
 impl Outputs {
     /// Encodes `levels` (each half the size of the one before) as `name` and, with `config.cube`,
-    /// as the cube map `cube_name`; records their formats.
+    /// as the cube map `cube_name`; records their formats as the figure `formats_figure`.
     fn chain(
         &mut self,
         levels: &[&EnvMap],
         (name, role): (&str, &'static str),
         (cube_name, cube_role): (&str, &'static str),
+        formats_figure: &'static str,
         config: &Config,
         writer: &str,
     ) -> Result<(), Error> {
@@ -59,7 +60,7 @@ impl Outputs {
                 bytes: cube.bytes,
             });
         }
-        self.figures.push((if role == "ggx-chain" { "ggx_formats" } else { "phong_chain_formats" }, json!(formats)));
+        self.figures.push((formats_figure, json!(formats)));
         Ok(())
     }
 }
@@ -81,7 +82,8 @@ pub(super) fn outputs(
             .map_err(|e| Error::stage("phong chain", e))?;
         let levels: Vec<&EnvMap> = chain.iter().map(|(_, level)| level).collect();
         let names = (PHONG_CHAIN_KTX2, "phong-chain");
-        out.chain(&levels, names, (PHONG_CHAIN_CUBE_KTX2, "phong-chain-cube"), config, writer)?;
+        let cube = (PHONG_CHAIN_CUBE_KTX2, "phong-chain-cube");
+        out.chain(&levels, names, cube, "phong_chain_formats", config, writer)?;
         let exponents: Vec<u32> = chain.iter().map(|(n, _)| *n).collect();
         out.report.push(format!(
             "phong chain   {} levels from {} x {}, exponents {} (level m: the m-th sharpest lobe at half the size of m - 1)",
@@ -110,7 +112,8 @@ fn ggx(
         prefilter::ggx::chain(map, config.width, config.ggx_levels, config.method, &|p| progress(p.done, p.total))
             .map_err(|e| Error::stage("ggx chain", e))?;
     let levels: Vec<&EnvMap> = chain.levels.iter().collect();
-    out.chain(&levels, (GGX_KTX2, "ggx-chain"), (GGX_CUBE_KTX2, "ggx-chain-cube"), config, writer)?;
+    let cube = (GGX_CUBE_KTX2, "ggx-chain-cube");
+    out.chain(&levels, (GGX_KTX2, "ggx-chain"), cube, "ggx_formats", config, writer)?;
 
     let size = prefilter::dfg::DFG_SIZE;
     let table = prefilter::dfg::table(size);
