@@ -171,6 +171,20 @@ pub fn chain(
     method: crate::Method,
     progress: &(dyn Fn(crate::Progress) + Sync),
 ) -> Result<Chain, crate::Error> {
+    let (mut lobes, mut sizes) = (Vec::new(), Vec::new());
+    let roughness = chain_lobes(width, levels, &mut lobes, &mut sizes)?;
+    let convolved = crate::convolve_lobes(map, &lobes, &sizes, method, progress)?;
+    Ok(assemble(map, width, roughness, convolved))
+}
+
+/// Appends the lobes and sizes of a chain's levels 1 and up ([`chain`]); returns every level's
+/// roughness.
+pub(crate) fn chain_lobes(
+    width: usize,
+    levels: usize,
+    lobes: &mut Vec<crate::Lobe>,
+    sizes: &mut Vec<(usize, usize)>,
+) -> Result<Vec<f64>, crate::Error> {
     if width < 2 || !width.is_multiple_of(2) || !(2..=max_levels(width)).contains(&levels) {
         return Err(crate::Error::InvalidConfig(format!(
             "a ggx chain of {levels} levels from a {width} x {} level 0: need an even width and 2 to {} levels",
@@ -179,14 +193,24 @@ pub fn chain(
         )));
     }
     let roughness: Vec<f64> = (0..levels).map(|m| m as f64 / (levels - 1) as f64).collect();
-    let lobes: Vec<crate::Lobe> =
-        roughness[1..].iter().map(|&r| crate::Lobe::Ggx(GgxLobe::new(alpha(r).max(MIN_ALPHA)))).collect();
-    let sizes: Vec<(usize, usize)> = (1..levels).map(|m| (width >> m, (width / 2) >> m)).collect();
-    let convolved = crate::convolve_lobes(map, &lobes, &sizes, method, progress)?;
+    for (m, &r) in roughness.iter().enumerate().skip(1) {
+        lobes.push(crate::Lobe::Ggx(GgxLobe::new(alpha(r).max(MIN_ALPHA))));
+        sizes.push((width >> m, (width / 2) >> m));
+    }
+    Ok(roughness)
+}
+
+/// The chain from its levels 1 and up, convolved, and the mirror level made here.
+pub(crate) fn assemble(
+    map: &envmap::EnvMap,
+    width: usize,
+    roughness: Vec<f64>,
+    convolved: Vec<crate::Convolved>,
+) -> Chain {
     let mirror = mirror_level(map, width);
     let methods = convolved.iter().map(|c| c.method).collect();
     let levels = std::iter::once(mirror).chain(convolved.into_iter().map(|c| c.map)).collect();
-    Ok(Chain { roughness, levels, methods })
+    Chain { roughness, levels, methods }
 }
 
 /// The map at `width x width / 2` (see [`Chain`]).

@@ -267,21 +267,52 @@ pub fn prefilter(map: &EnvMap, config: &Config) -> Result<Prefiltered, Error> {
 }
 
 /// The layers of `map` for `config`, calling `progress` (from any thread) as work gets done.
-/// Fails only on an invalid config, or when a layer value does not fit in `f32`.
+/// Fails only on an invalid config, or when a layer value does not fit in `f32`. (The chains the
+/// config may ask for are [`prefilter_all`]'s.)
 pub fn prefilter_with_progress(
     map: &EnvMap,
     config: &Config,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Prefiltered, Error> {
+    let array_only = Config { chain: false, ggx_levels: 0, ..config.clone() };
+    Ok(prefilter_all(map, &array_only, progress)?.prefiltered)
+}
+
+/// Everything a [`Config`] asks for: the layers, and the chains of [`Config::chain`] and
+/// [`Config::ggx_levels`] when set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct All {
+    pub prefiltered: Prefiltered,
+    /// [`phong_chain`]'s levels.
+    pub phong_chain: Option<Vec<(u32, EnvMap)>>,
+    pub ggx: Option<ggx::Chain>,
+}
+
+/// [`prefilter_with_progress`], [`phong_chain`] and [`ggx::chain`] as `config` asks, in one
+/// [`convolve_lobes`]: the map's harmonics are analysed once for all of them, and a chain level
+/// that is an array layer (the sharpest exponent at the layers' size) is computed once.
+pub fn prefilter_all(map: &EnvMap, config: &Config, progress: &(dyn Fn(Progress) + Sync)) -> Result<All, Error> {
     config.check()?;
-    let lobes: Vec<Lobe> = config.exponents.iter().map(|&n| Lobe::Phong(n)).collect();
-    let sizes = vec![(config.width, config.height); lobes.len()];
-    let layers = convolve_lobes(map, &lobes, &sizes, config.method, progress)?
-        .into_iter()
+    let mut lobes: Vec<Lobe> = config.exponents.iter().map(|&n| Lobe::Phong(n)).collect();
+    let mut sizes = vec![(config.width, config.height); lobes.len()];
+    let chain_exponents = config.chain.then(|| phong_chain_lobes(config, &mut lobes, &mut sizes));
+    let ggx_roughness = (config.ggx_levels > 0)
+        .then(|| ggx::chain_lobes(config.width, config.ggx_levels, &mut lobes, &mut sizes))
+        .transpose()?;
+    let mut convolved = convolve_lobes(map, &lobes, &sizes, config.method, progress)?.into_iter();
+    let layers = convolved
+        .by_ref()
+        .take(config.exponents.len())
         .zip(&config.exponents)
         .map(|(c, &exponent)| Layer { exponent, method: c.method, degree: c.degree, map: c.map })
         .collect();
-    Ok(Prefiltered { layers, mapping: LayerMapping::new(&config.exponents) })
+    let prefiltered = Prefiltered { layers, mapping: LayerMapping::new(&config.exponents) };
+    let phong_chain = chain_exponents.map(|exponents| {
+        let levels: Vec<EnvMap> = convolved.by_ref().take(exponents.len()).map(|c| c.map).collect();
+        exponents.into_iter().zip(levels).collect()
+    });
+    let ggx = ggx_roughness.map(|roughness| ggx::assemble(map, config.width, roughness, convolved.collect()));
+    Ok(All { prefiltered, phong_chain, ggx })
 }
 
 /// The exponents as one mip chain, the layout engines read (cmft's): level `m` holds the `m`-th
@@ -296,11 +327,20 @@ pub fn phong_chain(
 ) -> Result<Vec<(u32, EnvMap)>, Error> {
     config.check()?;
     config.check_chain()?;
-    let exponents: Vec<u32> = config.exponents.iter().rev().copied().collect();
-    let lobes: Vec<Lobe> = exponents.iter().map(|&n| Lobe::Phong(n)).collect();
-    let sizes: Vec<(usize, usize)> = (0..lobes.len()).map(|m| (config.width >> m, config.height >> m)).collect();
+    let (mut lobes, mut sizes) = (Vec::new(), Vec::new());
+    let exponents = phong_chain_lobes(config, &mut lobes, &mut sizes);
     let levels = convolve_lobes(map, &lobes, &sizes, config.method, progress)?;
     Ok(exponents.into_iter().zip(levels.into_iter().map(|c| c.map)).collect())
+}
+
+/// Appends the lobes and sizes of [`phong_chain`]'s levels; returns their exponents.
+fn phong_chain_lobes(config: &Config, lobes: &mut Vec<Lobe>, sizes: &mut Vec<(usize, usize)>) -> Vec<u32> {
+    let exponents: Vec<u32> = config.exponents.iter().rev().copied().collect();
+    for (m, &n) in exponents.iter().enumerate() {
+        lobes.push(Lobe::Phong(n));
+        sizes.push((config.width >> m, config.height >> m));
+    }
+    exponents
 }
 
 /// One convolution of [`convolve_lobes`].
@@ -324,6 +364,16 @@ pub fn convolve_lobes(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Convolved>, Error> {
     assert_eq!(lobes.len(), sizes.len(), "one size per lobe");
+    // A (lobe, size) pair asked for twice is computed once.
+    let first = |k: usize| (0..k).find(|&j| lobes[j] == lobes[k] && sizes[j] == sizes[k]).unwrap_or(k);
+    let unique: Vec<usize> = (0..lobes.len()).filter(|&k| first(k) == k).collect();
+    if unique.len() < lobes.len() {
+        let pick = |k: &usize| (lobes[*k], sizes[*k]);
+        let (unique_lobes, unique_sizes): (Vec<Lobe>, Vec<(usize, usize)>) = unique.iter().map(pick).unzip();
+        let computed = convolve_lobes(map, &unique_lobes, &unique_sizes, method, progress)?;
+        let at = |k: usize| unique.iter().position(|&u| u == first(k)).expect("a first occurrence");
+        return Ok((0..lobes.len()).map(|k| computed[at(k)].clone()).collect());
+    }
     // Per layer its method and, for harmonics, its degree and Legendre coefficients (GGX's come
     // from a quadrature: computed once, for the degree search, and kept).
     let plan: Vec<Plan> = lobes

@@ -39,3 +39,20 @@ fn the_default_exponents_make_cmfts_chain_and_match_the_brute_force() {
     let err = phong_chain(&map, &too_long, &|_| {}).unwrap_err().to_string();
     assert!(err.contains("at most 6 levels"), "7 levels need a level 0 of 256 x 128 at least: {err}");
 }
+
+#[test]
+fn prefilter_all_gives_the_same_layers_and_chains_in_one_pass() {
+    // One convolve_lobes for the array, the Phong chain and a GGX chain: the same maps as the
+    // separate calls, and the chain's level 0 (the sharpest exponent at the layers' size, asked
+    // for twice) is the array's layer.
+    let map = real_map("potsdamer_platz_1k.hdr");
+    let config =
+        Config { exponents: vec![1, 16, 256], width: 64, height: 32, chain: true, ggx_levels: 4, ..Config::default() };
+    let all = prefilter::prefilter_all(&map, &config, &|_| {}).unwrap();
+    assert_eq!(all.prefiltered, prefilter::prefilter(&map, &config).unwrap());
+    let chain = all.phong_chain.unwrap();
+    assert_eq!(chain, phong_chain(&map, &config, &|_| {}).unwrap());
+    assert_eq!(chain[0].1, all.prefiltered.layers[2].map);
+    let ggx = prefilter::ggx::chain(&map, 64, 4, prefilter::Method::Auto, &|_| {}).unwrap();
+    assert_eq!(all.ggx.unwrap(), ggx);
+}

@@ -62,12 +62,14 @@ pub fn run(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Staged, Prefiltered), Error> {
     config.check().map_err(|e| Error::stage("prefilter", e))?;
-    let prefiltered = prefilter::prefilter_with_progress(map, config, &|p| progress(p.done, p.total))
+    // The layers and the chains in one pass over the map's harmonics.
+    let all = prefilter::prefilter_all(map, config, &|p| progress(p.done, p.total))
         .map_err(|e| Error::stage("prefilter", e))?;
+    let prefiltered = all.prefiltered;
     let mut staged = outputs(map, source, program, config, &prefiltered)?;
-    if config.chain || config.ggx_levels > 0 {
+    if all.phong_chain.is_some() || all.ggx.is_some() {
         let writer = format!("{} {}", program.name, program.version);
-        let engine = engine::outputs(map, config, &writer, progress)?;
+        let engine = engine::outputs(all.phong_chain, all.ggx, config, &writer)?;
         // The manifest entries list the files in order; the asset stays last.
         let asset = staged.files.pop().expect("the asset");
         staged.files.extend(engine.files);

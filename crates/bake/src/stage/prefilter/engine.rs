@@ -69,17 +69,16 @@ fn encoding(what: &str, e: &dyn std::fmt::Display) -> Error {
     Error::Internal(format!("encoding {what}: {e}"))
 }
 
-/// The engine outputs `config` asks for (`chain`, `ggx_levels`).
+/// The engine outputs of the chains `prefilter::prefilter_all` made for `config` (`chain`,
+/// `ggx_levels`).
 pub(super) fn outputs(
-    map: &EnvMap,
+    phong_chain: Option<Vec<(u32, EnvMap)>>,
+    ggx_chain: Option<prefilter::ggx::Chain>,
     config: &Config,
     writer: &str,
-    progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<Outputs, Error> {
     let mut out = Outputs::default();
-    if config.chain {
-        let chain = prefilter::phong_chain(map, config, &|p| progress(p.done, p.total))
-            .map_err(|e| Error::stage("phong chain", e))?;
+    if let Some(chain) = phong_chain {
         let levels: Vec<&EnvMap> = chain.iter().map(|(_, level)| level).collect();
         let names = (PHONG_CHAIN_KTX2, "phong-chain");
         let cube = (PHONG_CHAIN_CUBE_KTX2, "phong-chain-cube");
@@ -94,23 +93,14 @@ pub(super) fn outputs(
         ));
         out.figures.push(("phong_chain_exponents", json!(exponents)));
     }
-    if config.ggx_levels > 0 {
-        ggx(map, config, writer, progress, &mut out)?;
+    if let Some(chain) = ggx_chain {
+        ggx(&chain, config, writer, &mut out)?;
     }
     Ok(out)
 }
 
 /// The GGX chain and the DFG table.
-fn ggx(
-    map: &EnvMap,
-    config: &Config,
-    writer: &str,
-    progress: &(dyn Fn(u64, u64) + Sync),
-    out: &mut Outputs,
-) -> Result<(), Error> {
-    let chain =
-        prefilter::ggx::chain(map, config.width, config.ggx_levels, config.method, &|p| progress(p.done, p.total))
-            .map_err(|e| Error::stage("ggx chain", e))?;
+fn ggx(chain: &prefilter::ggx::Chain, config: &Config, writer: &str, out: &mut Outputs) -> Result<(), Error> {
     let levels: Vec<&EnvMap> = chain.levels.iter().collect();
     let cube = (GGX_CUBE_KTX2, "ggx-chain-cube");
     out.chain(&levels, (GGX_KTX2, "ggx-chain"), cube, "ggx_formats", config, writer)?;
