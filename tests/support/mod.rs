@@ -309,7 +309,7 @@ pub fn reference_bake() -> &'static ReferenceBake {
 }
 
 /// `brdf-bake` of [`ggx_copper`] in [`bake_env`] into `dir`, with `args`. The lobes are analysed
-/// at 128 x 128 rather than the default 512 x 512: what these tests check does not depend on it,
+/// at 128 x 128 rather than the default 1024 x 1024: what these tests check does not depend on it,
 /// and the bake takes a fraction of the time (at 64 x 64 most of this GGX's lobes would reach the
 /// grid's limit, a validation problem that exits 1).
 pub fn bake_command(dir: &Path, args: &[&str]) -> Command {

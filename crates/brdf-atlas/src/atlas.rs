@@ -19,15 +19,15 @@ pub struct Config {
     /// Pixels per side of the grid each lobe is analysed on ([`crate::LobeMap`]): a power of
     /// two from 16 to 4096, at least `tile`. The highest bandwidth it can report is
     /// [`DEFAULT_C`](bandwidth::DEFAULT_C)` / 2` cycles per pixel, `0.088 size / pi` cycles per
-    /// radian at the centre of the lobe image (1.8 for 64, 14.4 for 512). The default, 512,
-    /// resolves normalized Phong lobes up to n = 1000 at every incident direction, the grazing
-    /// ones whose lobe straddles the horizon included (at 256 every lobe of n = 1000 reaches
-    /// the limit). A table of such a lobe made by `merl-synth` reads the limit in 3 of the 64
-    /// rows (192 of 4096 lobes; 128 at 1024), where the table's trilinear lookup has edges of
-    /// its own: on the horizon's last pixel at theta_i 86.9 and 89.6 degrees (the cells beyond
-    /// the horizon hold no data), and at the mirror direction at 21 degrees (cells linear in
-    /// `sqrt(theta_h)`, a cusp at `theta_h = 0`) (crate docs, "Lobe images").
-    /// It costs about 2.5 s for a real-derived material in a release build on two cores.
+    /// radian at the centre of the lobe image (1.8 for 64, 14.4 for 512, 28.8 for 1024). The
+    /// default, 1024, resolves normalized Phong lobes up to n = 1000 at every incident
+    /// direction, the grazing ones whose lobe straddles the horizon included, analytically and
+    /// as a table made by `merl-synth` (`lobes_at_limit` 0). At 512 such a lobe (1/e half width
+    /// 5 pixels there) is on the estimate's edge: the analytic lobe reads the limit at its peak
+    /// in one row (theta_i 21.6 degrees, where the peak falls on the finest wavelets' grid so
+    /// that they see more than `eps` of the largest coefficient), a table of it in three rows
+    /// (192 of 4096 lobes); at 256 every lobe of n = 1000 reaches the limit.
+    /// It costs about 12 s for a material in a release build on two cores (3 s at 512).
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).
     pub eps: f64,
@@ -41,7 +41,14 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Self { lobes: 64, tile: 16, analysis_size: 512, eps: 0.01, c: bandwidth::DEFAULT_C, relative_noise_floor: 1e-6 }
+        Self {
+            lobes: 64,
+            tile: 16,
+            analysis_size: 1024,
+            eps: 0.01,
+            c: bandwidth::DEFAULT_C,
+            relative_noise_floor: 1e-6,
+        }
     }
 }
 

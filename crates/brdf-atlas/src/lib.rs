@@ -7,9 +7,10 @@
 //! # Pipeline
 //!
 //! 1. The MERL table becomes one Rec. 709 luminance per cell ([`LuminanceTable`]), read by
-//!    `merl`'s trilinear interpolation (equal to `merl::luminance` of the RGB lookup to 1e-12).
+//!    `merl`'s trilinear interpolation (equal to `merl::luminance` of the RGB lookup to 1e-12
+//!    wherever the table holds data; the cells below the horizon continued, "Lobe images").
 //! 2. For each row of the incident grid (one `theta_i`), the lobe image: `n x n` pixels
-//!    (`Config::analysis_size`, default 512) of the hemisphere of `wo` ([`LobeMap`]).
+//!    (`Config::analysis_size`, default 1024) of the hemisphere of `wo` ([`LobeMap`]).
 //! 3. The image is continued to a periodic `2n x 2n` image by mirroring ([`extend_periodic`])
 //!    and handed to [`bandwidth::local_bandwidth`]: D4, `eps = 0.01`, `c = 2^-2.5`, the noise
 //!    floor scaled to the lobe's peak, [`analysis_levels`] levels. The estimate of the image's
@@ -80,21 +81,24 @@
 //! limit where a narrow lobe straddles the horizon (Phong n = 1000 at 512 x 512: 320 of 4096
 //! lobes, the last five rows; now none).
 //!
-//! Pixels with no table data around them (all eight trilinear corners empty, which happens only
-//! near the horizon) are filled with the mean of their neighbours ([`lobe_image`]); on the 20
-//! shared materials none is.
+//! Pixels with no table data around them (all eight trilinear corners in columns of the table
+//! that hold no data at all, which a damaged or hand-made table may have) are filled with the
+//! mean of their neighbours ([`lobe_image`]); on the 20 shared materials none is.
 //!
-//! What remains at the horizon is the table's own: MERL tables hold no data for configurations
-//! below it, and the trilinear lookup leaves those corners out and renormalizes, which bends
-//! the lobe within a cell of the horizon. Where a narrow lobe meets the horizon nearly opposite
-//! `wi` (grazing incidence, where the half vector swings fast with `wo` and a cell is small in
-//! `wo`) that reads the limit on the horizon's last pixel at any analysis size, while the same
-//! lobe analytically, or tabulated with values beyond the horizon, reads it in none (test
-//! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`). The table's other edge is
-//! at the mirror direction: its cells are linear in `sqrt(theta_h)`, a cusp at `theta_h = 0`
-//! that a narrow lobe can show where its peak falls between pixels. `merl-synth phong -n 1000`
-//! reads the limit in 3 of 64 rows at 512 (192 of 4096 lobes: the horizon at theta_i 86.9 and
-//! 89.6 degrees, the mirror direction at 21 degrees) and in 128 lobes at 1024.
+//! What remained at the horizon was the table's own: MERL tables hold no data for
+//! configurations below it, and `merl`'s trilinear lookup leaves those corners out and
+//! renormalizes, which holds the lobe flat across the last cell before the horizon. Where a
+//! narrow lobe meets the horizon nearly opposite `wi` (grazing incidence, where the half vector
+//! swings fast with `wo` and a cell is small in `wo`) that read the limit on the horizon's last
+//! pixel at any analysis size (`merl-synth phong -n 1000`: rows at theta_i 86.9 and 89.6
+//! degrees at 512, 86.9 at 1024), while the same lobe analytically, or tabulated with values
+//! beyond the horizon, read it in none (test
+//! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`). The analysis therefore
+//! reads the table with its cells below the horizon continued linearly along `theta_d`
+//! ([`LuminanceTable`]); a table of Phong n = 1000 then reads the limit nowhere at the default
+//! size. (The table's other edge, its cells linear in `sqrt(theta_h)`, a cusp at the mirror
+//! direction, was suspected too; reading the first cells linearly in `theta_h` instead changed
+//! no count at 512 or 1024, and is not done.)
 //!
 //! # Boundaries
 //!
@@ -175,8 +179,8 @@
 //!
 //! One analysis per row: 64 lobe images of `n^2` trilinear lookups (three per pixel below the
 //! horizon) and 64 estimates of `2n x 2n` images, in parallel over rows, each thread with its
-//! own buffers (only the `bandwidth` crate allocates per lobe). At the default `n = 512` the
-//! atlas of a real-derived material takes about 2.5 s in a release build on two cores.
+//! own buffers (only the `bandwidth` crate allocates per lobe). At the default `n = 1024` the
+//! atlas of a material takes about 12 s in a release build on two cores (3 s at 512).
 
 mod analysis;
 mod atlas;

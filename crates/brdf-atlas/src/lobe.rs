@@ -2,11 +2,20 @@
 //! trilinear interpolation ([`merl::Interp::Trilinear`]), at the pixels of a [`LobeMap`].
 //!
 //! [`LuminanceTable`] is the table reduced to one luminance per cell, read by its own copy of
-//! `merl`'s trilinear lookup: the lookup is linear in the cell values and shares the same
-//! no-data rule (a cell with any negative channel holds none), so it returns exactly the
-//! luminance of `merl`'s RGB lookup (to rounding; the tests hold it to 1e-12) while reading a
-//! third of the memory and skipping the trigonometry the general half/difference conversion
-//! needs (`cos phi_h` and `sin phi_h` come from the half vector itself).
+//! `merl`'s trilinear lookup: the lookup is linear in the cell values, so wherever the eight
+//! corners of a pair hold data it returns exactly the luminance of `merl`'s RGB lookup (to
+//! rounding; the tests hold it to 1e-12) while reading a third of the memory and skipping the
+//! trigonometry the general half/difference conversion needs (`cos phi_h` and `sin phi_h` come
+//! from the half vector itself).
+//!
+//! Where corners hold no data (configurations below the horizon, only near it) the two differ on
+//! purpose. `merl` leaves those corners out and renormalizes, which holds the lobe flat across
+//! the last cell before the horizon: an edge in the lobe's slope that a narrow lobe reaching
+//! the horizon shows as detail at the analysis grid's limit, at any grid size. Here the cells
+//! without data are continued instead ([`LuminanceTable::new`]): along `theta_d`, the axis on
+//! which a configuration sinks below the horizon, linearly from the last two cells with data,
+//! and never below 0, so the lookup carries the lobe's slope up to the horizon. A pair only
+//! ever reads them across its last cell; pairs below the horizon are never looked up.
 
 use std::f64::consts::FRAC_2_PI;
 
@@ -15,8 +24,8 @@ use merl::{Dims, MerlTable};
 
 use crate::param::{LobeMap, Sample};
 
-/// A MERL table reduced to the luminance of each cell, in 1/sr; NaN where the cell holds no
-/// data.
+/// A MERL table reduced to the luminance of each cell, in 1/sr, with the cells that hold no data
+/// continued (module docs); NaN only in a `(theta_h, phi_d)` column that holds no data at all.
 #[derive(Clone)]
 pub struct LuminanceTable {
     dims: Dims,
@@ -32,8 +41,9 @@ impl std::fmt::Debug for LuminanceTable {
 impl LuminanceTable {
     pub fn new(table: &MerlTable) -> Self {
         let dims = table.dims();
-        let luminance =
+        let mut luminance =
             (0..dims.cells()).map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance)).collect::<Vec<f64>>();
+        continue_below_horizon(dims, &mut luminance);
         Self { dims, luminance }
     }
 
@@ -42,8 +52,8 @@ impl LuminanceTable {
     }
 
     /// The luminance of the BRDF for a pair of unit directions, trilinear between cells as in
-    /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`]; `None` where all eight
-    /// corners hold no data.
+    /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`], the cells without data
+    /// continued (module docs); `None` where all eight corners are in columns without data.
     pub fn lookup(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
         let [x_h, x_d, x_p] = self.grid_coords(wi, wo);
         self.trilinear(x_h, x_d, x_p)
@@ -74,9 +84,9 @@ impl LuminanceTable {
         [x_h, x_d, phi_d * (d.n_phi_d as f64 / range)]
     }
 
-    /// The same interpolation as `merl`'s `trilinear`, on one channel: corners that hold no
-    /// data (NaN) or have weight 0 are left out and the other weights renormalized. Branch-free
-    /// over the eight corners.
+    /// The same interpolation as `merl`'s `trilinear`, on one channel: corners that are NaN
+    /// (a column without data) or have weight 0 are left out and the other weights renormalized.
+    /// Branch-free over the eight corners.
     fn trilinear(&self, x_h: f64, x_d: f64, x_p: f64) -> Option<f64> {
         let d = self.dims;
         let clamped = |x: f64, n: usize| {
@@ -105,6 +115,29 @@ impl LuminanceTable {
             }
         }
         (weight > 0.0).then(|| sum / weight)
+    }
+}
+
+/// Continues each `(theta_h, phi_d)` column of `luminance` (NaN where a cell holds no data)
+/// past its last cell with data, linearly from the last two (or constant from a single one),
+/// never below 0. The cells with data of a column are its first ones: a configuration sinks
+/// below the horizon as `theta_d` grows (both directions' heights are unimodal in `theta_d` and
+/// positive at 0), so the cells after the last one with data are all without.
+fn continue_below_horizon(dims: Dims, luminance: &mut [f64]) {
+    let (n_d, n_p) = (dims.n_theta_d, dims.n_phi_d);
+    for block in luminance.chunks_exact_mut(n_d * n_p) {
+        for p in 0..n_p {
+            let at = |d: usize| d * n_p + p;
+            let Some(last) = (0..n_d).rev().find(|&d| !block[at(d)].is_nan()) else { continue };
+            let value = block[at(last)];
+            let slope = match last.checked_sub(1).map(|d| block[at(d)]) {
+                Some(before) if !before.is_nan() => value - before,
+                _ => 0.0,
+            };
+            for d in last + 1..n_d {
+                block[at(d)] = (value + slope * (d - last) as f64).max(0.0);
+            }
+        }
     }
 }
 
@@ -184,25 +217,65 @@ mod tests {
     use merl::{Interp, spherical_dir};
     use rand::{Rng, SeedableRng, rngs::StdRng};
 
+    /// The eight cells `merl`'s trilinear lookup reads for a pair.
+    fn corners(dims: Dims, wi: DVec3, wo: DVec3) -> impl Iterator<Item = usize> {
+        let [x_h, x_d, x_p] = dims.grid_coords(&merl::half_diff(wi, wo));
+        let axis = |x: f64, n: usize| {
+            let i = (x.clamp(0.0, (n - 1) as f64) as usize).min(n - 1);
+            [i, (i + 1).min(n - 1)]
+        };
+        let p0 = (x_p as usize) % dims.n_phi_d;
+        let (h, d, p) = (axis(x_h, dims.n_theta_h), axis(x_d, dims.n_theta_d), [p0, (p0 + 1) % dims.n_phi_d]);
+        h.into_iter().flat_map(move |ih| {
+            d.into_iter()
+                .flat_map(move |id| p.into_iter().map(move |ip| (ih * dims.n_theta_d + id) * dims.n_phi_d + ip))
+        })
+    }
+
     #[test]
-    fn equals_the_luminance_of_merls_trilinear_lookup() {
+    fn equals_the_luminance_of_merls_trilinear_lookup_where_the_table_holds_data() {
         // A table with structure in every coordinate, and holes below the horizon.
         let table = Analytic::Ggx { alpha: 0.2, f0: [0.9, 0.5, 0.1] }.table(Dims::MERL);
         let luminance = LuminanceTable::new(&table);
         let mut rng = StdRng::seed_from_u64(3);
-        let mut missing = 0;
+        let (mut compared, mut continued) = (0, 0);
         for _ in 0..200_000 {
             let mut dir = || spherical_dir(rng.random::<f64>().acos(), rng.random::<f64>() * std::f64::consts::TAU);
             let (wi, wo) = (dir(), dir());
-            let expect = table.lookup(wi, wo, Interp::Trilinear).map(merl::luminance);
-            let got = luminance.lookup(wi, wo);
-            match (expect, got) {
-                (Some(e), Some(g)) => assert!((e - g).abs() <= 1e-12 * e.abs().max(1e-3), "{wi} {wo}: {e} {g}"),
-                (None, None) => missing += 1,
-                _ => panic!("{wi} {wo}: {expect:?} vs {got:?}"),
+            let got = luminance.lookup(wi, wo).expect("every column of a GGX table holds data");
+            assert!(got.is_finite() && got >= 0.0, "{wi} {wo}: {got}");
+            if corners(table.dims(), wi, wo).any(|c| table.cell_value(c).is_none()) {
+                continued += 1;
+                continue;
             }
+            let expect = merl::luminance(table.lookup(wi, wo, Interp::Trilinear).unwrap());
+            assert!((expect - got).abs() <= 1e-12 * expect.abs().max(1e-3), "{wi} {wo}: {expect} {got}");
+            compared += 1;
         }
-        println!("{missing} of 200000 random pairs have no data around them");
+        println!("{compared} pairs equal merl's lookup, {continued} read continued cells");
+        assert!(compared > 150_000, "{compared}");
+    }
+
+    #[test]
+    fn cells_without_data_continue_the_last_two_linearly() {
+        let dims = Dims::MERL;
+        let (n_d, n_p) = (dims.n_theta_d, dims.n_phi_d);
+        let mut luminance = vec![f64::NAN; dims.cells()];
+        // Column (0, 0): data in the first 10 cells, a line 2 + 0.5 d; column (0, 1): one cell;
+        // column (1, 3): falling, reaches 0 and stays there; column (2, 2): no data.
+        let (a, b, c) = (0, 1, n_d * n_p + 3);
+        for d in 0..10 {
+            luminance[a + d * n_p] = 2.0 + 0.5 * d as f64;
+            luminance[c + d * n_p] = 10.0 - d as f64;
+        }
+        luminance[b] = 7.0;
+        continue_below_horizon(dims, &mut luminance);
+        for d in 0..n_d {
+            assert_eq!(luminance[a + d * n_p], 2.0 + 0.5 * d as f64, "column a, cell {d}");
+            assert_eq!(luminance[b + d * n_p], 7.0, "column b, cell {d}");
+            assert_eq!(luminance[c + d * n_p], (10.0 - d as f64).max(0.0), "column c, cell {d}");
+            assert!(luminance[2 * n_d * n_p + 2 + d * n_p].is_nan(), "column (2, 2) stays without data");
+        }
     }
 
     #[test]
