@@ -19,6 +19,9 @@ pub struct Loaded {
     pub material: render::Material,
     /// Present when the bake has an environment.
     pub lighting: Option<render::Lighting>,
+    /// What adaptive shading predicts from (the environment's bandwidth and the material's
+    /// atlas); present when the bake has an environment.
+    pub bandwidths: Option<render::adaptive::Bandwidths>,
 }
 
 /// Reads the bake in `dir`. The MERL table is `material` when given, else the manifest's
@@ -61,6 +64,7 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     };
 
     let mut view_layers = Vec::new();
+    let mut bandwidths = None;
     let lighting = if manifest.environment.is_some() {
         let asset_path = file("prefiltered-envmap")?;
         let Payload::PrefilteredEnvmap(prefiltered) = read_payload(&asset_path)? else {
@@ -93,6 +97,16 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
             ));
         }
         view_layers = selection.view_layer;
+        let bandwidth_path = file("environment-bandwidth")?;
+        let image = envmap::read_image(&bandwidth_path, &envmap::Limits::default())
+            .map_err(|e| Error::read(&bandwidth_path, e))?;
+        let grey = image.rgb.chunks_exact(3).map(|t| t[0]).collect();
+        let environment = render::adaptive::EnvBandwidth::new(image.width, image.height, grey)
+            .map_err(|e| Error::read(&bandwidth_path, e))?;
+        let atlas_path = file("bandwidth-atlas")?;
+        let brdf =
+            crate::stage::atlas::from_payload(read_payload(&atlas_path)?).map_err(|e| Error::read(&atlas_path, e))?;
+        bandwidths = Some(render::adaptive::Bandwidths { environment, brdf });
         Some(render::Lighting { mips, layers, exponents: prefiltered.exponents })
     } else {
         None
@@ -102,6 +116,7 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
         manifest,
         material: render::Material { table, samples, view_layers, wavelet: None },
         lighting,
+        bandwidths,
     })
 }
 

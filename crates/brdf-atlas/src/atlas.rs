@@ -6,7 +6,8 @@ use rayon::prelude::*;
 use crate::analysis::{Analyser, Scratch};
 use crate::error::Error;
 use crate::lobe::LuminanceTable;
-use crate::param::IncidentGrid;
+use crate::param::{IncidentGrid, LobeMap, to_incidence_frame};
+use glam::DVec3;
 
 /// How the atlas is made. [`Config::default`] is the papers' setting: 64 x 64 incident
 /// directions, each lobe analysed at 64 x 64 and reduced to 16 x 16, a 1024 x 1024 atlas.
@@ -215,6 +216,21 @@ impl Atlas {
             let start = (j * t + y) * width + i * t;
             self.data[start..start + t].copy_from_slice(row);
         }
+    }
+
+    /// The bandwidth of the lobe of `wi` in the direction `wo` (unit vectors of the tangent
+    /// frame, `z >= 0`), in cycles per radian: the nearest texel, exactly as
+    /// `data-schema/brdf-atlas.md` ("Looking up a bandwidth") tells a renderer to read it. The
+    /// lobe's column comes from `wi`'s own azimuth, and `wo` is turned into the frame of that
+    /// plane of incidence.
+    pub fn lookup(&self, wi: DVec3, wo: DVec3) -> f32 {
+        let phi_i = wi.y.atan2(wi.x);
+        let column = |x: f64, n: usize| ((x * n as f64).floor().max(0.0) as usize).min(n - 1);
+        let i = column(phi_i.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU, self.lobes_x);
+        let j = column(1.0 - wi.z.clamp(0.0, 1.0), self.lobes_y);
+        let (u, v) = LobeMap::new(self.tile).uv(to_incidence_frame(wo, phi_i));
+        let (tx, ty) = (column(u, self.tile), column(v, self.tile));
+        self.data[(j * self.tile + ty) * self.width() + i * self.tile + tx]
     }
 
     /// Whether every tile of every row equals the row's first tile, bit for bit: the atlas of an

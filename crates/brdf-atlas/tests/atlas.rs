@@ -195,3 +195,38 @@ fn expanding_rows_checks_the_size_first() {
     let err = atlas_of(2, 2, |_, _, _| 1.0).expand_rows(3).unwrap_err().to_string();
     assert!(err.contains("one lobe wide, not 2"), "{err}");
 }
+
+/// `Atlas::lookup` reads the texel the layout puts a pair of directions in: for every lobe of a
+/// 4 x 3 grid of 4 x 4 tiles whose texels all differ, the incident direction at the lobe's
+/// centre (turned by a small azimuth within its column) and the outgoing direction at each
+/// hemisphere texel's centre (turned into the tangent frame) read that texel.
+#[test]
+fn lookup_reads_the_texel_of_a_pair_of_directions() {
+    use brdf_atlas::LobeMap;
+    let atlas = atlas_of(4, 3, |i, j, t| ((j * 4 + i) * 16 + t) as f32);
+    let map = LobeMap::new(4);
+    let grid_phi = |i: usize| std::f64::consts::TAU * (i as f64 + 0.3) / 4.0;
+    let mut checked = 0;
+    for j in 0..3 {
+        for i in 0..4 {
+            let cos_theta = 1.0 - (j as f64 + 0.5) / 3.0;
+            let phi_i = grid_phi(i);
+            let wi = merl::spherical_dir(cos_theta.acos(), phi_i);
+            for ty in 0..4 {
+                for tx in 0..4 {
+                    let w = map.direction(tx, ty);
+                    if w.z <= 0.0 {
+                        continue;
+                    }
+                    // Back from the frame of the plane of incidence: rotate by +phi_i.
+                    let (s, c) = phi_i.sin_cos();
+                    let wo = DVec3::new(c * w.x - s * w.y, s * w.x + c * w.y, w.z);
+                    let expect = ((j * 4 + i) * 16 + ty * 4 + tx) as f32;
+                    assert_eq!(atlas.lookup(wi, wo), expect, "lobe ({i}, {j}), texel ({tx}, {ty})");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 12 * 12, "the 12 texels of a 4 x 4 tile whose centre is on the hemisphere");
+}

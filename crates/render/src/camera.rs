@@ -107,16 +107,22 @@ impl Camera {
         self.projection(aspect) * self.view()
     }
 
+    /// The camera's basis in world space, in `f64`: `[f, r, u]` with `f = normalize(target -
+    /// eye)`, `r = normalize(f x z)` (screen right), `u = r x f` (screen up), the basis of
+    /// `look_at_rh`.
+    pub fn basis(&self) -> [DVec3; 3] {
+        let forward = (self.target.as_dvec3() - self.eye().as_dvec3()).normalize();
+        let right = forward.cross(DVec3::Z).normalize();
+        [forward, right, right.cross(forward)]
+    }
+
     /// The unit world-space direction of the ray from the eye through the centre of pixel
     /// `(x, y)` (row 0 at the top) of a `width x height` image, in `f64`:
     /// `normalize(f + x_ndc tan(fov_y / 2) aspect r + y_ndc tan(fov_y / 2) u)` with
     /// `f = normalize(target - eye)`, `r = normalize(f x z)`, `u = r x f` (the basis of
     /// `look_at_rh`), `x_ndc = 2 (x + 1/2) / width - 1`, `y_ndc = 1 - 2 (y + 1/2) / height`.
     pub fn ray(&self, x: usize, y: usize, width: usize, height: usize) -> DVec3 {
-        let eye = self.eye().as_dvec3();
-        let forward = (self.target.as_dvec3() - eye).normalize();
-        let right = forward.cross(DVec3::Z).normalize();
-        let up = right.cross(forward);
+        let [forward, right, up] = self.basis();
         let aspect = width as f64 / height as f64;
         let tan_half = (0.5 * f64::from(self.fov_y)).tan();
         let x_ndc = 2.0 * (x as f64 + 0.5) / width as f64 - 1.0;

@@ -124,6 +124,7 @@
 //! the lookup is; the [`converged`] module documentation has the details). Many samples, drawn
 //! from Owen-scrambled Sobol' sequences seeded per pixel: deterministic.
 
+pub mod adaptive;
 pub mod converged;
 pub mod metrics;
 pub mod raster;

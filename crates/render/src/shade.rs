@@ -140,7 +140,13 @@ enum Source<'a> {
 }
 
 /// The estimate of one covered pixel, averaged over the frames.
-fn shade(frame: &ShadingFrame, pixel: u32, material: &Material, lighting: &Lighting, settings: &Settings) -> [f64; 3] {
+pub(crate) fn shade(
+    frame: &ShadingFrame,
+    pixel: u32,
+    material: &Material,
+    lighting: &Lighting,
+    settings: &Settings,
+) -> [f64; 3] {
     let s: &SampleSet = &material.samples;
     let (n_vectors, n_samples, spp) = (s.n_vectors as u32, s.n_samples as u32, settings.spp);
     let k = slice_of(frame.theta_o(), s.n_slices);

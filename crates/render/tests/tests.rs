@@ -2,6 +2,7 @@
 
 mod support;
 
+mod adaptive;
 mod converged;
 mod determinism;
 mod known_answer;

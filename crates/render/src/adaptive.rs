@@ -1,0 +1,832 @@
+//! Bandwidth-driven multi-resolution shading (`000` section 3, `001` sections 2-3): predict, per
+//! pixel, how finely the image must be sampled and how many samples its integral needs; shade
+//! only the pixels of a pyramid whose level the prediction asks for, with a fixed total budget
+//! of samples spread by the predicted variance; up-sample the rest from coarser shaded pixels.
+//!
+//! Everything here is a specification as much as code: the GPU port will follow it step for
+//! step, as `gpu::preview` follows [`crate::render`].
+//!
+//! # The G-buffer
+//!
+//! [`crate::raster`]'s hits (position, normal) at the render resolution (the output size times
+//! `supersample`), and per pixel: the distance to the eye (`depth`), the surface's curvature `c`
+//! (radians of normal turn per unit of length: `|n(x+1) - n(x-1)| / |p(x+1) - p(x-1)|` over
+//! the covered neighbours, one-sided at the edges, the larger of the two screen axes; 1 / R on
+//! a sphere of radius R, 0 on a plane), and the material (one per scene: covered or not). A
+//! pixel is *shadeable* when it is covered and has a shading frame (crate docs).
+//!
+//! # The bandwidth buffer (`001` eq. 3-6, 9-11)
+//!
+//! For each shadeable pixel, `n_b` incident directions (default 16): the first `n_b` samples of
+//! one baked vector of the pixel's slice (the vector `pcg_hash(pixel ^ pcg_hash(seed ^
+//! 0x9e37_79b9)) % V`; the prefix of an Owen-scrambled Sobol' vector is stratified), each with
+//! its pdf. For each `wi`:
+//!
+//! - the light's bandwidth `nu_l = [0, nu_env(wi)]`, `nu_env` the bake's environment bandwidth
+//!   (cycles per radian, nearest texel; [`EnvBandwidth`]); a distant light has no spatial
+//!   bandwidth, so the transport from it (`T_d`) and `P_i` leave it unchanged;
+//! - the reflection operator of eq. 3, `R = P_x C_-c S B_{t,rho} C_c P_i`, with the matrices of
+//!   Fig. 4 exactly as printed: `C_c` shears `[0, nu_a]` to `[c nu_a, nu_a]`; `B` keeps the
+//!   spatial part (`t = 0`: no texture) and limits the angular one to `m = min(rho, nu_a)`,
+//!   `rho` the BRDF's bandwidth for `(wi, wo)` from the atlas ([`brdf_atlas::Atlas::lookup`]);
+//!   `S`, `C_-c` and `P_x = diag(1 / cos theta_x, 1)` follow; `c` is the G-buffer's curvature
+//!   (its magnitude: the sign of the shear is lost with it, the conservative side);
+//! - the transport to the eye `T_d'` with `d'` the pixel's depth. The angular bandwidth at the
+//!   eye is then `|nu_a| = m + d' c (nu_env + m) / cos theta_x`.
+//!
+//! Eq. 5 averages them with the weights `lambda_i = L(wi) f(wi, wo) cos theta_i` (luminances;
+//! `L` the environment's level 0), each divided by the sample's pdf so that the average
+//! estimates the integral it stands for whatever the sampling. Eq. 6 turns the result into
+//! cycles per pixel with the radians per pixel of the render, `fov_y / height`.
+//!
+//! The pixel's level (eq. 11): its sampling rate is twice its bandwidth (Nyquist), `s = 2 nu`
+//! samples per pixel, and its level `floor(log2(1 / s))` clamped to `[0, K]`, `K` the pyramid's
+//! top (`floor(log2(min(w, h)))`, or less when asked); a pixel with no bandwidth sits at `K`.
+//! (The paper writes `log2(1 / b_p)` with `b_p` the bandwidth; read literally it samples at
+//! the bandwidth, half the Nyquist rate, and its "floor ensures that the Nyquist sampling rate
+//! is respected" would not hold.)
+//!
+//! The predicted variance (eq. 9) is `sum_i (nu_env(wi) + rho_i) g_i^2 / pdf_i / n_b` with
+//! `g_i = L(wi) f(wi, wo) cos theta_i` the integrand, the angular bandwidths of the light and
+//! the BRDF at `wi` bounding the spectrum of their product; for the pre-convolved estimator
+//! (eq. 10) `sum_i 2 rho_i g_i^2 / pdf_i / n_b`: the layer holds no detail beyond the BRDF's.
+//!
+//! # The pyramid (`001` section 3.1)
+//!
+//! Level `k` has blocks of `2^k x 2^k` pixels (partial at the right and bottom edges). The
+//! *min* pyramid: `m_0` is a pixel's level (or "none" when it is not shadeable), `m_k` of a
+//! block the least `m` of its children, "none" when any child has none: a block that holds
+//! background or a silhouette is never shaded whole. A block is *valid* at level `k` when
+//! `m_k >= k`: all its pixels may be sampled that coarsely. The *max* pyramid of the variance
+//! gives a shaded block the largest variance of its pixels. Since a block's `m` is at most its
+//! children's, a valid block's children are valid: the pyramid is conservative.
+//!
+//! # Coarse to fine (`001` section 3.2)
+//!
+//! From the top level down, each valid block is either *shaded* (its parent is not valid, or it
+//! is the top level) or *up-sampled* from the valid blocks among the 2 x 2 parents of bilinear
+//! interpolation at the next coarser level, with the weights `w_i = g_z g_a alpha_i` normalized
+//! to sum to 1:
+//!
+//! - `alpha_i`: bilinear, from the blocks' centres (block `b` of level `k` sits at pixel
+//!   `b 2^k + floor(2^k / 2)` and is shaded with that pixel's G-buffer: "we always shade with
+//!   depth and normal values picked at the finest level");
+//! - `g_z = exp(-(z - z_i)^2 / (2 (sigma z)^2))`, `sigma` relative ([`Settings::depth_sigma`],
+//!   0.02): parents at another depth do not count;
+//! - `g_a = exp(-v^T M v)`, `v` the offset to the parent in units of the parent spacing,
+//!   `M = R^T diag(1 / cos^2 theta_x, 1) R` in the frame of the screen-projected normal: the
+//!   weight falls faster across the foreshortened direction (the paper's `R_phi` leaves which
+//!   axis takes `1 / cos^2` to its figure; foreshortening compresses the surface along the
+//!   projected normal, so that is the axis), `cos theta_x` clamped at 0.1.
+//!
+//! A block whose weights all vanish (every parent at another depth) is shaded instead
+//! (*rescued*). Every pixel therefore ends shaded at its level or up-sampled from shaded parents,
+//! and the plan is fixed by the G-buffer alone, before any shading.
+//!
+//! # Samples
+//!
+//! The frame's budget is `spp` times the covered pixels of the output image. Each shaded block
+//! gets at least 1 sample and the rest in proportion to its predicted variance, rounded down to
+//! a power of two (the baked vectors are read in aligned chunks: crate docs, "Samples") and at
+//! most `max_spp`; what rounding leaves is handed out by doubling the blocks furthest below
+//! their share, while it fits. The total never exceeds the budget; a budget below one sample per
+//! shaded block is an error. A shaded block is shaded by the chosen estimator with its count as
+//! `spp` and one frame, at its pixel (the random chunk of that pixel).
+//!
+//! # Anti-aliasing (`001` section 4.3)
+//!
+//! `supersample = s` renders at `s` times the output size in each axis: the pyramid gets
+//! `log2(s)` more levels, and smooth regions are shaded as coarsely as before, so the cost grows
+//! with the edges, not with `s^2`. The output pixel is the mean of its `s x s` render pixels.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::error::Error;
+use crate::raster::GBuffer;
+use crate::shade::{ShadingFrame, background, brdf, shade, slice_of, visibility};
+use crate::{Image, Lighting, Material, Mode, Scene, pcg_hash};
+
+/// The environment's local angular bandwidth, in cycles per radian, on the environment's
+/// lat-long grid (`envmap`'s orientation): the bake's `env-bandwidth.exr`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvBandwidth {
+    width: usize,
+    height: usize,
+    values: Vec<f32>,
+}
+
+impl EnvBandwidth {
+    /// Checks the sizes (a 2:1 lat-long grid) and that every value is finite and non-negative.
+    pub fn new(width: usize, height: usize, values: Vec<f32>) -> Result<Self, Error> {
+        if width == 0 || width != 2 * height || width.checked_mul(height) != Some(values.len()) {
+            return Err(Error::Invalid(format!(
+                "an environment bandwidth map of {width} x {height} with {} values: expected a 2:1 lat-long grid",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(Error::Invalid(format!(
+                "environment bandwidth texel ({}, {}) is {}: expected a finite bandwidth >= 0",
+                i % width,
+                i / width,
+                values[i]
+            )));
+        }
+        Ok(Self { width, height, values })
+    }
+
+    /// The bandwidth towards the world direction `dir` (unit): the nearest texel.
+    pub fn at(&self, dir: DVec3) -> f64 {
+        let (u, v) = envmap::uv(dir);
+        let x = ((u * self.width as f64) as usize).min(self.width - 1);
+        let y = ((v * self.height as f64) as usize).min(self.height - 1);
+        f64::from(self.values[y * self.width + x])
+    }
+}
+
+/// What the prediction reads besides the material and the lighting.
+#[derive(Clone, Debug)]
+pub struct Bandwidths {
+    pub environment: EnvBandwidth,
+    /// The material's bandwidth atlas (the full grid; `bake` expands stored rows).
+    pub brdf: brdf_atlas::Atlas,
+}
+
+/// How an adaptive frame is rendered (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The estimator of the shaded pixels: [`Mode::Reference`] (`adaptive`) or
+    /// [`Mode::Prefiltered`] (`adaptive-prefiltered`, eq. 10 for the variance).
+    pub mode: Mode,
+    /// The budget: mean samples per covered pixel of the output image.
+    pub spp: u32,
+    /// The most samples one shaded block gets: a power of two dividing the bake's samples per
+    /// vector.
+    pub max_spp: u32,
+    /// Incident directions per pixel for the prediction (`n_b`).
+    pub n_b: usize,
+    pub seed: u32,
+    /// Render pixels per output pixel along each axis: 1, 2 or 4 (anti-aliasing 1x, 4x, 16x).
+    pub supersample: usize,
+    /// The pyramid's top level; `None`: `floor(log2(min(w, h)))` of the render size (eq. 11).
+    pub max_level: Option<usize>,
+    /// `sigma` of the depth weight, relative to the child's depth.
+    pub depth_sigma: f64,
+    /// One prediction per `2^l x 2^l` block (0: every pixel, as the paper).
+    pub predict_level: usize,
+}
+
+impl Settings {
+    /// The defaults for a mode and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
+    /// `max_spp` 256, depth sigma 0.02, seed 0.
+    pub fn new(mode: Mode, spp: u32) -> Self {
+        Settings {
+            mode,
+            spp,
+            max_spp: 256,
+            n_b: 16,
+            seed: 0,
+            supersample: 1,
+            max_level: None,
+            depth_sigma: 0.02,
+            predict_level: 0,
+        }
+    }
+}
+
+/// A shadeable pixel's G-buffer (module docs, "The G-buffer").
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pixel {
+    pub frame: ShadingFrame,
+    pub depth: f64,
+    pub curvature: f64,
+    /// The normal projected on the screen (x right, y down), unit, or zero when it faces the
+    /// eye.
+    pub screen_normal: [f64; 2],
+}
+
+/// The G-buffer's pixels, `None` where a pixel is not shadeable.
+pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
+    let eye = scene.camera.eye().as_dvec3();
+    let [_, right, up] = scene.camera.basis();
+    let (w, h) = (gbuffer.width, gbuffer.height);
+    let frames: Vec<Option<ShadingFrame>> =
+        gbuffer.hits.iter().map(|hit| hit.as_ref().and_then(|hit| ShadingFrame::new(hit, eye))).collect();
+    let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|_| frames[y * w + x].is_some());
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let frame = frames[i]?;
+            let hit = at(x, y)?;
+            // The curvature along one axis from the neighbours that are there (module docs).
+            let axis = |a: Option<&crate::raster::Hit>, b: Option<&crate::raster::Hit>| {
+                let (a, b) = (a.unwrap_or(hit), b.unwrap_or(hit));
+                let dp = (a.position - b.position).length();
+                if dp > 0.0 { (a.normal - b.normal).length() / dp } else { 0.0 }
+            };
+            let horizontal = axis((x > 0).then(|| at(x - 1, y)).flatten(), (x + 1 < w).then(|| at(x + 1, y)).flatten());
+            let vertical = axis((y > 0).then(|| at(x, y - 1)).flatten(), (y + 1 < h).then(|| at(x, y + 1)).flatten());
+            let n = frame.n;
+            let projected = [n.dot(right), -n.dot(up)];
+            let length = projected[0].hypot(projected[1]);
+            let screen_normal = if length > 1e-9 { [projected[0] / length, projected[1] / length] } else { [0.0; 2] };
+            Some(Pixel {
+                frame,
+                depth: (eye - hit.position).length(),
+                curvature: horizontal.max(vertical),
+                screen_normal,
+            })
+        })
+        .collect()
+}
+
+/// The bandwidth buffer's entry of one pixel (module docs, "The bandwidth buffer").
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Prediction {
+    /// Image-space bandwidth, cycles per pixel (eq. 5-6).
+    pub bandwidth: f64,
+    /// The variance bound (eq. 9, or eq. 10 for the pre-convolved estimator).
+    pub variance: f64,
+    /// The pyramid level the pixel may be shaded at (eq. 11); -1 when it is not shadeable.
+    pub level: i32,
+}
+
+/// The bandwidth buffer: one [`Prediction`] per render pixel, row-major. With
+/// `settings.predict_level = l > 0`, one prediction per `2^l x 2^l` block, made at the block's
+/// pixel ([`Level::pixel`]) and copied to its shadeable pixels (a pixel whose block's pixel is
+/// not shadeable, at a silhouette, predicts for itself).
+pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize), frame: &Frame) -> Vec<Prediction> {
+    let one = |i: usize| match &pixels[i] {
+        Some(p) => predict_pixel(p, i, frame),
+        None => Prediction { level: -1, ..Prediction::default() },
+    };
+    let l = frame.settings.predict_level;
+    if l == 0 {
+        return (0..pixels.len()).into_par_iter().map(one).collect();
+    }
+    let grid = Level {
+        level: l,
+        width: width.div_ceil(1 << l),
+        height: height.div_ceil(1 << l),
+        min_level: Vec::new(),
+        max_variance: Vec::new(),
+    };
+    let rep = |b: usize| {
+        let (x, y) = grid.pixel(b % grid.width, b / grid.width, width, height);
+        y * width + x
+    };
+    let blocks: Vec<Option<Prediction>> =
+        (0..grid.width * grid.height).into_par_iter().map(|b| pixels[rep(b)].is_some().then(|| one(rep(b)))).collect();
+    (0..pixels.len())
+        .into_par_iter()
+        .map(|i| {
+            if pixels[i].is_none() {
+                return Prediction { level: -1, ..Prediction::default() };
+            }
+            let b = ((i / width) >> l) * grid.width + ((i % width) >> l);
+            blocks[b].unwrap_or_else(|| one(i))
+        })
+        .collect()
+}
+
+/// What the prediction of a frame reads.
+pub(crate) struct Frame<'a> {
+    pub material: &'a Material,
+    pub lighting: &'a Lighting,
+    pub bandwidths: &'a Bandwidths,
+    pub settings: &'a Settings,
+    /// Of the render, at the centre: `fov_y / height` (eq. 6).
+    pub radians_per_pixel: f64,
+    /// The pyramid's top level.
+    pub top: usize,
+}
+
+/// The prediction of one shadeable pixel (module docs, "The bandwidth buffer").
+fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> Prediction {
+    let Frame { material, lighting, bandwidths, settings, radians_per_pixel, top } = *frame;
+    let s = &material.samples;
+    let level0 = lighting.mips.level(0);
+    let n_b = settings.n_b.min(s.n_samples);
+    let hashed_seed = pcg_hash(settings.seed ^ 0x9e37_79b9);
+    let k = slice_of(p.frame.theta_o(), s.n_slices);
+    let vector = pcg_hash(i as u32 ^ hashed_seed) as usize % s.n_vectors;
+    let start = (k * s.n_vectors + vector) * s.n_samples;
+    let (mut weight, mut weighted, mut variance) = (0.0, 0.0, 0.0);
+    for texel in &s.texels[start..start + n_b] {
+        let wi_local = DVec3::new(texel[0].into(), texel[1].into(), texel[2].into());
+        let pdf = f64::from(texel[3]);
+        if !(pdf > 0.0 && wi_local.z > 0.0) {
+            continue;
+        }
+        let f = merl::luminance(brdf(material, wi_local, p.frame.wo_local));
+        let wi = p.frame.to_world(wi_local);
+        let radiance = envmap::luminance(level0.lookup(wi).map(f64::from));
+        let g = radiance * f * wi_local.z;
+        let nu_env = bandwidths.environment.at(wi);
+        let rho = f64::from(bandwidths.brdf.lookup(wi_local, p.frame.wo_local));
+        let at_eye = bandwidth_at_eye(nu_env, rho, p.curvature, p.depth, p.frame.cos_o);
+        weight += g / pdf;
+        weighted += g / pdf * at_eye;
+        variance += match settings.mode {
+            Mode::Prefiltered => 2.0 * rho,
+            _ => nu_env + rho,
+        } * g
+            * g
+            / pdf;
+    }
+    let bandwidth = if weight > 0.0 { weighted / weight * radians_per_pixel } else { 0.0 };
+    Prediction { bandwidth, variance: variance / n_b as f64, level: level_of(bandwidth, top) }
+}
+
+/// The angular bandwidth at the eye of the light from one incident direction (`001` eq. 3-4 with
+/// the matrices of Fig. 4, as printed): a distant light's `[0, nu_env]` through `C_c`, `B_{0,rho}`,
+/// `S`, `C_-c`, `P_x` and `T_d'` (`P_i` and `T_d` leave it unchanged); `|nu_a|` of the result,
+/// in cycles per radian. `curvature` in 1 / length, `depth` in the same length.
+pub fn bandwidth_at_eye(nu_env: f64, rho: f64, curvature: f64, depth: f64, cos_x: f64) -> f64 {
+    type M = [[f64; 2]; 2];
+    let apply = |m: M, v: [f64; 2]| [m[0][0] * v[0] + m[0][1] * v[1], m[1][0] * v[0] + m[1][1] * v[1]];
+    let c = curvature;
+    let mut nu = [0.0, nu_env];
+    nu = apply([[1.0, c], [0.0, 1.0]], nu); // C_c
+    nu = [nu[0], rho.min(nu[1])]; // B_{0, rho}
+    nu = apply([[1.0, 0.0], [0.0, -1.0]], nu); // S
+    nu = apply([[1.0, -c], [0.0, 1.0]], nu); // C_-c
+    nu = apply([[1.0 / cos_x, 0.0], [0.0, 1.0]], nu); // P_x
+    nu = apply([[1.0, 0.0], [-depth, 1.0]], nu); // T_d'
+    nu[1].abs()
+}
+
+/// Eq. 11 with the Nyquist rate: `floor(log2(1 / (2 bandwidth)))` clamped to `[0, top]`.
+pub fn level_of(bandwidth: f64, top: usize) -> i32 {
+    if bandwidth.is_nan() || bandwidth <= 0.0 {
+        return top as i32;
+    }
+    (1.0 / (2.0 * bandwidth)).log2().floor().clamp(0.0, top as f64) as i32
+}
+
+/// One level of the pyramid: `width x height` blocks of `2^level` pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    pub level: usize,
+    pub width: usize,
+    pub height: usize,
+    /// The min pyramid: the least level of the block's pixels, -1 when one is not shadeable.
+    pub min_level: Vec<i32>,
+    /// The max pyramid of the predicted variance.
+    pub max_variance: Vec<f64>,
+}
+
+impl Level {
+    /// Whether block `b` may be shaded at this level or coarser (module docs).
+    pub fn valid(&self, b: usize) -> bool {
+        self.min_level[b] >= self.level as i32
+    }
+
+    /// The render pixel block `(bx, by)` is shaded with: `b 2^k + floor(2^k / 2)` per axis,
+    /// clamped to the image.
+    pub fn pixel(&self, bx: usize, by: usize, width: usize, height: usize) -> (usize, usize) {
+        let (size, half) = (1usize << self.level, (1usize << self.level) / 2);
+        ((bx * size + half).min(width - 1), (by * size + half).min(height - 1))
+    }
+}
+
+/// The min and max pyramids of a bandwidth buffer of `width x height` pixels, levels `0..=top`.
+pub fn pyramid(predictions: &[Prediction], width: usize, height: usize, top: usize) -> Vec<Level> {
+    let mut levels = vec![Level {
+        level: 0,
+        width,
+        height,
+        min_level: predictions.iter().map(|p| p.level).collect(),
+        max_variance: predictions.iter().map(|p| p.variance).collect(),
+    }];
+    for k in 1..=top {
+        let child = &levels[k - 1];
+        let (w, h) = (child.width.div_ceil(2), child.height.div_ceil(2));
+        let mut min_level = vec![i32::MAX; w * h];
+        let mut max_variance = vec![0.0f64; w * h];
+        for cy in 0..child.height {
+            for cx in 0..child.width {
+                let (c, b) = (cy * child.width + cx, (cy / 2) * w + cx / 2);
+                min_level[b] = min_level[b].min(child.min_level[c]);
+                max_variance[b] = max_variance[b].max(child.max_variance[c]);
+            }
+        }
+        levels.push(Level { level: k, width: w, height: h, min_level, max_variance });
+    }
+    levels
+}
+
+/// What happens to a block (module docs, "Coarse to fine").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Action {
+    /// Not computed at this level (not valid).
+    Skip,
+    /// Shaded with this many samples; `rescued` when its parents' weights all vanished.
+    Shade { samples: u32, rescued: bool },
+    /// The weighted mean of `count` blocks of the next coarser level: `(index, weight)`, the
+    /// weights summing to 1.
+    Upsample { parents: [(u32, f32); 4], count: u8 },
+}
+
+/// The plan of a frame: every level's actions, fixed by the G-buffer before any shading.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub levels: Vec<Level>,
+    pub actions: Vec<Vec<Action>>,
+    /// The frame's budget of samples.
+    pub budget: u64,
+}
+
+impl Plan {
+    /// The blocks shaded at each level.
+    pub fn shaded_per_level(&self) -> Vec<usize> {
+        self.actions.iter().map(|a| a.iter().filter(|a| matches!(a, Action::Shade { .. })).count()).collect()
+    }
+
+    /// The samples the plan spends.
+    pub fn samples(&self) -> u64 {
+        self.actions
+            .iter()
+            .flatten()
+            .map(|a| match a {
+                Action::Shade { samples, .. } => u64::from(*samples),
+                _ => 0,
+            })
+            .sum()
+    }
+}
+
+/// The up-sampling weights of block `(bx, by)` of `child` from the valid blocks of `parent`
+/// (module docs); `None` when they all vanish.
+fn upsample_weights(
+    child: &Level,
+    parent: &Level,
+    (bx, by): (usize, usize),
+    pixels: &[Option<Pixel>],
+    (width, height): (usize, usize),
+    depth_sigma: f64,
+) -> Option<([(u32, f32); 4], u8)> {
+    let (cx, cy) = child.pixel(bx, by, width, height);
+    let me = pixels[cy * width + cx].as_ref()?;
+    let spacing = (1usize << parent.level) as f64;
+    let centre = |b: usize, level: usize| (b * (1 << level) + (1 << level) / 2) as f64 + 0.5;
+    // Bilinear neighbours along one axis: (first parent, fraction towards the second).
+    let axis = |b: usize, n: usize| -> (usize, f64) {
+        if n == 1 {
+            return (0, 0.0);
+        }
+        let offset = centre(0, parent.level);
+        let t = ((centre(b, child.level) - offset) / spacing).clamp(0.0, (n - 1) as f64);
+        let first = (t.floor() as usize).min(n - 2);
+        (first, t - first as f64)
+    };
+    let (x0, fx) = axis(bx, parent.width);
+    let (y0, fy) = axis(by, parent.height);
+    let cos_x = me.frame.cos_o.max(0.1);
+    let mut out = [(0u32, 0f32); 4];
+    let (mut count, mut total) = (0u8, 0.0f64);
+    let mut weights = [0.0f64; 4];
+    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let alpha = (if dx == 0 { 1.0 - fx } else { fx }) * (if dy == 0 { 1.0 - fy } else { fy });
+        let (px, py) = ((x0 + dx).min(parent.width - 1), (y0 + dy).min(parent.height - 1));
+        let b = py * parent.width + px;
+        if alpha <= 0.0 || !parent.valid(b) || out[..count as usize].iter().any(|(i, _)| *i as usize == b) {
+            continue;
+        }
+        let (rx, ry) = parent.pixel(px, py, width, height);
+        let Some(them) = pixels[ry * width + rx].as_ref() else { continue };
+        let dz = (me.depth - them.depth) / (depth_sigma * me.depth);
+        let g_z = (-0.5 * dz * dz).exp();
+        let v = [
+            (centre(px, parent.level) - centre(bx, child.level)) / spacing,
+            (centre(py, parent.level) - centre(by, child.level)) / spacing,
+        ];
+        // A normal facing the eye has no screen direction: M is then the identity.
+        let [nx, ny] = if me.screen_normal == [0.0; 2] { [1.0, 0.0] } else { me.screen_normal };
+        let along = v[0] * nx + v[1] * ny;
+        let across = -v[0] * ny + v[1] * nx;
+        let g_a = (-(along * along / (cos_x * cos_x) + across * across)).exp();
+        let w = g_z * g_a * alpha;
+        if w > 0.0 {
+            out[count as usize] = (b as u32, 0.0);
+            weights[count as usize] = w;
+            total += w;
+            count += 1;
+        }
+    }
+    if count == 0 || total.is_nan() || total <= 0.0 {
+        return None;
+    }
+    for j in 0..count as usize {
+        out[j].1 = (weights[j] / total) as f32;
+    }
+    Some((out, count))
+}
+
+/// The plan of a frame (module docs): which blocks are shaded, with how many samples, and the
+/// up-sampling weights of the others. `budget` samples in all.
+pub(crate) fn plan(
+    levels: Vec<Level>,
+    pixels: &[Option<Pixel>],
+    (width, height): (usize, usize),
+    budget: u64,
+    settings: &Settings,
+) -> Result<Plan, Error> {
+    let top = levels.len() - 1;
+    let mut actions: Vec<Vec<Action>> = Vec::with_capacity(levels.len());
+    for k in (0..=top).rev() {
+        let level = &levels[k];
+        let row: Vec<Action> = (0..level.width * level.height)
+            .into_par_iter()
+            .map(|b| {
+                if !level.valid(b) {
+                    return Action::Skip;
+                }
+                let (bx, by) = (b % level.width, b / level.width);
+                if k < top && levels[k + 1].valid((by / 2) * levels[k + 1].width + bx / 2) {
+                    match upsample_weights(
+                        level,
+                        &levels[k + 1],
+                        (bx, by),
+                        pixels,
+                        (width, height),
+                        settings.depth_sigma,
+                    ) {
+                        Some((parents, count)) => Action::Upsample { parents, count },
+                        None => Action::Shade { samples: 0, rescued: true },
+                    }
+                } else {
+                    Action::Shade { samples: 0, rescued: false }
+                }
+            })
+            .collect();
+        actions.push(row);
+    }
+    actions.reverse();
+    allocate(&levels, &mut actions, budget, settings.max_spp)?;
+    Ok(Plan { levels, actions, budget })
+}
+
+/// Splits `budget` among blocks of the given variances: each at least 1 and at most `cap`, the
+/// rest in proportion to the variance, what a capped block cannot take going to the others
+/// (water filling). The shares sum to `min(budget, cap * n)`.
+fn shares(variance: &[f64], budget: f64, cap: f64) -> Vec<f64> {
+    let mut share = vec![1.0; variance.len()];
+    let mut open: Vec<usize> = (0..variance.len()).collect();
+    let mut spare = budget - variance.len() as f64;
+    while spare > 0.0 && !open.is_empty() {
+        let total: f64 = open.iter().map(|&i| variance[i]).sum();
+        let portion = |i: usize| if total > 0.0 { spare * variance[i] / total } else { spare / open.len() as f64 };
+        let full: Vec<usize> = open.iter().copied().filter(|&i| share[i] + portion(i) >= cap).collect();
+        if full.is_empty() {
+            for &i in &open {
+                share[i] += portion(i);
+            }
+            break;
+        }
+        for &i in &full {
+            spare -= cap - share[i];
+            share[i] = cap;
+        }
+        open.retain(|&i| share[i] < cap);
+    }
+    share
+}
+
+/// Gives every shaded block its samples (module docs, "Samples").
+fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, max_spp: u32) -> Result<(), Error> {
+    // (level, block, variance)
+    let shaded: Vec<(usize, usize, f64)> = actions
+        .iter()
+        .enumerate()
+        .flat_map(|(k, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|(_, a)| matches!(a, Action::Shade { .. }))
+                .map(move |(b, _)| (k, b, levels[k].max_variance[b]))
+        })
+        .collect();
+    let count = shaded.len() as u64;
+    if count > budget {
+        return Err(Error::Invalid(format!(
+            "a budget of {budget} samples is less than one for each of the {count} shaded pixels: raise spp"
+        )));
+    }
+    let ideal = shares(&shaded.iter().map(|s| s.2).collect::<Vec<f64>>(), budget as f64, f64::from(max_spp));
+    let floor_pow2 = |x: f64| -> u32 {
+        let x = x.min(f64::from(max_spp)).max(1.0);
+        1u32 << (x.log2().floor() as u32)
+    };
+    let mut samples: Vec<u32> = ideal.iter().map(|&x| floor_pow2(x)).collect();
+    let mut left = budget - samples.iter().map(|&n| u64::from(n)).sum::<u64>();
+    let mut order: Vec<usize> = (0..shaded.len()).collect();
+    order.sort_by(|&a, &b| {
+        (ideal[b] / f64::from(samples[b])).total_cmp(&(ideal[a] / f64::from(samples[a]))).then(a.cmp(&b))
+    });
+    for i in order {
+        if samples[i] < max_spp && u64::from(samples[i]) <= left {
+            left -= u64::from(samples[i]);
+            samples[i] *= 2;
+        }
+    }
+    for ((k, b, _), n) in shaded.into_iter().zip(samples) {
+        if let Action::Shade { samples, .. } = &mut actions[k][b] {
+            *samples = n;
+        }
+    }
+    Ok(())
+}
+
+/// What an adaptive frame made: the picture and everything the debug views and the figures
+/// read.
+#[derive(Clone, Debug)]
+pub struct Adaptive {
+    /// The output image (the render averaged over `supersample^2` pixels).
+    pub image: Image,
+    /// The render size (the output size times `supersample`).
+    pub width: usize,
+    pub height: usize,
+    /// The bandwidth buffer, per render pixel.
+    pub predictions: Vec<Prediction>,
+    pub plan: Plan,
+    /// Per render pixel: the level of the block whose shading its value comes from (through
+    /// its own ancestors), -1 where it is not shadeable.
+    pub shaded_level: Vec<i32>,
+    /// Per render pixel: the samples of that block over its area in render pixels.
+    pub samples_per_pixel: Vec<f32>,
+    /// Shadeable render pixels.
+    pub shadeable: usize,
+    /// Wall time of the steps, in milliseconds: G-buffer, bandwidth buffer (prediction),
+    /// pyramid and plan, shading and up-sampling.
+    pub timings: Timings,
+}
+
+/// Wall time of an adaptive frame's steps, in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    pub gbuffer_ms: f64,
+    pub predict_ms: f64,
+    pub plan_ms: f64,
+    pub shade_ms: f64,
+}
+
+impl Adaptive {
+    /// Shaded blocks over shadeable render pixels: 1 when every pixel is shaded on its own.
+    pub fn shaded_fraction(&self) -> f64 {
+        let shaded: usize = self.plan.shaded_per_level().iter().sum();
+        if self.shadeable == 0 { 0.0 } else { shaded as f64 / self.shadeable as f64 }
+    }
+}
+
+/// The checks [`render`] makes on its settings.
+pub fn check_settings(settings: &Settings, material: &Material, lighting: &Lighting) -> Result<(), Error> {
+    if !matches!(settings.mode, Mode::Reference | Mode::Prefiltered) {
+        return Err(Error::Invalid(format!(
+            "adaptive shading uses the reference or the prefiltered estimator, not {}",
+            settings.mode.name()
+        )));
+    }
+    let base = crate::Settings { mode: settings.mode, spp: settings.max_spp, frames: 1, seed: settings.seed };
+    crate::check_settings(&base, material.samples.n_samples, lighting.layers.len(), &material.view_layers)?;
+    if settings.spp == 0 || settings.n_b == 0 || !matches!(settings.supersample, 1 | 2 | 4) {
+        return Err(Error::Invalid(format!(
+            "spp {} and n_b {} must be at least 1 and supersample ({}) 1, 2 or 4",
+            settings.spp, settings.n_b, settings.supersample
+        )));
+    }
+    if !(settings.depth_sigma > 0.0 && settings.depth_sigma.is_finite()) {
+        return Err(Error::Invalid(format!("depth sigma {} must be positive", settings.depth_sigma)));
+    }
+    Ok(())
+}
+
+/// The pyramid's top level for a render of `width x height`: eq. 11's `floor(log2(min(w, h)))`,
+/// at most `max_level`.
+pub fn top_level(width: usize, height: usize, max_level: Option<usize>) -> usize {
+    let full = (usize::BITS - 1 - width.min(height).max(1).leading_zeros()) as usize;
+    max_level.map_or(full, |m| m.min(full))
+}
+
+/// Renders one adaptive frame of `scene` (module docs for every step).
+pub fn render(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+) -> Result<Adaptive, Error> {
+    crate::check_inputs(material, lighting)?;
+    check_settings(settings, material, lighting)?;
+    let ss = settings.supersample;
+    let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
+    let (width, height) = (render_scene.width, render_scene.height);
+    let clock = std::time::Instant::now();
+    let lap = || clock.elapsed().as_secs_f64() * 1e3;
+    let gbuffer = visibility(&render_scene)?;
+    let pixels = pixels(&render_scene, &gbuffer);
+    let gbuffer_ms = lap();
+    let top = top_level(width, height, settings.max_level);
+    let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
+    let frame = Frame { material, lighting, bandwidths, settings, radians_per_pixel, top };
+    let predictions = predict(&pixels, (width, height), &frame);
+    let predict_ms = lap();
+    let levels = pyramid(&predictions, width, height, top);
+    let covered_output = (0..scene.width * scene.height)
+        .filter(|&i| {
+            let (x, y) = (i % scene.width * ss, i / scene.width * ss);
+            (0..ss * ss).any(|j| gbuffer.hits[(y + j / ss) * width + x + j % ss].is_some())
+        })
+        .count() as u64;
+    let plan = plan(levels, &pixels, (width, height), u64::from(settings.spp) * covered_output, settings)?;
+    let plan_ms = lap();
+
+    // Coarse to fine.
+    let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
+    let mut origin: Vec<Vec<(i32, f32)>> = vec![Vec::new(); top + 1];
+    for k in (0..=top).rev() {
+        let level = &plan.levels[k];
+        let (coarser, coarser_origin) =
+            if k < top { (&values[k + 1], &origin[k + 1]) } else { (&Vec::new(), &Vec::new()) };
+        let computed: Vec<([f32; 3], (i32, f32))> = plan.actions[k]
+            .par_iter()
+            .enumerate()
+            .map(|(b, action)| match *action {
+                Action::Skip => ([0.0; 3], (-1, 0.0)),
+                Action::Shade { samples, .. } => {
+                    let (x, y) = level.pixel(b % level.width, b / level.width, width, height);
+                    let pixel = pixels[y * width + x].as_ref().expect("a valid block's pixels are shadeable");
+                    let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
+                    let value = shade(&pixel.frame, (y * width + x) as u32, material, lighting, &shading);
+                    (value.map(|v| v as f32), (k as i32, samples as f32 / (1u64 << (2 * k)) as f32))
+                }
+                Action::Upsample { parents, count } => {
+                    let mut value = [0.0f32; 3];
+                    for &(i, w) in &parents[..count as usize] {
+                        for c in 0..3 {
+                            value[c] += w * coarser[i as usize][c];
+                        }
+                    }
+                    let own = (b / level.width / 2) * plan.levels[k + 1].width + (b % level.width) / 2;
+                    (value, coarser_origin[own])
+                }
+            })
+            .collect();
+        values[k] = computed.iter().map(|c| c.0).collect();
+        origin[k] = computed.iter().map(|c| c.1).collect();
+    }
+
+    let level0 = lighting.mips.level(0);
+    let render_rgb: Vec<[f32; 3]> = (0..width * height)
+        .into_par_iter()
+        .map(|i| match (&gbuffer.hits[i], &pixels[i]) {
+            (None, _) => background(&render_scene, level0, i % width, i / width).map(|v| v as f32),
+            (Some(_), None) => [0.0; 3],
+            (Some(_), Some(_)) => values[0][i],
+        })
+        .collect();
+    let image = downsample(&render_rgb, &gbuffer, scene.width, scene.height, ss);
+    let shade_ms = lap();
+    let timings = Timings {
+        gbuffer_ms,
+        predict_ms: predict_ms - gbuffer_ms,
+        plan_ms: plan_ms - predict_ms,
+        shade_ms: shade_ms - plan_ms,
+    };
+    Ok(Adaptive {
+        timings,
+        image,
+        width,
+        height,
+        predictions,
+        shaded_level: origin[0].iter().map(|o| o.0).collect(),
+        samples_per_pixel: origin[0].iter().map(|o| o.1).collect(),
+        shadeable: pixels.iter().filter(|p| p.is_some()).count(),
+        plan,
+    })
+}
+
+/// The output image: the mean of each `ss x ss` block of render pixels; covered when any of
+/// them is.
+fn downsample(rgb: &[[f32; 3]], gbuffer: &GBuffer, width: usize, height: usize, ss: usize) -> Image {
+    let render_width = width * ss;
+    let mut out = Vec::with_capacity(3 * width * height);
+    let mut covered = Vec::with_capacity(width * height);
+    for y in 0..height {
+        for x in 0..width {
+            let mut sum = [0.0f64; 3];
+            let mut any = false;
+            for j in 0..ss * ss {
+                let i = (y * ss + j / ss) * render_width + x * ss + j % ss;
+                for c in 0..3 {
+                    sum[c] += f64::from(rgb[i][c]);
+                }
+                any |= gbuffer.hits[i].is_some();
+            }
+            out.extend(sum.map(|v| (v / (ss * ss) as f64) as f32));
+            covered.push(any);
+        }
+    }
+    Image { width, height, rgb: out, covered }
+}

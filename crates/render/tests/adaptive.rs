@@ -1,0 +1,203 @@
+//! Adaptive multi-resolution shading (`render::adaptive`): the pyramid, the plan and the budget
+//! keep their invariants on real frames, and the plan reduces to the full-resolution renderer
+//! when it may not coarsen.
+
+use brdf_atlas::{Atlas, Parameterization};
+use rand::{Rng, SeedableRng, rngs::StdRng};
+use render::adaptive::{self, Action, Bandwidths, EnvBandwidth, Prediction};
+use render::{Mode, Settings};
+
+use crate::support::{phong, sky_lighting, sphere_scene};
+
+/// Bandwidths with structure, low enough for a small image to have pixels at every level: the
+/// environment's varies with latitude (0.2 to 4.2 cycles per radian), the atlas's with the
+/// incident row (0.25 to 2.25).
+fn bandwidths() -> Bandwidths {
+    let (w, h) = (64, 32);
+    let values = (0..w * h).map(|i| 0.2 + 4.0 * ((i / w) as f32 * 0.4).sin().abs()).collect();
+    let environment = EnvBandwidth::new(w, h, values).unwrap();
+    let (lobes, tile) = (8, 4);
+    let data =
+        (0..lobes * tile * lobes * tile).map(|i| 0.25 + 2.0 * ((i / (lobes * tile)) / tile) as f32 / 8.0).collect();
+    let brdf = Atlas {
+        lobes_x: lobes,
+        lobes_y: lobes,
+        tile,
+        data,
+        parameterization: Parameterization::IncidencePlaneEquidistant,
+        analysis_size: 16,
+        eps: 0.01,
+        c: 0.1767766952966369,
+    };
+    Bandwidths { environment, brdf }
+}
+
+#[test]
+fn eq_11_takes_the_nyquist_rate() {
+    // Sampling rate 2 nu per pixel; level floor(log2(1 / (2 nu))) in [0, top].
+    assert_eq!(adaptive::level_of(0.5, 6), 0);
+    assert_eq!(adaptive::level_of(0.3, 6), 0);
+    assert_eq!(adaptive::level_of(0.25, 6), 1);
+    assert_eq!(adaptive::level_of(0.2, 6), 1);
+    assert_eq!(adaptive::level_of(1.0 / 64.0, 6), 5);
+    assert_eq!(adaptive::level_of(1e-9, 6), 6);
+    assert_eq!(adaptive::level_of(0.0, 6), 6);
+    assert_eq!(adaptive::level_of(40.0, 6), 0);
+}
+
+#[test]
+fn the_reflection_operator_matches_its_closed_form() {
+    // R = P_x C_-c S B C_c on [0, nu] then T_d': |nu_a| = m + d c (nu + m) / cos, m = min(rho, nu).
+    let mut rng = StdRng::seed_from_u64(5);
+    for _ in 0..1000 {
+        let (nu, rho) = (rng.random::<f64>() * 50.0, rng.random::<f64>() * 50.0);
+        let (c, d, cos) = (rng.random::<f64>() * 3.0, rng.random::<f64>() * 10.0, 0.05 + 0.95 * rng.random::<f64>());
+        let m = rho.min(nu);
+        let expect = m + d * c * (nu + m) / cos;
+        let got = adaptive::bandwidth_at_eye(nu, rho, c, d, cos);
+        assert!((got - expect).abs() <= 1e-12 * expect.max(1.0), "{nu} {rho} {c} {d} {cos}: {got} vs {expect}");
+    }
+    // A flat surface shows the reflected bandwidth as it is, whatever the distance.
+    assert_eq!(adaptive::bandwidth_at_eye(8.0, 3.0, 0.0, 100.0, 0.5), 3.0);
+}
+
+#[test]
+fn the_min_pyramid_is_conservative() {
+    let mut rng = StdRng::seed_from_u64(9);
+    let (w, h, top) = (37, 23, 4);
+    let predictions: Vec<Prediction> = (0..w * h)
+        .map(|_| Prediction {
+            bandwidth: 0.0,
+            variance: rng.random::<f64>(),
+            level: if rng.random::<f64>() < 0.05 { -1 } else { rng.random_range(0..=top as i32) },
+        })
+        .collect();
+    let levels = adaptive::pyramid(&predictions, w, h, top);
+    assert_eq!(levels.len(), top + 1);
+    for k in 1..=top {
+        let (parent, child) = (&levels[k], &levels[k - 1]);
+        assert_eq!((parent.width, parent.height), (child.width.div_ceil(2), child.height.div_ceil(2)));
+        for cy in 0..child.height {
+            for cx in 0..child.width {
+                let (c, p) = (cy * child.width + cx, (cy / 2) * parent.width + cx / 2);
+                assert!(parent.min_level[p] <= child.min_level[c], "level {k}: a child finer than its parent");
+                assert!(parent.max_variance[p] >= child.max_variance[c]);
+                // A block valid at its level has valid children: no child needs a finer level.
+                assert!(!parent.valid(p) || child.valid(c), "level {k}, block ({}, {})", cx / 2, cy / 2);
+            }
+        }
+        // The min and the max are attained by a child (not merely bounds).
+        for p in 0..parent.width * parent.height {
+            let children: Vec<usize> = (0..child.width * child.height)
+                .filter(|&c| (c / child.width / 2) * parent.width + (c % child.width) / 2 == p)
+                .collect();
+            assert_eq!(parent.min_level[p], children.iter().map(|&c| child.min_level[c]).min().unwrap());
+            assert_eq!(parent.max_variance[p], children.iter().map(|&c| child.max_variance[c]).fold(0.0, f64::max));
+        }
+    }
+}
+
+/// Every invariant of a frame's plan (module docs): each valid block is shaded or up-sampled,
+/// nothing else is computed; an up-sampled block's parents are computed and its weights are
+/// positive and sum to 1; a non-rescued shaded block has no valid parent; every shadeable pixel
+/// gets a value from a block no coarser than its own level; the samples are powers of two within
+/// the cap and within the budget.
+fn check_plan(frame: &adaptive::Adaptive, settings: &adaptive::Settings) {
+    let plan = &frame.plan;
+    let top = plan.levels.len() - 1;
+    for (k, (level, actions)) in plan.levels.iter().zip(&plan.actions).enumerate() {
+        assert_eq!(actions.len(), level.width * level.height);
+        for (b, action) in actions.iter().enumerate() {
+            let parent = (k < top).then(|| (b / level.width / 2) * plan.levels[k + 1].width + (b % level.width) / 2);
+            let parent_valid = parent.is_some_and(|p| plan.levels[k + 1].valid(p));
+            match *action {
+                Action::Skip => assert!(!level.valid(b), "level {k} block {b}: valid but not computed"),
+                Action::Shade { samples, rescued } => {
+                    assert!(level.valid(b), "level {k} block {b}: shaded though a pixel needs a finer level");
+                    assert!(rescued || !parent_valid, "level {k} block {b}: shaded though its parent is valid");
+                    assert!(samples.is_power_of_two() && samples <= settings.max_spp, "{samples} samples");
+                }
+                Action::Upsample { parents, count } => {
+                    assert!(level.valid(b) && parent_valid, "level {k} block {b}");
+                    assert!((1..=4).contains(&count));
+                    let mut sum = 0.0f64;
+                    for &(p, w) in &parents[..count as usize] {
+                        assert!(plan.levels[k + 1].valid(p as usize), "level {k} block {b}: parent {p} not computed");
+                        assert_ne!(plan.actions[k + 1][p as usize], Action::Skip);
+                        assert!(w > 0.0, "weight {w}");
+                        sum += f64::from(w);
+                    }
+                    assert!((sum - 1.0).abs() <= 1e-6, "level {k} block {b}: weights sum to {sum}");
+                }
+            }
+        }
+    }
+    for (p, prediction) in frame.predictions.iter().enumerate() {
+        let action = plan.actions[0][p];
+        if prediction.level < 0 {
+            assert_eq!(action, Action::Skip);
+            assert_eq!(frame.shaded_level[p], -1);
+        } else {
+            assert_ne!(action, Action::Skip, "shadeable pixel {p} is neither shaded nor up-sampled");
+            let shaded = frame.shaded_level[p];
+            assert!(
+                (0..=prediction.level).contains(&shaded),
+                "pixel {p}: shaded at {shaded}, needs {}",
+                prediction.level
+            );
+        }
+    }
+    assert!(plan.samples() <= plan.budget, "{} samples over a budget of {}", plan.samples(), plan.budget);
+}
+
+#[test]
+fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
+    let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
+    // An odd size, so that the pyramid has partial blocks at the right and bottom edges.
+    let scene = sphere_scene(83, 61);
+    let mut coarse_levels = 0;
+    for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 2), (Mode::Reference, 2, 4)] {
+        for predict_level in [0, 1] {
+            let settings = adaptive::Settings { supersample, predict_level, ..adaptive::Settings::new(mode, spp) };
+            let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
+            check_plan(&frame, &settings);
+            let per_level = frame.plan.shaded_per_level();
+            coarse_levels += per_level[1..].iter().filter(|&&n| n > 0).count();
+            // The budget is used: rounding to powers of two loses less than half.
+            assert!(2 * frame.plan.samples() > frame.plan.budget, "{} of {}", frame.plan.samples(), frame.plan.budget);
+            println!(
+                "{} ss {supersample} predict {predict_level}: shaded {:.3}, per level {per_level:?}",
+                mode.name(),
+                frame.shaded_fraction()
+            );
+            assert!(frame.shaded_fraction() > 0.0 && frame.shaded_fraction() < 1.0, "{}", frame.shaded_fraction());
+        }
+    }
+    assert!(coarse_levels >= 6, "the frames shade at coarse levels too ({coarse_levels} level-frames)");
+}
+
+#[test]
+fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
+    // The pyramid's top at 0 and the cap at the mean: every shadeable pixel is shaded with
+    // exactly spp samples, so the frame equals render::render pixel for pixel.
+    let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let scene = sphere_scene(40, 30);
+    for mode in [Mode::Reference, Mode::Prefiltered] {
+        let settings =
+            adaptive::Settings { max_level: Some(0), max_spp: 8, seed: 3, ..adaptive::Settings::new(mode, 8) };
+        let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
+        let full = render::render(&scene, material, &lighting, &Settings { mode, spp: 8, frames: 1, seed: 3 }).unwrap();
+        assert_eq!(frame.image.covered, full.covered);
+        assert_eq!(frame.image.rgb, full.rgb, "{}", mode.name());
+        assert_eq!(frame.shaded_fraction(), 1.0);
+    }
+}
+
+#[test]
+fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
+    let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
+    let settings =
+        adaptive::Settings { max_level: Some(0), supersample: 4, ..adaptive::Settings::new(Mode::Reference, 1) };
+    let error = adaptive::render(&sphere_scene(16, 16), material, &lighting, &bandwidths, &settings).unwrap_err();
+    assert!(error.to_string().contains("raise spp"), "{error}");
+}
