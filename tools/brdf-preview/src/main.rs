@@ -12,6 +12,7 @@ use picture::Canvas;
 use render::{Camera, Mesh, Mode, Scene, Settings, metrics};
 use serde_json::json;
 
+mod adaptive;
 mod window;
 
 /// Render a baked material on a mesh under the bake's environment with wgpu (headless; --window
@@ -23,6 +24,14 @@ mod window;
 ///                level max(log4(w h / (N p)), 0) (002)
 ///   prefiltered  the Phong layer the bake's layer selection picks for the view, read by few
 ///                samples (001 sections 2.5 and 4.3)
+///   adaptive     bandwidth-driven multi-resolution shading (001 sections 2-3): the bake's
+///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
+///                variance; only the pixels of a pyramid whose level the prediction asks for are
+///                shaded (reference estimator), a budget of --spp samples per pixel on average
+///                is shared by the predicted variance, the rest is up-sampled; one frame, on the
+///                CPU renderer (crate render, module adaptive)
+///   adaptive-prefiltered
+///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
 /// The environment is drawn behind the mesh, so its orientation can be checked. Pictures are
 /// tone mapped: exposure 2^EV (by default the one that maps the environment's log-average
@@ -81,7 +90,9 @@ struct Args {
     mode: ModeArg,
 
     /// Samples per pixel and frame: a power of two up to the bake's samples per vector (256 by
-    /// default). Default: 64 for reference, 16 for fis and prefiltered.
+    /// default). Default: 64 for reference, 16 for fis and prefiltered. For the adaptive modes,
+    /// the frame's budget in mean samples per covered pixel (any number from 1; default 8 for
+    /// adaptive, 4 for adaptive-prefiltered).
     #[arg(long, value_name = "N")]
     spp: Option<u32>,
 
@@ -90,6 +101,21 @@ struct Args {
     /// (32 at 64 spp with the default bake); 1 for fis and prefiltered.
     #[arg(long, value_name = "N")]
     frames: Option<u32>,
+
+    /// Adaptive modes: anti-aliasing by extra pyramid levels, 1, 4 or 16 render pixels per output
+    /// pixel (001 section 4.3).
+    #[arg(long, value_name = "1|4|16", default_value_t = 1, value_parser = parse_aa)]
+    aa: usize,
+
+    /// Adaptive modes: one prediction per block of 2^L x 2^L pixels (0: every pixel, as the
+    /// paper; 1, the default, costs a quarter).
+    #[arg(long, value_name = "L", default_value_t = 1)]
+    predict_level: usize,
+
+    /// Adaptive modes: also write OUT-debug.png, the frame's debug views (level each pixel was
+    /// shaded at, samples per pixel, predicted bandwidth and variance).
+    #[arg(long)]
+    debug_views: bool,
 
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "256x256", value_parser = parse_size)]
@@ -109,7 +135,9 @@ struct Args {
     seed: u32,
 
     /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
-    /// and write OUT-difference.png.
+    /// and write OUT-difference.png. For the adaptive modes (which run on the CPU), report the
+    /// PSNR against the converged estimate instead (--converged N samples per strategy, 256 by
+    /// default).
     #[arg(long)]
     validate: bool,
 
@@ -149,20 +177,45 @@ enum BrdfArg {
     Wavelet,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum ModeArg {
     Reference,
     Fis,
     Prefiltered,
+    Adaptive,
+    AdaptivePrefiltered,
 }
 
-impl From<ModeArg> for Mode {
-    fn from(m: ModeArg) -> Mode {
-        match m {
-            ModeArg::Reference => Mode::Reference,
+impl ModeArg {
+    /// The estimator of the shaded pixels.
+    fn estimator(self) -> Mode {
+        match self {
+            ModeArg::Reference | ModeArg::Adaptive => Mode::Reference,
             ModeArg::Fis => Mode::Fis,
-            ModeArg::Prefiltered => Mode::Prefiltered,
+            ModeArg::Prefiltered | ModeArg::AdaptivePrefiltered => Mode::Prefiltered,
         }
+    }
+
+    fn is_adaptive(self) -> bool {
+        matches!(self, ModeArg::Adaptive | ModeArg::AdaptivePrefiltered)
+    }
+
+    /// The name on the command line and in JSON.
+    fn name(self) -> &'static str {
+        match self {
+            ModeArg::Adaptive => "adaptive",
+            ModeArg::AdaptivePrefiltered => "adaptive-prefiltered",
+            other => other.estimator().name(),
+        }
+    }
+}
+
+fn parse_aa(text: &str) -> Result<usize, String> {
+    match text.trim() {
+        "1" => Ok(1),
+        "4" => Ok(2),
+        "16" => Ok(4),
+        other => Err(format!("{other:?}: anti-aliasing is 1, 4 or 16 render pixels per pixel")),
     }
 }
 
@@ -213,125 +266,142 @@ fn run(args: Args) -> Result<ExitCode> {
                 args.bake.display()
             );
         };
-        let mode = Mode::from(args.mode);
-        let spp = args.spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
-        let settings = Settings {
-            mode,
-            spp,
-            frames: args.frames.unwrap_or(if mode == Mode::Reference {
-                let samples = &loaded.material.samples;
-                render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp)
-            } else {
-                1
-            }),
-            seed: args.seed,
-        };
-        let scene = scene(&args)?;
-        let preview = match args.exposure {
-            Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
-            None => metrics::auto_preview(lighting.mips.level(0)),
-        };
-        if args.window {
-            return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
-        }
-        let gpu = gpu::Gpu::new()?;
-        let out = args.out.as_ref().expect("clap requires --out without --window");
-        let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
-        let start = Instant::now();
-        let image = renderer.render_frames(&settings)?;
-        let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
-        let picture = metrics::tonemap(&image, &preview);
-        let names = names(&loaded.manifest);
-        let brdf = match &loaded.material.wavelet {
-            Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
-            None => "table".to_string(),
-        };
-        let caption = format!(
-            "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
-            names,
-            mode.name(),
-            settings.spp,
-            settings.frames,
-            scene.width,
-            scene.height,
-            preview.exposure_ev
-        );
-        let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-        files.push((out.clone(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?));
-        report.push(format!(
-            "{}: {} on {} ({}), {:.1} ms per frame",
-            out.display(),
-            mode.name(),
-            gpu.adapter_summary(),
-            args.mesh,
-            ms_per_frame
-        ));
-        value = json!({
-            "bake": args.bake.display().to_string(),
-            "mode": mode.name(),
-            "brdf": match args.brdf { BrdfArg::Table => "table", BrdfArg::Wavelet => "wavelet" },
-            "spp": settings.spp,
-            "frames": settings.frames,
-            "width": scene.width,
-            "height": scene.height,
-            "exposure_ev": preview.exposure_ev,
-            "adapter": gpu.adapter_summary(),
-            "ms_per_frame": ms_per_frame,
-            "mean_luminance": metrics::mean_luminance(&image),
-        });
-
-        if loaded.material.wavelet.is_some() {
-            // What the compression costs: the same render from the table itself.
-            let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
-            let table =
-                gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
-            let table_picture = metrics::tonemap(&table, &preview);
-            let psnr = metrics::psnr_db(&picture, &table_picture);
-            let relative = metrics::relative_error(&image.rgb, &table.rgb);
-            files.push((sibling(out, "table"), "table", png(&table_picture, scene.width, scene.height)?));
+        if args.mode.is_adaptive() {
+            if args.window {
+                bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
+            }
+            let out = args.out.as_ref().expect("clap requires --out without --window");
+            let step = render_adaptive(&args, &loaded, lighting, out)?;
+            files.extend(step.files);
+            report.extend(step.report);
+            problems.extend(step.problems);
+            value = step.value;
+        } else {
+            let mode = args.mode.estimator();
+            let spp = args.spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
+            let settings = Settings {
+                mode,
+                spp,
+                frames: args.frames.unwrap_or(if mode == Mode::Reference {
+                    let samples = &loaded.material.samples;
+                    render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp)
+                } else {
+                    1
+                }),
+                seed: args.seed,
+            };
+            let scene = scene(&args)?;
+            let preview = match args.exposure {
+                Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
+                None => metrics::auto_preview(lighting.mips.level(0)),
+            };
+            if args.window {
+                return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
+            }
+            let gpu = gpu::Gpu::new()?;
+            let out = args.out.as_ref().expect("clap requires --out without --window");
+            let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
+            let start = Instant::now();
+            let image = renderer.render_frames(&settings)?;
+            let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
+            let picture = metrics::tonemap(&image, &preview);
+            let names = names(&loaded.manifest);
+            let brdf = match &loaded.material.wavelet {
+                Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
+                None => "table".to_string(),
+            };
+            let caption = format!(
+                "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+                names,
+                mode.name(),
+                settings.spp,
+                settings.frames,
+                scene.width,
+                scene.height,
+                preview.exposure_ev
+            );
+            let captioned = with_caption(&picture, scene.width, scene.height, &caption);
+            files.push((out.clone(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?));
             report.push(format!(
+                "{}: {} on {} ({}), {:.1} ms per frame",
+                out.display(),
+                mode.name(),
+                gpu.adapter_summary(),
+                args.mesh,
+                ms_per_frame
+            ));
+            value = json!({
+                "bake": args.bake.display().to_string(),
+                "mode": mode.name(),
+                "brdf": match args.brdf { BrdfArg::Table => "table", BrdfArg::Wavelet => "wavelet" },
+                "spp": settings.spp,
+                "frames": settings.frames,
+                "width": scene.width,
+                "height": scene.height,
+                "exposure_ev": preview.exposure_ev,
+                "adapter": gpu.adapter_summary(),
+                "ms_per_frame": ms_per_frame,
+                "mean_luminance": metrics::mean_luminance(&image),
+            });
+
+            if loaded.material.wavelet.is_some() {
+                // What the compression costs: the same render from the table itself.
+                let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
+                let table =
+                    gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
+                let table_picture = metrics::tonemap(&table, &preview);
+                let psnr = metrics::psnr_db(&picture, &table_picture);
+                let relative = metrics::relative_error(&image.rgb, &table.rgb);
+                files.push((sibling(out, "table"), "table", png(&table_picture, scene.width, scene.height)?));
+                report.push(format!(
                 "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB,                  relative error {relative:.3}",
                 db(psnr)
             ));
-            value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
-        }
-        if args.validate {
-            let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
-            let cpu_picture = metrics::tonemap(&cpu, &preview);
-            let psnr = metrics::psnr_db(&picture, &cpu_picture);
-            let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
-            let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
-            let difference = metrics::difference_rgb8(&picture, &cpu_picture);
-            files.push((sibling(out, "difference"), "difference", png(&difference, scene.width, scene.height)?));
-            report.push(format!(
+                value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
+            }
+            if args.validate {
+                let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
+                let cpu_picture = metrics::tonemap(&cpu, &preview);
+                let psnr = metrics::psnr_db(&picture, &cpu_picture);
+                let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
+                let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
+                let difference = metrics::difference_rgb8(&picture, &cpu_picture);
+                files.push((sibling(out, "difference"), "difference", png(&difference, scene.width, scene.height)?));
+                report.push(format!(
                 "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
                  pixels covered by one renderer only",
                 db(psnr)
             ));
-            value["psnr_db"] = json_db(psnr);
-            value["relative_error"] = json!(relative);
-            value["coverage_mismatches"] = json!(coverage);
-            check_psnr(&args, "against the CPU", psnr, &mut problems);
-        }
-        if let Some(n) = args.converged {
-            let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
-            let converged_picture = metrics::tonemap(&converged, &preview);
-            let psnr = metrics::psnr_db(&picture, &converged_picture);
-            let relative = metrics::relative_error(&image.rgb, &converged.rgb);
-            let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
-            files.push((sibling(out, "converged"), "converged", png(&converged_picture, scene.width, scene.height)?));
-            report.push(format!(
+                value["psnr_db"] = json_db(psnr);
+                value["relative_error"] = json!(relative);
+                value["coverage_mismatches"] = json!(coverage);
+                check_psnr(&args, "against the CPU", psnr, &mut problems);
+            }
+            if let Some(n) = args.converged {
+                let converged =
+                    render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+                let converged_picture = metrics::tonemap(&converged, &preview);
+                let psnr = metrics::psnr_db(&picture, &converged_picture);
+                let relative = metrics::relative_error(&image.rgb, &converged.rgb);
+                let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
+                files.push((
+                    sibling(out, "converged"),
+                    "converged",
+                    png(&converged_picture, scene.width, scene.height)?,
+                ));
+                report.push(format!(
                 "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
                  mean luminance ratio {luminance_ratio:.4}",
                 db(psnr)
             ));
-            value["converged"] = json!({
-                "samples_per_strategy": n,
-                "psnr_db": json_db(psnr),
-                "relative_error": relative,
-                "mean_luminance_ratio": luminance_ratio,
-            });
-            check_psnr(&args, "against the converged estimate", psnr, &mut problems);
+                value["converged"] = json!({
+                    "samples_per_strategy": n,
+                    "psnr_db": json_db(psnr),
+                    "relative_error": relative,
+                    "mean_luminance_ratio": luminance_ratio,
+                });
+                check_psnr(&args, "against the converged estimate", psnr, &mut problems);
+            }
         }
     }
 
@@ -353,6 +423,113 @@ fn run(args: Args) -> Result<ExitCode> {
         })
         .collect();
     Ok(cli::finish(args.json, &value, &report, &problems, &written))
+}
+
+/// What one rendering step made: files (path, role, PNG bytes), report lines, problems and the
+/// JSON object.
+struct Step {
+    files: Vec<(PathBuf, &'static str, Vec<u8>)>,
+    report: Vec<String>,
+    problems: Vec<String>,
+    value: serde_json::Value,
+}
+
+/// `--mode adaptive` and `--mode adaptive-prefiltered`: one frame on the CPU renderer.
+fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighting, out: &Path) -> Result<Step> {
+    let bandwidths = loaded.bandwidths.as_ref().ok_or_else(|| {
+        anyhow!(
+            "{}: the bake has no environment bandwidth and atlas: bake it with brdf-bake --env",
+            args.bake.display()
+        )
+    })?;
+    let mode = args.mode.estimator();
+    let n_samples = loaded.material.samples.n_samples as u32;
+    let settings = render::adaptive::Settings {
+        supersample: args.aa,
+        predict_level: args.predict_level,
+        max_spp: n_samples.min(256),
+        seed: args.seed,
+        ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
+    };
+    let scene = scene(args)?;
+    let preview = match args.exposure {
+        Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
+        None => metrics::auto_preview(lighting.mips.level(0)),
+    };
+    let start = Instant::now();
+    let frame = render::adaptive::render(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+    let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
+    let picture = metrics::tonemap(&frame.image, &preview);
+    let aa = settings.supersample * settings.supersample;
+    let caption = format!(
+        "{} | {} | {} spp budget, {} samples | shaded fraction {:.3} | AA {aa}x | {}x{} | exposure {:+.2} EV",
+        names(&loaded.manifest),
+        args.mode.name(),
+        settings.spp,
+        frame.plan.samples(),
+        frame.shaded_fraction(),
+        scene.width,
+        scene.height,
+        preview.exposure_ev
+    );
+    let captioned = with_caption(&picture, scene.width, scene.height, &caption);
+    let mut files = vec![(out.to_path_buf(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?)];
+    if args.debug_views {
+        let sheet =
+            adaptive::debug_views(&frame, &picture, &format!("{}: {}", args.mode.name(), names(&loaded.manifest)));
+        files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
+    }
+    let t = frame.timings;
+    let mut report = vec![format!(
+        "{}: {} on the CPU ({}), {ms_per_frame:.1} ms (G-buffer {:.1}, prediction {:.1}, plan {:.1}, shading {:.1}); \
+         shaded fraction {:.4}, {} samples of a budget of {}",
+        out.display(),
+        args.mode.name(),
+        args.mesh,
+        t.gbuffer_ms,
+        t.predict_ms,
+        t.plan_ms,
+        t.shade_ms,
+        frame.shaded_fraction(),
+        frame.plan.samples(),
+        frame.plan.budget
+    )];
+    let mut value = json!({
+        "bake": args.bake.display().to_string(),
+        "mode": args.mode.name(),
+        "renderer": "cpu",
+        "spp": settings.spp,
+        "aa": aa,
+        "predict_level": settings.predict_level,
+        "width": scene.width,
+        "height": scene.height,
+        "exposure_ev": preview.exposure_ev,
+        "ms_per_frame": ms_per_frame,
+        "timings_ms": {"gbuffer": t.gbuffer_ms, "prediction": t.predict_ms, "plan": t.plan_ms, "shading": t.shade_ms},
+        "shaded_fraction": frame.shaded_fraction(),
+        "shaded_per_level": frame.plan.shaded_per_level(),
+        "samples": frame.plan.samples(),
+        "budget": frame.plan.budget,
+        "mean_luminance": metrics::mean_luminance(&frame.image),
+    });
+    let mut problems = Vec::new();
+    if args.validate || args.converged.is_some() {
+        let n = args.converged.unwrap_or(256);
+        let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+        let converged_picture = metrics::tonemap(&converged, &preview);
+        let psnr = metrics::psnr_db(&picture, &converged_picture);
+        let relative = metrics::relative_error(&frame.image.rgb, &converged.rgb);
+        files.push((sibling(out, "converged"), "converged", png(&converged_picture, scene.width, scene.height)?));
+        report.push(format!(
+            "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}",
+            db(psnr)
+        ));
+        value["psnr_db"] = json_db(psnr);
+        value["relative_error"] = json!(relative);
+        value["converged"] = json!({ "samples_per_strategy": n, "psnr_db": json_db(psnr), "relative_error": relative });
+        check_psnr(args, "against the converged estimate", psnr, &mut problems);
+    }
+    Ok(Step { files, report, problems, value })
 }
 
 /// An 8-bit RGB picture as PNG bytes.

@@ -1,0 +1,96 @@
+//! `--mode adaptive` and `--mode adaptive-prefiltered`: one frame of bandwidth-driven
+//! multi-resolution shading (`render::adaptive`, on the CPU) and its debug views.
+
+use picture::colormap::{Scale, inferno, viridis};
+use picture::layout::{Axis, Grid as Panels, caption, heat_map, stack};
+use picture::legend::Legend;
+use picture::{Canvas, format_number};
+use render::adaptive::Adaptive;
+
+/// Black: pixels the views say nothing about (background, silhouettes).
+const NONE: [u8; 3] = [0, 0, 0];
+
+/// The debug views of a frame, as the papers' figures show them (001 Fig. 9, 11, 12): the
+/// picture, the level each pixel was shaded at, samples per pixel, the predicted image bandwidth
+/// and the predicted variance, each with a legend.
+pub fn debug_views(frame: &Adaptive, picture_rgb: &[u8], title: &str) -> Canvas {
+    let (w, h) = (frame.width, frame.height);
+    let (ow, oh) = (frame.image.width, frame.image.height);
+    let zoom = (256 / w.max(h)).max(1);
+    let axes = (Axis::new("x, pixels", 0.0, w as f64), Axis::new("y, pixels", 0.0, h as f64));
+    let shadeable = |i: usize| frame.predictions[i].level >= 0;
+    let top = frame.plan.levels.len() - 1;
+
+    let levels = Scale::linear(0.0, top.max(1) as f64);
+    let level_image = Canvas::from_fn(w, h, |x, y| {
+        let l = frame.shaded_level[y * w + x];
+        if l < 0 { NONE } else { viridis(levels.position(f64::from(l))) }
+    });
+    let positive = |values: Vec<f64>| -> Vec<f64> { values.into_iter().filter(|v| *v > 0.0).collect() };
+    let log_scale = |values: &[f64], decades: f64| {
+        let hi = values.iter().copied().fold(0.0f64, f64::max).max(1e-30);
+        Scale::log(hi * 10f64.powf(-decades), hi).nice()
+    };
+    let heat = |values: &dyn Fn(usize) -> f64, scale: &Scale, map: fn(f64) -> [u8; 3]| {
+        Canvas::from_fn(w, h, |x, y| {
+            let i = y * w + x;
+            let v = values(i);
+            if !shadeable(i) || v <= 0.0 { NONE } else { map(scale.position(v).clamp(0.0, 1.0)) }
+        })
+    };
+    let spp: Vec<f64> = positive(frame.samples_per_pixel.iter().map(|&s| f64::from(s)).collect());
+    let spp_scale = log_scale(&spp, 4.0);
+    let bandwidth: Vec<f64> = positive(frame.predictions.iter().map(|p| p.bandwidth).collect());
+    let bandwidth_scale = Scale::log(1e-3, 1.0);
+    let variance: Vec<f64> = positive(frame.predictions.iter().map(|p| p.variance).collect());
+    let variance_scale = log_scale(&variance, 6.0);
+
+    let mut panels = Panels::new(3);
+    panels.title(title);
+    let image = Canvas::from_rgb8(ow, oh, picture_rgb.to_vec()).resized(w, h);
+    panels.add(heat_map(&image, zoom, &axes.0, &axes.1), "the frame");
+    panels.add(heat_map(&level_image, zoom, &axes.0, &axes.1), "level each pixel was shaded at");
+    panels.add(
+        heat_map(&heat(&|i| f64::from(frame.samples_per_pixel[i]), &spp_scale, inferno), zoom, &axes.0, &axes.1),
+        "samples per pixel",
+    );
+    panels.add(
+        heat_map(&heat(&|i| frame.predictions[i].bandwidth, &bandwidth_scale, inferno), zoom, &axes.0, &axes.1),
+        "predicted image bandwidth",
+    );
+    panels.add(
+        heat_map(&heat(&|i| frame.predictions[i].variance, &variance_scale, viridis), zoom, &axes.0, &axes.1),
+        "predicted variance",
+    );
+    let width = panels.width();
+    let shaded = frame.plan.shaded_per_level();
+    let per_level: Vec<String> =
+        shaded.iter().enumerate().filter(|(_, n)| **n > 0).map(|(k, n)| format!("{n} at {k}")).collect();
+    let text = format!(
+        "Level k: the pixel's value comes from a block of s x s pixels, s = 2 to the power k, shaded once and \
+         up-sampled (0: shaded on its own). Shaded blocks per level: {}. {} samples of a budget of {}; shaded fraction {}. Samples per \
+         pixel: a shaded block's samples over its pixels. Bandwidth: cycles per pixel from the environment's and \
+         the BRDF's bandwidth through the paper's reflection operators (001 eq. 3-6); the level is \
+         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered), which \
+         shares the samples out. Black: background or silhouette.",
+        per_level.join(", "),
+        frame.plan.samples(),
+        frame.plan.budget,
+        format_number((frame.shaded_fraction() * 1e4).round() / 1e4),
+    );
+    panels.footer(stack(&[
+        Legend::new(levels, viridis, "shaded at level k (a block of s x s pixels, s = 2 to the power k; linear)")
+            .render(width),
+        Legend::new(spp_scale, inferno, "samples per pixel (log scale)")
+            .clipped(spp_scale.clipping(&spp))
+            .render(width),
+        Legend::new(bandwidth_scale, inferno, "predicted image bandwidth, cycles per pixel (log scale)")
+            .clipped(bandwidth_scale.clipping(&bandwidth))
+            .render(width),
+        Legend::new(variance_scale, viridis, "predicted variance, luminance squared (log scale)")
+            .clipped(variance_scale.clipping(&variance))
+            .render(width),
+        caption(&text, width),
+    ]));
+    panels.render()
+}
