@@ -227,3 +227,23 @@ fn spatial_maps_equal_the_library_estimate() {
     let run = run_tool(&path, &["--spatial", "--eps", "0.05", "--levels", "6"]);
     assert_equal(&run, 512, 768, custom.frequency(), "memorial, periodic, eps 0.05, 6 levels");
 }
+
+/// `--reading level-normalized` (issue 11): recorded in the JSON parameters, and never reads a
+/// coarser level than the paper's reading, so its median and 95th percentile are at least the
+/// paper's; on quarry it reads the fine texture the paper's reading masks (its median is higher).
+#[test]
+fn the_level_normalized_reading_reads_finer() {
+    let dir = temp_dir();
+    let input = shared().join("data/env/quarry_01_1k.hdr");
+    let (paper_dir, normalized_dir) = (dir.path().join("paper"), dir.path().join("normalized"));
+    let paper = envmap_bandwidth(&input, &paper_dir, &["--json"]).expect_code(0);
+    let normalized =
+        envmap_bandwidth(&input, &normalized_dir, &["--json", "--reading", "level-normalized"]).expect_code(0);
+    assert_eq!(paper.json_object()["parameters"]["reading"], "paper", "{paper}");
+    assert_eq!(normalized.json_object()["parameters"]["reading"], "level-normalized", "{normalized}");
+    let (p, n) = (figures(&paper, &paper_dir), figures(&normalized, &normalized_dir));
+    let stat = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    println!("median {} -> {}, p95 {} -> {}", stat(&p, "median"), stat(&n, "median"), stat(&p, "p95"), stat(&n, "p95"));
+    assert!(stat(&n, "median") > stat(&p, "median"), "{p}\n{n}");
+    assert!(stat(&n, "p95") >= stat(&p, "p95"), "{p}\n{n}");
+}

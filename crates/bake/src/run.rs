@@ -108,7 +108,7 @@ impl BakeConfig {
                 "environment_bandwidth",
                 json!({
                     "mode": e.mode.name(), "eps": e.config.eps, "c": e.config.c, "levels": e.config.levels,
-                    "fft_diagnostic": e.fft_diagnostic,
+                    "reading": e.config.reading.name(), "fft_diagnostic": e.fft_diagnostic,
                 }),
             ),
             (

@@ -31,11 +31,50 @@ pub struct Config {
     /// Number of levels `J`; `None` for as many as the (padded or extended) image allows (crate
     /// docs, "Sizes").
     pub levels: Option<usize>,
+    /// How eq. 7 compares the levels: as the paper does, or level-normalized.
+    pub reading: Reading,
+}
+
+/// How eq. 7 compares the levels' coefficients (crate docs, "Readings").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Reading {
+    /// Appendix A as printed: `lambda_j`, the largest coefficient of level `j` covering the
+    /// pixel, against `eps` times the largest `lambda` of any level. An orthonormal transform
+    /// answers a pattern of amplitude `a` with coefficients of about `a 2^j` at level `j`, so a
+    /// strong edge's coarse coefficients set the bar and fine detail next to it reads as nothing.
+    Paper,
+    /// `lambda_j 2^-j`: every level in units of the amplitude of the pattern it answers (the
+    /// scaling the noise floor already uses), so that detail of 1% of the local contrast counts
+    /// whatever its scale.
+    LevelNormalized,
+}
+
+impl Reading {
+    /// The name on command lines and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reading::Paper => "paper",
+            Reading::LevelNormalized => "level-normalized",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Reading> {
+        [Reading::Paper, Reading::LevelNormalized].into_iter().find(|r| r.name() == name)
+    }
+}
+
+impl std::str::FromStr for Reading {
+    type Err = String;
+
+    /// The name of [`Reading::name`], for command lines.
+    fn from_str(text: &str) -> Result<Reading, String> {
+        Reading::from_name(text.trim()).ok_or_else(|| format!("{text:?}: the readings are paper and level-normalized"))
+    }
 }
 
 impl Default for Config {
     fn default() -> Self {
-        Self { eps: 0.01, noise_floor: 1e-6, c: DEFAULT_C, wavelet: Wavelet::D4, levels: None }
+        Self { eps: 0.01, noise_floor: 1e-6, c: DEFAULT_C, wavelet: Wavelet::D4, levels: None, reading: Reading::Paper }
     }
 }
 
@@ -260,8 +299,13 @@ pub(crate) fn estimate(
             let level = i + 1;
             let (m_x, m_y) = (w >> level, h >> level);
             let floor = config.noise_floor * (1u64 << level) as f64;
+            let gain = match config.reading {
+                Reading::Paper => 1.0,
+                Reading::LevelNormalized => 0.5f64.powi(level as i32),
+            };
             let [ch, cv, cd] = details;
-            // The largest magnitude of the three orientations, zero below the noise floor.
+            // The largest magnitude of the three orientations, zero below the noise floor, in the
+            // reading's units.
             let grid: Vec<f64> = ch
                 .data()
                 .iter()
@@ -269,7 +313,7 @@ pub(crate) fn estimate(
                 .zip(cd.data())
                 .map(|((a, b), c)| {
                     let v = a.abs().max(b.abs()).max(c.abs());
-                    if v < floor { 0.0 } else { v }
+                    if v < floor { 0.0 } else { v * gain }
                 })
                 .collect();
             let cover_x = Cover::new(config.wavelet, level, w, out_w);

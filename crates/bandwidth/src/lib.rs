@@ -164,6 +164,18 @@
 //!   at 512 and 1024, for the same reason.
 //! - Frequencies above `c / 2 = 0.088` cycles per pixel all read `c / 2` and are flagged.
 //!
+//! # Readings
+//!
+//! [`Config::reading`] chooses how eq. 7 compares the levels. [`Reading::Paper`] is Appendix A
+//! as printed, with the masking above. [`Reading::LevelNormalized`] scales `lambda_j` by `2^-j`
+//! first, so each level counts in units of the amplitude of the pattern it answers: its eq. 7
+//! ratio is at least the paper's at every level (the sums gain at least `2^-j`, the largest
+//! `lambda` loses at least as much), so it never reads a coarser level, and faint noise beside a
+//! strong step reads at the limit instead of 3 octaves below (test `readings`). Its cost is the
+//! finest level's leakage on sinusoids of periods below about 23 pixels. Which one serves a
+//! renderer is measured end to end, by shading with each (`render::adaptive`, the previewer's
+//! adaptive benchmark).
+//!
 //! # Performance
 //!
 //! The transform is `wavelet`'s (parallel over rows). Per level, the maximum over orientations
@@ -183,7 +195,7 @@ mod latlong;
 
 pub use compare::{Comparison, PERCENTILES, compare_maps, wavelet_at_windows};
 pub use error::Error;
-pub use estimate::{BandwidthMap, Config, DEFAULT_C, local_bandwidth, local_bandwidth_zero_padded};
+pub use estimate::{BandwidthMap, Config, DEFAULT_C, Reading, local_bandwidth, local_bandwidth_zero_padded};
 pub use fft::{WindowedFftConfig, WindowedFftMap, window_spread, windowed_fft_bandwidth};
 pub use hdr::{log1p_luminance, luminance};
 pub use latlong::{

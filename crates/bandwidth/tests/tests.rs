@@ -7,6 +7,7 @@ mod brute_force;
 mod compare;
 mod errors;
 mod flat;
+mod readings;
 mod real_maps;
 mod sinusoids;
 mod split;

@@ -87,6 +87,11 @@ struct Args {
     #[arg(long, value_name = "M", requires = "env")]
     ggx_levels: Option<usize>,
 
+    /// How the environment's bandwidth compares wavelet levels (see envmap-bandwidth --help):
+    /// paper (the default) or level-normalized.
+    #[arg(long, value_name = "paper|level-normalized", default_value = "paper", requires = "env")]
+    env_reading: bandwidth::Reading,
+
     /// Store the environment's KTX2 files as half floats even where texels exceed 65504, clamping
     /// them (the default stores such a file as single floats).
     #[arg(long)]
@@ -145,6 +150,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.prefilter.ggx_levels = args.ggx_levels.unwrap_or(0);
     config.prefilter.chain = args.chain;
     config.env_bandwidth.max_memory = args.max_memory;
+    config.env_bandwidth.config.reading = args.env_reading;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {
         Progress::Stage { index, count, name } => progress.step(format!("{}/{count} {name}", index + 1)),

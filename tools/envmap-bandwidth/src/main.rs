@@ -73,6 +73,13 @@ struct Args {
     #[arg(long, value_parser = cli::parse_count)]
     levels: Option<usize>,
 
+    /// How eq. 7 compares the levels: paper (Appendix A as printed: a strong edge's coarse
+    /// coefficients set the bar, which masks fine detail beside it) or level-normalized (each
+    /// level in units of the amplitude it answers). The paper's reading is the default: it won
+    /// the previewer's equal-quality benchmark (cargo bench -p brdf-preview --bench adaptive).
+    #[arg(long, value_name = "paper|level-normalized", default_value = "paper")]
+    reading: bandwidth::Reading,
+
     /// Memory budget (4G, 512M, ...): a map whose estimated need (80 bytes per texel) is larger
     /// is refused from its header, before decoding.
     #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
@@ -100,7 +107,7 @@ fn run(args: Args) -> Result<ExitCode> {
     };
     let settings = Settings {
         mode,
-        config: Config { eps: args.eps, levels: args.levels, ..Config::default() },
+        config: Config { eps: args.eps, levels: args.levels, reading: args.reading, ..Config::default() },
         fft_diagnostic: args.fft_diagnostic,
         max_memory: args.max_memory,
     };

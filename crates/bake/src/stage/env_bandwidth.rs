@@ -120,6 +120,7 @@ fn run_on(input: &Path, width: usize, height: usize, image: Image, settings: &Se
             ("eps", json!(settings.config.eps)),
             ("c", json!(settings.config.c)),
             ("levels", json!(analysis.pixels.levels())),
+            ("reading", json!(settings.config.reading.name())),
         ]),
         figures: figures(mode, &analysis, &stats, fft.as_ref()),
         files: vec![
