@@ -73,7 +73,9 @@ pub use read::{
     DEFAULT_MAX_MEMORY, HdrImage, Limits, READ_BYTES_PER_TEXEL, format_bytes, load, load_from_memory, load_with_limits,
     read_image, read_image_from_memory,
 };
-pub use write::{Preview, SampleType, ToneMap, encode_exr, encode_png_rgb8, tonemap_rgb8, write_exr, write_png_rgb8};
+pub use write::{
+    Preview, SampleType, ToneMap, encode_exr, encode_png_rgb8, tonemap, tonemap_rgb8, write_exr, write_png_rgb8,
+};
 
 /// Rec. 709 luminance of a linear RGB triple (weights 0.2126, 0.7152, 0.0722).
 pub fn luminance(rgb: [f64; 3]) -> f64 {

@@ -188,23 +188,29 @@ pub enum ToneMap {
 /// 8-bit sRGB. NaN maps to 0.
 pub fn tonemap_rgb8(rgb: &[f32], preview: &Preview) -> Vec<u8> {
     let scale = f64::from(preview.exposure_ev).exp2();
-    rgb.iter()
-        .map(|&value| {
-            let x = (f64::from(value) * scale).max(0.0);
-            let mapped = match preview.tone_map {
-                ToneMap::Clamp => x.min(1.0),
-                ToneMap::Reinhard => {
-                    if x.is_infinite() {
-                        1.0
-                    } else {
-                        x / (1.0 + x)
-                    }
-                }
-            };
-            // `max(0.0)` above turned NaN into 0.
-            (srgb_encode(mapped) * 255.0).round() as u8
-        })
-        .collect()
+    rgb.iter().map(|&value| (tonemap_value(f64::from(value), scale, preview.tone_map) * 255.0).round() as u8).collect()
+}
+
+/// One value as [`tonemap_rgb8`] shows it, before the rounding to 8 bits: the sRGB-encoded
+/// level in `[0, 1]`. NaN maps to 0.
+pub fn tonemap(value: f64, preview: &Preview) -> f64 {
+    tonemap_value(value, f64::from(preview.exposure_ev).exp2(), preview.tone_map)
+}
+
+fn tonemap_value(value: f64, scale: f64, tone_map: ToneMap) -> f64 {
+    let x = (value * scale).max(0.0);
+    let mapped = match tone_map {
+        ToneMap::Clamp => x.min(1.0),
+        ToneMap::Reinhard => {
+            if x.is_infinite() {
+                1.0
+            } else {
+                x / (1.0 + x)
+            }
+        }
+    };
+    // `max(0.0)` above turned NaN into 0.
+    srgb_encode(mapped)
 }
 
 /// The sRGB transfer function (linear to encoded), for `x` in `[0, 1]`.

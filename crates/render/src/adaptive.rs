@@ -17,7 +17,10 @@
 //!
 //! # The bandwidth buffer (`001` eq. 3-6, 9-11)
 //!
-//! For each shadeable pixel, `n_b` incident directions (default 16): the first `n_b` samples of
+//! For each shadeable pixel (or, with [`Settings::predict_level`] `l`, once per block of `2^l x
+//! 2^l` output pixels, at the block's pixel, copied to its shadeable pixels: the prediction
+//! costs as much as shading `n_b` samples, and a block's pixels are alike), `n_b` incident
+//! directions (default 16): the first `n_b` samples of
 //! one baked vector of the pixel's slice (the vector `pcg_hash(pixel ^ pcg_hash(seed ^
 //! 0x9e37_79b9)) % V`; the prefix of an Owen-scrambled Sobol' vector is stratified), each with
 //! its pdf. For each `wi`:
@@ -86,18 +89,23 @@
 //! # Samples
 //!
 //! The frame's budget is `spp` times the covered pixels of the output image. Each shaded block
-//! gets at least 1 sample and the rest in proportion to its predicted variance, rounded down to
-//! a power of two (the baked vectors are read in aligned chunks: crate docs, "Samples") and at
-//! most `max_spp`; what rounding leaves is handed out by doubling the blocks furthest below
-//! their share, while it fits. The total never exceeds the budget; a budget below one sample per
+//! gets at least 1 sample and the rest in proportion to its predicted variance
+//! ([`Allocation::Variance`], the paper: every pixel equally noisy) or to the variance's square
+//! root ([`Allocation::StdDev`]: the least total squared error for the budget, which is what a
+//! PSNR measures; the benchmark measures both), at most `max_spp` (what a capped block cannot
+//! take goes to the others), rounded down to a power of two (the baked vectors are read in
+//! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
+//! blocks furthest below their share, while it fits. The total never exceeds the budget; a budget below one sample per
 //! shaded block is an error. A shaded block is shaded by the chosen estimator with its count as
 //! `spp` and one frame, at its pixel (the random chunk of that pixel).
 //!
 //! # Anti-aliasing (`001` section 4.3)
 //!
 //! `supersample = s` renders at `s` times the output size in each axis: the pyramid gets
-//! `log2(s)` more levels, and smooth regions are shaded as coarsely as before, so the cost grows
-//! with the edges, not with `s^2`. The output pixel is the mean of its `s x s` render pixels.
+//! `log2(s)` more levels, and smooth regions are shaded as coarsely as before, so the shading
+//! grows with the edges, not with `s^2`; the prediction stays at the output's resolution (its
+//! blocks are `s` times larger in render pixels); the G-buffer is the render's. The output pixel
+//! is the mean of its `s x s` render pixels.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -173,13 +181,38 @@ pub struct Settings {
     pub max_level: Option<usize>,
     /// `sigma` of the depth weight, relative to the child's depth.
     pub depth_sigma: f64,
-    /// One prediction per `2^l x 2^l` block (0: every pixel, as the paper).
+    /// One prediction per `2^l x 2^l` block of output pixels (0: every pixel, as the paper);
+    /// with anti-aliasing the blocks are `supersample` times larger in render pixels.
     pub predict_level: usize,
+    /// How the samples follow the predicted variance.
+    pub allocation: Allocation,
+}
+
+/// How a frame's samples are shared among its shaded blocks (module docs, "Samples").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Allocation {
+    /// In proportion to the predicted variance: every pixel's estimate equally noisy (`001`
+    /// section 2.4: "keep the variance of the shading globally constant").
+    Variance,
+    /// In proportion to its square root, the predicted standard deviation: the least total
+    /// squared error for the budget (minimizing `sum_p V_p / N_p` under `sum_p N_p = B` gives
+    /// `N_p` proportional to `sqrt(V_p)`).
+    StdDev,
+}
+
+impl Allocation {
+    pub fn name(self) -> &'static str {
+        match self {
+            Allocation::Variance => "variance",
+            Allocation::StdDev => "std-dev",
+        }
+    }
 }
 
 impl Settings {
     /// The defaults for a mode and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
-    /// `max_spp` 256, depth sigma 0.02, seed 0.
+    /// `max_spp` 256, depth sigma 0.02, seed 0, a prediction per pixel, samples in proportion
+    /// to the variance (the paper's choices where it makes one).
     pub fn new(mode: Mode, spp: u32) -> Self {
         Settings {
             mode,
@@ -191,6 +224,7 @@ impl Settings {
             max_level: None,
             depth_sigma: 0.02,
             predict_level: 0,
+            allocation: Allocation::Variance,
         }
     }
 }
@@ -262,7 +296,7 @@ pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize),
         Some(p) => predict_pixel(p, i, frame),
         None => Prediction { level: -1, ..Prediction::default() },
     };
-    let l = frame.settings.predict_level;
+    let l = frame.settings.predict_level + frame.settings.supersample.trailing_zeros() as usize;
     if l == 0 {
         return (0..pixels.len()).into_par_iter().map(one).collect();
     }
@@ -565,7 +599,7 @@ pub(crate) fn plan(
         actions.push(row);
     }
     actions.reverse();
-    allocate(&levels, &mut actions, budget, settings.max_spp)?;
+    allocate(&levels, &mut actions, budget, settings)?;
     Ok(Plan { levels, actions, budget })
 }
 
@@ -596,7 +630,8 @@ fn shares(variance: &[f64], budget: f64, cap: f64) -> Vec<f64> {
 }
 
 /// Gives every shaded block its samples (module docs, "Samples").
-fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, max_spp: u32) -> Result<(), Error> {
+fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings: &Settings) -> Result<(), Error> {
+    let max_spp = settings.max_spp;
     // (level, block, variance)
     let shaded: Vec<(usize, usize, f64)> = actions
         .iter()
@@ -614,7 +649,14 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, max_spp:
             "a budget of {budget} samples is less than one for each of the {count} shaded pixels: raise spp"
         )));
     }
-    let ideal = shares(&shaded.iter().map(|s| s.2).collect::<Vec<f64>>(), budget as f64, f64::from(max_spp));
+    let weights: Vec<f64> = shaded
+        .iter()
+        .map(|s| match settings.allocation {
+            Allocation::Variance => s.2,
+            Allocation::StdDev => s.2.sqrt(),
+        })
+        .collect();
+    let ideal = shares(&weights, budget as f64, f64::from(max_spp));
     let floor_pow2 = |x: f64| -> u32 {
         let x = x.min(f64::from(max_spp)).max(1.0);
         1u32 << (x.log2().floor() as u32)
@@ -717,6 +759,20 @@ pub fn render(
     bandwidths: &Bandwidths,
     settings: &Settings,
 ) -> Result<Adaptive, Error> {
+    render_with(scene, material, lighting, bandwidths, settings, None)
+}
+
+/// [`render`], with the image bandwidth of every render pixel (cycles per pixel, row-major)
+/// given instead of predicted when `oracle` is set: the benchmark's oracle, a windowed FFT of
+/// the converged image (`001` Fig. 12). The variance is predicted as usual.
+pub fn render_with(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+    oracle: Option<&[f64]>,
+) -> Result<Adaptive, Error> {
     crate::check_inputs(material, lighting)?;
     check_settings(settings, material, lighting)?;
     let ss = settings.supersample;
@@ -730,7 +786,20 @@ pub fn render(
     let top = top_level(width, height, settings.max_level);
     let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
     let frame = Frame { material, lighting, bandwidths, settings, radians_per_pixel, top };
-    let predictions = predict(&pixels, (width, height), &frame);
+    let mut predictions = predict(&pixels, (width, height), &frame);
+    if let Some(oracle) = oracle {
+        if oracle.len() != predictions.len() {
+            return Err(Error::Invalid(format!(
+                "an oracle of {} values for {width} x {height} render pixels",
+                oracle.len()
+            )));
+        }
+        for (p, &bandwidth) in predictions.iter_mut().zip(oracle) {
+            if p.level >= 0 {
+                *p = Prediction { bandwidth, level: level_of(bandwidth, top), ..*p };
+            }
+        }
+    }
     let predict_ms = lap();
     let levels = pyramid(&predictions, width, height, top);
     let covered_output = (0..scene.width * scene.height)
@@ -829,4 +898,29 @@ fn downsample(rgb: &[[f32; 3]], gbuffer: &GBuffer, width: usize, height: usize, 
         }
     }
     Image { width, height, rgb: out, covered }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shares;
+
+    #[test]
+    fn water_filling_respects_the_budget_the_cap_and_the_proportions() {
+        let weights = [0.0, 1.0, 2.0, 4.0, 100.0, 0.5];
+        for (budget, cap) in [(6.0, 256.0), (50.0, 256.0), (50.0, 16.0), (1000.0, 16.0), (10_000.0, 1e9)] {
+            let s = shares(&weights, budget, cap);
+            let total: f64 = s.iter().sum();
+            assert!((total - f64::min(budget, cap * weights.len() as f64)).abs() < 1e-9, "{budget} {cap}: {s:?}");
+            assert!(s.iter().all(|&x| (1.0..=cap + 1e-9).contains(&x)), "{budget} {cap}: {s:?}");
+            // Below the cap, every share is 1 plus the same multiple of its weight.
+            let open: Vec<usize> = (0..weights.len()).filter(|&i| s[i] < cap - 1e-9 && weights[i] > 0.0).collect();
+            for pair in open.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let (ra, rb) = ((s[a] - 1.0) / weights[a], (s[b] - 1.0) / weights[b]);
+                assert!((ra - rb).abs() <= 1e-9 * ra.max(rb), "{budget} {cap}: {s:?}");
+            }
+        }
+        // No variance anywhere: equal shares.
+        assert_eq!(shares(&[0.0; 4], 40.0, 256.0), vec![10.0; 4]);
+    }
 }

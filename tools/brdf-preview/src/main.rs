@@ -108,9 +108,15 @@ struct Args {
     aa: usize,
 
     /// Adaptive modes: one prediction per block of 2^L x 2^L pixels (0: every pixel, as the
-    /// paper; 1, the default, costs a quarter).
-    #[arg(long, value_name = "L", default_value_t = 1)]
+    /// paper; 2, the default, costs a sixteenth: cargo bench -p brdf-preview --bench adaptive).
+    #[arg(long, value_name = "L", default_value_t = 2)]
     predict_level: usize,
+
+    /// Adaptive modes: the samples follow the predicted variance (the paper: every pixel
+    /// equally noisy) or its square root (std-dev, the default: the least total squared error
+    /// for the budget).
+    #[arg(long, value_enum, default_value_t = AllocationArg::StdDev)]
+    allocation: AllocationArg,
 
     /// Adaptive modes: also write OUT-debug.png, the frame's debug views (level each pixel was
     /// shaded at, samples per pixel, predicted bandwidth and variance).
@@ -208,6 +214,12 @@ impl ModeArg {
             other => other.estimator().name(),
         }
     }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AllocationArg {
+    Variance,
+    StdDev,
 }
 
 fn parse_aa(text: &str) -> Result<usize, String> {
@@ -447,6 +459,10 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let settings = render::adaptive::Settings {
         supersample: args.aa,
         predict_level: args.predict_level,
+        allocation: match args.allocation {
+            AllocationArg::Variance => render::adaptive::Allocation::Variance,
+            AllocationArg::StdDev => render::adaptive::Allocation::StdDev,
+        },
         max_spp: n_samples.min(256),
         seed: args.seed,
         ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
@@ -501,6 +517,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "spp": settings.spp,
         "aa": aa,
         "predict_level": settings.predict_level,
+        "allocation": settings.allocation.name(),
         "width": scene.width,
         "height": scene.height,
         "exposure_ev": preview.exposure_ev,

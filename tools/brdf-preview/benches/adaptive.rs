@@ -1,0 +1,477 @@
+//! Issue 11's equal-quality benchmark of adaptive multi-resolution shading (a benchmark, not a
+//! test): 3 real-derived materials x 2 real maps x 2 meshes (a sphere, and a torus, whose
+//! curvature varies and changes sign), 256 x 256, on the CPU renderer (crate `render`; the GPU
+//! renderer equals it to rounding for the full-resolution modes).
+//!
+//! For each case:
+//!
+//! 1. the brute-force reference mode at 1 to 256 samples per pixel: PSNR against the converged
+//!    estimate (1024 samples per strategy; `--quick`: 256) and milliseconds;
+//! 2. `adaptive` and `adaptive-prefiltered` at two budgets each, with the environment bandwidth
+//!    read (a) as the paper does (`bandwidth::Reading::Paper`), (b) level-normalized, and (c)
+//!    replaced by an oracle: the image bandwidth of a windowed FFT of the converged picture (32 x
+//!    32 windows, as `001` Fig. 12). For each: PSNR, milliseconds, shaded fraction, samples, and
+//!    the time the brute force needs for the same PSNR (interpolated between its budgets, in
+//!    log time) over the adaptive time: the speed-up at equal quality (`>` when the brute force
+//!    never reaches the PSNR: a lower bound from its 256 spp);
+//! 3. Spearman's rank correlation of the predicted image bandwidth with the windowed FFT of the
+//!    converged picture (windows wholly on the mesh), and of the predicted variance with the
+//!    measured variance of the one-sample estimator (16 independent renders), per reading;
+//! 4. 16x anti-aliasing against none: milliseconds and shaded blocks.
+//!
+//! `cargo bench -p brdf-preview --bench adaptive [-- --quick]`. Needs `../shared` (the maps, and
+//! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
+//! converged estimates are kept under target/bench-adaptive/ between runs. The report is printed
+//! and written to target/bench-adaptive/report.md.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use bandwidth::Reading;
+use render::adaptive::{self, Bandwidths, EnvBandwidth};
+use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
+
+const MATERIALS: [&str; 3] = ["gold-paint", "white-paint", "chrome"];
+const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
+const MESHES: [&str; 2] = ["sphere", "torus"];
+const SIZE: usize = 256;
+const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn shared() -> PathBuf {
+    let dir = root().join("../shared");
+    assert!(dir.join("data").is_dir(), "the shared data is missing: expected it at {}", dir.display());
+    dir
+}
+
+fn work() -> PathBuf {
+    root().join("target/bench-adaptive")
+}
+
+/// A real-derived MERL table's path, made once under target/merl/ by nbrdf2merl.py.
+fn material_path(name: &str) -> PathBuf {
+    let path = root().join("target/merl").join(format!("{name}.binary"));
+    if !path.exists() {
+        let status = std::process::Command::new("python3")
+            .arg(shared().join("tools/nbrdf2merl.py"))
+            .arg("--out")
+            .arg(root().join("target/merl"))
+            .arg(name)
+            .status()
+            .expect("running python3");
+        assert!(status.success(), "nbrdf2merl.py {name} failed (it needs numpy)");
+    }
+    path
+}
+
+fn environment_path(name: &str) -> PathBuf {
+    shared().join("data/env").join(format!("{name}.hdr"))
+}
+
+/// The bake of a material under a map (incremental: a rerun reuses it). 128 importance vectors,
+/// so that the brute force keeps improving up to its largest budget.
+fn bake(material: &str, environment: &str) -> bake::Loaded {
+    let dir = work().join(format!("{material}-{environment}"));
+    let mut config = bake::BakeConfig::new(material_path(material), Some(environment_path(environment)), dir.clone());
+    config.importance.n_vectors = 128;
+    let program = bake::Program { name: "adaptive-bench", version: env!("CARGO_PKG_VERSION") };
+    bake::run_bake(&config, &program, &|_| {}).unwrap_or_else(|e| panic!("baking {material} under {environment}: {e}"));
+    bake::load(&dir, None).expect("loading the bake")
+}
+
+/// The environment's bandwidth read the given way, as the bake's stage computes it.
+fn environment_bandwidth(environment: &str, reading: Reading) -> EnvBandwidth {
+    let path = environment_path(environment);
+    let map = envmap::load(&path).expect("loading the map");
+    let mut settings = bake::stage::env_bandwidth::Settings::default();
+    settings.config.reading = reading;
+    let staged = bake::stage::env_bandwidth::run_on_map(&path, &map, &settings).expect("environment bandwidth");
+    let exr = &staged.files.iter().find(|f| f.role == "environment-bandwidth").expect("the EXR").bytes;
+    let image = envmap::read_image_from_memory(exr, &envmap::Limits::default()).expect("decoding the EXR");
+    EnvBandwidth::new(image.width, image.height, image.rgb.chunks_exact(3).map(|t| t[0]).collect()).unwrap()
+}
+
+fn scene(mesh: &str) -> Scene {
+    let mesh = match mesh {
+        "sphere" => Mesh::sphere(1.0, 128, 64),
+        _ => Mesh::torus(0.7, 0.3, 128, 48),
+    };
+    Scene {
+        mesh,
+        camera: Camera::orbit(glam::Vec3::ZERO, 3.2, 0.0, 0.5, 45f32.to_radians()).unwrap(),
+        width: SIZE,
+        height: SIZE,
+    }
+}
+
+/// The converged estimate of a case, kept as raw little-endian `f32` RGB.
+fn converged(name: &str, scene: &Scene, material: &Material, lighting: &Lighting, samples: u32) -> Image {
+    let path = work().join(format!("{name}-converged-{samples}.f32"));
+    let covered = render::raster::rasterize(&scene.mesh, scene.camera.view_proj(1.0), scene.width, scene.height)
+        .expect("rasterizing")
+        .hits
+        .iter()
+        .map(Option::is_some)
+        .collect();
+    if let Ok(bytes) = std::fs::read(&path)
+        && bytes.len() == 12 * SIZE * SIZE
+    {
+        let rgb = bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        return Image { width: SIZE, height: SIZE, rgb, covered };
+    }
+    let start = Instant::now();
+    let image = render::converged::converged(scene, material, lighting, samples, 1).expect("converged");
+    eprintln!("{name}: converged estimate ({samples} per strategy) in {:.1} s", start.elapsed().as_secs_f64());
+    std::fs::write(&path, image.rgb.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).expect("caching");
+    image
+}
+
+/// The best of `runs` wall times of `f`, in milliseconds, and its last result.
+fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..runs {
+        let start = Instant::now();
+        let value = f();
+        best = best.min(start.elapsed().as_secs_f64() * 1e3);
+        out = Some(value);
+    }
+    (best, out.expect("at least one run"))
+}
+
+/// The brute-force time for `psnr`, interpolated in log time between the budgets around it on
+/// the curve's running maximum; `None` above its best PSNR.
+fn brute_time(curve: &[(f64, f64)], psnr: f64) -> Option<f64> {
+    let mut best = f64::NEG_INFINITY;
+    let mut previous: Option<(f64, f64)> = None;
+    for &(p, ms) in curve {
+        if p <= best {
+            continue;
+        }
+        if psnr <= p {
+            return Some(match previous {
+                None => ms,
+                Some((p0, ms0)) => {
+                    let t = ((psnr - p0) / (p - p0)).clamp(0.0, 1.0);
+                    (ms0.ln() + t * (ms.ln() - ms0.ln())).exp()
+                }
+            });
+        }
+        best = p;
+        previous = Some((p, ms));
+    }
+    None
+}
+
+/// Spearman's rank correlation (average ranks for ties).
+fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    fn ranks(v: &[f64]) -> Vec<f64> {
+        let mut order: Vec<usize> = (0..v.len()).collect();
+        order.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
+        let mut r = vec![0.0; v.len()];
+        let mut i = 0;
+        while i < order.len() {
+            let mut j = i;
+            while j + 1 < order.len() && v[order[j + 1]] == v[order[i]] {
+                j += 1;
+            }
+            for k in i..=j {
+                r[order[k]] = (i + j) as f64 / 2.0;
+            }
+            i = j + 1;
+        }
+        r
+    }
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = a.len() as f64;
+    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
+    let (mut cov, mut va, mut vb) = (0.0, 0.0, 0.0);
+    for (x, y) in ra.iter().zip(&rb) {
+        cov += (x - ma) * (y - mb);
+        va += (x - ma) * (x - ma);
+        vb += (y - mb) * (y - mb);
+    }
+    cov / (va * vb).sqrt()
+}
+
+/// The windowed FFT of a converged image as a person sees it: the tone-mapped luminance in
+/// [0, 1], before 8-bit quantization (whose steps would read as detail everywhere), windows
+/// whose RMS is below an 8-bit step's (1 / 255 / sqrt(12)) reading 0: detail the pictures the
+/// PSNR compares cannot show. Per window centre, cycles per pixel.
+fn picture_fft(image: &Image, preview: &envmap::Preview) -> bandwidth::WindowedFftMap {
+    let luminance: Vec<f64> = image
+        .rgb
+        .chunks_exact(3)
+        .map(|p| bandwidth::luminance([p[0], p[1], p[2]].map(|v| envmap::tonemap(f64::from(v), preview))))
+        .collect();
+    let image = bandwidth::Image::new(SIZE, SIZE, luminance).unwrap();
+    let config = bandwidth::WindowedFftConfig { noise_floor: 1.0 / 255.0 / 12f64.sqrt(), ..Default::default() };
+    bandwidth::windowed_fft_bandwidth(&image, &config).expect("windowed FFT")
+}
+
+/// The oracle bandwidth of every pixel: the windowed FFT's value at the nearest window centre.
+fn oracle(fft: &bandwidth::WindowedFftMap) -> Vec<f64> {
+    let (half, stride) = (fft.window() / 2, fft.centre(1.min(fft.columns() - 1), 0).0 - fft.centre(0, 0).0);
+    let nearest = |p: usize, n: usize| ((p.saturating_sub(half) + stride / 2) / stride.max(1)).min(n - 1);
+    (0..SIZE * SIZE)
+        .map(|i| fft.frequency_at(nearest(i % SIZE, fft.columns()), nearest(i / SIZE, fft.rows())))
+        .collect()
+}
+
+struct Variant {
+    name: &'static str,
+    bandwidths: Bandwidths,
+    oracle: Option<Vec<f64>>,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let option = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
+    // --case SUBSTRING: only the cases whose name contains it; --predict-level L (default 2, as
+    // brdf-preview); --allocation variance|std-dev (default std-dev, as brdf-preview);
+    // --no-extras: skip the correlations and the anti-aliasing.
+    let only = option("--case");
+    let predict_level: usize = option("--predict-level").map_or(2, |l| l.parse().expect("--predict-level L"));
+    let allocation = match option("--allocation").as_deref() {
+        Some("variance") => adaptive::Allocation::Variance,
+        None | Some("std-dev") => adaptive::Allocation::StdDev,
+        Some(other) => panic!("--allocation {other}: variance or std-dev"),
+    };
+    let extras = !args.iter().any(|a| a == "--no-extras");
+    let converged_samples = if quick { 256 } else { 1024 };
+    std::fs::create_dir_all(work()).expect("creating target/bench-adaptive");
+    let mut report = String::new();
+    let mut out = |line: String| {
+        println!("{line}");
+        report.push_str(&line);
+        report.push('\n');
+    };
+    out("# Adaptive shading: equal-quality benchmark (CPU renderer)".into());
+    out(String::new());
+    out(format!(
+        "256 x 256, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \
+         speed-up: brute-force time at the adaptive PSNR over the adaptive time (best of 3 runs each; `>`: the brute force never reaches it)."
+    ));
+    out(String::new());
+    out("| case | mode | env reading | budget spp | PSNR dB | ms | shaded | samples | brute ms | speed-up |".into());
+    out("|---|---|---|---:|---:|---:|---:|---:|---:|---:|".into());
+    let mut speedups: Vec<(String, &'static str, &'static str, f64, bool)> = Vec::new();
+    let mut correlations = Vec::new();
+    let mut aa_rows = Vec::new();
+    let mut readings: Vec<(String, EnvBandwidth, EnvBandwidth)> = Vec::new();
+    for env in ENVIRONMENTS {
+        readings.push((
+            env.to_string(),
+            environment_bandwidth(env, Reading::Paper),
+            environment_bandwidth(env, Reading::LevelNormalized),
+        ));
+    }
+    for material in MATERIALS {
+        for (env, paper, normalized) in &readings {
+            let wanted =
+                |mesh: &str| only.as_ref().is_none_or(|o| format!("{material} / {env} / {mesh}").contains(o.as_str()));
+            if !MESHES.iter().any(|m| wanted(m)) {
+                continue;
+            }
+            let loaded = bake(material, env);
+            let lighting = loaded.lighting.as_ref().expect("an environment");
+            let atlas = loaded.bandwidths.as_ref().expect("bandwidths").brdf.clone();
+            let preview = metrics::auto_preview(lighting.mips.level(0));
+            for mesh in MESHES {
+                let name = format!("{material} / {env} / {mesh}");
+                if !wanted(mesh) {
+                    continue;
+                }
+                let scene = scene(mesh);
+                let reference = converged(
+                    &format!("{material}-{env}-{mesh}"),
+                    &scene,
+                    &loaded.material,
+                    lighting,
+                    converged_samples,
+                );
+                let reference_picture = metrics::tonemap(&reference, &preview);
+                let psnr = |image: &Image| metrics::psnr_db(&metrics::tonemap(image, &preview), &reference_picture);
+
+                let curve: Vec<(f64, f64)> = BRUTE_SPP
+                    .iter()
+                    .map(|&spp| {
+                        let settings = Settings { mode: Mode::Reference, spp, frames: 1, seed: 11 };
+                        let (ms, image) = timed(if spp <= 32 { 3 } else { 1 }, || {
+                            render::render(&scene, &loaded.material, lighting, &settings).expect("render")
+                        });
+                        (psnr(&image), ms)
+                    })
+                    .collect();
+                let brute: Vec<String> =
+                    BRUTE_SPP.iter().zip(&curve).map(|(s, (p, ms))| format!("{s}: {p:.2} dB {ms:.0} ms")).collect();
+                eprintln!("{name}: brute force {}", brute.join(", "));
+
+                let fft = picture_fft(&reference, &preview);
+                let variants = [
+                    Variant {
+                        name: "paper",
+                        bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
+                        oracle: None,
+                    },
+                    Variant {
+                        name: "level-normalized",
+                        bandwidths: Bandwidths { environment: normalized.clone(), brdf: atlas.clone() },
+                        oracle: None,
+                    },
+                    Variant {
+                        name: "oracle (FFT)",
+                        bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
+                        oracle: Some(oracle(&fft)),
+                    },
+                ];
+                for (mode, label, budgets) in
+                    [(Mode::Reference, "adaptive", [4u32, 16]), (Mode::Prefiltered, "adaptive-prefiltered", [2, 8])]
+                {
+                    for variant in &variants {
+                        for spp in budgets {
+                            let settings =
+                                adaptive::Settings { predict_level, allocation, ..adaptive::Settings::new(mode, spp) };
+                            let (ms, frame) = timed(3, || {
+                                adaptive::render_with(
+                                    &scene,
+                                    &loaded.material,
+                                    lighting,
+                                    &variant.bandwidths,
+                                    &settings,
+                                    variant.oracle.as_deref(),
+                                )
+                                .expect("adaptive render")
+                            });
+                            let p = psnr(&frame.image);
+                            let (brute_ms, lower_bound) = match brute_time(&curve, p) {
+                                Some(t) => (t, false),
+                                None => (curve.last().unwrap().1, true),
+                            };
+                            let speedup = brute_ms / ms;
+                            out(format!(
+                                "| {name} | {label} | {} | {spp} | {p:.2} | {ms:.0} | {:.3} | {} | {brute_ms:.0} | {}{speedup:.1} |",
+                                variant.name,
+                                frame.shaded_fraction(),
+                                frame.plan.samples(),
+                                if lower_bound { ">" } else { "" }
+                            ));
+                            speedups.push((name.clone(), label, variant.name, speedup, lower_bound));
+                        }
+                    }
+                }
+
+                if !extras {
+                    continue;
+                }
+                // Must show 3: the predictions against the measurements.
+                let one_spp: Vec<Image> = (0..16)
+                    .map(|s| {
+                        let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 100 + s };
+                        render::render(&scene, &loaded.material, lighting, &settings).expect("render")
+                    })
+                    .collect();
+                let luminance =
+                    |img: &Image, i: usize| bandwidth::luminance([0, 1, 2].map(|c| f64::from(img.rgb[3 * i + c])));
+                let measured_variance: Vec<f64> = (0..SIZE * SIZE)
+                    .map(|i| {
+                        let v: Vec<f64> = one_spp.iter().map(|img| luminance(img, i)).collect();
+                        let mean = v.iter().sum::<f64>() / v.len() as f64;
+                        v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (v.len() - 1) as f64
+                    })
+                    .collect();
+                for variant in &variants[..2] {
+                    let settings =
+                        adaptive::Settings { predict_level: 0, ..adaptive::Settings::new(Mode::Reference, 4) };
+                    let frame = adaptive::render(&scene, &loaded.material, lighting, &variant.bandwidths, &settings)
+                        .expect("adaptive");
+                    let (mut predicted, mut measured) = (Vec::new(), Vec::new());
+                    for j in 0..fft.rows() {
+                        for i in 0..fft.columns() {
+                            let (cx, cy) = fft.centre(i, j);
+                            let (x0, y0) = (cx - fft.window() / 2, cy - fft.window() / 2);
+                            let inside = (0..fft.window() * fft.window()).all(|k| {
+                                frame.predictions[(y0 + k / fft.window()) * SIZE + x0 + k % fft.window()].level >= 0
+                            });
+                            if inside {
+                                predicted.push(frame.predictions[cy * SIZE + cx].bandwidth);
+                                measured.push(fft.frequency_at(i, j));
+                            }
+                        }
+                    }
+                    let bandwidth_rho = if predicted.len() > 2 { spearman(&predicted, &measured) } else { f64::NAN };
+                    let shadeable: Vec<usize> = (0..SIZE * SIZE).filter(|&i| frame.predictions[i].level >= 0).collect();
+                    let pv: Vec<f64> = shadeable.iter().map(|&i| frame.predictions[i].variance).collect();
+                    let mv: Vec<f64> = shadeable.iter().map(|&i| measured_variance[i]).collect();
+                    correlations.push((name.clone(), variant.name, bandwidth_rho, predicted.len(), spearman(&pv, &mv)));
+                }
+
+                // Must show 4: 16x anti-aliasing.
+                let (plain_ms, plain) = timed(3, || {
+                    let settings =
+                        adaptive::Settings { predict_level, allocation, ..adaptive::Settings::new(Mode::Reference, 8) };
+                    adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
+                        .expect("adaptive")
+                });
+                let (aa_ms, aa) = timed(3, || {
+                    let settings = adaptive::Settings {
+                        supersample: 4,
+                        predict_level,
+                        allocation,
+                        ..adaptive::Settings::new(Mode::Reference, 8)
+                    };
+                    adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
+                        .expect("adaptive")
+                });
+                let shaded = |f: &adaptive::Adaptive| f.plan.shaded_per_level().iter().sum::<usize>();
+                aa_rows.push((name.clone(), plain_ms, aa_ms, shaded(&plain), shaded(&aa)));
+            }
+        }
+    }
+
+    out(String::new());
+    out("## Speed-up at equal quality, per mode and reading (over cases and budgets)".into());
+    out(String::new());
+    out("| mode | env reading | min | median | max | cases >= goal |".into());
+    out("|---|---|---:|---:|---:|---:|".into());
+    for label in ["adaptive", "adaptive-prefiltered"] {
+        for reading in ["paper", "level-normalized", "oracle (FFT)"] {
+            let mut v: Vec<f64> = speedups.iter().filter(|s| s.1 == label && s.2 == reading).map(|s| s.3).collect();
+            v.sort_by(f64::total_cmp);
+            if v.is_empty() {
+                continue;
+            }
+            let goal = if label == "adaptive" { 4.0 } else { 10.0 };
+            let hit = v.iter().filter(|&&s| s >= goal).count();
+            out(format!(
+                "| {label} | {reading} | {:.1} | {:.1} | {:.1} | {hit} of {} (goal {goal}x) |",
+                v[0],
+                v[v.len() / 2],
+                v[v.len() - 1],
+                v.len()
+            ));
+        }
+    }
+    out(String::new());
+    out("## Predictions against measurements (Spearman's rank correlation)".into());
+    out(String::new());
+    out("| case | env reading | bandwidth vs windowed FFT | windows | variance vs measured |".into());
+    out("|---|---|---:|---:|---:|".into());
+    for (name, reading, rho_b, windows, rho_v) in &correlations {
+        out(format!("| {name} | {reading} | {rho_b:.3} | {windows} | {rho_v:.3} |"));
+    }
+    out(String::new());
+    out("## 16x anti-aliasing (adaptive, 8 spp budget, paper reading)".into());
+    out(String::new());
+    out("| case | ms 1x | ms 16x | time ratio | shaded blocks 1x | 16x |".into());
+    out("|---|---:|---:|---:|---:|---:|".into());
+    for (name, a, b, sa, sb) in &aa_rows {
+        out(format!("| {name} | {a:.0} | {b:.0} | {:.2} | {sa} | {sb} |", b / a));
+    }
+    std::fs::write(work().join("report.md"), &report).expect("writing the report");
+    eprintln!("report written to {}", work().join("report.md").display());
+}
