@@ -82,8 +82,14 @@
 //!   axis takes `1 / cos^2` to its figure; foreshortening compresses the surface along the
 //!   projected normal, so that is the axis), `cos theta_x` clamped at 0.1.
 //!
-//! A block whose weights all vanish (every parent at another depth) is shaded instead
-//! (*rescued*). Every pixel therefore ends shaded at its level or up-sampled from shaded parents,
+//! - with [`Settings::lobe_weight`], also `003`'s lobe weight: the inner product of the two
+//!   pixels' specular lobes as normalized spherical Gaussians ([`lobe_similarity`]), each
+//!   around its mirror direction with the sharpness of the Phong layer the bake's layer
+//!   selection picks for its view (`exp(n (cos - 1))` is the SG of `cos^n`): parents whose
+//!   reflections point elsewhere, relative to the lobe's width, count less.
+//!
+//! A block whose weights all vanish (every parent at another depth), or sum to at most
+//! [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel therefore ends shaded at its level or up-sampled from shaded parents,
 //! and the plan is fixed by the G-buffer alone, before any shading.
 //!
 //! # Samples
@@ -186,6 +192,14 @@ pub struct Settings {
     pub predict_level: usize,
     /// How the samples follow the predicted variance.
     pub allocation: Allocation,
+    /// Multiply the up-sampling weights by the similarity of the two pixels' specular lobes
+    /// (`003` eq. 4, module docs).
+    pub lobe_weight: bool,
+    /// Shade a block instead of up-sampling it when the sum of its weights before
+    /// normalization (at most 1) is at most this: `003`'s "recomputing the pixel values
+    /// adaptively" where the weights say the parents do not represent it. 0: only when they
+    /// all vanish.
+    pub rescue_below: f64,
 }
 
 /// How a frame's samples are shared among its shaded blocks (module docs, "Samples").
@@ -225,6 +239,8 @@ impl Settings {
             depth_sigma: 0.02,
             predict_level: 0,
             allocation: Allocation::Variance,
+            lobe_weight: false,
+            rescue_below: 0.0,
         }
     }
 }
@@ -238,6 +254,8 @@ pub(crate) struct Pixel {
     /// The normal projected on the screen (x right, y down), unit, or zero when it faces the
     /// eye.
     pub screen_normal: [f64; 2],
+    /// The mirror direction of the view about the normal: the axis of a specular lobe.
+    pub mirror: DVec3,
 }
 
 /// The G-buffer's pixels, `None` where a pixel is not shadeable.
@@ -266,8 +284,10 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
             let projected = [n.dot(right), -n.dot(up)];
             let length = projected[0].hypot(projected[1]);
             let screen_normal = if length > 1e-9 { [projected[0] / length, projected[1] / length] } else { [0.0; 2] };
+            let wo = (eye - hit.position).normalize();
             Some(Pixel {
                 frame,
+                mirror: 2.0 * frame.n.dot(wo) * frame.n - wo,
                 depth: (eye - hit.position).length(),
                 curvature: horizontal.max(vertical),
                 screen_normal,
@@ -500,8 +520,10 @@ fn upsample_weights(
     (bx, by): (usize, usize),
     pixels: &[Option<Pixel>],
     (width, height): (usize, usize),
-    depth_sigma: f64,
+    settings: &Settings,
+    sharpness: Option<&[f64]>,
 ) -> Option<([(u32, f32); 4], u8)> {
+    let (depth_sigma, rescue_below) = (settings.depth_sigma, settings.rescue_below);
     let (cx, cy) = child.pixel(bx, by, width, height);
     let me = pixels[cy * width + cx].as_ref()?;
     let spacing = (1usize << parent.level) as f64;
@@ -542,7 +564,11 @@ fn upsample_weights(
         let along = v[0] * nx + v[1] * ny;
         let across = -v[0] * ny + v[1] * nx;
         let g_a = (-(along * along / (cos_x * cos_x) + across * across)).exp();
-        let w = g_z * g_a * alpha;
+        let g_lobe = sharpness.map_or(1.0, |rows| {
+            let lambda = |p: &Pixel| rows[(((1.0 - p.frame.cos_o) * rows.len() as f64) as usize).min(rows.len() - 1)];
+            lobe_similarity(me.mirror, lambda(me), them.mirror, lambda(them))
+        });
+        let w = g_z * g_a * alpha * g_lobe;
         if w > 0.0 {
             out[count as usize] = (b as u32, 0.0);
             weights[count as usize] = w;
@@ -550,7 +576,7 @@ fn upsample_weights(
             count += 1;
         }
     }
-    if count == 0 || total.is_nan() || total <= 0.0 {
+    if count == 0 || total.is_nan() || total <= rescue_below {
         return None;
     }
     for j in 0..count as usize {
@@ -567,6 +593,7 @@ pub(crate) fn plan(
     (width, height): (usize, usize),
     budget: u64,
     settings: &Settings,
+    sharpness: Option<&[f64]>,
 ) -> Result<Plan, Error> {
     let top = levels.len() - 1;
     let mut actions: Vec<Vec<Action>> = Vec::with_capacity(levels.len());
@@ -586,7 +613,8 @@ pub(crate) fn plan(
                         (bx, by),
                         pixels,
                         (width, height),
-                        settings.depth_sigma,
+                        settings,
+                        sharpness,
                     ) {
                         Some((parents, count)) => Action::Upsample { parents, count },
                         None => Action::Shade { samples: 0, rescued: true },
@@ -681,6 +709,19 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
     Ok(())
 }
 
+/// The inner product of two normalized spherical Gaussians `exp(lambda (xi . w - 1))` (`003`
+/// eq. 4): 1 for equal lobes, towards 0 as their axes part relative to their widths.
+/// `4 sqrt(a_i a_j) sinh(d) / (exp(lambda_i + lambda_j) d)`, `d = |lambda_i xi_i + lambda_j
+/// xi_j|`, `a = lambda / (1 - exp(-4 lambda))`, evaluated as `exp(d - l_i - l_j)` terms so
+/// that sharp lobes do not overflow.
+pub fn lobe_similarity(xi_i: DVec3, lambda_i: f64, xi_j: DVec3, lambda_j: f64) -> f64 {
+    let alpha = |l: f64| if l < 1e-9 { 0.25 } else { l / -(-4.0 * l).exp_m1() };
+    let sum = lambda_i + lambda_j;
+    let d = (lambda_i * xi_i + lambda_j * xi_j).length();
+    let sinh_over = if d < 1e-9 { (-sum).exp() } else { ((d - sum).exp() - (-d - sum).exp()) / (2.0 * d) };
+    4.0 * (alpha(lambda_i) * alpha(lambda_j)).sqrt() * sinh_over
+}
+
 /// What an adaptive frame made: the picture and everything the debug views and the figures
 /// read.
 #[derive(Clone, Debug)]
@@ -737,6 +778,14 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
             "spp {} and n_b {} must be at least 1 and supersample ({}) 1, 2 or 4",
             settings.spp, settings.n_b, settings.supersample
         )));
+    }
+    if settings.lobe_weight
+        && (material.view_layers.is_empty()
+            || material.view_layers.iter().any(|&l| l as usize >= lighting.exponents.len()))
+    {
+        return Err(Error::Invalid(
+            "the lobe weight reads the bake's layer selection, which is missing or out of range".into(),
+        ));
     }
     if !(settings.depth_sigma > 0.0 && settings.depth_sigma.is_finite()) {
         return Err(Error::Invalid(format!("depth sigma {} must be positive", settings.depth_sigma)));
@@ -808,7 +857,18 @@ pub fn render_with(
             (0..ss * ss).any(|j| gbuffer.hits[(y + j / ss) * width + x + j % ss].is_some())
         })
         .count() as u64;
-    let plan = plan(levels, &pixels, (width, height), u64::from(settings.spp) * covered_output, settings)?;
+    // The lobe weight's sharpness per view row: the exponent of the Phong layer the bake picks.
+    let sharpness: Option<Vec<f64>> = settings
+        .lobe_weight
+        .then(|| material.view_layers.iter().map(|&l| f64::from(lighting.exponents[l as usize])).collect());
+    let plan = plan(
+        levels,
+        &pixels,
+        (width, height),
+        u64::from(settings.spp) * covered_output,
+        settings,
+        sharpness.as_deref(),
+    )?;
     let plan_ms = lap();
 
     // Coarse to fine.
@@ -902,7 +962,32 @@ fn downsample(rgb: &[[f32; 3]], gbuffer: &GBuffer, width: usize, height: usize, 
 
 #[cfg(test)]
 mod tests {
-    use super::shares;
+    use super::{lobe_similarity, shares};
+    use glam::DVec3;
+
+    #[test]
+    fn the_lobe_similarity_is_a_normalized_inner_product() {
+        let z = DVec3::Z;
+        for lambda in [0.0, 0.5, 4.0, 100.0, 4096.0] {
+            assert!((lobe_similarity(z, lambda, z, lambda) - 1.0).abs() < 1e-9, "lambda {lambda}");
+        }
+        let tilted = DVec3::new(0.2f64.sin(), 0.0, 0.2f64.cos());
+        let mut previous = 1.0;
+        for lambda in [1.0, 10.0, 100.0, 1000.0] {
+            let w = lobe_similarity(z, lambda, tilted, lambda);
+            assert!(w > 0.0 && w < previous, "lambda {lambda}: {w} (sharper lobes 0.2 rad apart are less alike)");
+            // Symmetric, and at most 1 (Cauchy-Schwarz) for different sharpness too.
+            assert!((w - lobe_similarity(tilted, lambda, z, lambda)).abs() < 1e-12);
+            assert!(lobe_similarity(z, lambda, tilted, 3.0 * lambda) <= 1.0);
+            previous = w;
+        }
+        // Equal sharp lobes at an angle a: d = 2 lambda cos(a / 2) and sinh(d) ~ exp(d) / 2, so
+        // the weight is exp(2 lambda (cos(a / 2) - 1)) / cos(a / 2) (~ exp(-lambda a^2 / 4)).
+        let (lambda, a) = (1000.0f64, 0.2f64);
+        let expect = (2.0 * lambda * ((a / 2.0).cos() - 1.0)).exp() / (a / 2.0).cos();
+        let w = lobe_similarity(z, lambda, tilted, lambda);
+        assert!((w / expect - 1.0).abs() < 1e-9, "{w} vs {expect}");
+    }
 
     #[test]
     fn water_filling_respects_the_budget_the_cap_and_the_proportions() {

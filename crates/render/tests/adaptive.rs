@@ -174,6 +174,16 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
         }
     }
     assert!(coarse_levels >= 6, "the frames shade at coarse levels too ({coarse_levels} level-frames)");
+
+    // With 003's lobe weight and a rescue threshold the invariants hold too, and blocks whose
+    // weights sum to little are shaded rather than up-sampled.
+    let settings =
+        adaptive::Settings { lobe_weight: true, rescue_below: 0.3, ..adaptive::Settings::new(Mode::Prefiltered, 4) };
+    let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
+    check_plan(&frame, &settings);
+    let rescued =
+        frame.plan.actions.iter().flatten().filter(|a| matches!(a, Action::Shade { rescued: true, .. })).count();
+    assert!(rescued > 0, "no block rescued");
 }
 
 #[test]

@@ -10,7 +10,8 @@
 //! 2. `adaptive` and `adaptive-prefiltered` at two budgets each, with the environment bandwidth
 //!    read (a) as the paper does (`bandwidth::Reading::Paper`), (b) level-normalized, and (c)
 //!    replaced by an oracle: the image bandwidth of a windowed FFT of the converged picture (32 x
-//!    32 windows, as `001` Fig. 12). For each: PSNR, milliseconds, shaded fraction, samples, and
+//!    32 windows, as `001` Fig. 12), and (d) the paper's with `003`'s lobe weight in the
+//!    up-sampling. For each: PSNR, milliseconds, shaded fraction, samples, and
 //!    the time the brute force needs for the same PSNR (interpolated between its budgets, in
 //!    log time) over the adaptive time: the speed-up at equal quality (`>` when the brute force
 //!    never reaches the PSNR: a lower bound from its 256 spp);
@@ -225,6 +226,7 @@ struct Variant {
     name: &'static str,
     bandwidths: Bandwidths,
     oracle: Option<Vec<f64>>,
+    lobe_weight: bool,
 }
 
 fn main() {
@@ -242,6 +244,7 @@ fn main() {
         Some(other) => panic!("--allocation {other}: variance or std-dev"),
     };
     let extras = !args.iter().any(|a| a == "--no-extras");
+    let rescue_below: f64 = option("--rescue-below").map_or(0.0, |v| v.parse().expect("--rescue-below W"));
     let converged_samples = if quick { 256 } else { 1024 };
     std::fs::create_dir_all(work()).expect("creating target/bench-adaptive");
     let mut report = String::new();
@@ -317,16 +320,25 @@ fn main() {
                         name: "paper",
                         bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
                         oracle: None,
+                        lobe_weight: false,
                     },
                     Variant {
                         name: "level-normalized",
                         bandwidths: Bandwidths { environment: normalized.clone(), brdf: atlas.clone() },
                         oracle: None,
+                        lobe_weight: false,
                     },
                     Variant {
                         name: "oracle (FFT)",
                         bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
                         oracle: Some(oracle(&fft)),
+                        lobe_weight: false,
+                    },
+                    Variant {
+                        name: "paper + lobe weight",
+                        bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
+                        oracle: None,
+                        lobe_weight: true,
                     },
                 ];
                 for (mode, label, budgets) in
@@ -334,8 +346,13 @@ fn main() {
                 {
                     for variant in &variants {
                         for spp in budgets {
-                            let settings =
-                                adaptive::Settings { predict_level, allocation, ..adaptive::Settings::new(mode, spp) };
+                            let settings = adaptive::Settings {
+                                predict_level,
+                                allocation,
+                                lobe_weight: variant.lobe_weight,
+                                rescue_below,
+                                ..adaptive::Settings::new(mode, spp)
+                            };
                             let (ms, frame) = timed(3, || {
                                 adaptive::render_with(
                                     &scene,
@@ -439,7 +456,7 @@ fn main() {
     out("| mode | env reading | min | median | max | cases >= goal |".into());
     out("|---|---|---:|---:|---:|---:|".into());
     for label in ["adaptive", "adaptive-prefiltered"] {
-        for reading in ["paper", "level-normalized", "oracle (FFT)"] {
+        for reading in ["paper", "level-normalized", "oracle (FFT)", "paper + lobe weight"] {
             let mut v: Vec<f64> = speedups.iter().filter(|s| s.1 == label && s.2 == reading).map(|s| s.3).collect();
             v.sort_by(f64::total_cmp);
             if v.is_empty() {

@@ -13,7 +13,12 @@ const NONE: [u8; 3] = [0, 0, 0];
 /// The debug views of a frame, as the papers' figures show them (001 Fig. 9, 11, 12): the
 /// picture, the level each pixel was shaded at, samples per pixel, the predicted image bandwidth
 /// and the predicted variance, each with a legend.
-pub fn debug_views(frame: &Adaptive, picture_rgb: &[u8], title: &str) -> Canvas {
+pub fn debug_views(
+    frame: &Adaptive,
+    allocation: render::adaptive::Allocation,
+    picture_rgb: &[u8],
+    title: &str,
+) -> Canvas {
     let (w, h) = (frame.width, frame.height);
     let (ow, oh) = (frame.image.width, frame.image.height);
     let zoom = (256 / w.max(h)).max(1);
@@ -71,12 +76,16 @@ pub fn debug_views(frame: &Adaptive, picture_rgb: &[u8], title: &str) -> Canvas 
          up-sampled (0: shaded on its own). Shaded blocks per level: {}. {} samples of a budget of {}; shaded fraction {}. Samples per \
          pixel: a shaded block's samples over its pixels. Bandwidth: cycles per pixel from the environment's and \
          the BRDF's bandwidth through the paper's reflection operators (001 eq. 3-6); the level is \
-         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered), which \
-         shares the samples out. Black: background or silhouette.",
+         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered); the \
+         samples follow it ({}). Black: background or silhouette.",
         per_level.join(", "),
         frame.plan.samples(),
         frame.plan.budget,
         format_number((frame.shaded_fraction() * 1e4).round() / 1e4),
+        match allocation {
+            render::adaptive::Allocation::Variance => "in proportion",
+            render::adaptive::Allocation::StdDev => "in proportion to its square root",
+        },
     );
     panels.footer(stack(&[
         Legend::new(levels, viridis, "shaded at level k (a block of s x s pixels, s = 2 to the power k; linear)")

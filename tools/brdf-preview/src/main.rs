@@ -118,6 +118,11 @@ struct Args {
     #[arg(long, value_enum, default_value_t = AllocationArg::StdDev)]
     allocation: AllocationArg,
 
+    /// Adaptive modes: weight the up-sampling by how alike the specular lobes of the two pixels
+    /// are (Tokuyoshi's spherical-Gaussian inner product, 003 eq. 4).
+    #[arg(long)]
+    lobe_weight: bool,
+
     /// Adaptive modes: also write OUT-debug.png, the frame's debug views (level each pixel was
     /// shaded at, samples per pixel, predicted bandwidth and variance).
     #[arg(long)]
@@ -463,6 +468,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
             AllocationArg::Variance => render::adaptive::Allocation::Variance,
             AllocationArg::StdDev => render::adaptive::Allocation::StdDev,
         },
+        lobe_weight: args.lobe_weight,
         max_spp: n_samples.min(256),
         seed: args.seed,
         ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
@@ -491,8 +497,12 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let captioned = with_caption(&picture, scene.width, scene.height, &caption);
     let mut files = vec![(out.to_path_buf(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?)];
     if args.debug_views {
-        let sheet =
-            adaptive::debug_views(&frame, &picture, &format!("{}: {}", args.mode.name(), names(&loaded.manifest)));
+        let sheet = adaptive::debug_views(
+            &frame,
+            settings.allocation,
+            &picture,
+            &format!("{}: {}", args.mode.name(), names(&loaded.manifest)),
+        );
         files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
     let t = frame.timings;
@@ -518,6 +528,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "aa": aa,
         "predict_level": settings.predict_level,
         "allocation": settings.allocation.name(),
+        "lobe_weight": settings.lobe_weight,
         "width": scene.width,
         "height": scene.height,
         "exposure_ev": preview.exposure_ev,
