@@ -263,7 +263,7 @@ pub fn analysis_levels(n: usize) -> usize {
 /// The periodic continuation of an `n x n` lobe image (row-major) that the analysis reads: a
 /// `2n x 2n` image, the lobe image in its top-left quarter, periodic, and continuous with its
 /// slope across every border of the lobe image (crate docs, "Boundaries"): each row, then
-/// each column of the result, is continued by [`extend_line`].
+/// each column of the result, is continued by `extend_line`.
 pub fn extend_periodic(image: &[f64], n: usize) -> wavelet::Image {
     let mut ext = Vec::new();
     extend_into(image, n, &mut ext);
