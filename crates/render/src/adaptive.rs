@@ -20,10 +20,9 @@
 //! For each shadeable pixel (or, with [`Settings::predict_level`] `l`, once per block of `2^l x
 //! 2^l` output pixels, at the block's pixel, copied to its shadeable pixels: the prediction
 //! costs as much as shading `n_b` samples, and a block's pixels are alike), `n_b` incident
-//! directions (default 16): the first `n_b` samples of
-//! one baked vector of the pixel's slice (the vector `pcg_hash(pixel ^ pcg_hash(seed ^
-//! 0x9e37_79b9)) % V`; the prefix of an Owen-scrambled Sobol' vector is stratified), each with
-//! its pdf. For each `wi`:
+//! directions (default 16): the first `n_b` samples of one baked vector of the pixel's slice
+//! (the vector `pcg_hash(pixel ^ pcg_hash(seed ^ 0x9e37_79b9)) % V`; the prefix of an
+//! Owen-scrambled Sobol' vector is stratified), each with its pdf. For each `wi`:
 //!
 //! - the light's bandwidth `nu_l = [0, nu_env(wi)]`, `nu_env` the bake's environment bandwidth
 //!   (cycles per radian, nearest texel; [`EnvBandwidth`]); a distant light has no spatial
@@ -89,8 +88,9 @@
 //!   reflections point elsewhere, relative to the lobe's width, count less.
 //!
 //! A block whose weights all vanish (every parent at another depth), or sum to at most
-//! [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel therefore ends shaded at its level or up-sampled from shaded parents,
-//! and the plan is fixed by the G-buffer alone, before any shading.
+//! [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel
+//! therefore ends shaded at its level or up-sampled from shaded parents, and the plan is fixed
+//! by the G-buffer alone, before any shading.
 //!
 //! # Samples
 //!
@@ -101,9 +101,10 @@
 //! PSNR measures; the benchmark measures both), at most `max_spp` (what a capped block cannot
 //! take goes to the others), rounded down to a power of two (the baked vectors are read in
 //! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
-//! blocks furthest below their share, while it fits. The total never exceeds the budget; a budget below one sample per
-//! shaded block is an error. A shaded block is shaded by the chosen estimator with its count as
-//! `spp` and one frame, at its pixel (the random chunk of that pixel).
+//! blocks furthest below their share, while it fits. The total never exceeds the budget; a
+//! budget below one sample per shaded block is an error. A shaded block is shaded by the chosen
+//! estimator with its count as `spp` and one frame, at its pixel (the random chunk of that
+//! pixel).
 //!
 //! # Anti-aliasing (`001` section 4.3)
 //!
@@ -264,7 +265,7 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
     let [_, right, up] = scene.camera.basis();
     let (w, h) = (gbuffer.width, gbuffer.height);
     let frames: Vec<Option<ShadingFrame>> =
-        gbuffer.hits.iter().map(|hit| hit.as_ref().and_then(|hit| ShadingFrame::new(hit, eye))).collect();
+        gbuffer.hits.par_iter().map(|hit| hit.as_ref().and_then(|hit| ShadingFrame::new(hit, eye))).collect();
     let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|_| frames[y * w + x].is_some());
     (0..w * h)
         .into_par_iter()
@@ -962,8 +963,27 @@ fn downsample(rgb: &[[f32; 3]], gbuffer: &GBuffer, width: usize, height: usize, 
 
 #[cfg(test)]
 mod tests {
-    use super::{lobe_similarity, shares};
+    use super::{lobe_similarity, pixels, shares};
+    use crate::shade::visibility;
+    use crate::{Camera, Mesh, Scene};
     use glam::DVec3;
+
+    #[test]
+    fn the_curvature_of_a_sphere_is_one_over_its_radius() {
+        // Interpolated vertex normals of a finely tessellated sphere: the median over the
+        // pixels is within 2% of 1 / R (the tessellation's flat spans and the one-sided
+        // differences at the silhouette are the rest).
+        for radius in [1.0f32, 0.5] {
+            let scene =
+                Scene { mesh: Mesh::sphere(radius, 256, 128), camera: Camera::default(), width: 96, height: 96 };
+            let gbuffer = visibility(&scene).unwrap();
+            let mut curvature: Vec<f64> = pixels(&scene, &gbuffer).iter().flatten().map(|p| p.curvature).collect();
+            curvature.sort_by(f64::total_cmp);
+            let median = curvature[curvature.len() / 2];
+            let expect = 1.0 / f64::from(radius);
+            assert!((median / expect - 1.0).abs() < 0.02, "radius {radius}: median curvature {median}");
+        }
+    }
 
     #[test]
     fn the_lobe_similarity_is_a_normalized_inner_product() {
