@@ -104,6 +104,7 @@ fn run_on(input: &Path, width: usize, height: usize, image: Image, settings: &Se
         levels: analysis.pixels.level(),
         unit: mode.unit(),
         latlong: mode == Mode::Angular,
+        reading: settings.config.reading,
     });
     let png = envmap::encode_png_rgb8(pic.width, pic.height, &pic.rgb)
         .map_err(|e| Error::Internal(format!("encoding {PICTURE}: {e}")))?;

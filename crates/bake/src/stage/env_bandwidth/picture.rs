@@ -54,6 +54,8 @@ pub struct Input<'a> {
     pub unit: &'a str,
     /// A lat-long map: pixels weigh their solid angle, axes in degrees.
     pub latlong: bool,
+    /// How eq. 7 compared the levels (`bandwidth::Reading`), for the title.
+    pub reading: bandwidth::Reading,
 }
 
 /// Whether a pixel is drawn with the colour map (neither flat nor at the Nyquist limit).
@@ -110,7 +112,7 @@ pub fn render(input: &Input<'_>) -> Canvas {
     };
     let mut grid = Grid::new(1);
     let mode = if input.latlong { "lat-long map" } else { "image" };
-    grid.title(format!("local bandwidth of {} ({mode}, {w} x {h})", input.name));
+    grid.title(format!("local bandwidth of {} ({mode}, {w} x {h}, {} reading)", input.name, input.reading.name()));
     grid.add(heat_map(&image, zoom(w, h), &x_axis, &y_axis), "");
     let width = grid.width();
     let weighting = if input.latlong { "weighted by solid angle (sin theta per row)" } else { "counting pixels alike" };
@@ -169,6 +171,7 @@ mod tests {
             levels: &levels,
             unit: "cycles per pixel",
             latlong: false,
+            reading: bandwidth::Reading::Paper,
         };
         let figure = render(&input);
         let k = zoom(w, h);
@@ -183,7 +186,7 @@ mod tests {
         for label in ["at the Nyquist limit: may be higher", "flat: no significant detail", "y, pixels"] {
             assert!(figure.find(&Canvas::label(label)).is_some(), "{label}");
         }
-        assert!(figure.find(&Canvas::label("local bandwidth of tiny.exr (image, 4 x 2)")).is_some());
+        assert!(figure.find(&Canvas::label("local bandwidth of tiny.exr (image, 4 x 2, paper reading)")).is_some());
     }
 
     /// A lat-long map whose values grow like 1 / sin(theta) towards the poles, as the Jacobian
@@ -204,6 +207,7 @@ mod tests {
             levels: &levels,
             unit: "cycles per radian",
             latlong: true,
+            reading: bandwidth::Reading::Paper,
         };
         let s = scale(&input);
         let max = values.iter().copied().fold(0.0, f64::max);
@@ -240,8 +244,16 @@ mod tests {
     fn special_pixels_stay_out_of_the_range() {
         let values = [1.0, 2.0, 1000.0, 1e-6];
         let levels = [4, 4, 1, 0];
-        let input =
-            Input { name: "m", width: 2, height: 2, values: &values, levels: &levels, unit: "u", latlong: false };
+        let input = Input {
+            name: "m",
+            width: 2,
+            height: 2,
+            values: &values,
+            levels: &levels,
+            unit: "u",
+            latlong: false,
+            reading: bandwidth::Reading::Paper,
+        };
         let s = scale(&input);
         assert_eq!((s.lo(), s.hi()), (1.0, 2.0));
         let none = Input { levels: &[0, 1, 0, 1], ..input };
