@@ -225,6 +225,8 @@ pub struct Renderer {
     triangle_target: wgpu::Texture,
     depth_target: wgpu::Texture,
     shade_pipeline: wgpu::ComputePipeline,
+    /// `shade_blocks`: the shaded blocks of an adaptive frame.
+    blocks_pipeline: wgpu::ComputePipeline,
     table_group: wgpu::BindGroup,
     bake_group: wgpu::BindGroup,
     render_group: wgpu::BindGroup,
@@ -395,18 +397,23 @@ impl Renderer {
                     format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}").into(),
                 ),
             });
-            let shade_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("shade_frame"),
-                layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("preview shade"),
-                    bind_group_layouts: &[Some(&table_layout), Some(&bake_layout), Some(&render_layout)],
-                    immediate_size: 0,
-                })),
-                module: &shade_module,
-                entry_point: Some("shade_frame"),
-                compilation_options: Default::default(),
-                cache: None,
+            let shade_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("preview shade"),
+                bind_group_layouts: &[Some(&table_layout), Some(&bake_layout), Some(&render_layout)],
+                immediate_size: 0,
             });
+            let compute_pipeline = |entry: &'static str| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&shade_layout),
+                    module: &shade_module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+            };
+            let shade_pipeline = compute_pipeline("shade_frame");
+            let blocks_pipeline = compute_pipeline("shade_blocks");
 
             let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("merl dims"),
@@ -500,6 +507,7 @@ impl Renderer {
                 triangle_target,
                 depth_target,
                 shade_pipeline,
+                blocks_pipeline,
                 table_group,
                 bake_group,
                 render_group,
@@ -677,6 +685,94 @@ impl Renderer {
             // A clear with no frame after it still has to reach the GPU.
             self.queue.submit([encoder.finish()]);
         })
+    }
+
+    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) with its shaded
+    /// blocks shaded here ([`Renderer::shade_blocks`]) and everything else (G-buffer,
+    /// prediction, plan, up-sampling) on the CPU. The renderer must have been made for the
+    /// frame's render size (`scene` times `settings.supersample`) with `scene`'s camera.
+    pub fn render_adaptive(
+        &self,
+        scene: &Scene,
+        material: &Material,
+        lighting: &Lighting,
+        bandwidths: &render::adaptive::Bandwidths,
+        settings: &render::adaptive::Settings,
+    ) -> Result<render::adaptive::Adaptive, GpuError> {
+        let ss = settings.supersample as u32;
+        if (self.width, self.height) != (scene.width as u32 * ss, scene.height as u32 * ss)
+            || self.camera != scene.camera
+        {
+            return Err(render::Error::Invalid(format!(
+                "the renderer draws {} x {}, the adaptive frame needs {} x {} with the scene's camera",
+                self.width,
+                self.height,
+                scene.width as u32 * ss,
+                scene.height as u32 * ss
+            ))
+            .into());
+        }
+        let mut failure = None;
+        let mut shader = |blocks: &[(u32, u32)]| match self.shade_blocks(settings.mode, settings.seed, blocks) {
+            Ok(values) => Ok(values),
+            Err(e) => {
+                failure = Some(e);
+                Err(render::Error::Invalid("shading on the GPU failed".into()))
+            }
+        };
+        let frame =
+            render::adaptive::render_with_shader(scene, material, lighting, bandwidths, settings, None, &mut shader);
+        match failure {
+            Some(e) => Err(e),
+            None => Ok(frame?),
+        }
+    }
+
+    /// Shades the blocks of an adaptive frame (`render::adaptive::render_with_shader`'s shader):
+    /// each `(pixel, samples)` of the renderer's image, in frame 0 with `seed`, by `mode`'s
+    /// estimator, as `render::adaptive` shades them on the CPU. The accumulation buffer carries
+    /// the items in and the estimates out (so it holds nothing to continue afterwards).
+    pub fn shade_blocks(&self, mode: Mode, seed: u32, blocks: &[(u32, u32)]) -> Result<Vec<[f32; 3]>, GpuError> {
+        let pixels = u64::from(self.width) * u64::from(self.height);
+        if blocks.len() as u64 > pixels {
+            return Err(render::Error::Invalid(format!("{} blocks for {pixels} pixels", blocks.len())).into());
+        }
+        for &(pixel, samples) in blocks {
+            let settings = Settings { mode, spp: samples, frames: 1, seed };
+            if u64::from(pixel) >= pixels {
+                return Err(render::Error::Invalid(format!("block pixel {pixel} is outside {pixels} pixels")).into());
+            }
+            self.check_settings(&settings)?;
+        }
+        if blocks.is_empty() {
+            return Ok(Vec::new());
+        }
+        self.progress.set(None);
+        let items: Vec<[u32; 4]> = blocks.iter().map(|&(pixel, samples)| [pixel, samples, 0, 0]).collect();
+        // The item count travels in `spp`.
+        let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: blocks.len() as u32, frames: 1, seed });
+        let groups = (blocks.len() as u32).div_ceil(64);
+        let (x, y) = (groups.min(32768), groups.div_ceil(32768));
+        capture_errors(&self.device, || {
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
+            self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("shade_blocks"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.blocks_pipeline);
+                pass.set_bind_group(0, &self.table_group, &[]);
+                pass.set_bind_group(1, &self.bake_group, &[]);
+                pass.set_bind_group(2, &self.render_group, &[0]);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            self.queue.submit([encoder.finish()]);
+        })?;
+        let sums = self.read_accumulation()?;
+        Ok(sums[..blocks.len()].iter().map(|s| [s[0], s[1], s[2]]).collect())
     }
 
     /// The accumulation buffer's sums, read back.

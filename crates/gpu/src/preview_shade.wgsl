@@ -101,12 +101,12 @@ fn pcg_hash(v: u32) -> u32 {
 
 // `render::sample_range`: (vector, first sample) of pixel `pixel` in frame `f`. The seed is hashed
 // before it meets the frame, so that renders with small seeds do not share their frames' words.
-fn sample_range(pixel: u32, f: u32) -> vec2<u32> {
-    let per_vector = shade.n_samples / shade.spp;
+fn sample_range(pixel: u32, f: u32, spp: u32) -> vec2<u32> {
+    let per_vector = shade.n_samples / spp;
     let chunks = shade.n_vectors * per_vector;
     let h = pcg_hash(pixel ^ pcg_hash(shade.seed));
     let chunk = (h % chunks + f % chunks) % chunks;
-    return vec2<u32>(chunk / per_vector, (chunk % per_vector) * shade.spp);
+    return vec2<u32>(chunk / per_vector, (chunk % per_vector) * spp);
 }
 
 // What covers a pixel (`render::raster::Hit`): the world position and the normalized normal
@@ -394,13 +394,13 @@ fn debug_index(frame: ShadingFrame) -> vec3<f32> {
 
 // One frame's estimate at a covered pixel: 1 / spp sum_j f(wi_j, wo) L(wi_j) cos(theta_j) / pdf_j
 // over the pixel's samples; a sample with pdf <= 0, wi below the horizon or no table data adds 0.
-fn estimate(frame: ShadingFrame, pixel: u32, f: u32) -> vec3<f32> {
+fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
     let k = slice_of(frame);
     let map = source_map(frame);
-    let range = sample_range(pixel, f);
+    let range = sample_range(pixel, f, spp);
     let start = (k * shade.n_vectors + range.x) * shade.n_samples + range.y;
     var sum = vec3<f32>(0.0);
-    for (var j = 0u; j < shade.spp; j++) {
+    for (var j = 0u; j < spp; j++) {
         let texel = samples[start + j];
         let wi_local = texel.xyz;
         let pdf = texel.w;
@@ -415,7 +415,7 @@ fn estimate(frame: ShadingFrame, pixel: u32, f: u32) -> vec3<f32> {
         let radiance = incident_radiance(map, to_world(frame, wi_local), pdf);
         sum += brdf * radiance * (wi_local.z / pdf);
     }
-    return sum / f32(shade.spp);
+    return sum / f32(spp);
 }
 
 // `render::Camera::ray`: the ray from the eye through the centre of pixel (x, y), row 0 at the
@@ -455,7 +455,7 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (shade.mode == MODE_DEBUG_LAYER || shade.mode == MODE_DEBUG_SLICE) {
                 radiance = debug_index(maybe.frame);
             } else {
-                radiance = estimate(maybe.frame, pixel, frame.index);
+                radiance = estimate(maybe.frame, pixel, frame.index, shade.spp);
             }
         }
     } else {
@@ -464,4 +464,29 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let sum = accumulation[pixel].xyz + radiance;
     accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));
+}
+
+// The shaded blocks of an adaptive frame (`render::adaptive`): item `i` of `shade.spp` items
+// arrives in `accumulation[i]` as the bits of (pixel, samples, 0, 0) and leaves as the pixel's
+// estimate in frame 0 with that many samples (`render::adaptive`'s shading, the same estimator
+// as `shade_frame`), w = 1. Each invocation reads and writes its own item only.
+@compute @workgroup_size(64)
+fn shade_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let i = gid.y * groups.x * 64u + gid.x;
+    if (i >= shade.spp) {
+        return;
+    }
+    let item = bitcast<vec4<u32>>(accumulation[i]);
+    let pixel = item.x;
+    let x = pixel % shade.width;
+    let y = pixel / shade.width;
+    let triangle = textureLoad(gbuffer_triangle, vec2<i32>(i32(x), i32(y)), 0).x;
+    var radiance = vec3<f32>(0.0);
+    if (triangle > 0u) {
+        let maybe = shading_frame(interpolate_hit(triangle - 1u, x, y));
+        if (maybe.valid) {
+            radiance = estimate(maybe.frame, pixel, 0u, item.y);
+        }
+    }
+    accumulation[i] = vec4<f32>(radiance, 1.0);
 }

@@ -515,3 +515,54 @@ fn inconsistent_settings_are_rejected_like_the_cpu_rejects_them() {
     let error = Renderer::new(gpu(), &scene, &bad_samples, &no_layers).expect_err("a short sample set");
     assert!(matches!(error, GpuError::Scene(_)), "{error}");
 }
+
+/// Bandwidths for the adaptive frames: a smooth environment bandwidth (0.2 to 4.2 cycles per
+/// radian over latitude) and an atlas varying with the incident row, low enough for a 64-pixel
+/// image to shade at several levels.
+fn adaptive_bandwidths() -> render::adaptive::Bandwidths {
+    let (w, h) = (64, 32);
+    let values = (0..w * h).map(|i| 0.2 + 4.0 * ((i / w) as f32 * 0.4).sin().abs()).collect();
+    let environment = render::adaptive::EnvBandwidth::new(w, h, values).unwrap();
+    let (lobes, tile) = (8, 4);
+    let data =
+        (0..lobes * tile * lobes * tile).map(|i| 0.25 + 2.0 * ((i / (lobes * tile)) / tile) as f32 / 8.0).collect();
+    let brdf = brdf_atlas::Atlas {
+        lobes_x: lobes,
+        lobes_y: lobes,
+        tile,
+        data,
+        parameterization: brdf_atlas::Parameterization::IncidencePlaneEquidistant,
+        analysis_size: 16,
+        eps: 0.01,
+        c: 0.1767766952966369,
+    };
+    render::adaptive::Bandwidths { environment, brdf }
+}
+
+/// Issue 11: an adaptive frame whose shaded blocks the GPU shades (`Renderer::render_adaptive`)
+/// equals the CPU's (`render::adaptive::render`): the same plan (it is made on the CPU either
+/// way), and the shaded values within the full-resolution modes' tolerances, with and without
+/// anti-aliasing, for both estimators.
+#[test]
+fn adaptive_frames_shaded_on_the_gpu_equal_the_cpu() {
+    let (material, lighting, bandwidths) = (phong(), sky_lighting(), adaptive_bandwidths());
+    let scene = sphere_scene(SIZE);
+    for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 4), (Mode::Reference, 2, 4)] {
+        let settings =
+            render::adaptive::Settings { supersample, max_spp: 64, ..render::adaptive::Settings::new(mode, spp) };
+        let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
+        let gpu_frame = renderer(&render_scene, material, lighting)
+            .render_adaptive(&scene, material, lighting, &bandwidths, &settings)
+            .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
+        let cpu_frame = render::adaptive::render(&scene, material, lighting, &bandwidths, &settings).unwrap();
+        assert_eq!(gpu_frame.plan.actions, cpu_frame.plan.actions, "the plans differ");
+        let shaded: usize = cpu_frame.plan.shaded_per_level().iter().sum();
+        assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
+        let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
+        log(&format!(
+            "adaptive {} {supersample}x{supersample}: {shaded} shaded blocks, PSNR {psnr:.2} dB, relative error {relative:.2e}",
+            mode.name()
+        ));
+        assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
+    }
+}

@@ -3,8 +3,10 @@
 //! only the pixels of a pyramid whose level the prediction asks for, with a fixed total budget
 //! of samples spread by the predicted variance; up-sample the rest from coarser shaded pixels.
 //!
-//! Everything here is a specification as much as code: the GPU port will follow it step for
-//! step, as `gpu::preview` follows [`crate::render`].
+//! Everything here is a specification as much as code. The shaded blocks may be shaded by
+//! another renderer ([`render_with_shader`]: `gpu::preview::Renderer::render_adaptive` shades
+//! them on the GPU and is held to this module); the prediction, the plan and the up-sampling
+//! are ported next, step for step, as `gpu::preview` follows [`crate::render`].
 //!
 //! # The G-buffer
 //!
@@ -823,6 +825,41 @@ pub fn render_with(
     settings: &Settings,
     oracle: Option<&[f64]>,
 ) -> Result<Adaptive, Error> {
+    frame_with(scene, material, lighting, bandwidths, settings, oracle, None)
+}
+
+/// [`render_with`], the shaded blocks shaded by `shader`: given every shaded block's render
+/// pixel (row-major index at the render size) and samples, it returns each one's estimate in
+/// frame 0 with that many samples by `settings.mode`'s estimator, as [`crate::render`] computes
+/// it (the CPU's own shader, or the GPU's: `gpu::preview::Renderer::shade_blocks`). Everything
+/// else (G-buffer, prediction, plan, up-sampling) runs here, and the timings include the
+/// shader's.
+pub fn render_with_shader(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+    oracle: Option<&[f64]>,
+    shader: Shader,
+) -> Result<Adaptive, Error> {
+    frame_with(scene, material, lighting, bandwidths, settings, oracle, Some(shader))
+}
+
+/// A shader of shaded blocks (see [`render_with_shader`]): `(render pixel, samples)` in, each
+/// block's estimate out.
+pub type Shader<'a> = &'a mut dyn FnMut(&[(u32, u32)]) -> Result<Vec<[f32; 3]>, Error>;
+
+/// One frame: the shaded blocks by `shader`, or by [`crate::render`]'s estimator here.
+fn frame_with(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+    oracle: Option<&[f64]>,
+    shader: Option<Shader>,
+) -> Result<Adaptive, Error> {
     crate::check_inputs(material, lighting)?;
     check_settings(settings, material, lighting)?;
     let ss = settings.supersample;
@@ -872,7 +909,42 @@ pub fn render_with(
     )?;
     let plan_ms = lap();
 
-    // Coarse to fine.
+    // Shading does not depend on up-sampling: every shaded block at once, then coarse to fine.
+    let mut shaded: Vec<(u32, u32)> = Vec::new();
+    let mut slot: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
+    for (k, actions) in plan.actions.iter().enumerate() {
+        let level = &plan.levels[k];
+        slot[k] = actions
+            .iter()
+            .enumerate()
+            .map(|(b, action)| match *action {
+                Action::Shade { samples, .. } => {
+                    let (x, y) = level.pixel(b % level.width, b / level.width, width, height);
+                    shaded.push(((y * width + x) as u32, samples));
+                    (shaded.len() - 1) as u32
+                }
+                _ => u32::MAX,
+            })
+            .collect();
+    }
+    let estimates = match shader {
+        Some(shader) => shader(&shaded)?,
+        None => shaded
+            .par_iter()
+            .map(|&(pixel, samples)| {
+                let frame = &pixels[pixel as usize].as_ref().expect("a valid block's pixels are shadeable").frame;
+                let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
+                shade(frame, pixel, material, lighting, &shading).map(|v| v as f32)
+            })
+            .collect(),
+    };
+    if estimates.len() != shaded.len() {
+        return Err(Error::Invalid(format!(
+            "the shader returned {} estimates for {} blocks",
+            estimates.len(),
+            shaded.len()
+        )));
+    }
     let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
     let mut origin: Vec<Vec<(i32, f32)>> = vec![Vec::new(); top + 1];
     for k in (0..=top).rev() {
@@ -885,11 +957,7 @@ pub fn render_with(
             .map(|(b, action)| match *action {
                 Action::Skip => ([0.0; 3], (-1, 0.0)),
                 Action::Shade { samples, .. } => {
-                    let (x, y) = level.pixel(b % level.width, b / level.width, width, height);
-                    let pixel = pixels[y * width + x].as_ref().expect("a valid block's pixels are shadeable");
-                    let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
-                    let value = shade(&pixel.frame, (y * width + x) as u32, material, lighting, &shading);
-                    (value.map(|v| v as f32), (k as i32, samples as f32 / (1u64 << (2 * k)) as f32))
+                    (estimates[slot[k][b] as usize], (k as i32, samples as f32 / (1u64 << (2 * k)) as f32))
                 }
                 Action::Upsample { parents, count } => {
                     let mut value = [0.0f32; 3];

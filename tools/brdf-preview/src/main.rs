@@ -28,8 +28,9 @@ mod window;
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
 ///                variance; only the pixels of a pyramid whose level the prediction asks for are
 ///                shaded (reference estimator), a budget of --spp samples per pixel on average
-///                is shared by the predicted variance, the rest is up-sampled; one frame, on the
-///                CPU renderer (crate render, module adaptive)
+///                is shared by the predicted variance, the rest is up-sampled; one frame: the
+///                shaded pixels on the GPU, the prediction, the plan and the up-sampling on the
+///                CPU (crate render, module adaptive)
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
@@ -146,9 +147,9 @@ struct Args {
     seed: u32,
 
     /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
-    /// and write OUT-difference.png. For the adaptive modes (which run on the CPU), report the
-    /// PSNR against the converged estimate instead (--converged N samples per strategy, 256 by
-    /// default).
+    /// and write OUT-difference.png. For the adaptive modes, compare with the same frame shaded
+    /// on the CPU (reported as "cpu") and report psnr_db against the converged estimate
+    /// (--converged N samples per strategy, 256 by default).
     #[arg(long)]
     validate: bool,
 
@@ -478,8 +479,12 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
         None => metrics::auto_preview(lighting.mips.level(0)),
     };
+    let gpu = gpu::Gpu::new()?;
+    let ss = settings.supersample;
+    let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
+    let renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
     let start = Instant::now();
-    let frame = render::adaptive::render(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+    let frame = renderer.render_adaptive(&scene, &loaded.material, lighting, bandwidths, &settings)?;
     let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
@@ -507,10 +512,11 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     }
     let t = frame.timings;
     let mut report = vec![format!(
-        "{}: {} on the CPU ({}), {ms_per_frame:.1} ms (G-buffer {:.1}, prediction {:.1}, plan {:.1}, shading {:.1}); \
-         shaded fraction {:.4}, {} samples of a budget of {}",
+        "{}: {} on {} ({}), {ms_per_frame:.1} ms (G-buffer {:.1}, prediction {:.1}, plan {:.1} on the CPU; \
+         shading on the GPU and up-sampling {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
         out.display(),
         args.mode.name(),
+        gpu.adapter_summary(),
         args.mesh,
         t.gbuffer_ms,
         t.predict_ms,
@@ -523,7 +529,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let mut value = json!({
         "bake": args.bake.display().to_string(),
         "mode": args.mode.name(),
-        "renderer": "cpu",
+        "adapter": gpu.adapter_summary(),
         "spp": settings.spp,
         "aa": aa,
         "predict_level": settings.predict_level,
@@ -541,6 +547,24 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "mean_luminance": metrics::mean_luminance(&frame.image),
     });
     let mut problems = Vec::new();
+    if args.validate {
+        // The same frame with the CPU's shading: the plan is the same, the values equal to rounding.
+        let cpu = render::adaptive::render(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+        let cpu_picture = metrics::tonemap(&cpu.image, &preview);
+        let psnr = metrics::psnr_db(&picture, &cpu_picture);
+        let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
+        let same_plan = cpu.plan.actions == frame.plan.actions;
+        report.push(format!(
+            "against the CPU (the same plan{}): PSNR {} dB, relative error {relative:.2e}",
+            if same_plan { "" } else { ": NOT the same plan" },
+            db(psnr)
+        ));
+        value["cpu"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative, "same_plan": same_plan });
+        if !same_plan {
+            problems.push("the GPU's adaptive frame was planned differently from the CPU's".to_string());
+        }
+        check_psnr(args, "against the CPU", psnr, &mut problems);
+    }
     if args.validate || args.converged.is_some() {
         let n = args.converged.unwrap_or(256);
         let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
