@@ -20,10 +20,13 @@
 //!    measured variance of the one-sample estimator (16 independent renders), per reading;
 //! 4. 16x anti-aliasing against none: milliseconds and shaded blocks.
 //!
-//! `cargo bench -p brdf-preview --bench adaptive [-- --quick]`. Needs `../shared` (the maps, and
+//! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and the adaptive frames'
+//! shaded blocks are shaded there too (`Renderer::shade_blocks`), as `brdf-preview` runs them.
+//!
+//! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
 //! converged estimates are kept under target/bench-adaptive/ between runs. The report is printed
-//! and written to target/bench-adaptive/report.md.
+//! and written to target/bench-adaptive/report.md (report-gpu.md with `--gpu`).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -244,6 +247,9 @@ fn main() {
         Some(other) => panic!("--allocation {other}: variance or std-dev"),
     };
     let extras = !args.iter().any(|a| a == "--no-extras");
+    // --gpu: the brute force and the adaptive frames' shading on the GPU (lavapipe in CI), the
+    // adaptive frames' prediction, plan and up-sampling on the CPU as brdf-preview runs them.
+    let gpu = args.iter().any(|a| a == "--gpu").then(|| gpu::Gpu::new().expect("a GPU adapter (make setup-gpu)"));
     let rescue_below: f64 = option("--rescue-below").map_or(0.0, |v| v.parse().expect("--rescue-below W"));
     let converged_samples = if quick { 256 } else { 1024 };
     std::fs::create_dir_all(work()).expect("creating target/bench-adaptive");
@@ -253,7 +259,13 @@ fn main() {
         report.push_str(&line);
         report.push('\n');
     };
-    out("# Adaptive shading: equal-quality benchmark (CPU renderer)".into());
+    out(format!(
+        "# Adaptive shading: equal-quality benchmark ({})",
+        match &gpu {
+            Some(g) => format!("shading on {}, prediction and plan on the CPU", g.adapter_summary()),
+            None => "CPU renderer".to_string(),
+        }
+    ));
     out(String::new());
     out(format!(
         "256 x 256, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \
@@ -300,12 +312,16 @@ fn main() {
                 let reference_picture = metrics::tonemap(&reference, &preview);
                 let psnr = |image: &Image| metrics::psnr_db(&metrics::tonemap(image, &preview), &reference_picture);
 
+                let mut renderer = gpu.as_ref().map(|g| {
+                    gpu::preview::Renderer::new(g, &scene, &loaded.material, lighting).expect("the GPU renderer")
+                });
                 let curve: Vec<(f64, f64)> = BRUTE_SPP
                     .iter()
                     .map(|&spp| {
                         let settings = Settings { mode: Mode::Reference, spp, frames: 1, seed: 11 };
-                        let (ms, image) = timed(if spp <= 32 { 3 } else { 1 }, || {
-                            render::render(&scene, &loaded.material, lighting, &settings).expect("render")
+                        let (ms, image) = timed(if spp <= 32 { 3 } else { 1 }, || match renderer.as_mut() {
+                            Some(r) => r.render_frames(&settings).expect("render on the GPU"),
+                            None => render::render(&scene, &loaded.material, lighting, &settings).expect("render"),
                         });
                         (psnr(&image), ms)
                     })
@@ -353,8 +369,24 @@ fn main() {
                                 rescue_below,
                                 ..adaptive::Settings::new(mode, spp)
                             };
-                            let (ms, frame) = timed(3, || {
-                                adaptive::render_with(
+                            let (ms, frame) = timed(3, || match renderer.as_ref() {
+                                Some(r) => {
+                                    let mut shader = |blocks: &[(u32, u32)]| {
+                                        r.shade_blocks(mode, settings.seed, blocks)
+                                            .map_err(|e| render::Error::Invalid(e.to_string()))
+                                    };
+                                    adaptive::render_with_shader(
+                                        &scene,
+                                        &loaded.material,
+                                        lighting,
+                                        &variant.bandwidths,
+                                        &settings,
+                                        variant.oracle.as_deref(),
+                                        &mut shader,
+                                    )
+                                    .expect("adaptive render, shaded on the GPU")
+                                }
+                                None => adaptive::render_with(
                                     &scene,
                                     &loaded.material,
                                     lighting,
@@ -362,7 +394,7 @@ fn main() {
                                     &settings,
                                     variant.oracle.as_deref(),
                                 )
-                                .expect("adaptive render")
+                                .expect("adaptive render"),
                             });
                             let p = psnr(&frame.image);
                             let (brute_ms, lower_bound) = match brute_time(&curve, p) {
@@ -427,23 +459,30 @@ fn main() {
                     correlations.push((name.clone(), variant.name, bandwidth_rho, predicted.len(), spearman(&pv, &mv)));
                 }
 
-                // Must show 4: 16x anti-aliasing.
-                let (plain_ms, plain) = timed(3, || {
-                    let settings =
-                        adaptive::Settings { predict_level, allocation, ..adaptive::Settings::new(Mode::Reference, 8) };
-                    adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
-                        .expect("adaptive")
+                // Must show 4: 16x anti-aliasing, on the renderer the rest ran on.
+                let aa_renderer = gpu.as_ref().map(|g| {
+                    let big = Scene { width: SIZE * 4, height: SIZE * 4, ..scene.clone() };
+                    gpu::preview::Renderer::new(g, &big, &loaded.material, lighting).expect("the GPU renderer")
                 });
-                let (aa_ms, aa) = timed(3, || {
+                let frame = |supersample: usize, renderer: Option<&gpu::preview::Renderer>| {
                     let settings = adaptive::Settings {
-                        supersample: 4,
+                        supersample,
                         predict_level,
                         allocation,
                         ..adaptive::Settings::new(Mode::Reference, 8)
                     };
-                    adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
-                        .expect("adaptive")
-                });
+                    match renderer {
+                        Some(r) => r
+                            .render_adaptive(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
+                            .expect("adaptive on the GPU"),
+                        None => {
+                            adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
+                                .expect("adaptive")
+                        }
+                    }
+                };
+                let (plain_ms, plain) = timed(3, || frame(1, renderer.as_ref()));
+                let (aa_ms, aa) = timed(3, || frame(4, aa_renderer.as_ref()));
                 let shaded = |f: &adaptive::Adaptive| f.plan.shaded_per_level().iter().sum::<usize>();
                 aa_rows.push((name.clone(), plain_ms, aa_ms, shaded(&plain), shaded(&aa)));
             }
@@ -489,6 +528,7 @@ fn main() {
     for (name, a, b, sa, sb) in &aa_rows {
         out(format!("| {name} | {a:.0} | {b:.0} | {:.2} | {sa} | {sb} |", b / a));
     }
-    std::fs::write(work().join("report.md"), &report).expect("writing the report");
-    eprintln!("report written to {}", work().join("report.md").display());
+    let file = work().join(if gpu.is_some() { "report-gpu.md" } else { "report.md" });
+    std::fs::write(&file, &report).expect("writing the report");
+    eprintln!("report written to {}", file.display());
 }
