@@ -483,6 +483,9 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let ss = settings.supersample;
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
     let renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
+    // A driver may compile the pipeline at its first dispatch (lavapipe does, tens of
+    // milliseconds): one block first, so that ms_per_frame times the frame.
+    renderer.shade_blocks(mode, settings.seed, &[(0, 1)])?;
     let start = Instant::now();
     let frame = renderer.render_adaptive(&scene, &loaded.material, lighting, bandwidths, &settings)?;
     let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
