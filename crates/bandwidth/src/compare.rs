@@ -103,7 +103,9 @@ fn ranks(values: &[f64]) -> Vec<f64> {
     ranks
 }
 
-fn spearman(a: &[f64], b: &[f64]) -> Option<f64> {
+/// Spearman's rank correlation of two equally long samples (ties share their mean rank);
+/// `None` when either is constant.
+pub fn spearman(a: &[f64], b: &[f64]) -> Option<f64> {
     let (ra, rb) = (ranks(a), ranks(b));
     let n = ra.len() as f64;
     let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);

@@ -193,7 +193,7 @@ mod fft;
 mod hdr;
 mod latlong;
 
-pub use compare::{Comparison, PERCENTILES, compare_maps, wavelet_at_windows};
+pub use compare::{Comparison, PERCENTILES, compare_maps, spearman, wavelet_at_windows};
 pub use error::Error;
 pub use estimate::{BandwidthMap, Config, DEFAULT_C, Reading, local_bandwidth, local_bandwidth_zero_padded};
 pub use fft::{WindowedFftConfig, WindowedFftMap, window_spread, windowed_fft_bandwidth};

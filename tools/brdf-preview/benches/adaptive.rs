@@ -29,6 +29,9 @@
 //! and written to target/bench-adaptive/report.md (report-gpu.md with `--gpu`).
 
 use std::path::PathBuf;
+
+mod common;
+use common::{material_path, root, shared};
 use std::time::Instant;
 
 use bandwidth::Reading;
@@ -41,34 +44,8 @@ const MESHES: [&str; 2] = ["sphere", "torus"];
 const SIZE: usize = 256;
 const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn shared() -> PathBuf {
-    let dir = root().join("../shared");
-    assert!(dir.join("data").is_dir(), "the shared data is missing: expected it at {}", dir.display());
-    dir
-}
-
 fn work() -> PathBuf {
     root().join("target/bench-adaptive")
-}
-
-/// A real-derived MERL table's path, made once under target/merl/ by nbrdf2merl.py.
-fn material_path(name: &str) -> PathBuf {
-    let path = root().join("target/merl").join(format!("{name}.binary"));
-    if !path.exists() {
-        let status = std::process::Command::new("python3")
-            .arg(shared().join("tools/nbrdf2merl.py"))
-            .arg("--out")
-            .arg(root().join("target/merl"))
-            .arg(name)
-            .status()
-            .expect("running python3");
-        assert!(status.success(), "nbrdf2merl.py {name} failed (it needs numpy)");
-    }
-    path
 }
 
 fn environment_path(name: &str) -> PathBuf {
@@ -168,37 +145,6 @@ fn brute_time(curve: &[(f64, f64)], psnr: f64) -> Option<f64> {
         previous = Some((p, ms));
     }
     None
-}
-
-/// Spearman's rank correlation (average ranks for ties).
-fn spearman(a: &[f64], b: &[f64]) -> f64 {
-    fn ranks(v: &[f64]) -> Vec<f64> {
-        let mut order: Vec<usize> = (0..v.len()).collect();
-        order.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
-        let mut r = vec![0.0; v.len()];
-        let mut i = 0;
-        while i < order.len() {
-            let mut j = i;
-            while j + 1 < order.len() && v[order[j + 1]] == v[order[i]] {
-                j += 1;
-            }
-            for k in i..=j {
-                r[order[k]] = (i + j) as f64 / 2.0;
-            }
-            i = j + 1;
-        }
-        r
-    }
-    let (ra, rb) = (ranks(a), ranks(b));
-    let n = a.len() as f64;
-    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
-    let (mut cov, mut va, mut vb) = (0.0, 0.0, 0.0);
-    for (x, y) in ra.iter().zip(&rb) {
-        cov += (x - ma) * (y - mb);
-        va += (x - ma) * (x - ma);
-        vb += (y - mb) * (y - mb);
-    }
-    cov / (va * vb).sqrt()
 }
 
 /// The windowed FFT of a converged image as a person sees it: the tone-mapped luminance in
@@ -452,11 +398,17 @@ fn main() {
                             }
                         }
                     }
-                    let bandwidth_rho = if predicted.len() > 2 { spearman(&predicted, &measured) } else { f64::NAN };
+                    let bandwidth_rho = bandwidth::spearman(&predicted, &measured).unwrap_or(f64::NAN);
                     let shadeable: Vec<usize> = (0..SIZE * SIZE).filter(|&i| frame.predictions[i].level >= 0).collect();
                     let pv: Vec<f64> = shadeable.iter().map(|&i| frame.predictions[i].variance).collect();
                     let mv: Vec<f64> = shadeable.iter().map(|&i| measured_variance[i]).collect();
-                    correlations.push((name.clone(), variant.name, bandwidth_rho, predicted.len(), spearman(&pv, &mv)));
+                    correlations.push((
+                        name.clone(),
+                        variant.name,
+                        bandwidth_rho,
+                        predicted.len(),
+                        bandwidth::spearman(&pv, &mv).unwrap_or(f64::NAN),
+                    ));
                 }
 
                 // Must show 4: 16x anti-aliasing, on the renderer the rest ran on.

@@ -11,7 +11,8 @@
 //! `../shared` (the maps, and nbrdf2merl.py with numpy for the materials, made once under
 //! target/merl/) and a GPU adapter (lavapipe: `make setup-gpu`).
 
-use std::path::PathBuf;
+mod common;
+use common::shared;
 use std::time::Instant;
 
 use brdf_atlas::view::{ViewReduction, select_layers_of_table};
@@ -21,29 +22,9 @@ const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k.hdr", "quarry_01_1k.hdr"];
 const SIZE: usize = 128;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn shared() -> PathBuf {
-    let dir = root().join("../shared");
-    assert!(dir.join("data").is_dir(), "the shared data is missing: expected it at {}", dir.display());
-    dir
-}
-
 /// A real-derived MERL table, made once under target/merl/ by nbrdf2merl.py.
 fn material(name: &str) -> merl::MerlTable {
-    let path = root().join("target/merl").join(format!("{name}.binary"));
-    if !path.exists() {
-        let status = std::process::Command::new("python3")
-            .arg(shared().join("tools/nbrdf2merl.py"))
-            .arg("--out")
-            .arg(root().join("target/merl"))
-            .arg(name)
-            .status()
-            .expect("running python3");
-        assert!(status.success(), "nbrdf2merl.py {name} failed (it needs numpy)");
-    }
+    let path = common::material_path(name);
     merl::read_file(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
 }
 
