@@ -721,14 +721,14 @@ impl Renderer {
             }
         };
         let frame =
-            render::adaptive::render_with_shader(scene, material, lighting, bandwidths, settings, None, &mut shader);
+            render::adaptive::render_with(scene, material, lighting, bandwidths, settings, None, Some(&mut shader));
         match failure {
             Some(e) => Err(e),
             None => Ok(frame?),
         }
     }
 
-    /// Shades the blocks of an adaptive frame (`render::adaptive::render_with_shader`'s shader):
+    /// Shades the blocks of an adaptive frame (`render::adaptive::render_with`'s shader):
     /// each `(pixel, samples)` of the renderer's image, in frame 0 with `seed`, by `mode`'s
     /// estimator, as `render::adaptive` shades them on the CPU. The accumulation buffer carries
     /// the items in and the estimates out (so it holds nothing to continue afterwards).

@@ -4,7 +4,7 @@
 //! of samples spread by the predicted variance; up-sample the rest from coarser shaded pixels.
 //!
 //! Everything here is a specification as much as code. The shaded blocks may be shaded by
-//! another renderer ([`render_with_shader`]: `gpu::preview::Renderer::render_adaptive` shades
+//! another renderer ([`render_with`]: `gpu::preview::Renderer::render_adaptive` shades
 //! them on the GPU and is held to this module); the prediction, the plan and the up-sampling
 //! are ported next, step for step, as `gpu::preview` follows [`crate::render`].
 //!
@@ -323,26 +323,20 @@ pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize),
     if l == 0 {
         return (0..pixels.len()).into_par_iter().map(one).collect();
     }
-    let grid = Level {
-        level: l,
-        width: width.div_ceil(1 << l),
-        height: height.div_ceil(1 << l),
-        min_level: Vec::new(),
-        max_variance: Vec::new(),
-    };
+    let (grid_width, grid_height) = (width.div_ceil(1 << l), height.div_ceil(1 << l));
     let rep = |b: usize| {
-        let (x, y) = grid.pixel(b % grid.width, b / grid.width, width, height);
+        let (x, y) = block_pixel(l, b % grid_width, b / grid_width, width, height);
         y * width + x
     };
     let blocks: Vec<Option<Prediction>> =
-        (0..grid.width * grid.height).into_par_iter().map(|b| pixels[rep(b)].is_some().then(|| one(rep(b)))).collect();
+        (0..grid_width * grid_height).into_par_iter().map(|b| pixels[rep(b)].is_some().then(|| one(rep(b)))).collect();
     (0..pixels.len())
         .into_par_iter()
         .map(|i| {
             if pixels[i].is_none() {
                 return Prediction { level: -1, ..Prediction::default() };
             }
-            let b = ((i / width) >> l) * grid.width + ((i % width) >> l);
+            let b = ((i / width) >> l) * grid_width + ((i % width) >> l);
             blocks[b].unwrap_or_else(|| one(i))
         })
         .collect()
@@ -444,9 +438,15 @@ impl Level {
     /// The render pixel block `(bx, by)` is shaded with: `b 2^k + floor(2^k / 2)` per axis,
     /// clamped to the image.
     pub fn pixel(&self, bx: usize, by: usize, width: usize, height: usize) -> (usize, usize) {
-        let (size, half) = (1usize << self.level, (1usize << self.level) / 2);
-        ((bx * size + half).min(width - 1), (by * size + half).min(height - 1))
+        block_pixel(self.level, bx, by, width, height)
     }
+}
+
+/// The render pixel block `(bx, by)` of level `level` stands for: `b 2^k + floor(2^k / 2)` per
+/// axis, clamped to the `width x height` image.
+fn block_pixel(level: usize, bx: usize, by: usize, width: usize, height: usize) -> (usize, usize) {
+    let (size, half) = (1usize << level, (1usize << level) / 2);
+    ((bx * size + half).min(width - 1), (by * size + half).min(height - 1))
 }
 
 /// The min and max pyramids of a bandwidth buffer of `width x height` pixels, levels `0..=top`.
@@ -811,47 +811,22 @@ pub fn render(
     bandwidths: &Bandwidths,
     settings: &Settings,
 ) -> Result<Adaptive, Error> {
-    render_with(scene, material, lighting, bandwidths, settings, None)
+    render_with(scene, material, lighting, bandwidths, settings, None, None)
 }
 
-/// [`render`], with the image bandwidth of every render pixel (cycles per pixel, row-major)
-/// given instead of predicted when `oracle` is set: the benchmark's oracle, a windowed FFT of
-/// the converged image (`001` Fig. 12). The variance is predicted as usual.
-pub fn render_with(
-    scene: &Scene,
-    material: &Material,
-    lighting: &Lighting,
-    bandwidths: &Bandwidths,
-    settings: &Settings,
-    oracle: Option<&[f64]>,
-) -> Result<Adaptive, Error> {
-    frame_with(scene, material, lighting, bandwidths, settings, oracle, None)
-}
-
-/// [`render_with`], the shaded blocks shaded by `shader`: given every shaded block's render
-/// pixel (row-major index at the render size) and samples, it returns each one's estimate in
-/// frame 0 with that many samples by `settings.mode`'s estimator, as [`crate::render`] computes
-/// it (the CPU's own shader, or the GPU's: `gpu::preview::Renderer::shade_blocks`). Everything
-/// else (G-buffer, prediction, plan, up-sampling) runs here, and the timings include the
-/// shader's.
-pub fn render_with_shader(
-    scene: &Scene,
-    material: &Material,
-    lighting: &Lighting,
-    bandwidths: &Bandwidths,
-    settings: &Settings,
-    oracle: Option<&[f64]>,
-    shader: Shader,
-) -> Result<Adaptive, Error> {
-    frame_with(scene, material, lighting, bandwidths, settings, oracle, Some(shader))
-}
-
-/// A shader of shaded blocks (see [`render_with_shader`]): `(render pixel, samples)` in, each
-/// block's estimate out.
+/// A shader of shaded blocks (see [`render_with`]): `(render pixel, samples)` in, each block's
+/// estimate out.
 pub type Shader<'a> = &'a mut dyn FnMut(&[(u32, u32)]) -> Result<Vec<[f32; 3]>, Error>;
 
-/// One frame: the shaded blocks by `shader`, or by [`crate::render`]'s estimator here.
-fn frame_with(
+/// [`render`], with two substitutions. `oracle`: the image bandwidth of every render pixel
+/// (cycles per pixel, row-major) given instead of predicted, the benchmark's oracle, a windowed
+/// FFT of the converged image (`001` Fig. 12); the variance is predicted as usual. `shader`: the
+/// shaded blocks shaded elsewhere: given every shaded block's render pixel (row-major index at
+/// the render size) and samples, it returns each one's estimate in frame 0 with that many
+/// samples by `settings.mode`'s estimator, as [`crate::render`] computes it (the GPU's:
+/// `gpu::preview::Renderer::shade_blocks`); everything else (G-buffer, prediction, plan,
+/// up-sampling) runs here, and the timings include the shader's.
+pub fn render_with(
     scene: &Scene,
     material: &Material,
     lighting: &Lighting,

@@ -315,32 +315,23 @@ fn main() {
                                 rescue_below,
                                 ..adaptive::Settings::new(mode, spp)
                             };
-                            let (ms, frame) = timed(3, || match renderer.as_ref() {
-                                Some(r) => {
-                                    let mut shader = |blocks: &[(u32, u32)]| {
+                            let (ms, frame) = timed(3, || {
+                                let mut on_gpu = renderer.as_ref().map(|r| {
+                                    move |blocks: &[(u32, u32)]| {
                                         r.shade_blocks(mode, settings.seed, blocks)
                                             .map_err(|e| render::Error::Invalid(e.to_string()))
-                                    };
-                                    adaptive::render_with_shader(
-                                        &scene,
-                                        &loaded.material,
-                                        lighting,
-                                        &variant.bandwidths,
-                                        &settings,
-                                        variant.oracle.as_deref(),
-                                        &mut shader,
-                                    )
-                                    .expect("adaptive render, shaded on the GPU")
-                                }
-                                None => adaptive::render_with(
+                                    }
+                                });
+                                adaptive::render_with(
                                     &scene,
                                     &loaded.material,
                                     lighting,
                                     &variant.bandwidths,
                                     &settings,
                                     variant.oracle.as_deref(),
+                                    on_gpu.as_mut().map(|s| s as adaptive::Shader),
                                 )
-                                .expect("adaptive render"),
+                                .expect("adaptive render")
                             });
                             let p = psnr(&frame.image);
                             let (brute_ms, lower_bound) = match brute_time(&curve, p) {
