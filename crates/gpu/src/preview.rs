@@ -528,6 +528,11 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// Pixels of the image: entries of the accumulation buffer.
+    fn pixels(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
     pub fn width(&self) -> usize {
         self.width as usize
     }
@@ -608,7 +613,7 @@ impl Renderer {
         if frames == 0 {
             return Err(GpuError::Scene(render::Error::Invalid("no frame has been accumulated".into())));
         }
-        let sums = self.read_accumulation()?;
+        let sums = self.read_accumulation(self.pixels())?;
         let frames = frames as f32;
         Ok(Image {
             width: self.width(),
@@ -639,7 +644,7 @@ impl Renderer {
     fn run_shading(&self, shade: &ShadeUniform) -> Result<Vec<[f32; 4]>, GpuError> {
         self.progress.set(None);
         self.shade_frames(shade, 0, 1, true)?;
-        self.read_accumulation()
+        self.read_accumulation(self.pixels())
     }
 
     /// Runs the shading pass with `shade` for frames `first .. first + frames`, adding into the
@@ -733,7 +738,7 @@ impl Renderer {
     /// estimator, as `render::adaptive` shades them on the CPU. The accumulation buffer carries
     /// the items in and the estimates out (so it holds nothing to continue afterwards).
     pub fn shade_blocks(&self, mode: Mode, seed: u32, blocks: &[(u32, u32)]) -> Result<Vec<[f32; 3]>, GpuError> {
-        let pixels = u64::from(self.width) * u64::from(self.height);
+        let pixels = self.pixels();
         if blocks.len() as u64 > pixels {
             return Err(render::Error::Invalid(format!("{} blocks for {pixels} pixels", blocks.len())).into());
         }
@@ -771,13 +776,13 @@ impl Renderer {
             }
             self.queue.submit([encoder.finish()]);
         })?;
-        let sums = self.read_accumulation()?;
-        Ok(sums[..blocks.len()].iter().map(|s| [s[0], s[1], s[2]]).collect())
+        let sums = self.read_accumulation(blocks.len() as u64)?;
+        Ok(sums.iter().map(|s| [s[0], s[1], s[2]]).collect())
     }
 
-    /// The accumulation buffer's sums, read back.
-    fn read_accumulation(&self) -> Result<Vec<[f32; 4]>, GpuError> {
-        let bytes = 16 * u64::from(self.width) * u64::from(self.height);
+    /// The accumulation buffer's first `entries` sums, read back.
+    fn read_accumulation(&self, entries: u64) -> Result<Vec<[f32; 4]>, GpuError> {
+        let bytes = 16 * entries;
         let readback = capture_errors(&self.device, || {
             let mut encoder = self.device.create_command_encoder(&Default::default());
             let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
