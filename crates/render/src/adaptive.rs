@@ -153,9 +153,9 @@ impl EnvBandwidth {
         Ok(Self { width, height, values })
     }
 
-    /// The bandwidth towards the world direction `dir` (unit): the nearest texel.
-    pub fn at(&self, dir: DVec3) -> f64 {
-        let (u, v) = envmap::uv(dir);
+    /// The bandwidth at the map coordinates `(u, v)` of a direction (`envmap::uv`): the nearest
+    /// texel.
+    pub fn at_uv(&self, u: f64, v: f64) -> f64 {
         let x = ((u * self.width as f64) as usize).min(self.width - 1);
         let y = ((v * self.height as f64) as usize).min(self.height - 1);
         f64::from(self.values[y * self.width + x])
@@ -373,9 +373,11 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> Prediction {
         }
         let f = merl::luminance(brdf(material, wi_local, p.frame.wo_local));
         let wi = p.frame.to_world(wi_local);
-        let radiance = envmap::luminance(level0.lookup(wi).map(f64::from));
+        // One map coordinate for the radiance and the bandwidth: the same texel grid.
+        let (u, v) = envmap::uv(wi);
+        let radiance = envmap::luminance(level0.lookup_uv(u, v).map(f64::from));
         let g = radiance * f * wi_local.z;
-        let nu_env = bandwidths.environment.at(wi);
+        let nu_env = bandwidths.environment.at_uv(u, v);
         let rho = f64::from(bandwidths.brdf.lookup(wi_local, p.frame.wo_local));
         let at_eye = bandwidth_at_eye(nu_env, rho, p.curvature, p.depth, p.frame.cos_o);
         weight += g / pdf;
@@ -864,12 +866,8 @@ pub fn render_with(
     }
     let predict_ms = lap();
     let levels = pyramid(&predictions, width, height, top);
-    let covered_output = (0..scene.width * scene.height)
-        .filter(|&i| {
-            let (x, y) = (i % scene.width * ss, i / scene.width * ss);
-            (0..ss * ss).any(|j| gbuffer.hits[(y + j / ss) * width + x + j % ss].is_some())
-        })
-        .count() as u64;
+    let covered = output_coverage(&gbuffer, scene.width, scene.height, ss);
+    let covered_output = covered.iter().filter(|&&c| c).count() as u64;
     // The lobe weight's sharpness per view row: the exponent of the Phong layer the bake picks.
     let sharpness: Option<Vec<f64>> = settings
         .lobe_weight
@@ -959,7 +957,7 @@ pub fn render_with(
             (Some(_), Some(_)) => values[0][i],
         })
         .collect();
-    let image = downsample(&render_rgb, &gbuffer, scene.width, scene.height, ss);
+    let image = downsample(&render_rgb, covered, scene.width, scene.height, ss);
     let shade_ms = lap();
     let timings = Timings {
         gbuffer_ms,
@@ -980,25 +978,30 @@ pub fn render_with(
     })
 }
 
-/// The output image: the mean of each `ss x ss` block of render pixels; covered when any of
-/// them is.
-fn downsample(rgb: &[[f32; 3]], gbuffer: &GBuffer, width: usize, height: usize, ss: usize) -> Image {
+/// Per output pixel: whether a triangle covers any of its `ss x ss` render pixels.
+fn output_coverage(gbuffer: &GBuffer, width: usize, height: usize, ss: usize) -> Vec<bool> {
+    (0..width * height)
+        .map(|i| {
+            let (x, y) = (i % width * ss, i / width * ss);
+            (0..ss * ss).any(|j| gbuffer.hits[(y + j / ss) * gbuffer.width + x + j % ss].is_some())
+        })
+        .collect()
+}
+
+/// The output image: the mean of each `ss x ss` block of render pixels, with its coverage.
+fn downsample(rgb: &[[f32; 3]], covered: Vec<bool>, width: usize, height: usize, ss: usize) -> Image {
     let render_width = width * ss;
     let mut out = Vec::with_capacity(3 * width * height);
-    let mut covered = Vec::with_capacity(width * height);
     for y in 0..height {
         for x in 0..width {
             let mut sum = [0.0f64; 3];
-            let mut any = false;
             for j in 0..ss * ss {
                 let i = (y * ss + j / ss) * render_width + x * ss + j % ss;
                 for c in 0..3 {
                     sum[c] += f64::from(rgb[i][c]);
                 }
-                any |= gbuffer.hits[i].is_some();
             }
             out.extend(sum.map(|v| (v / (ss * ss) as f64) as f32));
-            covered.push(any);
         }
     }
     Image { width, height, rgb: out, covered }
