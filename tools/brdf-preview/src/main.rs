@@ -309,10 +309,7 @@ fn run(args: Args) -> Result<ExitCode> {
                 seed: args.seed,
             };
             let scene = scene(&args)?;
-            let preview = match args.exposure {
-                Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
-                None => metrics::auto_preview(lighting.mips.level(0)),
-            };
+            let preview = preview(&args, lighting);
             if args.window {
                 return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
             }
@@ -475,10 +472,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
     };
     let scene = scene(args)?;
-    let preview = match args.exposure {
-        Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
-        None => metrics::auto_preview(lighting.mips.level(0)),
-    };
+    let preview = preview(args, lighting);
     let gpu = gpu::Gpu::new()?;
     let ss = settings.supersample;
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
@@ -585,6 +579,14 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         check_psnr(args, "against the converged estimate", psnr, &mut problems);
     }
     Ok(Step { files, report, problems, value })
+}
+
+/// How pictures are tone mapped: --exposure, or the environment's automatic exposure.
+fn preview(args: &Args, lighting: &render::Lighting) -> envmap::Preview {
+    match args.exposure {
+        Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
+        None => metrics::auto_preview(lighting.mips.level(0)),
+    }
 }
 
 /// An 8-bit RGB picture as PNG bytes.
