@@ -97,10 +97,23 @@
 //! # Samples
 //!
 //! The frame's budget is `spp` times the covered pixels of the output image. Each shaded block
-//! gets at least 1 sample and the rest in proportion to its predicted variance
-//! ([`Allocation::Variance`], the paper: every pixel equally noisy) or to the variance's square
-//! root ([`Allocation::StdDev`]: the least total squared error for the budget, which is what a
-//! PSNR measures; the benchmark measures both), at most `max_spp` (what a capped block cannot
+//! gets at least 1 sample and the rest in proportion to a weight ([`Allocation`]):
+//!
+//! - its predicted variance `V_b` ([`Allocation::Variance`], the paper: every block, hence
+//!   every pixel, equally noisy);
+//! - `sqrt(A_b V_b)`, `A_b = 4^k` the pixels a block of level `k` stands for
+//!   ([`Allocation::StdDev`]): the least total squared error over the pixels, which is what a
+//!   PSNR measures. A block's noise `V_b / N_b` reaches every pixel up-sampled from it, whose
+//!   weights sum to `A_b` over the pixels, so the error is `sum_b A_b V_b / N_b`; minimizing
+//!   it under `sum_b N_b = B` gives `N_b ~ sqrt(A_b V_b)`;
+//! - `sqrt(A_b)` ([`Allocation::Area`]): the same with every pixel's variance taken equal, the
+//!   prediction's variance not used. At the budgets of the benchmark (`cargo bench -p
+//!   brdf-preview --bench adaptive`, which measures the three) it is the best: eq. 9's bound
+//!   ranks the pixels' noise moderately well but not its size, and weighting by it (or, tried
+//!   and dropped, by it in display space or by the sample variance of the `n_b` directions)
+//!   did not beat the area alone;
+//!
+//! at most `max_spp` (what a capped block cannot
 //! take goes to the others), rounded down to a power of two (the baked vectors are read in
 //! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
 //! blocks furthest below their share, while it fits. The total never exceeds the budget; a
@@ -211,10 +224,13 @@ pub enum Allocation {
     /// In proportion to the predicted variance: every pixel's estimate equally noisy (`001`
     /// section 2.4: "keep the variance of the shading globally constant").
     Variance,
-    /// In proportion to its square root, the predicted standard deviation: the least total
-    /// squared error for the budget (minimizing `sum_p V_p / N_p` under `sum_p N_p = B` gives
-    /// `N_p` proportional to `sqrt(V_p)`).
+    /// In proportion to `sqrt(A_b V_b)`, `A_b = 4^k` the pixels a block of level `k` stands
+    /// for: the least total squared error over the pixels for the budget (module docs,
+    /// "Samples").
     StdDev,
+    /// In proportion to `sqrt(A_b)`: the least total squared error with every pixel's variance
+    /// taken equal (the predicted variance not used).
+    Area,
 }
 
 impl Allocation {
@@ -222,6 +238,7 @@ impl Allocation {
         match self {
             Allocation::Variance => "variance",
             Allocation::StdDev => "std-dev",
+            Allocation::Area => "area",
         }
     }
 }
@@ -684,9 +701,13 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
     }
     let weights: Vec<f64> = shaded
         .iter()
-        .map(|s| match settings.allocation {
-            Allocation::Variance => s.2,
-            Allocation::StdDev => s.2.sqrt(),
+        .map(|&(k, _, variance)| {
+            let area = (1u64 << (2 * k)) as f64;
+            match settings.allocation {
+                Allocation::Variance => variance,
+                Allocation::StdDev => (area * variance).sqrt(),
+                Allocation::Area => area.sqrt(),
+            }
         })
         .collect();
     let ideal = shares(&weights, budget as f64, f64::from(max_spp));
@@ -1009,7 +1030,8 @@ fn downsample(rgb: &[[f32; 3]], covered: Vec<bool>, width: usize, height: usize,
 
 #[cfg(test)]
 mod tests {
-    use super::{lobe_similarity, pixels, shares};
+    use super::{Action, Allocation, Level, Settings, allocate, lobe_similarity, pixels, shares};
+    use crate::Mode;
     use crate::shade::visibility;
     use crate::{Camera, Mesh, Scene};
     use glam::DVec3;
@@ -1053,6 +1075,40 @@ mod tests {
         let expect = (2.0 * lambda * ((a / 2.0).cos() - 1.0)).exp() / (a / 2.0).cos();
         let w = lobe_similarity(z, lambda, tilted, lambda);
         assert!((w / expect - 1.0).abs() < 1e-9, "{w} vs {expect}");
+    }
+
+    #[test]
+    fn a_coarse_block_gets_samples_for_the_pixels_it_stands_for() {
+        // One shaded block at level 0 and one at level 2 (16 pixels), the same variance; 10
+        // samples. Variance: equal ideal shares, 5 and 5, rounded to 4 and 4. StdDev and Area:
+        // weights 1 and sqrt(16) = 4, ideal shares 1 + 8 / 5 = 2.6 and 1 + 32 / 5 = 7.4, rounded
+        // to 2 and 4, and the 4 left double the block furthest below its share (7.4 / 4): 2 and 8.
+        let level = |k: usize, variance: f64| Level {
+            level: k,
+            width: 1,
+            height: 1,
+            min_level: vec![k as i32],
+            max_variance: vec![variance],
+        };
+        for (allocation, variance_2, expect) in [
+            (Allocation::Variance, 3.0, [4, 4]),
+            (Allocation::StdDev, 3.0, [2, 8]),
+            (Allocation::Area, 3.0, [2, 8]),
+            // StdDev follows the variance too; Area does not: sqrt(16 * 3 / 48) = 1.
+            (Allocation::StdDev, 3.0 / 16.0, [4, 4]),
+            (Allocation::Area, 3.0 / 16.0, [2, 8]),
+        ] {
+            let levels = [level(0, 3.0), level(1, 0.0), level(2, variance_2)];
+            let shade = Action::Shade { samples: 0, rescued: false };
+            let mut actions = vec![vec![shade], vec![Action::Skip], vec![shade]];
+            let settings = Settings { allocation, ..Settings::new(Mode::Reference, 1) };
+            allocate(&levels, &mut actions, 10, &settings).unwrap();
+            let got = [0, 2].map(|k| match actions[k][0] {
+                Action::Shade { samples, .. } => samples,
+                _ => unreachable!(),
+            });
+            assert_eq!(got, expect, "{} with variances 3 and {variance_2}", allocation.name());
+        }
     }
 
     #[test]

@@ -156,9 +156,14 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
     // An odd size, so that the pyramid has partial blocks at the right and bottom edges.
     let scene = sphere_scene(83, 61);
     let mut coarse_levels = 0;
-    for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 2), (Mode::Reference, 2, 4)] {
+    // Each allocation twice.
+    let allocations = [adaptive::Allocation::Variance, adaptive::Allocation::StdDev, adaptive::Allocation::Area];
+    let cases = [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 2), (Mode::Reference, 2, 4)];
+    for (i, (mode, supersample, spp)) in cases.into_iter().enumerate() {
         for predict_level in [0, 1] {
-            let settings = adaptive::Settings { supersample, predict_level, ..adaptive::Settings::new(mode, spp) };
+            let allocation = allocations[(2 * i + predict_level) % 3];
+            let settings =
+                adaptive::Settings { supersample, predict_level, allocation, ..adaptive::Settings::new(mode, spp) };
             let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
             check_plan(&frame, &settings);
             let per_level = frame.plan.shaded_per_level();
@@ -166,8 +171,9 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
             // The budget is used: rounding to powers of two loses less than half.
             assert!(2 * frame.plan.samples() > frame.plan.budget, "{} of {}", frame.plan.samples(), frame.plan.budget);
             println!(
-                "{} ss {supersample} predict {predict_level}: shaded {:.3}, per level {per_level:?}",
+                "{} ss {supersample} predict {predict_level} {}: shaded {:.3}, per level {per_level:?}",
                 mode.name(),
+                allocation.name(),
                 frame.shaded_fraction()
             );
             assert!(frame.shaded_fraction() > 0.0 && frame.shaded_fraction() < 1.0, "{}", frame.shaded_fraction());

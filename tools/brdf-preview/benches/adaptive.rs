@@ -11,7 +11,9 @@
 //!    read (a) as the paper does (`bandwidth::Reading::Paper`), (b) level-normalized, and (c)
 //!    replaced by an oracle: the image bandwidth of a windowed FFT of the converged picture (32 x
 //!    32 windows, as `001` Fig. 12), and (d) the paper's with `003`'s lobe weight in the
-//!    up-sampling. For each: PSNR, milliseconds, shaded fraction, samples, and
+//!    up-sampling. For each: PSNR, the *ceiling* (the PSNR of the same plan with every shaded
+//!    block given its converged value: the up-sampling's error alone, which no budget passes),
+//!    milliseconds, shaded fraction, samples, and
 //!    the time the brute force needs for the same PSNR (interpolated between its budgets, in
 //!    log time) over the adaptive time: the speed-up at equal quality (`>` when the brute force
 //!    never reaches the PSNR: a lower bound from its 256 spp);
@@ -183,14 +185,15 @@ fn main() {
     let quick = args.iter().any(|a| a == "--quick");
     let option = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     // --case SUBSTRING: only the cases whose name contains it; --predict-level L (default 2, as
-    // brdf-preview); --allocation variance|std-dev (default std-dev, as brdf-preview);
+    // brdf-preview); --allocation variance|std-dev|area (default area, as brdf-preview);
     // --no-extras: skip the correlations and the anti-aliasing.
     let only = option("--case");
     let predict_level: usize = option("--predict-level").map_or(2, |l| l.parse().expect("--predict-level L"));
     let allocation = match option("--allocation").as_deref() {
         Some("variance") => adaptive::Allocation::Variance,
-        None | Some("std-dev") => adaptive::Allocation::StdDev,
-        Some(other) => panic!("--allocation {other}: variance or std-dev"),
+        Some("std-dev") => adaptive::Allocation::StdDev,
+        None | Some("area") => adaptive::Allocation::Area,
+        Some(other) => panic!("--allocation {other}: variance, std-dev or area"),
     };
     let extras = !args.iter().any(|a| a == "--no-extras");
     // --gpu: the brute force and the adaptive frames' shading on the GPU (lavapipe in CI), the
@@ -215,11 +218,14 @@ fn main() {
     out(String::new());
     out(format!(
         "256 x 256, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \
-         speed-up: brute-force time at the adaptive PSNR over the adaptive time (best of 3 runs each; `>`: the brute force never reaches it)."
+         speed-up: brute-force time at the adaptive PSNR over the adaptive time (best of 3 runs each; `>`: the brute force never reaches it); \
+         ceiling: the PSNR of the plan with the converged values in its shaded blocks. Adaptive frames: prediction level {predict_level}, \
+         allocation {}, rescue below {rescue_below}.",
+        allocation.name()
     ));
     out(String::new());
-    out("| case | mode | env reading | budget spp | PSNR dB | ms | shaded | samples | brute ms | speed-up |".into());
-    out("|---|---|---|---:|---:|---:|---:|---:|---:|---:|".into());
+    out("| case | mode | env reading | budget spp | PSNR dB | ceiling dB | ms | shaded | samples | brute ms | speed-up |".into());
+    out("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|".into());
     let mut speedups: Vec<(String, &'static str, &'static str, f64, bool)> = Vec::new();
     let mut correlations = Vec::new();
     let mut aa_rows = Vec::new();
@@ -334,13 +340,34 @@ fn main() {
                                 .expect("adaptive render")
                             });
                             let p = psnr(&frame.image);
+                            // The same plan with every shaded block given its converged value:
+                            // the up-sampling's error alone, the PSNR no budget can pass.
+                            let mut exact = |blocks: &[(u32, u32)]| {
+                                Ok(blocks
+                                    .iter()
+                                    .map(|&(i, _)| [0, 1, 2].map(|c| reference.rgb[3 * i as usize + c]))
+                                    .collect())
+                            };
+                            let ceiling = psnr(
+                                &adaptive::render_with(
+                                    &scene,
+                                    &loaded.material,
+                                    lighting,
+                                    &variant.bandwidths,
+                                    &settings,
+                                    variant.oracle.as_deref(),
+                                    Some(&mut exact),
+                                )
+                                .expect("adaptive render with the converged values")
+                                .image,
+                            );
                             let (brute_ms, lower_bound) = match brute_time(&curve, p) {
                                 Some(t) => (t, false),
                                 None => (curve.last().unwrap().1, true),
                             };
                             let speedup = brute_ms / ms;
                             out(format!(
-                                "| {name} | {label} | {} | {spp} | {p:.2} | {ms:.0} | {:.3} | {} | {brute_ms:.0} | {}{speedup:.1} |",
+                                "| {name} | {label} | {} | {spp} | {p:.2} | {ceiling:.2} | {ms:.0} | {:.3} | {} | {brute_ms:.0} | {}{speedup:.1} |",
                                 variant.name,
                                 frame.shaded_fraction(),
                                 frame.plan.samples(),

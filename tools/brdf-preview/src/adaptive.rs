@@ -76,15 +76,17 @@ pub fn debug_views(
          up-sampled (0: shaded on its own). Shaded blocks per level: {}. {} samples of a budget of {}; shaded fraction {}. Samples per \
          pixel: a shaded block's samples over its pixels. Bandwidth: cycles per pixel from the environment's and \
          the BRDF's bandwidth through the paper's reflection operators (001 eq. 3-6); the level is \
-         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered); the \
-         samples follow it ({}). Black: background or silhouette.",
+         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). \
+         A shaded block's samples: {}. Black: background or silhouette.",
         per_level.join(", "),
         frame.plan.samples(),
         frame.plan.budget,
         format_number((frame.shaded_fraction() * 1e4).round() / 1e4),
         match allocation {
-            render::adaptive::Allocation::Variance => "in proportion",
-            render::adaptive::Allocation::StdDev => "in proportion to its square root",
+            render::adaptive::Allocation::Variance => "in proportion to the variance",
+            render::adaptive::Allocation::StdDev => "in proportion to the square root of its pixels times the variance",
+            render::adaptive::Allocation::Area =>
+                "in proportion to the square root of its pixels (the variance not used)",
         },
     );
     panels.footer(stack(&[

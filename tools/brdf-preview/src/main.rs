@@ -113,10 +113,12 @@ struct Args {
     #[arg(long, value_name = "L", default_value_t = 2)]
     predict_level: usize,
 
-    /// Adaptive modes: the samples follow the predicted variance (the paper: every pixel
-    /// equally noisy) or its square root (std-dev, the default: the least total squared error
-    /// for the budget).
-    #[arg(long, value_enum, default_value_t = AllocationArg::StdDev)]
+    /// Adaptive modes: how the budget is shared among the shaded blocks: in proportion to the
+    /// predicted variance (the paper: every pixel equally noisy), to sqrt(pixels x variance)
+    /// (std-dev: the least total squared error for the budget), or to sqrt(pixels) (area, the
+    /// default: the same with every pixel's variance taken equal; it wins the benchmark,
+    /// cargo bench -p brdf-preview --bench adaptive).
+    #[arg(long, value_enum, default_value_t = AllocationArg::Area)]
     allocation: AllocationArg,
 
     /// Adaptive modes: weight the up-sampling by how alike the specular lobes of the two pixels
@@ -226,6 +228,7 @@ impl ModeArg {
 enum AllocationArg {
     Variance,
     StdDev,
+    Area,
 }
 
 fn parse_aa(text: &str) -> Result<usize, String> {
@@ -465,6 +468,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         allocation: match args.allocation {
             AllocationArg::Variance => render::adaptive::Allocation::Variance,
             AllocationArg::StdDev => render::adaptive::Allocation::StdDev,
+            AllocationArg::Area => render::adaptive::Allocation::Area,
         },
         lobe_weight: args.lobe_weight,
         max_spp: n_samples.min(256),
