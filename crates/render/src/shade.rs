@@ -222,7 +222,11 @@ pub fn check_inputs(material: &Material, lighting: &Lighting) -> Result<(), Erro
             s.n_samples
         )));
     }
-    if let Some(i) = s.texels.iter().position(|t| !t.iter().all(|v| v.is_finite())) {
+    // Millions of texels, checked on every call: in parallel chunks, then the first bad one.
+    let finite = |t: &[f32; 4]| t.iter().all(|v| v.is_finite());
+    if !s.texels.par_chunks(1 << 16).all(|chunk| chunk.iter().all(finite))
+        && let Some(i) = s.texels.iter().position(|t| !finite(t))
+    {
         return Err(Error::Invalid(format!("sample texel {i} is not finite: {:?}", s.texels[i])));
     }
     if lighting.exponents.len() != lighting.layers.len() {
