@@ -28,7 +28,7 @@ mod window;
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
 ///                variance; only the pixels of a pyramid whose level the prediction asks for are
 ///                shaded (reference estimator), a budget of --spp samples per pixel on average
-///                is shared by the predicted variance, the rest is up-sampled; one frame: the
+///                is shared among them (--allocation), the rest is up-sampled; one frame: the
 ///                shaded pixels on the GPU, the prediction, the plan and the up-sampling on the
 ///                CPU (crate render, module adaptive)
 ///   adaptive-prefiltered
