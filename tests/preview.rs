@@ -193,6 +193,10 @@ fn the_adaptive_modes_report_their_work_and_their_quality() {
         assert_eq!(json["cpu"]["same_plan"], true, "{json}");
         assert!(json["cpu"]["psnr_db"].as_f64().unwrap_or(f64::INFINITY) >= 40.0, "{json}");
         assert!(psnr >= 30.0, "{json}");
+        // The ceiling: the plan's shaded blocks at the converged values. The frame's own noise
+        // can only lose against it (0.5 dB of slack for the 8-bit rounding of two pictures).
+        let ceiling = json["ceiling_db"].as_f64().unwrap();
+        assert!(ceiling >= psnr - 0.5, "{json}");
         let roles: Vec<&str> = json["files"].as_array().unwrap().iter().map(|f| f["role"].as_str().unwrap()).collect();
         assert_eq!(roles, ["preview", "debug-views", "converged"], "{json}");
         let (w, h) = png_decode(&tmp.path().join(format!("{mode}-debug.png")));

@@ -839,7 +839,30 @@ pub fn render(
 
 /// A shader of shaded blocks (see [`render_with`]): `(render pixel, samples)` in, each block's
 /// estimate out.
-pub type Shader<'a> = &'a mut dyn FnMut(&[(u32, u32)]) -> Result<Vec<[f32; 3]>, Error>;
+pub type Shader<'a> = &'a mut dyn FnMut(&[(u32, u32)]) -> Estimates;
+
+/// What a [`Shader`] returns: each block's estimate (linear RGB), in the order given.
+pub type Estimates = Result<Vec<[f32; 3]>, Error>;
+
+/// A [`Shader`] that gives every shaded block `reference`'s value at its pixel, so that
+/// [`render_with`] makes the frame whose only error is the up-sampling's: the plan's *ceiling*,
+/// the quality no budget passes. `reference` is at the render size (no supersampling).
+pub fn exact_shader(reference: &Image) -> impl FnMut(&[(u32, u32)]) -> Estimates + '_ {
+    |blocks| {
+        blocks
+            .iter()
+            .map(|&(i, _)| {
+                let i = i as usize;
+                reference.rgb.get(3 * i..3 * i + 3).map(|v| [v[0], v[1], v[2]]).ok_or_else(|| {
+                    Error::Invalid(format!(
+                        "block pixel {i} is outside the reference image of {} x {}",
+                        reference.width, reference.height
+                    ))
+                })
+            })
+            .collect()
+    }
+}
 
 /// [`render`], with two substitutions. `oracle`: the image bandwidth of every render pixel
 /// (cycles per pixel, row-major) given instead of predicted, the benchmark's oracle, a windowed

@@ -210,6 +210,39 @@ fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
 }
 
 #[test]
+fn the_exact_shader_gives_the_plans_ceiling() {
+    // A reference image of scattered values (a pixel's index times a prime, modulo 1000),
+    // which no interpolation reproduces: a plan that may not coarsen
+    // takes it back exactly, a coarser plan equals it at its shaded blocks' pixels only and
+    // up-samples between them, and a reference too small is an error naming the pixel.
+    let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let scene = sphere_scene(40, 30);
+    let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+    let full = render::render(&scene, material, &lighting, &settings).unwrap();
+    let reference = render::Image { rgb: (0..full.rgb.len()).map(|i| (i / 3 * 7919 % 1000) as f32).collect(), ..full };
+    let render_exact = |settings: &adaptive::Settings, reference: &render::Image| {
+        let mut exact = adaptive::exact_shader(reference);
+        adaptive::render_with(&scene, material, &lighting, &bandwidths, settings, None, Some(&mut exact))
+    };
+    let fine = adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Mode::Reference, 8) };
+    let frame = render_exact(&fine, &reference).unwrap();
+    for i in (0..40 * 30).filter(|&i| frame.predictions[i].level >= 0) {
+        assert_eq!(frame.image.rgb[3 * i], reference.rgb[3 * i], "pixel {i}");
+    }
+    let coarse = adaptive::Settings::new(Mode::Reference, 8);
+    let frame = render_exact(&coarse, &reference).unwrap();
+    let is_exact = |i: usize| frame.image.rgb[3 * i] == reference.rgb[3 * i];
+    let from = |level: fn(i32) -> bool| (0..40 * 30).filter(|&i| level(frame.shaded_level[i])).collect::<Vec<_>>();
+    let (own, upsampled) = (from(|l| l == 0), from(|l| l > 0));
+    assert!(own.iter().all(|&i| is_exact(i)), "pixels shaded on their own take their reference value");
+    assert!(!upsampled.is_empty(), "the plan shades coarse blocks");
+    assert!(upsampled.iter().filter(|&&i| is_exact(i)).count() < upsampled.len() / 2, "up-sampled pixels interpolate");
+    let small = render::Image { width: 4, height: 4, rgb: vec![0.0; 48], covered: vec![true; 16] };
+    let error = render_exact(&fine, &small).unwrap_err().to_string();
+    assert!(error.contains("outside the reference image of 4 x 4"), "{error}");
+}
+
+#[test]
 fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
     let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
     let settings =

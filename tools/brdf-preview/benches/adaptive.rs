@@ -342,12 +342,7 @@ fn main() {
                             let p = psnr(&frame.image);
                             // The same plan with every shaded block given its converged value:
                             // the up-sampling's error alone, the PSNR no budget can pass.
-                            let mut exact = |blocks: &[(u32, u32)]| {
-                                Ok(blocks
-                                    .iter()
-                                    .map(|&(i, _)| [0, 1, 2].map(|c| reference.rgb[3 * i as usize + c]))
-                                    .collect())
-                            };
+                            let mut exact = adaptive::exact_shader(&reference);
                             let ceiling = psnr(
                                 &adaptive::render_with(
                                     &scene,

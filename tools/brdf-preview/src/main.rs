@@ -151,7 +151,10 @@ struct Args {
     /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
     /// and write OUT-difference.png. For the adaptive modes, compare with the same frame shaded
     /// on the CPU (reported as "cpu") and report psnr_db against the converged estimate
-    /// (--converged N samples per strategy, 256 by default).
+    /// (--converged N samples per strategy, 256 by default) and, without anti-aliasing,
+    /// ceiling_db: the PSNR of the same plan with its shaded blocks given the converged values
+    /// (when psnr_db is near it, more --spp will not help; it is as exact as the converged
+    /// estimate, whose noise it carries into the up-sampled pixels).
     #[arg(long)]
     validate: bool,
 
@@ -581,6 +584,28 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         value["relative_error"] = json!(relative);
         value["converged"] = json!({ "samples_per_strategy": n, "psnr_db": json_db(psnr), "relative_error": relative });
         check_psnr(args, "against the converged estimate", psnr, &mut problems);
+        if ss == 1 {
+            // The same plan with the converged values in its shaded blocks: the up-sampling's
+            // error alone, the PSNR no budget can pass (render pixels are the converged
+            // estimate's pixels only without anti-aliasing).
+            let mut exact = render::adaptive::exact_shader(&converged);
+            let ceiling = render::adaptive::render_with(
+                &scene,
+                &loaded.material,
+                lighting,
+                bandwidths,
+                &settings,
+                None,
+                Some(&mut exact),
+            )?;
+            let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &preview), &converged_picture);
+            report.push(format!(
+                "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
+                 near it, more --spp does not help, the up-sampling is the error",
+                db(ceiling)
+            ));
+            value["ceiling_db"] = json_db(ceiling);
+        }
     }
     Ok(Step { files, report, problems, value })
 }
