@@ -204,7 +204,8 @@ pub struct Settings {
     /// `sigma` of the depth weight, relative to the child's depth.
     pub depth_sigma: f64,
     /// One prediction per `2^l x 2^l` block of output pixels (0: every pixel, as the paper);
-    /// with anti-aliasing the blocks are `supersample` times larger in render pixels.
+    /// with anti-aliasing the blocks are `supersample` times larger in render pixels; at most
+    /// the pyramid's top level (a larger value means the top).
     pub predict_level: usize,
     /// How the samples follow the predicted variance.
     pub allocation: Allocation,
@@ -336,7 +337,9 @@ pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize),
         Some(p) => predict_pixel(p, i, frame),
         None => Prediction { level: -1, ..Prediction::default() },
     };
-    let l = frame.settings.predict_level + frame.settings.supersample.trailing_zeros() as usize;
+    // At most the pyramid's top: a block no larger than the image (and a shift that fits).
+    let l = (frame.settings.predict_level.saturating_add(frame.settings.supersample.trailing_zeros() as usize))
+        .min(frame.top);
     if l == 0 {
         return (0..pixels.len()).into_par_iter().map(one).collect();
     }

@@ -243,6 +243,24 @@ fn the_exact_shader_gives_the_plans_ceiling() {
 }
 
 #[test]
+fn a_prediction_level_above_the_pyramid_is_its_top() {
+    // 40 x 30 has a pyramid of 5 levels (top 4, blocks of 16 x 16): predict levels above it
+    // mean the top, and shifts beyond the word size do not wrap.
+    let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let scene = sphere_scene(40, 30);
+    let frame = |predict_level: usize| {
+        let settings = adaptive::Settings { predict_level, ..adaptive::Settings::new(Mode::Reference, 4) };
+        adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap()
+    };
+    let top = frame(4);
+    for predict_level in [5, 40, 64, usize::MAX] {
+        let f = frame(predict_level);
+        assert_eq!(f.predictions, top.predictions, "predict level {predict_level}");
+        assert_eq!(f.image.rgb, top.image.rgb, "predict level {predict_level}");
+    }
+}
+
+#[test]
 fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
     let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
     let settings =
