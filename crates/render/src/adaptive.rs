@@ -20,8 +20,9 @@
 //! # The bandwidth buffer (`001` eq. 3-6, 9-11)
 //!
 //! For each shadeable pixel (or, with [`Settings::predict_level`] `l`, once per block of `2^l x
-//! 2^l` output pixels, at the block's pixel, copied to its shadeable pixels: the prediction
-//! costs as much as shading `n_b` samples, and a block's pixels are alike), `n_b` incident
+//! 2^l` output pixels, at the block's pixel, copied to its shadeable pixels, a block whose pixel
+//! is not shadeable split into its quarters: the prediction costs as much as shading `n_b`
+//! samples, and a block's pixels are alike), `n_b` incident
 //! directions (default 16): the first `n_b` samples of one baked vector of the pixel's slice
 //! (the vector `pcg_hash(pixel ^ pcg_hash(seed ^ 0x9e37_79b9)) % V`; the prefix of an
 //! Owen-scrambled Sobol' vector is stratified), each with its pdf. For each `wi`:
@@ -330,8 +331,9 @@ pub struct Prediction {
 
 /// The bandwidth buffer: one [`Prediction`] per render pixel, row-major. With
 /// `settings.predict_level = l > 0`, one prediction per `2^l x 2^l` block, made at the block's
-/// pixel ([`Level::pixel`]) and copied to its shadeable pixels (a pixel whose block's pixel is
-/// not shadeable, at a silhouette, predicts for itself).
+/// pixel ([`Level::pixel`]) and copied to its shadeable pixels; a block whose pixel is not
+/// shadeable (at a silhouette, or over a hole) is split into its four quarters, each predicted
+/// the same way, down to single pixels.
 pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize), frame: &Frame) -> Vec<Prediction> {
     let one = |i: usize| match &pixels[i] {
         Some(p) => predict_pixel(p, i, frame),
@@ -343,23 +345,45 @@ pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize),
     if l == 0 {
         return (0..pixels.len()).into_par_iter().map(one).collect();
     }
-    let (grid_width, grid_height) = (width.div_ceil(1 << l), height.div_ceil(1 << l));
-    let rep = |b: usize| {
-        let (x, y) = block_pixel(l, b % grid_width, b / grid_width, width, height);
-        y * width + x
-    };
-    let blocks: Vec<Option<Prediction>> =
-        (0..grid_width * grid_height).into_par_iter().map(|b| pixels[rep(b)].is_some().then(|| one(rep(b)))).collect();
-    (0..pixels.len())
-        .into_par_iter()
-        .map(|i| {
-            if pixels[i].is_none() {
-                return Prediction { level: -1, ..Prediction::default() };
+    // The predictions of block (bx, by) of level k, as (pixel, prediction) pairs.
+    fn block(
+        k: usize,
+        (bx, by): (usize, usize),
+        (width, height): (usize, usize),
+        pixels: &[Option<Pixel>],
+        one: &(impl Fn(usize) -> Prediction + Sync),
+        out: &mut Vec<(usize, Prediction)>,
+    ) {
+        let (x0, y0) = (bx << k, by << k);
+        if x0 >= width || y0 >= height {
+            return;
+        }
+        let (x, y) = block_pixel(k, bx, by, width, height);
+        if k > 0 && pixels[y * width + x].is_none() {
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                block(k - 1, (2 * bx + dx, 2 * by + dy), (width, height), pixels, one, out);
             }
-            let b = ((i / width) >> l) * grid_width + ((i % width) >> l);
-            blocks[b].unwrap_or_else(|| one(i))
+            return;
+        }
+        let prediction = one(y * width + x);
+        let (x1, y1) = ((x0 + (1 << k)).min(width), (y0 + (1 << k)).min(height));
+        let shadeable = (y0..y1).flat_map(|y| (x0..x1).map(move |x| y * width + x)).filter(|&i| pixels[i].is_some());
+        out.extend(shadeable.map(|i| (i, prediction)));
+    }
+    let grid_width = width.div_ceil(1 << l);
+    let blocks: Vec<Vec<(usize, Prediction)>> = (0..grid_width * height.div_ceil(1 << l))
+        .into_par_iter()
+        .map(|b| {
+            let mut out = Vec::new();
+            block(l, (b % grid_width, b / grid_width), (width, height), pixels, &one, &mut out);
+            out
         })
-        .collect()
+        .collect();
+    let mut predictions = vec![Prediction { level: -1, ..Prediction::default() }; pixels.len()];
+    for (i, prediction) in blocks.into_iter().flatten() {
+        predictions[i] = prediction;
+    }
+    predictions
 }
 
 /// What the prediction of a frame reads.

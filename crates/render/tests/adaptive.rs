@@ -245,7 +245,8 @@ fn the_exact_shader_gives_the_plans_ceiling() {
 #[test]
 fn a_prediction_level_above_the_pyramid_is_its_top() {
     // 40 x 30 has a pyramid of 5 levels (top 4, blocks of 16 x 16): predict levels above it
-    // mean the top, and shifts beyond the word size do not wrap.
+    // mean the top, and shifts beyond the word size do not wrap. The sphere leaves most of the
+    // blocks' own pixels uncovered.
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
     let scene = sphere_scene(40, 30);
     let frame = |predict_level: usize| {
@@ -253,6 +254,17 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
         adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap()
     };
     let top = frame(4);
+    // Every shadeable pixel has a prediction, and blocks whose pixel is off the sphere share
+    // theirs by quarters rather than predicting every pixel.
+    let shadeable: Vec<&Prediction> = top.predictions.iter().filter(|p| p.level >= 0).collect();
+    let mut distinct: Vec<(u64, u64)> =
+        shadeable.iter().map(|p| (p.bandwidth.to_bits(), p.variance.to_bits())).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert_eq!(shadeable.len(), top.shadeable);
+    // 3 x 2 blocks, those off the sphere split: 8 predictions for 444 pixels (130 when every
+    // pixel of such a block predicted for itself).
+    assert!(distinct.len() <= 16, "{} predictions for {} pixels", distinct.len(), shadeable.len());
     for predict_level in [5, 40, 64, usize::MAX] {
         let f = frame(predict_level);
         assert_eq!(f.predictions, top.predictions, "predict level {predict_level}");
