@@ -208,7 +208,7 @@ pub struct Settings {
     /// with anti-aliasing the blocks are `supersample` times larger in render pixels; at most
     /// the pyramid's top level (a larger value means the top).
     pub predict_level: usize,
-    /// How the samples follow the predicted variance.
+    /// How the budget is shared among the shaded blocks.
     pub allocation: Allocation,
     /// Multiply the up-sampling weights by the similarity of the two pixels' specular lobes
     /// (`003` eq. 4, module docs).
