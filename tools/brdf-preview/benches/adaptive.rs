@@ -321,13 +321,7 @@ fn main() {
                                 rescue_below,
                                 ..adaptive::Settings::new(mode, spp)
                             };
-                            let (ms, frame) = timed(3, || {
-                                let mut on_gpu = renderer.as_ref().map(|r| {
-                                    move |blocks: &[(u32, u32)]| {
-                                        r.shade_blocks(mode, settings.seed, blocks)
-                                            .map_err(|e| render::Error::Invalid(e.to_string()))
-                                    }
-                                });
+                            let frame_with = |shader: Option<adaptive::Shader>| {
                                 adaptive::render_with(
                                     &scene,
                                     &loaded.material,
@@ -335,27 +329,23 @@ fn main() {
                                     &variant.bandwidths,
                                     &settings,
                                     variant.oracle.as_deref(),
-                                    on_gpu.as_mut().map(|s| s as adaptive::Shader),
+                                    shader,
                                 )
                                 .expect("adaptive render")
+                            };
+                            let (ms, frame) = timed(3, || {
+                                let mut on_gpu = renderer.as_ref().map(|r| {
+                                    move |blocks: &[(u32, u32)]| {
+                                        r.shade_blocks(mode, settings.seed, blocks)
+                                            .map_err(|e| render::Error::Invalid(e.to_string()))
+                                    }
+                                });
+                                frame_with(on_gpu.as_mut().map(|s| s as adaptive::Shader))
                             });
                             let p = psnr(&frame.image);
                             // The same plan with every shaded block given its converged value:
                             // the up-sampling's error alone, the PSNR no budget can pass.
-                            let mut exact = adaptive::exact_shader(&reference);
-                            let ceiling = psnr(
-                                &adaptive::render_with(
-                                    &scene,
-                                    &loaded.material,
-                                    lighting,
-                                    &variant.bandwidths,
-                                    &settings,
-                                    variant.oracle.as_deref(),
-                                    Some(&mut exact),
-                                )
-                                .expect("adaptive render with the converged values")
-                                .image,
-                            );
+                            let ceiling = psnr(&frame_with(Some(&mut adaptive::exact_shader(&reference))).image);
                             let (brute_ms, lower_bound) = match brute_time(&curve, p) {
                                 Some(t) => (t, false),
                                 None => (curve.last().unwrap().1, true),
