@@ -1,7 +1,7 @@
 //! Issue 11's equal-quality benchmark of adaptive multi-resolution shading (a benchmark, not a
 //! test): 3 real-derived materials x 2 real maps x 2 meshes (a sphere, and a torus, whose
-//! curvature varies and changes sign), 256 x 256, on the CPU renderer (crate `render`; the GPU
-//! renderer equals it to rounding for the full-resolution modes).
+//! curvature varies and changes sign), 256 x 256 (`--size N` for another), on the CPU renderer
+//! (crate `render`; the GPU renderer equals it to rounding for the full-resolution modes).
 //!
 //! For each case:
 //!
@@ -20,7 +20,9 @@
 //! 3. Spearman's rank correlation of the predicted image bandwidth with the windowed FFT of the
 //!    converged picture (windows wholly on the mesh), and of the predicted variance with the
 //!    measured variance of the one-sample estimator (16 independent renders), per reading;
-//! 4. 16x anti-aliasing against none: milliseconds and shaded blocks.
+//! 4. 16x anti-aliasing against none: milliseconds and shaded blocks;
+//! 5. where the adaptive frames' time goes (paper reading): G-buffer, prediction, pyramid and
+//!    plan, shading and up-sampling, against the brute force's whole frame.
 //!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and the adaptive frames'
 //! shaded blocks are shaded there too (`Renderer::shade_blocks`), as `brdf-preview` runs them.
@@ -43,6 +45,7 @@ use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, met
 const MATERIALS: [&str; 3] = ["gold-paint", "white-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
 const MESHES: [&str; 2] = ["sphere", "torus"];
+/// The default render size (`--size N`).
 const SIZE: usize = 256;
 const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
 
@@ -77,7 +80,7 @@ fn environment_bandwidth(environment: &str, reading: Reading) -> EnvBandwidth {
     EnvBandwidth::new(image.width, image.height, image.rgb.chunks_exact(3).map(|t| t[0]).collect()).unwrap()
 }
 
-fn scene(mesh: &str) -> Scene {
+fn scene(mesh: &str, size: usize) -> Scene {
     let mesh = match mesh {
         "sphere" => Mesh::sphere(1.0, 128, 64),
         _ => Mesh::torus(0.7, 0.3, 128, 48),
@@ -85,14 +88,15 @@ fn scene(mesh: &str) -> Scene {
     Scene {
         mesh,
         camera: Camera::orbit(glam::Vec3::ZERO, 3.2, 0.0, 0.5, 45f32.to_radians()).unwrap(),
-        width: SIZE,
-        height: SIZE,
+        width: size,
+        height: size,
     }
 }
 
 /// The converged estimate of a case, kept as raw little-endian `f32` RGB.
 fn converged(name: &str, scene: &Scene, material: &Material, lighting: &Lighting, samples: u32) -> Image {
-    let path = work().join(format!("{name}-converged-{samples}.f32"));
+    let (width, height) = (scene.width, scene.height);
+    let path = work().join(format!("{name}-{width}x{height}-converged-{samples}.f32"));
     let covered = render::raster::rasterize(&scene.mesh, scene.camera.view_proj(1.0), scene.width, scene.height)
         .expect("rasterizing")
         .hits
@@ -100,10 +104,10 @@ fn converged(name: &str, scene: &Scene, material: &Material, lighting: &Lighting
         .map(Option::is_some)
         .collect();
     if let Ok(bytes) = std::fs::read(&path)
-        && bytes.len() == 12 * SIZE * SIZE
+        && bytes.len() == 12 * width * height
     {
         let rgb = bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
-        return Image { width: SIZE, height: SIZE, rgb, covered };
+        return Image { width, height, rgb, covered };
     }
     let start = Instant::now();
     let image = render::converged::converged(scene, material, lighting, samples, 1).expect("converged");
@@ -123,6 +127,12 @@ fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
         out = Some(value);
     }
     (best, out.expect("at least one run"))
+}
+
+/// Milliseconds as the tables print them: whole above 10 ms, else to 0.01 ms (a real GPU
+/// renders these frames in a millisecond or two).
+fn millis(ms: f64) -> String {
+    if ms >= 10.0 { format!("{ms:.0}") } else { format!("{ms:.2}") }
 }
 
 /// The brute-force time for `psnr`, interpolated in log time between the budgets around it on
@@ -159,17 +169,18 @@ fn picture_fft(image: &Image, preview: &envmap::Preview) -> bandwidth::WindowedF
         .chunks_exact(3)
         .map(|p| bandwidth::luminance([p[0], p[1], p[2]].map(|v| envmap::tonemap(f64::from(v), preview))))
         .collect();
-    let image = bandwidth::Image::new(SIZE, SIZE, luminance).unwrap();
+    let image = bandwidth::Image::new(image.width, image.height, luminance).unwrap();
     let config = bandwidth::WindowedFftConfig { noise_floor: 1.0 / 255.0 / 12f64.sqrt(), ..Default::default() };
     bandwidth::windowed_fft_bandwidth(&image, &config).expect("windowed FFT")
 }
 
-/// The oracle bandwidth of every pixel: the windowed FFT's value at the nearest window centre.
-fn oracle(fft: &bandwidth::WindowedFftMap) -> Vec<f64> {
+/// The oracle bandwidth of every pixel of a `size x size` image: the windowed FFT's value at the
+/// nearest window centre.
+fn oracle(fft: &bandwidth::WindowedFftMap, size: usize) -> Vec<f64> {
     let (half, stride) = (fft.window() / 2, fft.centre(1.min(fft.columns() - 1), 0).0 - fft.centre(0, 0).0);
     let nearest = |p: usize, n: usize| ((p.saturating_sub(half) + stride / 2) / stride.max(1)).min(n - 1);
-    (0..SIZE * SIZE)
-        .map(|i| fft.frequency_at(nearest(i % SIZE, fft.columns()), nearest(i / SIZE, fft.rows())))
+    (0..size * size)
+        .map(|i| fft.frequency_at(nearest(i % size, fft.columns()), nearest(i / size, fft.rows())))
         .collect()
 }
 
@@ -185,10 +196,12 @@ fn main() {
     let quick = args.iter().any(|a| a == "--quick");
     let option = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     // --case SUBSTRING: only the cases whose name contains it; --predict-level L (default 2, as
-    // brdf-preview); --allocation variance|std-dev|area (default area, as brdf-preview);
+    // brdf-preview); --size N (default 256): N x N pixels; --allocation variance|std-dev|area
+    // (default area, as brdf-preview);
     // --no-extras: skip the correlations and the anti-aliasing.
     let only = option("--case");
     let predict_level: usize = option("--predict-level").map_or(2, |l| l.parse().expect("--predict-level L"));
+    let size: usize = option("--size").map_or(SIZE, |n| n.parse().expect("--size N"));
     let allocation = match option("--allocation").as_deref() {
         Some("variance") => adaptive::Allocation::Variance,
         Some("std-dev") => adaptive::Allocation::StdDev,
@@ -217,7 +230,7 @@ fn main() {
     ));
     out(String::new());
     out(format!(
-        "256 x 256, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \
+        "{size} x {size}, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \
          speed-up: brute-force time at the adaptive PSNR over the adaptive time (best of 3 runs each; `>`: the brute force never reaches it); \
          ceiling: the PSNR of the plan with the converged values in its shaded blocks. Adaptive frames: prediction level {predict_level}, \
          allocation {}, rescue below {rescue_below}.",
@@ -229,6 +242,7 @@ fn main() {
     let mut speedups: Vec<(String, &'static str, &'static str, f64, bool)> = Vec::new();
     let mut correlations = Vec::new();
     let mut aa_rows = Vec::new();
+    let mut stages = Vec::new();
     let mut readings: Vec<(String, EnvBandwidth, EnvBandwidth)> = Vec::new();
     for env in ENVIRONMENTS {
         readings.push((
@@ -253,7 +267,7 @@ fn main() {
                 if !wanted(mesh) {
                     continue;
                 }
-                let scene = scene(mesh);
+                let scene = scene(mesh, size);
                 let reference = converged(
                     &format!("{material}-{env}-{mesh}"),
                     &scene,
@@ -279,7 +293,7 @@ fn main() {
                     })
                     .collect();
                 let brute: Vec<String> =
-                    BRUTE_SPP.iter().zip(&curve).map(|(s, (p, ms))| format!("{s}: {p:.2} dB {ms:.0} ms")).collect();
+                    BRUTE_SPP.iter().zip(&curve).map(|(s, (p, ms))| format!("{s}: {p:.2} dB {} ms", millis(*ms))).collect();
                 eprintln!("{name}: brute force {}", brute.join(", "));
 
                 let fft = picture_fft(&reference, &preview);
@@ -299,7 +313,7 @@ fn main() {
                     Variant {
                         name: "oracle (FFT)",
                         bandwidths: Bandwidths { environment: paper.clone(), brdf: atlas.clone() },
-                        oracle: Some(oracle(&fft)),
+                        oracle: Some(oracle(&fft, size)),
                         lobe_weight: false,
                     },
                     Variant {
@@ -352,13 +366,18 @@ fn main() {
                             };
                             let speedup = brute_ms / ms;
                             out(format!(
-                                "| {name} | {label} | {} | {spp} | {p:.2} | {ceiling:.2} | {ms:.0} | {:.3} | {} | {brute_ms:.0} | {}{speedup:.1} |",
+                                "| {name} | {label} | {} | {spp} | {p:.2} | {ceiling:.2} | {} | {:.3} | {} | {} | {}{speedup:.1} |",
                                 variant.name,
+                                millis(ms),
                                 frame.shaded_fraction(),
                                 frame.plan.samples(),
+                                millis(brute_ms),
                                 if lower_bound { ">" } else { "" }
                             ));
                             speedups.push((name.clone(), label, variant.name, speedup, lower_bound));
+                            if variant.name == "paper" {
+                                stages.push((name.clone(), label, spp, frame.timings, ms, brute_ms));
+                            }
                         }
                     }
                 }
@@ -375,7 +394,7 @@ fn main() {
                     .collect();
                 let luminance =
                     |img: &Image, i: usize| bandwidth::luminance([0, 1, 2].map(|c| f64::from(img.rgb[3 * i + c])));
-                let measured_variance: Vec<f64> = (0..SIZE * SIZE)
+                let measured_variance: Vec<f64> = (0..size * size)
                     .map(|i| {
                         let v: Vec<f64> = one_spp.iter().map(|img| luminance(img, i)).collect();
                         let mean = v.iter().sum::<f64>() / v.len() as f64;
@@ -393,16 +412,16 @@ fn main() {
                             let (cx, cy) = fft.centre(i, j);
                             let (x0, y0) = (cx - fft.window() / 2, cy - fft.window() / 2);
                             let inside = (0..fft.window() * fft.window()).all(|k| {
-                                frame.predictions[(y0 + k / fft.window()) * SIZE + x0 + k % fft.window()].level >= 0
+                                frame.predictions[(y0 + k / fft.window()) * size + x0 + k % fft.window()].level >= 0
                             });
                             if inside {
-                                predicted.push(frame.predictions[cy * SIZE + cx].bandwidth);
+                                predicted.push(frame.predictions[cy * size + cx].bandwidth);
                                 measured.push(fft.frequency_at(i, j));
                             }
                         }
                     }
                     let bandwidth_rho = bandwidth::spearman(&predicted, &measured).unwrap_or(f64::NAN);
-                    let shadeable: Vec<usize> = (0..SIZE * SIZE).filter(|&i| frame.predictions[i].level >= 0).collect();
+                    let shadeable: Vec<usize> = (0..size * size).filter(|&i| frame.predictions[i].level >= 0).collect();
                     let pv: Vec<f64> = shadeable.iter().map(|&i| frame.predictions[i].variance).collect();
                     let mv: Vec<f64> = shadeable.iter().map(|&i| measured_variance[i]).collect();
                     correlations.push((
@@ -416,7 +435,7 @@ fn main() {
 
                 // Must show 4: 16x anti-aliasing, on the renderer the rest ran on.
                 let aa_renderer = gpu.as_ref().map(|g| {
-                    let big = Scene { width: SIZE * 4, height: SIZE * 4, ..scene.clone() };
+                    let big = Scene { width: size * 4, height: size * 4, ..scene.clone() };
                     gpu::preview::Renderer::new(g, &big, &loaded.material, lighting).expect("the GPU renderer")
                 });
                 let frame = |supersample: usize, renderer: Option<&gpu::preview::Renderer>| {
@@ -481,7 +500,28 @@ fn main() {
     out("| case | ms 1x | ms 16x | time ratio | shaded blocks 1x | 16x |".into());
     out("|---|---:|---:|---:|---:|---:|".into());
     for (name, a, b, sa, sb) in &aa_rows {
-        out(format!("| {name} | {a:.0} | {b:.0} | {:.2} | {sa} | {sb} |", b / a));
+        out(format!("| {name} | {} | {} | {:.2} | {sa} | {sb} |", millis(*a), millis(*b), b / a));
+    }
+    out(String::new());
+    out("## Where the adaptive frames' time goes (paper reading; ms)".into());
+    out(String::new());
+    out("Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). \
+         G-buffer, prediction, pyramid and plan run on the CPU; `shading` is the shaded blocks (on the \
+         renderer the rest ran on) and the up-sampling."
+        .into());
+    out(String::new());
+    out("| case | mode | budget spp | G-buffer | prediction | pyramid and plan | shading and up-sampling | frame | brute force at equal PSNR |".into());
+    out("|---|---|---:|---:|---:|---:|---:|---:|---:|".into());
+    for (name, label, spp, t, ms, brute_ms) in &stages {
+        out(format!(
+            "| {name} | {label} | {spp} | {} | {} | {} | {} | {} | {} |",
+            millis(t.gbuffer_ms),
+            millis(t.predict_ms),
+            millis(t.plan_ms),
+            millis(t.shade_ms),
+            millis(*ms),
+            millis(*brute_ms)
+        ));
     }
     let file = work().join(if gpu.is_some() { "report-gpu.md" } else { "report.md" });
     std::fs::write(&file, &report).expect("writing the report");
