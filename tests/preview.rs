@@ -169,9 +169,9 @@ fn without_an_adapter_the_previewer_says_how_to_get_one() {
     assert!(!tmp.path().join("x.png").exists(), "{r}");
 }
 
-/// Issue 11: the adaptive modes through the tool. One frame each (shaded on the GPU), with the
-/// debug views, the same frame shaded on the CPU (same plan, 40 dB like the other modes) and the
-/// PSNR against the converged estimate; the JSON carries what scripts gate on.
+/// Issue 11: the adaptive modes through the tool. One frame each (predicted and shaded on the
+/// GPU), with the debug views, the same frame shaded on the CPU (same plan, 40 dB like the other
+/// modes) and the PSNR against the converged estimate; the JSON carries what scripts gate on.
 /// The frame is within 30 dB of the converged estimate (measured 35.4 and 35.5 dB here; a plan
 /// that up-sampled from the wrong blocks, or shaded nothing, falls far below).
 #[test]
@@ -190,6 +190,12 @@ fn the_adaptive_modes_report_their_work_and_their_quality() {
         assert_eq!(json["aa"], 1);
         let psnr = json["psnr_db"].as_f64().unwrap();
         println!("{mode}: {psnr:.2} dB against the converged estimate, shaded fraction {fraction:.3}");
+        // Predicted on the GPU: the CPU predicts the same levels (but where a direction on a
+        // nearest texel's edge reads its neighbour in f32), and with the GPU's predictions
+        // makes the same plan.
+        let prediction = &json["cpu"]["prediction"];
+        let (pixels, differ) = (prediction["pixels"].as_u64().unwrap(), prediction["levels_differ"].as_u64().unwrap());
+        assert!(pixels > 1000 && 100 * differ <= pixels, "{json}");
         assert_eq!(json["cpu"]["same_plan"], true, "{json}");
         assert!(json["cpu"]["psnr_db"].as_f64().unwrap_or(f64::INFINITY) >= 40.0, "{json}");
         assert!(psnr >= 30.0, "{json}");

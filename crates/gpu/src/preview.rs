@@ -22,7 +22,7 @@
 //! prefiltered layers as f32 RGB, the view-layer table) rather than textures: float32 textures
 //! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -109,6 +109,28 @@ struct ShadeUniform {
     n_levels: u32,
     n_view_rows: u32,
     _pad: [u32; 2],
+}
+
+/// `Predict` of the WGSL.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct PredictUniform {
+    n_b: u32,
+    env_width: u32,
+    env_height: u32,
+    lobes_x: u32,
+    lobes_y: u32,
+    tile: u32,
+    radians_per_pixel: f32,
+    _pad: u32,
+}
+
+/// The bandwidths the prediction of adaptive frames reads ([`Renderer::set_bandwidths`]).
+#[derive(Debug)]
+struct Prediction {
+    bandwidths: render::adaptive::Bandwidths,
+    uniform: wgpu::Buffer,
+    group: wgpu::BindGroup,
 }
 
 /// `MODE_*` of the WGSL.
@@ -227,6 +249,13 @@ pub struct Renderer {
     shade_pipeline: wgpu::ComputePipeline,
     /// `shade_blocks`: the shaded blocks of an adaptive frame.
     blocks_pipeline: wgpu::ComputePipeline,
+    /// `predict_blocks`: the bandwidth buffer of an adaptive frame, with group 3 from
+    /// `predict_layout`, made by [`Renderer::set_bandwidths`].
+    predict_pipeline: wgpu::ComputePipeline,
+    predict_layout: wgpu::BindGroupLayout,
+    prediction: Option<Prediction>,
+    /// For the limit errors of later uploads.
+    adapter_info: wgpu::AdapterInfo,
     table_group: wgpu::BindGroup,
     bake_group: wgpu::BindGroup,
     render_group: wgpu::BindGroup,
@@ -414,6 +443,27 @@ impl Renderer {
             };
             let shade_pipeline = compute_pipeline("shade_frame");
             let blocks_pipeline = compute_pipeline("shade_blocks");
+            let predict_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("preview predict"),
+                entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
+            });
+            let predict_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("predict_blocks"),
+                layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("preview predict"),
+                    bind_group_layouts: &[
+                        Some(&table_layout),
+                        Some(&bake_layout),
+                        Some(&render_layout),
+                        Some(&predict_layout),
+                    ],
+                    immediate_size: 0,
+                })),
+                module: &shade_module,
+                entry_point: Some("predict_blocks"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
 
             let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("merl dims"),
@@ -508,6 +558,10 @@ impl Renderer {
                 depth_target,
                 shade_pipeline,
                 blocks_pipeline,
+                predict_pipeline,
+                predict_layout,
+                prediction: None,
+                adapter_info: info.clone(),
                 table_group,
                 bake_group,
                 render_group,
@@ -692,16 +746,61 @@ impl Renderer {
         })
     }
 
-    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) with its shaded
-    /// blocks shaded here ([`Renderer::shade_blocks`]) and everything else (G-buffer,
-    /// prediction, plan, up-sampling) on the CPU. The renderer must have been made for the
-    /// frame's render size (`scene` times `settings.supersample`) with `scene`'s camera.
+    /// Uploads the bandwidths the prediction of adaptive frames reads (the environment's and the
+    /// BRDF atlas), replacing any set before; [`Renderer::render_adaptive`] and
+    /// [`Renderer::predict_blocks`] need them.
+    pub fn set_bandwidths(&mut self, bandwidths: &render::adaptive::Bandwidths) -> Result<(), GpuError> {
+        let (environment, atlas) = (&bandwidths.environment, &bandwidths.brdf);
+        let expected = atlas.width() * atlas.lobes_y * atlas.tile;
+        if atlas.tile == 0 || atlas.lobes_x == 0 || atlas.lobes_y == 0 || atlas.data.len() != expected {
+            return Err(render::Error::Invalid(format!(
+                "a BRDF atlas of {} x {} tiles of {} texels with {} values",
+                atlas.lobes_x,
+                atlas.lobes_y,
+                atlas.tile,
+                atlas.data.len()
+            ))
+            .into());
+        }
+        let texels: Vec<f32> = environment.values().iter().chain(&atlas.data).copied().collect();
+        check_buffer_fits(&self.device.limits(), &self.adapter_info, 4 * texels.len() as u64, "the bandwidths")?;
+        let prediction = capture_errors(&self.device, || {
+            let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("preview predict"),
+                size: size_of::<PredictUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let texels = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("preview bandwidths"),
+                contents: bytemuck::cast_slice(&texels),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview predict"),
+                layout: &self.predict_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: texels.as_entire_binding() },
+                ],
+            });
+            Prediction { bandwidths: bandwidths.clone(), uniform, group }
+        })?;
+        self.prediction = Some(prediction);
+        Ok(())
+    }
+
+    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) with its bandwidth
+    /// buffer predicted ([`Renderer::predict_blocks`], with the bandwidths of
+    /// [`Renderer::set_bandwidths`]) and its shaded blocks shaded ([`Renderer::shade_blocks`])
+    /// here, and the G-buffer, the pyramid, the plan and the up-sampling on the CPU. The renderer
+    /// must have been made for the frame's render size (`scene` times `settings.supersample`)
+    /// with `scene`'s camera.
     pub fn render_adaptive(
         &self,
         scene: &Scene,
         material: &Material,
         lighting: &Lighting,
-        bandwidths: &render::adaptive::Bandwidths,
         settings: &render::adaptive::Settings,
     ) -> Result<render::adaptive::Adaptive, GpuError> {
         let ss = settings.supersample as u32;
@@ -717,20 +816,92 @@ impl Renderer {
             ))
             .into());
         }
-        let mut failure = None;
-        let mut shader = |blocks: &[(u32, u32)]| match self.shade_blocks(settings.mode, settings.seed, blocks) {
-            Ok(values) => Ok(values),
-            Err(e) => {
-                failure = Some(e);
-                Err(render::Error::Invalid("shading on the GPU failed".into()))
-            }
+        let bandwidths = &self.prediction.as_ref().ok_or_else(no_bandwidths)?.bandwidths;
+        let failure = RefCell::new(None);
+        let fail = |e: GpuError, what: &str| {
+            *failure.borrow_mut() = Some(e);
+            render::Error::Invalid(format!("{what} on the GPU failed"))
         };
-        let frame =
-            render::adaptive::render_with(scene, material, lighting, bandwidths, settings, None, Some(&mut shader));
-        match failure {
+        let mut predictor =
+            |pixels: &[u32]| self.predict_blocks(settings, pixels).map_err(|e| fail(e, "the prediction"));
+        let mut shader = |blocks: &[(u32, u32)]| {
+            self.shade_blocks(settings.mode, settings.seed, blocks).map_err(|e| fail(e, "shading"))
+        };
+        let hooks = render::adaptive::Hooks {
+            predictor: Some(&mut predictor),
+            shader: Some(&mut shader),
+            ..Default::default()
+        };
+        let frame = render::adaptive::render_with(scene, material, lighting, bandwidths, settings, hooks);
+        match failure.into_inner() {
             Some(e) => Err(e),
             None => Ok(frame?),
         }
+    }
+
+    /// Predicts the bandwidth buffer of an adaptive frame at `pixels` (its
+    /// `render::adaptive::prediction_pixels`, row-major indices of the renderer's image) as
+    /// `render::adaptive` does on the CPU, with `settings`' `n_b`, seed and estimator and the
+    /// bandwidths of [`Renderer::set_bandwidths`]: each pixel's image bandwidth (cycles per pixel)
+    /// and variance. A pixel the GPU's raster finds not shadeable (the renderers may disagree at
+    /// a few silhouette pixels: crate docs) predicts the Nyquist rate, bandwidth 1/2 and variance
+    /// 0: level 0, shaded at full resolution, the safe side.
+    pub fn predict_blocks(
+        &self,
+        settings: &render::adaptive::Settings,
+        pixels: &[u32],
+    ) -> Result<Vec<[f64; 2]>, GpuError> {
+        let prediction = self.prediction.as_ref().ok_or_else(no_bandwidths)?;
+        let n = self.pixels();
+        if pixels.len() as u64 > n {
+            return Err(render::Error::Invalid(format!("{} prediction pixels for {n} pixels", pixels.len())).into());
+        }
+        if let Some(&pixel) = pixels.iter().find(|&&p| u64::from(p) >= n) {
+            return Err(render::Error::Invalid(format!("prediction pixel {pixel} is outside {n} pixels")).into());
+        }
+        if pixels.is_empty() {
+            return Ok(Vec::new());
+        }
+        let (environment, atlas) = (&prediction.bandwidths.environment, &prediction.bandwidths.brdf);
+        let uniform = PredictUniform {
+            n_b: settings.n_b.min(u32::MAX as usize) as u32,
+            env_width: environment.width() as u32,
+            env_height: environment.height() as u32,
+            lobes_x: atlas.lobes_x as u32,
+            lobes_y: atlas.lobes_y as u32,
+            tile: atlas.tile as u32,
+            radians_per_pixel: (f64::from(self.camera.fov_y()) / f64::from(self.height)) as f32,
+            _pad: 0,
+        };
+        self.progress.set(None);
+        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        // The item count travels in `spp`.
+        let base = Settings { mode: settings.mode, spp: pixels.len() as u32, frames: 1, seed: settings.seed };
+        let shade = self.shade_uniform(mode_index(settings.mode), &base);
+        let groups = (pixels.len() as u32).div_ceil(64);
+        let (x, y) = (groups.min(32768), groups.div_ceil(32768));
+        capture_errors(&self.device, || {
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            self.queue.write_buffer(&prediction.uniform, 0, bytemuck::bytes_of(&uniform));
+            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
+            self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("predict_blocks"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.predict_pipeline);
+                pass.set_bind_group(0, &self.table_group, &[]);
+                pass.set_bind_group(1, &self.bake_group, &[]);
+                pass.set_bind_group(2, &self.render_group, &[0]);
+                pass.set_bind_group(3, &prediction.group, &[]);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            self.queue.submit([encoder.finish()]);
+        })?;
+        let values = self.read_accumulation(pixels.len() as u64)?;
+        Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
 
     /// Shades the blocks of an adaptive frame (`render::adaptive::render_with`'s shader):
@@ -880,6 +1051,11 @@ impl Renderer {
     fn check_settings(&self, settings: &Settings) -> Result<(), GpuError> {
         Ok(render::check_settings(settings, self.n_samples as usize, self.n_layers, &self.view_layers)?)
     }
+}
+
+fn no_bandwidths() -> GpuError {
+    render::Error::Invalid("an adaptive frame's prediction needs the bandwidths: Renderer::set_bandwidths".into())
+        .into()
 }
 
 /// The checks of `render::render` on the scene, the material and the lighting, before anything is

@@ -539,22 +539,79 @@ fn adaptive_bandwidths() -> render::adaptive::Bandwidths {
     render::adaptive::Bandwidths { environment, brdf }
 }
 
-/// Issue 11: an adaptive frame whose shaded blocks the GPU shades (`Renderer::render_adaptive`)
-/// equals the CPU's (`render::adaptive::render`): the same plan (it is made on the CPU either
-/// way), and the shaded values within the full-resolution modes' tolerances, with and without
-/// anti-aliasing, for both estimators.
+/// Issue 11: the bandwidth buffer predicted on the GPU (`Renderer::predict_blocks`) equals the
+/// CPU's (`render::adaptive`) to f32 rounding, for both estimators' variances, with and without
+/// anti-aliasing and per pixel or per block. Tolerance: the GPU works in f32 and reads the
+/// environment bandwidth and the atlas at the nearest texel, so a direction on a texel's edge
+/// may read the neighbour (a different value, by design of the fixture); so 98% of the
+/// predictions within 1e-3 relative, and 98% of the levels (eq. 11, applied to both in f64)
+/// equal.
 #[test]
-fn adaptive_frames_shaded_on_the_gpu_equal_the_cpu() {
+fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
+    let (material, lighting, bandwidths) = (phong(), sky_lighting(), adaptive_bandwidths());
+    let scene = sphere_scene(SIZE);
+    for (mode, supersample, predict_level) in
+        [(Mode::Reference, 1, 0), (Mode::Prefiltered, 1, 0), (Mode::Reference, 2, 1), (Mode::Reference, 1, 2)]
+    {
+        let settings = render::adaptive::Settings {
+            supersample,
+            predict_level,
+            max_spp: 64,
+            ..render::adaptive::Settings::new(mode, 4)
+        };
+        let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
+        let mut renderer = renderer(&render_scene, material, lighting);
+        renderer.set_bandwidths(&bandwidths).unwrap();
+        let cpu = render::adaptive::render(&scene, material, lighting, &bandwidths, &settings).unwrap();
+        let (w, h) = (render_scene.width, render_scene.height);
+        let shadeable: Vec<bool> = cpu.predictions.iter().map(|p| p.level >= 0).collect();
+        let top = render::adaptive::top_level(w, h, None);
+        let level = (predict_level + supersample.trailing_zeros() as usize).min(top);
+        let (pixels, _) = render::adaptive::prediction_pixels(&shadeable, (w, h), level);
+        let gpu = renderer.predict_blocks(&settings, &pixels).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-3 * a.abs().max(b.abs()).max(1e-12);
+        let (mut near, mut same_level, mut worst) = (0, 0, 0.0f64);
+        for (&i, &[bandwidth, variance]) in pixels.iter().zip(&gpu) {
+            let p = cpu.predictions[i as usize];
+            if close(bandwidth, p.bandwidth) && close(variance, p.variance) {
+                near += 1;
+            }
+            if render::adaptive::level_of(bandwidth, top) == p.level {
+                same_level += 1;
+            }
+            worst = worst.max((bandwidth - p.bandwidth).abs() / p.bandwidth.max(1e-12));
+        }
+        let n = pixels.len();
+        log(&format!(
+            "predictions {} {supersample}x{supersample} level {predict_level}: {n} pixels, {near} within 1e-3, \
+             {same_level} at the same level, worst bandwidth difference {worst:.2e} relative",
+            mode.name()
+        ));
+        assert!(n > 100 && 50 * near >= 49 * n && 50 * same_level >= 49 * n, "{near} and {same_level} of {n}");
+    }
+}
+
+/// Issue 11: an adaptive frame predicted and shaded on the GPU (`Renderer::render_adaptive`)
+/// equals the CPU's frame with the same predictions (`render::adaptive::replay_predictor`): the
+/// same plan, and the shaded values within the full-resolution modes' tolerances, with and
+/// without anti-aliasing, for both estimators.
+#[test]
+fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), adaptive_bandwidths());
     let scene = sphere_scene(SIZE);
     for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 4), (Mode::Reference, 2, 4)] {
         let settings =
             render::adaptive::Settings { supersample, max_spp: 64, ..render::adaptive::Settings::new(mode, spp) };
         let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
-        let gpu_frame = renderer(&render_scene, material, lighting)
-            .render_adaptive(&scene, material, lighting, &bandwidths, &settings)
+        let mut renderer = renderer(&render_scene, material, lighting);
+        renderer.set_bandwidths(&bandwidths).unwrap();
+        let gpu_frame = renderer
+            .render_adaptive(&scene, material, lighting, &settings)
             .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
-        let cpu_frame = render::adaptive::render(&scene, material, lighting, &bandwidths, &settings).unwrap();
+        let mut replay = render::adaptive::replay_predictor(&gpu_frame.predictions);
+        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let cpu_frame =
+            render::adaptive::render_with(&scene, material, lighting, &bandwidths, &settings, hooks).unwrap();
         assert_eq!(gpu_frame.plan.actions, cpu_frame.plan.actions, "the plans differ");
         let shaded: usize = cpu_frame.plan.shaded_per_level().iter().sum();
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
@@ -565,4 +622,9 @@ fn adaptive_frames_shaded_on_the_gpu_equal_the_cpu() {
         ));
         assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
     }
+    // The prediction needs the bandwidths; without them the frame is an error that says so.
+    let renderer = renderer(&scene, material, lighting);
+    let settings = render::adaptive::Settings::new(Mode::Reference, 4);
+    let error = renderer.render_adaptive(&scene, material, lighting, &settings).expect_err("no bandwidths");
+    assert!(error.to_string().contains("set_bandwidths"), "{error}");
 }

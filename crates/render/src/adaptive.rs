@@ -3,10 +3,11 @@
 //! only the pixels of a pyramid whose level the prediction asks for, with a fixed total budget
 //! of samples spread by the predicted variance; up-sample the rest from coarser shaded pixels.
 //!
-//! Everything here is a specification as much as code. The shaded blocks may be shaded by
-//! another renderer ([`render_with`]: `gpu::preview::Renderer::render_adaptive` shades
-//! them on the GPU and is held to this module); the prediction, the plan and the up-sampling
-//! are ported next, step for step, as `gpu::preview` follows [`crate::render`].
+//! Everything here is a specification as much as code. The bandwidth buffer may be predicted
+//! and the shaded blocks shaded by another renderer ([`render_with`]'s [`Hooks`]:
+//! `gpu::preview::Renderer::render_adaptive` does both on the GPU and is held to this module);
+//! the G-buffer, the plan and the up-sampling are ported next, step for step, as `gpu::preview`
+//! follows [`crate::render`].
 //!
 //! # The G-buffer
 //!
@@ -165,6 +166,19 @@ impl EnvBandwidth {
             )));
         }
         Ok(Self { width, height, values })
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The texels, row-major.
+    pub fn values(&self) -> &[f32] {
+        &self.values
     }
 
     /// The bandwidth at the map coordinates `(u, v)` of a direction (`envmap::uv`): the nearest
@@ -329,61 +343,91 @@ pub struct Prediction {
     pub level: i32,
 }
 
-/// The bandwidth buffer: one [`Prediction`] per render pixel, row-major. With
-/// `settings.predict_level = l > 0`, one prediction per `2^l x 2^l` block, made at the block's
-/// pixel ([`Level::pixel`]) and copied to its shadeable pixels; a block whose pixel is not
-/// shadeable (at a silhouette, or over a hole) is split into its four quarters, each predicted
-/// the same way, down to single pixels.
-pub(crate) fn predict(pixels: &[Option<Pixel>], (width, height): (usize, usize), frame: &Frame) -> Vec<Prediction> {
-    let one = |i: usize| match &pixels[i] {
-        Some(p) => predict_pixel(p, i, frame),
-        None => Prediction { level: -1, ..Prediction::default() },
+/// Where the bandwidth buffer is predicted: the render pixels predicted at (row-major order),
+/// and for every render pixel the index in that list of the prediction it takes, `u32::MAX`
+/// where it is not shadeable. With `predict_level = l > 0`, one prediction per `2^l x 2^l` block
+/// of output pixels ([`Settings::predict_level`]), made at the block's pixel
+/// ([`Level::pixel`]); a block whose pixel is not shadeable (at a silhouette, or over a hole) is
+/// split into its four quarters, each predicted the same way, down to single pixels. So a
+/// shadeable pixel takes the prediction of the largest block around it, of level at most `l`,
+/// whose pixel is shadeable (itself at level 0), and that pixel takes its own.
+pub fn prediction_pixels(shadeable: &[bool], (width, height): (usize, usize), l: usize) -> (Vec<u32>, Vec<u32>) {
+    let source = |i: usize| -> Option<usize> {
+        if !shadeable[i] {
+            return None;
+        }
+        let (x, y) = (i % width, i / width);
+        let block = (1..=l)
+            .rev()
+            .map(|k| block_pixel(k, x >> k, y >> k, width, height))
+            .find(|&(bx, by)| shadeable[by * width + bx]);
+        Some(block.map_or(i, |(bx, by)| by * width + bx))
     };
+    let sources: Vec<Option<usize>> = (0..shadeable.len()).into_par_iter().map(source).collect();
+    let mut index = vec![u32::MAX; shadeable.len()];
+    let mut pixels = Vec::new();
+    for (i, s) in sources.iter().enumerate() {
+        if *s == Some(i) {
+            index[i] = pixels.len() as u32;
+            pixels.push(i as u32);
+        }
+    }
+    let of_pixel = sources.iter().map(|s| s.map_or(u32::MAX, |s| index[s])).collect();
+    (pixels, of_pixel)
+}
+
+/// The bandwidth buffer: one [`Prediction`] per render pixel, row-major, made at the
+/// [`prediction_pixels`] by `predictor` (`(bandwidth, variance)` of each, in order) or here,
+/// with eq. 11's level applied here either way.
+pub(crate) fn predict(
+    pixels: &[Option<Pixel>],
+    (width, height): (usize, usize),
+    frame: &Frame,
+    predictor: Option<Predictor>,
+) -> Result<Vec<Prediction>, Error> {
     // At most the pyramid's top: a block no larger than the image (and a shift that fits).
     let l = (frame.settings.predict_level.saturating_add(frame.settings.supersample.trailing_zeros() as usize))
         .min(frame.top);
-    if l == 0 {
-        return (0..pixels.len()).into_par_iter().map(one).collect();
-    }
-    // The predictions of block (bx, by) of level k, as (pixel, prediction) pairs.
-    fn block(
-        k: usize,
-        (bx, by): (usize, usize),
-        (width, height): (usize, usize),
-        pixels: &[Option<Pixel>],
-        one: &(impl Fn(usize) -> Prediction + Sync),
-        out: &mut Vec<(usize, Prediction)>,
-    ) {
-        let (x0, y0) = (bx << k, by << k);
-        if x0 >= width || y0 >= height {
-            return;
-        }
-        let (x, y) = block_pixel(k, bx, by, width, height);
-        if k > 0 && pixels[y * width + x].is_none() {
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                block(k - 1, (2 * bx + dx, 2 * by + dy), (width, height), pixels, one, out);
+    let shadeable: Vec<bool> = pixels.iter().map(Option::is_some).collect();
+    let (at, of_pixel) = prediction_pixels(&shadeable, (width, height), l);
+    let values = match predictor {
+        Some(predictor) => {
+            let values = predictor(&at)?;
+            if values.len() != at.len() {
+                return Err(Error::Invalid(format!(
+                    "the predictor returned {} predictions for {} pixels",
+                    values.len(),
+                    at.len()
+                )));
             }
-            return;
+            if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.iter().all(|x| x.is_finite() && *x >= 0.0))
+            {
+                return Err(Error::Invalid(format!(
+                    "the predictor's bandwidth and variance at render pixel {} are {} and {}: expected finite values >= 0",
+                    at[i], v[0], v[1]
+                )));
+            }
+            values
         }
-        let prediction = one(y * width + x);
-        let (x1, y1) = ((x0 + (1 << k)).min(width), (y0 + (1 << k)).min(height));
-        let shadeable = (y0..y1).flat_map(|y| (x0..x1).map(move |x| y * width + x)).filter(|&i| pixels[i].is_some());
-        out.extend(shadeable.map(|i| (i, prediction)));
-    }
-    let grid_width = width.div_ceil(1 << l);
-    let blocks: Vec<Vec<(usize, Prediction)>> = (0..grid_width * height.div_ceil(1 << l))
-        .into_par_iter()
-        .map(|b| {
-            let mut out = Vec::new();
-            block(l, (b % grid_width, b / grid_width), (width, height), pixels, &one, &mut out);
-            out
-        })
+        None => at
+            .par_iter()
+            .map(|&i| {
+                predict_pixel(pixels[i as usize].as_ref().expect("a prediction pixel is shadeable"), i as usize, frame)
+            })
+            .collect(),
+    };
+    let predictions: Vec<Prediction> = values
+        .iter()
+        .map(|&[bandwidth, variance]| Prediction { bandwidth, variance, level: level_of(bandwidth, frame.top) })
         .collect();
-    let mut predictions = vec![Prediction { level: -1, ..Prediction::default() }; pixels.len()];
-    for (i, prediction) in blocks.into_iter().flatten() {
-        predictions[i] = prediction;
-    }
-    predictions
+    Ok(of_pixel
+        .iter()
+        .map(
+            |&j| {
+                if j == u32::MAX { Prediction { level: -1, ..Prediction::default() } } else { predictions[j as usize] }
+            },
+        )
+        .collect())
 }
 
 /// What the prediction of a frame reads.
@@ -398,9 +442,10 @@ pub(crate) struct Frame<'a> {
     pub top: usize,
 }
 
-/// The prediction of one shadeable pixel (module docs, "The bandwidth buffer").
-fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> Prediction {
-    let Frame { material, lighting, bandwidths, settings, radians_per_pixel, top } = *frame;
+/// The prediction of one shadeable pixel (module docs, "The bandwidth buffer"): its image
+/// bandwidth (cycles per pixel) and variance.
+fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
+    let Frame { material, lighting, bandwidths, settings, radians_per_pixel, .. } = *frame;
     let s = &material.samples;
     let level0 = lighting.mips.level(0);
     let n_b = settings.n_b.min(s.n_samples);
@@ -434,7 +479,7 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> Prediction {
             / pdf;
     }
     let bandwidth = if weight > 0.0 { weighted / weight * radians_per_pixel } else { 0.0 };
-    Prediction { bandwidth, variance: variance / n_b as f64, level: level_of(bandwidth, top) }
+    [bandwidth, variance / n_b as f64]
 }
 
 /// The angular bandwidth at the eye of the light from one incident direction (`001` eq. 3-4 with
@@ -861,7 +906,54 @@ pub fn render(
     bandwidths: &Bandwidths,
     settings: &Settings,
 ) -> Result<Adaptive, Error> {
-    render_with(scene, material, lighting, bandwidths, settings, None, None)
+    render_with(scene, material, lighting, bandwidths, settings, Hooks::default())
+}
+
+/// What [`render_with`] may take from elsewhere instead of computing it here; the default takes
+/// nothing.
+#[derive(Default)]
+pub struct Hooks<'a> {
+    /// The image bandwidth of every render pixel (cycles per pixel, row-major) given instead of
+    /// predicted: the benchmark's oracle, a windowed FFT of the converged image (`001` Fig.
+    /// 12); the variance is predicted as usual.
+    pub oracle: Option<&'a [f64]>,
+    /// The predictions made elsewhere (the GPU's: `gpu::preview::Renderer::predict_blocks`).
+    pub predictor: Option<Predictor<'a>>,
+    /// The shaded blocks shaded elsewhere (the GPU's: `gpu::preview::Renderer::shade_blocks`).
+    pub shader: Option<Shader<'a>>,
+}
+
+impl std::fmt::Debug for Hooks<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hooks")
+            .field("oracle", &self.oracle.map(<[f64]>::len))
+            .field("predictor", &self.predictor.is_some())
+            .field("shader", &self.shader.is_some())
+            .finish()
+    }
+}
+
+/// A predictor of the bandwidth buffer (see [`Hooks`]): the [`prediction_pixels`] in (row-major
+/// indices at the render size), each one's `(bandwidth, variance)` out, as the module docs
+/// specify them for `settings` (eq. 11's level is applied by the caller).
+pub type Predictor<'a> = &'a mut dyn FnMut(&[u32]) -> Predicted;
+
+/// What a [`Predictor`] returns: each pixel's image bandwidth (cycles per pixel) and variance.
+pub type Predicted = Result<Vec<[f64; 2]>, Error>;
+
+/// A [`Predictor`] that gives back the predictions of an earlier frame (at the same render size),
+/// so that [`render_with`] makes its plan again: the previewer checks a frame the GPU planned
+/// with the CPU's shading this way.
+pub fn replay_predictor(predictions: &[Prediction]) -> impl FnMut(&[u32]) -> Predicted + '_ {
+    |pixels| {
+        pixels
+            .iter()
+            .map(|&i| match predictions.get(i as usize) {
+                Some(p) if p.level >= 0 => Ok([p.bandwidth, p.variance]),
+                _ => Err(Error::Invalid(format!("render pixel {i} has no prediction to replay"))),
+            })
+            .collect()
+    }
 }
 
 /// A shader of shaded blocks (see [`render_with`]): `(render pixel, samples)` in, each block's
@@ -891,23 +983,22 @@ pub fn exact_shader(reference: &Image) -> impl FnMut(&[(u32, u32)]) -> Estimates
     }
 }
 
-/// [`render`], with two substitutions. `oracle`: the image bandwidth of every render pixel
-/// (cycles per pixel, row-major) given instead of predicted, the benchmark's oracle, a windowed
-/// FFT of the converged image (`001` Fig. 12); the variance is predicted as usual. `shader`: the
-/// shaded blocks shaded elsewhere: given every shaded block's render pixel (row-major index at
-/// the render size) and samples, it returns each one's estimate in frame 0 with that many
-/// samples by `settings.mode`'s estimator, as [`crate::render`] computes it (the GPU's:
-/// `gpu::preview::Renderer::shade_blocks`); everything else (G-buffer, prediction, plan,
-/// up-sampling) runs here, and the timings include the shader's.
+/// [`render`], with what `hooks` gives instead of computing it here. `oracle` replaces the
+/// predicted bandwidths (the prediction still runs, for the variance). `predictor`: given the
+/// [`prediction_pixels`], it returns their predictions. `shader`: given every shaded block's
+/// render pixel (row-major index at the render size) and samples, it returns each one's
+/// estimate in frame 0 with that many samples by `settings.mode`'s estimator, as
+/// [`crate::render`] computes it. Everything else (G-buffer, pyramid, plan, up-sampling) runs
+/// here, and the timings include the hooks'.
 pub fn render_with(
     scene: &Scene,
     material: &Material,
     lighting: &Lighting,
     bandwidths: &Bandwidths,
     settings: &Settings,
-    oracle: Option<&[f64]>,
-    shader: Option<Shader>,
+    hooks: Hooks,
 ) -> Result<Adaptive, Error> {
+    let Hooks { oracle, predictor, shader } = hooks;
     crate::check_inputs(material, lighting)?;
     check_settings(settings, material, lighting)?;
     let ss = settings.supersample;
@@ -921,7 +1012,7 @@ pub fn render_with(
     let top = top_level(width, height, settings.max_level);
     let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
     let frame = Frame { material, lighting, bandwidths, settings, radians_per_pixel, top };
-    let mut predictions = predict(&pixels, (width, height), &frame);
+    let mut predictions = predict(&pixels, (width, height), &frame, predictor)?;
     if let Some(oracle) = oracle {
         if oracle.len() != predictions.len() {
             return Err(Error::Invalid(format!(

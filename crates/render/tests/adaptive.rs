@@ -222,7 +222,14 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     let reference = render::Image { rgb: (0..full.rgb.len()).map(|i| (i / 3 * 7919 % 1000) as f32).collect(), ..full };
     let render_exact = |settings: &adaptive::Settings, reference: &render::Image| {
         let mut exact = adaptive::exact_shader(reference);
-        adaptive::render_with(&scene, material, &lighting, &bandwidths, settings, None, Some(&mut exact))
+        adaptive::render_with(
+            &scene,
+            material,
+            &lighting,
+            &bandwidths,
+            settings,
+            adaptive::Hooks { shader: Some(&mut exact), ..Default::default() },
+        )
     };
     let fine = adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Mode::Reference, 8) };
     let frame = render_exact(&fine, &reference).unwrap();
@@ -279,4 +286,83 @@ fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
         adaptive::Settings { max_level: Some(0), supersample: 4, ..adaptive::Settings::new(Mode::Reference, 1) };
     let error = adaptive::render(&sphere_scene(16, 16), material, &lighting, &bandwidths, &settings).unwrap_err();
     assert!(error.to_string().contains("raise spp"), "{error}");
+}
+
+/// The recursion the module docs describe, written out: block `(bx, by)` of level `k` predicts
+/// at its pixel when that pixel is shadeable (or at level 0), else splits into its quarters.
+fn sources_by_recursion(shadeable: &[bool], (w, h): (usize, usize), l: usize) -> Vec<Option<usize>> {
+    fn visit(k: usize, (bx, by): (usize, usize), s: &[bool], (w, h): (usize, usize), out: &mut [Option<usize>]) {
+        let (x0, y0) = (bx << k, by << k);
+        if x0 >= w || y0 >= h {
+            return;
+        }
+        let half = (1 << k) / 2;
+        let (x, y) = ((x0 + half).min(w - 1), (y0 + half).min(h - 1));
+        if k > 0 && !s[y * w + x] {
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                visit(k - 1, (2 * bx + dx, 2 * by + dy), s, (w, h), out);
+            }
+            return;
+        }
+        for py in y0..(y0 + (1 << k)).min(h) {
+            for px in x0..(x0 + (1 << k)).min(w) {
+                if s[py * w + px] {
+                    out[py * w + px] = Some(y * w + x);
+                }
+            }
+        }
+    }
+    let mut out = vec![None; w * h];
+    for by in 0..h.div_ceil(1 << l) {
+        for bx in 0..w.div_ceil(1 << l) {
+            visit(l, (bx, by), shadeable, (w, h), &mut out);
+        }
+    }
+    out
+}
+
+#[test]
+fn prediction_pixels_follow_the_block_recursion() {
+    // A ragged mask (holes, a partial last block row and column) at every level up to above the
+    // image: each shadeable pixel takes the prediction of the pixel the recursion gives it, that
+    // pixel takes its own, and the list is row-major without repeats.
+    let (w, h) = (13, 10);
+    let shadeable: Vec<bool> = (0..w * h).map(|i| (i * 7919 + i / w * 31) % 5 != 0 && i % w != 6).collect();
+    for l in 0..5 {
+        let (pixels, of_pixel) = adaptive::prediction_pixels(&shadeable, (w, h), l);
+        let expected = sources_by_recursion(&shadeable, (w, h), l);
+        assert!(pixels.windows(2).all(|p| p[0] < p[1]), "level {l}: {pixels:?}");
+        for i in 0..w * h {
+            let got = (of_pixel[i] != u32::MAX).then(|| pixels[of_pixel[i] as usize] as usize);
+            assert_eq!(got, expected[i], "level {l}, pixel {i}");
+        }
+        for (j, &p) in pixels.iter().enumerate() {
+            assert_eq!(of_pixel[p as usize], j as u32, "level {l}: pixel {p} predicts for itself");
+        }
+    }
+}
+
+#[test]
+fn a_predictor_replaces_the_prediction_and_is_checked() {
+    // The frame's own predictions replayed make the same frame; a predictor that answers for the
+    // wrong pixels or with values that are no bandwidth is an error naming what is wrong.
+    let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let scene = sphere_scene(40, 30);
+    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Mode::Reference, 4) };
+    let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
+    let with = |predictor: adaptive::Predictor| {
+        let hooks = adaptive::Hooks { predictor: Some(predictor), ..Default::default() };
+        adaptive::render_with(&scene, material, &lighting, &bandwidths, &settings, hooks)
+    };
+    let replayed = with(&mut adaptive::replay_predictor(&frame.predictions)).unwrap();
+    assert_eq!(replayed.predictions, frame.predictions);
+    assert_eq!(replayed.plan.actions, frame.plan.actions);
+    assert_eq!(replayed.image.rgb, frame.image.rgb);
+    let short = with(&mut |pixels: &[u32]| Ok(vec![[0.1, 1.0]; pixels.len() - 1])).unwrap_err().to_string();
+    assert!(short.contains("predictions for"), "{short}");
+    let nan = with(&mut |pixels: &[u32]| Ok(vec![[f64::NAN, 1.0]; pixels.len()])).unwrap_err().to_string();
+    assert!(nan.contains("render pixel") && nan.contains("NaN"), "{nan}");
+    let none = vec![adaptive::Prediction { level: -1, ..Default::default() }; frame.predictions.len()];
+    let missing = with(&mut adaptive::replay_predictor(&none)).unwrap_err().to_string();
+    assert!(missing.contains("no prediction to replay"), "{missing}");
 }

@@ -25,7 +25,8 @@
 //!    plan, shading and up-sampling, against the brute force's whole frame.
 //!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and the adaptive frames'
-//! shaded blocks are shaded there too (`Renderer::shade_blocks`), as `brdf-preview` runs them.
+//! bandwidth buffers are predicted and their shaded blocks shaded there too
+//! (`Renderer::predict_blocks`, `Renderer::shade_blocks`), as `brdf-preview` runs them.
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
@@ -114,6 +115,19 @@ fn converged(name: &str, scene: &Scene, material: &Material, lighting: &Lighting
     eprintln!("{name}: converged estimate ({samples} per strategy) in {:.1} s", start.elapsed().as_secs_f64());
     std::fs::write(&path, image.rgb.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).expect("caching");
     image
+}
+
+/// An adaptive frame with what `hooks` gives (a function rather than a closure, whose one
+/// lifetime would make every call's hooks borrow for the same span).
+fn adaptive_frame(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &adaptive::Settings,
+    hooks: adaptive::Hooks,
+) -> adaptive::Adaptive {
+    adaptive::render_with(scene, material, lighting, bandwidths, settings, hooks).expect("adaptive render")
 }
 
 /// The best of `runs` wall times of `f`, in milliseconds, and its last result.
@@ -209,8 +223,9 @@ fn main() {
         Some(other) => panic!("--allocation {other}: variance, std-dev or area"),
     };
     let extras = !args.iter().any(|a| a == "--no-extras");
-    // --gpu: the brute force and the adaptive frames' shading on the GPU (lavapipe in CI), the
-    // adaptive frames' prediction, plan and up-sampling on the CPU as brdf-preview runs them.
+    // --gpu: the brute force and the adaptive frames' prediction and shading on the GPU (lavapipe
+    // in CI), the adaptive frames' G-buffer, plan and up-sampling on the CPU as brdf-preview runs
+    // them.
     let gpu = args.iter().any(|a| a == "--gpu").then(|| gpu::Gpu::new().expect("a GPU adapter (make setup-gpu)"));
     let rescue_below: f64 = option("--rescue-below").map_or(0.0, |v| v.parse().expect("--rescue-below W"));
     let converged_samples = if quick { 256 } else { 1024 };
@@ -224,7 +239,7 @@ fn main() {
     out(format!(
         "# Adaptive shading: equal-quality benchmark ({})",
         match &gpu {
-            Some(g) => format!("shading on {}, prediction and plan on the CPU", g.adapter_summary()),
+            Some(g) => format!("prediction and shading on {}, G-buffer and plan on the CPU", g.adapter_summary()),
             None => "CPU renderer".to_string(),
         }
     ));
@@ -292,8 +307,11 @@ fn main() {
                         (psnr(&image), ms)
                     })
                     .collect();
-                let brute: Vec<String> =
-                    BRUTE_SPP.iter().zip(&curve).map(|(s, (p, ms))| format!("{s}: {p:.2} dB {} ms", millis(*ms))).collect();
+                let brute: Vec<String> = BRUTE_SPP
+                    .iter()
+                    .zip(&curve)
+                    .map(|(s, (p, ms))| format!("{s}: {p:.2} dB {} ms", millis(*ms)))
+                    .collect();
                 eprintln!("{name}: brute force {}", brute.join(", "));
 
                 let fft = picture_fft(&reference, &preview);
@@ -327,6 +345,9 @@ fn main() {
                     [(Mode::Reference, "adaptive", [4u32, 16]), (Mode::Prefiltered, "adaptive-prefiltered", [2, 8])]
                 {
                     for variant in &variants {
+                        if let Some(r) = renderer.as_mut() {
+                            r.set_bandwidths(&variant.bandwidths).expect("uploading the bandwidths");
+                        }
                         for spp in budgets {
                             let settings = adaptive::Settings {
                                 predict_level,
@@ -335,31 +356,49 @@ fn main() {
                                 rescue_below,
                                 ..adaptive::Settings::new(mode, spp)
                             };
-                            let frame_with = |shader: Option<adaptive::Shader>| {
-                                adaptive::render_with(
+                            let oracle = variant.oracle.as_deref();
+                            let bandwidths = &variant.bandwidths;
+                            let (ms, frame) = timed(3, || {
+                                let gpu_error = |e: gpu::GpuError| render::Error::Invalid(e.to_string());
+                                let mut predict = renderer.as_ref().map(|r| {
+                                    move |pixels: &[u32]| r.predict_blocks(&settings, pixels).map_err(gpu_error)
+                                });
+                                let mut shade = renderer.as_ref().map(|r| {
+                                    move |blocks: &[(u32, u32)]| {
+                                        r.shade_blocks(mode, settings.seed, blocks).map_err(gpu_error)
+                                    }
+                                });
+                                adaptive_frame(
                                     &scene,
                                     &loaded.material,
                                     lighting,
-                                    &variant.bandwidths,
+                                    bandwidths,
                                     &settings,
-                                    variant.oracle.as_deref(),
-                                    shader,
+                                    adaptive::Hooks {
+                                        oracle,
+                                        predictor: predict.as_mut().map(|p| p as adaptive::Predictor),
+                                        shader: shade.as_mut().map(|s| s as adaptive::Shader),
+                                    },
                                 )
-                                .expect("adaptive render")
-                            };
-                            let (ms, frame) = timed(3, || {
-                                let mut on_gpu = renderer.as_ref().map(|r| {
-                                    move |blocks: &[(u32, u32)]| {
-                                        r.shade_blocks(mode, settings.seed, blocks)
-                                            .map_err(|e| render::Error::Invalid(e.to_string()))
-                                    }
-                                });
-                                frame_with(on_gpu.as_mut().map(|s| s as adaptive::Shader))
                             });
                             let p = psnr(&frame.image);
                             // The same plan with every shaded block given its converged value:
                             // the up-sampling's error alone, the PSNR no budget can pass.
-                            let ceiling = psnr(&frame_with(Some(&mut adaptive::exact_shader(&reference))).image);
+                            let ceiling = psnr(
+                                &adaptive_frame(
+                                    &scene,
+                                    &loaded.material,
+                                    lighting,
+                                    bandwidths,
+                                    &settings,
+                                    adaptive::Hooks {
+                                        oracle,
+                                        predictor: Some(&mut adaptive::replay_predictor(&frame.predictions)),
+                                        shader: Some(&mut adaptive::exact_shader(&reference)),
+                                    },
+                                )
+                                .image,
+                            );
                             let (brute_ms, lower_bound) = match brute_time(&curve, p) {
                                 Some(t) => (t, false),
                                 None => (curve.last().unwrap().1, true),
@@ -436,8 +475,14 @@ fn main() {
                 // Must show 4: 16x anti-aliasing, on the renderer the rest ran on.
                 let aa_renderer = gpu.as_ref().map(|g| {
                     let big = Scene { width: size * 4, height: size * 4, ..scene.clone() };
-                    gpu::preview::Renderer::new(g, &big, &loaded.material, lighting).expect("the GPU renderer")
+                    let mut r =
+                        gpu::preview::Renderer::new(g, &big, &loaded.material, lighting).expect("the GPU renderer");
+                    r.set_bandwidths(&variants[0].bandwidths).expect("uploading the bandwidths");
+                    r
                 });
+                if let Some(r) = renderer.as_mut() {
+                    r.set_bandwidths(&variants[0].bandwidths).expect("uploading the bandwidths");
+                }
                 let frame = |supersample: usize, renderer: Option<&gpu::preview::Renderer>| {
                     let settings = adaptive::Settings {
                         supersample,
@@ -447,7 +492,7 @@ fn main() {
                     };
                     match renderer {
                         Some(r) => r
-                            .render_adaptive(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
+                            .render_adaptive(&scene, &loaded.material, lighting, &settings)
                             .expect("adaptive on the GPU"),
                         None => {
                             adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
@@ -506,8 +551,8 @@ fn main() {
     out("## Where the adaptive frames' time goes (paper reading; ms)".into());
     out(String::new());
     out("Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). \
-         G-buffer, prediction, pyramid and plan run on the CPU; `shading` is the shaded blocks (on the \
-         renderer the rest ran on) and the up-sampling."
+         G-buffer, pyramid and plan run on the CPU; the prediction and `shading` (the shaded blocks, \
+         then the up-sampling on the CPU) on the renderer the rest ran on."
         .into());
     out(String::new());
     out("| case | mode | budget spp | G-buffer | prediction | pyramid and plan | shading and up-sampling | frame | brute force at equal PSNR |".into());

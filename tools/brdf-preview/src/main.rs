@@ -29,8 +29,8 @@ mod window;
 ///                variance; only the pixels of a pyramid whose level the prediction asks for are
 ///                shaded (reference estimator), a budget of --spp samples per pixel on average
 ///                is shared among them (--allocation), the rest is up-sampled; one frame: the
-///                shaded pixels on the GPU, the prediction, the plan and the up-sampling on the
-///                CPU (crate render, module adaptive)
+///                prediction and the shaded pixels on the GPU, the G-buffer, the plan and the
+///                up-sampling on the CPU (crate render, module adaptive)
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
@@ -149,8 +149,10 @@ struct Args {
     seed: u32,
 
     /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
-    /// and write OUT-difference.png. For the adaptive modes, compare with the same frame shaded
-    /// on the CPU (reported as "cpu") and report psnr_db against the converged estimate
+    /// and write OUT-difference.png. For the adaptive modes, count the pixels the GPU predicted
+    /// at another level than the CPU predicts (exit 1 over 2%), compare with the same frame
+    /// (the GPU's predictions, the same plan) shaded on the CPU (reported as "cpu") and report
+    /// psnr_db against the converged estimate
     /// (--converged N samples per strategy, 256 by default) and, without anti-aliasing,
     /// ceiling_db: the PSNR of the same plan with its shaded blocks given the converged values
     /// (when psnr_db is near it, more --spp will not help; it is as exact as the converged
@@ -483,12 +485,14 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let gpu = gpu::Gpu::new()?;
     let ss = settings.supersample;
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
-    let renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
-    // A driver may compile the pipeline at its first dispatch (lavapipe does, tens of
-    // milliseconds): one block first, so that ms_per_frame times the frame.
+    let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
+    renderer.set_bandwidths(bandwidths)?;
+    // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
+    // milliseconds): one pixel of each first, so that ms_per_frame times the frame.
+    renderer.predict_blocks(&settings, &[0])?;
     renderer.shade_blocks(mode, settings.seed, &[(0, 1)])?;
     let start = Instant::now();
-    let frame = renderer.render_adaptive(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+    let frame = renderer.render_adaptive(&scene, &loaded.material, lighting, &settings)?;
     let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
@@ -516,8 +520,8 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     }
     let t = frame.timings;
     let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms (G-buffer {:.1}, prediction {:.1}, plan {:.1} on the CPU; \
-         shading on the GPU and up-sampling {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
+        "{}: {} on {} ({}), {ms_per_frame:.1} ms (G-buffer {:.1} on the CPU, prediction {:.1} on the GPU, plan {:.1} \
+         on the CPU, shading on the GPU and up-sampling {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
         out.display(),
         args.mode.name(),
         gpu.adapter_summary(),
@@ -552,20 +556,42 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     });
     let mut problems = Vec::new();
     if args.validate {
-        // The same frame with the CPU's shading: the plan is the same, the values equal to rounding.
-        let cpu = render::adaptive::render(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+        // The CPU's own prediction: the levels equal but where a direction on the edge of a
+        // nearest texel reads its neighbour in f32 (the tests hold 98% of them equal).
+        let own = render::adaptive::render(&scene, &loaded.material, lighting, bandwidths, &settings)?;
+        let predicted = frame.predictions.iter().zip(&own.predictions).filter(|(g, _)| g.level >= 0);
+        let (pixels, differ) =
+            predicted.fold((0usize, 0usize), |(n, d), (g, c)| (n + 1, d + usize::from(g.level != c.level)));
+        // The same frame with the GPU's predictions and the CPU's shading: the plan is the same,
+        // the values equal to rounding.
+        let mut replay = render::adaptive::replay_predictor(&frame.predictions);
+        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let cpu = render::adaptive::render_with(&scene, &loaded.material, lighting, bandwidths, &settings, hooks)?;
         let cpu_picture = metrics::tonemap(&cpu.image, &preview);
         let psnr = metrics::psnr_db(&picture, &cpu_picture);
         let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
         let same_plan = cpu.plan.actions == frame.plan.actions;
         report.push(format!(
-            "against the CPU (the same plan{}): PSNR {} dB, relative error {relative:.2e}",
+            "against the CPU: {differ} of {pixels} pixels predicted at another level than the CPU predicts; \
+             with the GPU's predictions (the same plan{}): PSNR {} dB, relative error {relative:.2e}",
             if same_plan { "" } else { ": NOT the same plan" },
             db(psnr)
         ));
-        value["cpu"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative, "same_plan": same_plan });
+        value["cpu"] = json!({
+            "psnr_db": json_db(psnr),
+            "relative_error": relative,
+            "same_plan": same_plan,
+            "prediction": { "pixels": pixels, "levels_differ": differ },
+        });
         if !same_plan {
-            problems.push("the GPU's adaptive frame was planned differently from the CPU's".to_string());
+            problems.push(
+                "the GPU's adaptive frame was planned differently from the CPU's with the same predictions".to_string(),
+            );
+        }
+        if 50 * differ > pixels {
+            problems.push(format!(
+                "{differ} of {pixels} pixels were predicted at another level on the GPU than on the CPU"
+            ));
         }
         check_psnr(args, "against the CPU", psnr, &mut problems);
     }
@@ -589,15 +615,14 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
             // error alone, the PSNR no budget can pass (render pixels are the converged
             // estimate's pixels only without anti-aliasing).
             let mut exact = render::adaptive::exact_shader(&converged);
-            let ceiling = render::adaptive::render_with(
-                &scene,
-                &loaded.material,
-                lighting,
-                bandwidths,
-                &settings,
-                None,
-                Some(&mut exact),
-            )?;
+            let mut replay = render::adaptive::replay_predictor(&frame.predictions);
+            let hooks = render::adaptive::Hooks {
+                predictor: Some(&mut replay),
+                shader: Some(&mut exact),
+                ..Default::default()
+            };
+            let ceiling =
+                render::adaptive::render_with(&scene, &loaded.material, lighting, bandwidths, &settings, hooks)?;
             let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &preview), &converged_picture);
             report.push(format!(
                 "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
