@@ -873,34 +873,12 @@ impl Renderer {
             radians_per_pixel: (f64::from(self.camera.fov_y()) / f64::from(self.height)) as f32,
             _pad: 0,
         };
-        self.progress.set(None);
-        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
-        // The item count travels in `spp`.
-        let base = Settings { mode: settings.mode, spp: pixels.len() as u32, frames: 1, seed: settings.seed };
-        let shade = self.shade_uniform(mode_index(settings.mode), &base);
-        let groups = (pixels.len() as u32).div_ceil(64);
-        let (x, y) = (groups.min(32768), groups.div_ceil(32768));
         capture_errors(&self.device, || {
-            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&prediction.uniform, 0, bytemuck::bytes_of(&uniform));
-            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
-            self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("predict_blocks"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.predict_pipeline);
-                pass.set_bind_group(0, &self.table_group, &[]);
-                pass.set_bind_group(1, &self.bake_group, &[]);
-                pass.set_bind_group(2, &self.render_group, &[0]);
-                pass.set_bind_group(3, &prediction.group, &[]);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-            self.queue.submit([encoder.finish()]);
         })?;
-        let values = self.read_accumulation(pixels.len() as u64)?;
+        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        let values =
+            self.run_items(&self.predict_pipeline, Some(&prediction.group), settings.mode, settings.seed, &items)?;
         Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
 
@@ -923,32 +901,50 @@ impl Renderer {
         if blocks.is_empty() {
             return Ok(Vec::new());
         }
-        self.progress.set(None);
         let items: Vec<[u32; 4]> = blocks.iter().map(|&(pixel, samples)| [pixel, samples, 0, 0]).collect();
-        // The item count travels in `spp`.
-        let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: blocks.len() as u32, frames: 1, seed });
-        let groups = (blocks.len() as u32).div_ceil(64);
+        let sums = self.run_items(&self.blocks_pipeline, None, mode, seed, &items)?;
+        Ok(sums.iter().map(|s| [s[0], s[1], s[2]]).collect())
+    }
+
+    /// Runs an entry that takes a list of items (`shade_blocks`, `predict_blocks`): the items
+    /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
+    /// count in the shade uniform's `spp`, with `mode` and `seed`; `extra` is group 3. Returns
+    /// the first `items.len()` entries the pass leaves.
+    fn run_items(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        extra: Option<&wgpu::BindGroup>,
+        mode: Mode,
+        seed: u32,
+        items: &[[u32; 4]],
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        self.progress.set(None);
+        let count = items.len() as u32;
+        let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: count, frames: 1, seed });
+        let groups = count.div_ceil(64);
         let (x, y) = (groups.min(32768), groups.div_ceil(32768));
         capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
-            self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
+            self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(items));
             let mut encoder = self.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("shade_blocks"),
+                    label: Some("adaptive items"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.blocks_pipeline);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &self.table_group, &[]);
                 pass.set_bind_group(1, &self.bake_group, &[]);
                 pass.set_bind_group(2, &self.render_group, &[0]);
+                if let Some(group) = extra {
+                    pass.set_bind_group(3, group, &[]);
+                }
                 pass.dispatch_workgroups(x, y, 1);
             }
             self.queue.submit([encoder.finish()]);
         })?;
-        let sums = self.read_accumulation(blocks.len() as u64)?;
-        Ok(sums.iter().map(|s| [s[0], s[1], s[2]]).collect())
+        self.read_accumulation(u64::from(count))
     }
 
     /// The accumulation buffer's first `entries` sums, read back.
