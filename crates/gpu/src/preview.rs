@@ -751,17 +751,7 @@ impl Renderer {
     /// [`Renderer::predict_blocks`] need them.
     pub fn set_bandwidths(&mut self, bandwidths: &render::adaptive::Bandwidths) -> Result<(), GpuError> {
         let (environment, atlas) = (&bandwidths.environment, &bandwidths.brdf);
-        let expected = atlas.width() * atlas.lobes_y * atlas.tile;
-        if atlas.tile == 0 || atlas.lobes_x == 0 || atlas.lobes_y == 0 || atlas.data.len() != expected {
-            return Err(render::Error::Invalid(format!(
-                "a BRDF atlas of {} x {} tiles of {} texels with {} values",
-                atlas.lobes_x,
-                atlas.lobes_y,
-                atlas.tile,
-                atlas.data.len()
-            ))
-            .into());
-        }
+        atlas.check().map_err(|e| render::Error::Invalid(format!("the BRDF atlas: {e}")))?;
         let texels: Vec<f32> = environment.values().iter().chain(&atlas.data).copied().collect();
         check_buffer_fits(&self.device.limits(), &self.adapter_info, 4 * texels.len() as u64, "the bandwidths")?;
         let prediction = capture_errors(&self.device, || {

@@ -566,8 +566,7 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
         let (w, h) = (render_scene.width, render_scene.height);
         let shadeable: Vec<bool> = cpu.predictions.iter().map(|p| p.level >= 0).collect();
         let top = render::adaptive::top_level(w, h, None);
-        let level = (predict_level + supersample.trailing_zeros() as usize).min(top);
-        let (pixels, _) = render::adaptive::prediction_pixels(&shadeable, (w, h), level);
+        let (pixels, _) = render::adaptive::prediction_pixels(&shadeable, (w, h), settings.prediction_level(top));
         let gpu = renderer.predict_blocks(&settings, &pixels).unwrap();
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-3 * a.abs().max(b.abs()).max(1e-12);
         let (mut near, mut same_level, mut worst) = (0, 0, 0.0f64);

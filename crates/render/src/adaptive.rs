@@ -260,6 +260,13 @@ impl Allocation {
 }
 
 impl Settings {
+    /// [`Settings::predict_level`] in render pixels, as [`prediction_pixels`] takes it: `l +
+    /// log2(supersample)`, at most the pyramid's `top` (a block no larger than the image, and a
+    /// shift that fits).
+    pub fn prediction_level(&self, top: usize) -> usize {
+        self.predict_level.saturating_add(self.supersample.trailing_zeros() as usize).min(top)
+    }
+
     /// The defaults for a mode and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
     /// `max_spp` 256, depth sigma 0.02, seed 0, a prediction per pixel, samples in proportion
     /// to the variance (the paper's choices where it makes one).
@@ -345,8 +352,8 @@ pub struct Prediction {
 
 /// Where the bandwidth buffer is predicted: the render pixels predicted at (row-major order),
 /// and for every render pixel the index in that list of the prediction it takes, `u32::MAX`
-/// where it is not shadeable. With `predict_level = l > 0`, one prediction per `2^l x 2^l` block
-/// of output pixels ([`Settings::predict_level`]), made at the block's pixel
+/// where it is not shadeable. With `l > 0` ([`Settings::prediction_level`]), one prediction per
+/// `2^l x 2^l` block of render pixels, made at the block's pixel
 /// ([`Level::pixel`]); a block whose pixel is not shadeable (at a silhouette, or over a hole) is
 /// split into its four quarters, each predicted the same way, down to single pixels. So a
 /// shadeable pixel takes the prediction of the largest block around it, of level at most `l`,
@@ -385,9 +392,7 @@ pub(crate) fn predict(
     frame: &Frame,
     predictor: Option<Predictor>,
 ) -> Result<Vec<Prediction>, Error> {
-    // At most the pyramid's top: a block no larger than the image (and a shift that fits).
-    let l = (frame.settings.predict_level.saturating_add(frame.settings.supersample.trailing_zeros() as usize))
-        .min(frame.top);
+    let l = frame.settings.prediction_level(frame.top);
     let shadeable: Vec<bool> = pixels.iter().map(Option::is_some).collect();
     let (at, of_pixel) = prediction_pixels(&shadeable, (width, height), l);
     let values = match predictor {
