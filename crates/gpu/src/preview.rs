@@ -18,6 +18,12 @@
 //! interpolated at the exact point where the pixel ray meets it, not from the clipped polygon's
 //! snapped vertices (the two differ by that snapping, 1/512 pixel).
 //!
+//! The vertices' projection and snapping (steps 1 and 3) are the CPU's, uploaded with each
+//! camera (`render::raster::project` and `snapped`), and the edge functions are exact integers
+//! as on the CPU. A GPU that projected for itself may fuse multiply-adds and divide to 2.5 ULP,
+//! as Vulkan allows: a coordinate near a rounding tie then snaps one sub-pixel step away, and a
+//! small triangle's interpolation moves with it (on an NVIDIA H200, by 4e-4 on a torus of unit size).
+//!
 //! Everything the shaders read lives in storage buffers (the samples, the mip chain and the
 //! prefiltered layers as f32 RGB, the view-layer table) rather than textures: float32 textures
 //! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
@@ -88,12 +94,14 @@ const FRAMES_PER_SUBMIT: u32 = 16;
 /// The G-buffer: the covering triangle's index plus one, 0 where none covers the pixel.
 const TRIANGLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Values per vertex in the mesh buffer: clip-space position, snapped viewport x and y,
+/// position, normal (`preview_shade.wgsl`).
+const VERTEX_FLOATS: u64 = 12;
 
 /// `Shade` of the WGSL.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct ShadeUniform {
-    view_proj: [f32; 16],
     eye: [f32; 4],
     ray_forward: [f32; 4],
     ray_right: [f32; 4],
@@ -242,7 +250,12 @@ pub struct Renderer {
     camera: Camera,
     n_indices: u32,
     raster_pipeline: wgpu::RenderPipeline,
-    raster_uniform: wgpu::Buffer,
+    /// `VERTEX_FLOATS` per vertex: the clip-space position and the snapped viewport coordinates
+    /// with the current camera, the position and the normal (`rasterize` writes it).
+    vertex_buffer: wgpu::Buffer,
+    /// The mesh's positions and normals.
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
     raster_group: wgpu::BindGroup,
     triangle_target: wgpu::Texture,
     depth_target: wgpu::Texture,
@@ -308,16 +321,10 @@ impl Renderer {
         check_buffer_fits(&limits, info, 4 * env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
         let pixels = u64::from(width) * u64::from(height);
         check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
-        // Positions and normals interleaved: one storage buffer for both, so that the shading
-        // pass stays within the 8 storage buffers every adapter offers.
-        let vertices: Vec<[f32; 6]> = scene
-            .mesh
-            .positions
-            .iter()
-            .zip(&scene.mesh.normals)
-            .map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
-            .collect();
-        check_buffer_fits(&limits, info, 24 * vertices.len() as u64, "the mesh's vertices")?;
+        // Clip-space positions, positions and normals interleaved: one storage buffer for all
+        // three, so that the shading pass stays within the 8 storage buffers every adapter offers.
+        let n_vertices = scene.mesh.positions.len() as u64;
+        check_buffer_fits(&limits, info, 4 * VERTEX_FLOATS * n_vertices, "the mesh's vertices")?;
         check_buffer_fits(&limits, info, 4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
 
         let device = gpu.device().clone();
@@ -341,32 +348,32 @@ impl Renderer {
             };
 
             // The mesh, read by both passes.
-            let vertex_buffer = storage("preview mesh vertices", bytemuck::cast_slice(&vertices));
+            // Written by `rasterize`, with the camera's projection.
+            let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("preview mesh vertices"),
+                size: 4 * VERTEX_FLOATS * n_vertices,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
             let index_buffer = storage("preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
 
             // The raster pass.
             let vertex = wgpu::ShaderStages::VERTEX;
             let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview raster"),
-                entries: &[
-                    uniform_entry(0, vertex, false),
-                    storage_entry(1, vertex, true),
-                    storage_entry(2, vertex, true),
-                ],
+                entries: &[storage_entry(0, vertex, true), storage_entry(1, vertex, true)],
             });
             let raster_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_raster.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(PREVIEW_RASTER_WGSL.into()),
             });
             let raster_pipeline = raster_pipeline(&device, &raster_layout, &raster_module);
-            let raster_uniform = uniform("preview view_proj", size_of::<[f32; 16]>() as u64);
             let raster_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview raster"),
                 layout: &raster_layout,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: raster_uniform.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: vertex_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: index_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 0, resource: vertex_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: index_buffer.as_entire_binding() },
                 ],
             });
             let target = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
@@ -552,7 +559,9 @@ impl Renderer {
                 camera: scene.camera,
                 n_indices: scene.mesh.indices.len() as u32,
                 raster_pipeline,
-                raster_uniform,
+                vertex_buffer,
+                positions: scene.mesh.positions.clone(),
+                normals: scene.mesh.normals.clone(),
                 raster_group,
                 triangle_target,
                 depth_target,
@@ -957,9 +966,18 @@ impl Renderer {
 
     /// Draws the G-buffer with the current camera.
     fn rasterize(&self) -> Result<(), GpuError> {
-        let view_proj = self.view_proj();
+        // The CPU's projection and snapping, which the passes read rather than compute
+        // (`preview_shade.wgsl`).
+        let clip = render::raster::project(&self.positions, self.view_proj());
+        let (width, height) = (self.width(), self.height());
+        let vertices: Vec<[f32; VERTEX_FLOATS as usize]> = (clip.iter().zip(&self.positions).zip(&self.normals))
+            .map(|((&c, p), n)| {
+                let [x, y] = render::raster::snapped(c, width, height).map_or([0.0; 2], |v| v.map(|s| s as f32));
+                [c.x, c.y, c.z, c.w, x, y, p[0], p[1], p[2], n[0], n[1], n[2]]
+            })
+            .collect();
         capture_errors(&self.device, || {
-            self.queue.write_buffer(&self.raster_uniform, 0, bytemuck::cast_slice(&view_proj.to_cols_array()));
+            self.queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&vertices));
             let mut encoder = self.device.create_command_encoder(&Default::default());
             {
                 let triangle = self.triangle_target.create_view(&Default::default());
@@ -1014,7 +1032,6 @@ impl Renderer {
         let tan_half = (0.5 * f64::from(camera.fov_y())).tan();
         let vec4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         ShadeUniform {
-            view_proj: self.view_proj().to_cols_array(),
             eye: vec4(eye),
             ray_forward: vec4(forward),
             ray_right: vec4(right * (tan_half * aspect)),
@@ -1159,12 +1176,11 @@ mod tests {
 
     #[test]
     fn host_layouts_match_the_wgsl_structs() {
-        // WGSL `Shade`: a mat4x4<f32> and four vec4<f32> (128 bytes), ten u32 (40), rounded up
-        // to its 16-byte alignment: 176.
-        assert_eq!(size_of::<ShadeUniform>(), 176);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, eye), 64);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, width), 128);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 164);
+        // WGSL `Shade`: four vec4<f32> (64 bytes), ten u32 (40), rounded up to its 16-byte
+        // alignment: 112.
+        assert_eq!(size_of::<ShadeUniform>(), 112);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, width), 64);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 100);
     }
 
     #[test]

@@ -7,18 +7,14 @@
 //! 1/500 of a pixel's footprint at grazing angles).
 //!
 //! The draw is not indexed: vertex `i` of the draw is corner `i % 3` of triangle `i / 3`, read
-//! from the same mesh buffers the shading pass reads.
+//! from the same mesh buffers the shading pass reads. The vertices' clip-space positions are the
+//! CPU's (`render::raster::project`): a GPU may fuse the projection's multiply-adds and round
+//! differently.
 
-struct Raster {
-    // `render::Camera::view_proj`, in f32 like the CPU's projection of the vertices.
-    view_proj: mat4x4<f32>,
-}
-
-@group(0) @binding(0) var<uniform> raster: Raster;
-// Six values per vertex: position, then normal (`render::Mesh`).
-@group(0) @binding(1) var<storage, read> mesh_vertices: array<f32>;
+// Twelve values per vertex (`preview_shade.wgsl`): the clip-space position first.
+@group(0) @binding(0) var<storage, read> mesh_vertices: array<f32>;
 // Three per triangle (`render::Mesh::indices`).
-@group(0) @binding(2) var<storage, read> mesh_indices: array<u32>;
+@group(0) @binding(1) var<storage, read> mesh_indices: array<u32>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -27,9 +23,9 @@ struct VertexOut {
 
 @vertex
 fn raster_vertex(@builtin(vertex_index) corner: u32) -> VertexOut {
-    let v = 6u * mesh_indices[corner];
-    let position = vec3<f32>(mesh_vertices[v], mesh_vertices[v + 1u], mesh_vertices[v + 2u]);
-    return VertexOut(raster.view_proj * vec4<f32>(position, 1.0), corner / 3u);
+    let v = 12u * mesh_indices[corner];
+    let clip = vec4<f32>(mesh_vertices[v], mesh_vertices[v + 1u], mesh_vertices[v + 2u], mesh_vertices[v + 3u]);
+    return VertexOut(clip, corner / 3u);
 }
 
 @fragment

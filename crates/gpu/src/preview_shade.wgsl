@@ -50,18 +50,21 @@ const SUBPIXELS: f32 = 256.0;
 @group(1) @binding(2) var<storage, read> env_texels: array<f32>;
 // `render::Material::view_layers`.
 @group(1) @binding(3) var<storage, read> view_layers: array<u32>;
-// The mesh, as `preview_raster.wgsl` reads it: six values per vertex (position, normal), three
-// indices per triangle.
+// The mesh, as `preview_raster.wgsl` reads it: twelve values per vertex, three indices per
+// triangle. Per vertex: the clip-space position with the current camera and the snapped viewport
+// x and y in 1/256 pixels (integers, exact in f32 within the guard band; 0 outside the clip
+// volume), both as `render::raster` computes them on the CPU, then the position and the normal.
+// The CPU's rather than the GPU's own: a GPU may fuse multiply-adds and divide to 2.5 ULP
+// (Vulkan allows both), which moves a vertex whose coordinate lies near a rounding tie by a
+// sub-pixel step, and a small triangle's interpolation with it.
 @group(1) @binding(4) var<storage, read> mesh_vertices: array<f32>;
 @group(1) @binding(5) var<storage, read> mesh_indices: array<u32>;
 
 // Group 2: the render.
 
 struct Shade {
-    // The camera: the matrix the raster pass projected with, the eye, and the pixel ray's basis
-    // as `render::Camera::ray` builds it, `forward`, `right tan(fov_y / 2) aspect` and
-    // `up tan(fov_y / 2)`.
-    view_proj: mat4x4<f32>,
+    // The camera: the eye, and the pixel ray's basis as `render::Camera::ray` builds it,
+    // `forward`, `right tan(fov_y / 2) aspect` and `up tan(fov_y / 2)`.
     eye: vec4<f32>,
     ray_forward: vec4<f32>,
     ray_right: vec4<f32>,
@@ -116,12 +119,24 @@ struct Hit {
     normal: vec3<f32>,
 }
 
+fn mesh_clip(v: u32) -> vec4<f32> {
+    let i = 12u * v;
+    return vec4<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u], mesh_vertices[i + 3u]);
+}
+
+fn mesh_snapped(v: u32) -> vec2<i32> {
+    let i = 12u * v + 4u;
+    return vec2<i32>(i32(mesh_vertices[i]), i32(mesh_vertices[i + 1u]));
+}
+
 fn mesh_position(v: u32) -> vec3<f32> {
-    return vec3<f32>(mesh_vertices[6u * v], mesh_vertices[6u * v + 1u], mesh_vertices[6u * v + 2u]);
+    let i = 12u * v + 6u;
+    return vec3<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u]);
 }
 
 fn mesh_normal(v: u32) -> vec3<f32> {
-    return vec3<f32>(mesh_vertices[6u * v + 3u], mesh_vertices[6u * v + 4u], mesh_vertices[6u * v + 5u]);
+    let i = 12u * v + 9u;
+    return vec3<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u]);
 }
 
 // Whether a clip-space vertex lies in the volume `render::raster` clips to
@@ -131,35 +146,74 @@ fn inside_clip_volume(c: vec4<f32>) -> bool {
     return c.z >= 0.0 && c.w - c.z >= 0.0 && c.x + g >= 0.0 && g - c.x >= 0.0 && c.y + g >= 0.0 && g - c.y >= 0.0;
 }
 
-// `render::raster::to_viewport` then `snap`: viewport x and y in 1/256 pixels, rounded half to
-// even (WGSL's round), as integers held exactly in f32 (below 2^24 within the guard band of any
-// image of up to 16384 pixels a side).
-fn snapped_viewport(c: vec4<f32>) -> vec2<f32> {
-    let half_w = f32(shade.width) * 0.5;
-    let half_h = f32(shade.height) * 0.5;
-    let ndc = c.xyz / c.w;
-    return round(vec2<f32>(half_w * ndc.x + half_w, -half_h * ndc.y + half_h) * SUBPIXELS);
+// A signed 64-bit integer, two's complement: the edge functions' exact values. Snapped
+// coordinates relative to the pixel centre stay below 2^25 in magnitude (within the guard band of
+// an image of up to 16384 pixels), so the products need 51 bits: f32 would round them, and a
+// sliver's small edge function is the difference of two large products.
+struct Wide {
+    hi: u32,
+    lo: u32,
 }
 
-// 2D cross product: the edge function of `render::raster::for_each_covered` for the edge from
-// `a` to `b`, both relative to the point it is evaluated at.
-fn edge(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return a.x * b.y - a.y * b.x;
+fn wide_add(a: Wide, b: Wide) -> Wide {
+    let lo = a.lo + b.lo;
+    return Wide(a.hi + b.hi + select(0u, 1u, lo < a.lo), lo);
+}
+
+fn wide_negate(a: Wide) -> Wide {
+    let lo = ~a.lo + 1u;
+    return Wide(~a.hi + select(0u, 1u, lo == 0u), lo);
+}
+
+// a b exactly, for |a|, |b| < 2^31: the magnitude from 16-bit halves, then the sign.
+fn wide_product(a: i32, b: i32) -> Wide {
+    let ua = u32(abs(a));
+    let ub = u32(abs(b));
+    let a0 = ua & 0xffffu;
+    let a1 = ua >> 16u;
+    let b0 = ub & 0xffffu;
+    let b1 = ub >> 16u;
+    let low = a0 * b0;
+    // Each term is below 2^31, so the sum does not wrap.
+    let middle = a0 * b1 + a1 * b0;
+    let lo = low + (middle << 16u);
+    let magnitude = Wide(a1 * b1 + (middle >> 16u) + select(0u, 1u, lo < low), lo);
+    if ((a < 0) != (b < 0)) {
+        return wide_negate(magnitude);
+    }
+    return magnitude;
+}
+
+// The nearest f32, to within two roundings (relative error below 2^-23): the high word is exact
+// (below 2^24), and when it is not zero the low word's rounding is 2^-25 of the value at most.
+fn wide_to_f32(a: Wide) -> f32 {
+    if ((a.hi & 0x80000000u) != 0u) {
+        let m = wide_negate(a);
+        return -(f32(m.hi) * 4294967296.0 + f32(m.lo));
+    }
+    return f32(a.hi) * 4294967296.0 + f32(a.lo);
+}
+
+// The edge function of `render::raster::for_each_covered` for the edge from `a` to `b`, both
+// relative to the point it is evaluated at: their 2D cross product, exactly.
+fn edge(a: vec2<i32>, b: vec2<i32>) -> Wide {
+    return wide_add(wide_product(a.x, b.y), wide_negate(wide_product(a.y, b.x)));
 }
 
 // Steps 5 and 6 of `render::raster` at pixel (x, y) for a triangle drawn whole (no vertex outside
 // the clip volume): screen-space barycentrics from the snapped vertices' edge functions at the
-// pixel centre, then perspective-correct weights (b_i / w_i) / sum_j (b_j / w_j). Coordinates are
-// taken relative to the pixel centre, so the edge functions are products of small integers.
-fn snapped_weights(clip: array<vec4<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
-    let centre = vec2<f32>(SUBPIXELS * f32(x), SUBPIXELS * f32(y)) + 0.5 * SUBPIXELS;
-    let a = snapped_viewport(clip[0]) - centre;
-    let b = snapped_viewport(clip[1]) - centre;
-    let c = snapped_viewport(clip[2]) - centre;
+// pixel centre, exact as on the CPU and divided in f32, then perspective-correct weights
+// (b_i / w_i) / sum_j (b_j / w_j).
+fn snapped_weights(snapped: array<vec2<i32>, 3>, w: vec3<f32>, x: u32, y: u32) -> vec3<f32> {
+    let centre = vec2<i32>(i32(SUBPIXELS) * i32(x), i32(SUBPIXELS) * i32(y)) + i32(SUBPIXELS) / 2;
+    let a = snapped[0] - centre;
+    let b = snapped[1] - centre;
+    let c = snapped[2] - centre;
     // Edge k is opposite vertex k; its function is vertex k's weight.
-    let e = vec3<f32>(edge(b, c), edge(c, a), edge(a, b));
-    let bary = e / (e.x + e.y + e.z);
-    let q = bary / vec3<f32>(clip[0].w, clip[1].w, clip[2].w);
+    let e = array<Wide, 3>(edge(b, c), edge(c, a), edge(a, b));
+    let area = wide_to_f32(wide_add(wide_add(e[0], e[1]), e[2]));
+    let bary = vec3<f32>(wide_to_f32(e[0]), wide_to_f32(e[1]), wide_to_f32(e[2])) / area;
+    let q = bary / w;
     return q / (q.x + q.y + q.z);
 }
 
@@ -185,18 +239,21 @@ fn ray_weights(p: array<vec3<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
 fn interpolate_hit(t: u32, x: u32, y: u32) -> Hit {
     var p: array<vec3<f32>, 3>;
     var n: array<vec3<f32>, 3>;
-    var clip: array<vec4<f32>, 3>;
+    var snapped: array<vec2<i32>, 3>;
+    var w: vec3<f32>;
     var whole = true;
     for (var k = 0u; k < 3u; k++) {
         let v = mesh_indices[3u * t + k];
         p[k] = mesh_position(v);
         n[k] = mesh_normal(v);
-        clip[k] = shade.view_proj * vec4<f32>(p[k], 1.0);
-        whole = whole && inside_clip_volume(clip[k]);
+        snapped[k] = mesh_snapped(v);
+        let clip = mesh_clip(v);
+        w[k] = clip.w;
+        whole = whole && inside_clip_volume(clip);
     }
     var weights: vec3<f32>;
     if (whole) {
-        weights = snapped_weights(clip, x, y);
+        weights = snapped_weights(snapped, w, x, y);
     } else {
         weights = ray_weights(p, x, y);
     }

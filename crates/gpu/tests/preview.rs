@@ -376,6 +376,8 @@ fn the_gbuffer_matches_the_cpu_rasterizer() {
             let mut other_triangle = Vec::new();
             // The largest position and normal errors, on triangles drawn whole and clipped.
             let mut worst = [[0.0f64; 2]; 2];
+            // Where the largest position errors are: (x, y, triangle).
+            let mut worst_at = [(0, 0, 0); 2];
             for (i, hit) in cpu.hits.iter().enumerate() {
                 let (Some(hit), Some(triangle)) = (hit, gbuffer.triangle[i]) else { continue };
                 if triangle != hit.triangle {
@@ -386,15 +388,19 @@ fn the_gbuffer_matches_the_cpu_rasterizer() {
                 let normal = glam::Vec3::from(gbuffer.normal[i]).as_dvec3();
                 let kind = usize::from(clipped(mesh, view_proj, triangle));
                 clipped_pixels += kind;
-                worst[kind][0] = worst[kind][0].max((position - hit.position).length());
+                let error = (position - hit.position).length();
+                if error > worst[kind][0] {
+                    worst_at[kind] = (i % scene.width, i / scene.width, triangle);
+                }
+                worst[kind][0] = worst[kind][0].max(error);
                 worst[kind][1] = worst[kind][1].max((normal - hit.normal).length());
             }
             let covered = cpu_covered.iter().filter(|c| **c).count();
             log(&format!(
                 "camera {c}, mesh {m}: {covered} pixels covered, coverage mismatches {mismatches:?}, other \
-                 triangle {other_triangle:?}, largest position and normal errors {:.1e} {:.1e} (clipped \
-                 triangles: {:.1e} {:.1e})",
-                worst[0][0], worst[0][1], worst[1][0], worst[1][1]
+                 triangle {other_triangle:?}, largest position and normal errors {:.1e} {:.1e} at {:?} \
+                 (clipped triangles: {:.1e} {:.1e} at {:?}; (x, y, triangle))",
+                worst[0][0], worst[0][1], worst_at[0], worst[1][0], worst[1][1], worst_at[1]
             ));
             assert!(covered > 100, "camera {c}, mesh {m}: only {covered} pixels covered");
             assert!(

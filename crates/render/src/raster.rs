@@ -88,7 +88,7 @@ pub fn check_size(width: usize, height: usize) -> Result<(), Error> {
 pub fn rasterize(mesh: &Mesh, view_proj: Mat4, width: usize, height: usize) -> Result<GBuffer, Error> {
     mesh.validate()?;
     check_size(width, height)?;
-    let clip: Vec<Vec4> = mesh.positions.par_iter().map(|p| view_proj * Vec3::from(*p).extend(1.0)).collect();
+    let clip = project(&mesh.positions, view_proj);
     let subs: Vec<SubTriangle> = mesh
         .indices
         .par_chunks_exact(3)
@@ -128,11 +128,27 @@ pub fn rasterize(mesh: &Mesh, view_proj: Mat4, width: usize, height: usize) -> R
     Ok(GBuffer { width, height, hits })
 }
 
+/// Step 1: the vertices' clip-space positions, `view_proj * (p, 1)` in `f32`. A GPU that
+/// projects for itself may fuse the multiply-adds and round differently, which moves a snapped
+/// vertex by a sub-pixel step where it lies near a rounding tie: `gpu::preview` draws with these.
+pub fn project(positions: &[[f32; 3]], view_proj: Mat4) -> Vec<Vec4> {
+    positions.par_iter().map(|p| view_proj * Vec3::from(*p).extend(1.0)).collect()
+}
+
 /// The viewport coordinates `(x_f, y_f, z_f)` of a clip-space position (step 3, before snapping).
 pub fn to_viewport(clip: Vec4, width: usize, height: usize) -> Vec3 {
     let (half_w, half_h) = (width as f32 * 0.5, height as f32 * 0.5);
     let ndc = clip.truncate() / clip.w;
     Vec3::new(half_w * ndc.x + half_w, -half_h * ndc.y + half_h, ndc.z)
+}
+
+/// The snapped viewport `x` and `y` (steps 3 and 4) of a vertex inside the clip volume, `None`
+/// outside it (where the triangle is clipped first).
+pub fn snapped(clip: Vec4, width: usize, height: usize) -> Option<[i64; 2]> {
+    plane_distances(clip).iter().all(|d| *d >= 0.0).then(|| {
+        let v = to_viewport(clip, width, height);
+        [snap(v.x), snap(v.y)]
+    })
 }
 
 /// A viewport coordinate snapped to 1/256 pixel, as an integer count of 1/256 pixels.
