@@ -288,10 +288,13 @@ impl Settings {
     }
 }
 
-/// A shadeable pixel's G-buffer (module docs, "The G-buffer").
+/// A shadeable pixel's G-buffer (module docs, "The G-buffer"), what the plan reads; its shading
+/// frame is made again where a pixel is shaded or predicted ([`shading_frame`]). Kept small: a
+/// frame allocates one per render pixel, and fresh memory costs more than the arithmetic.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Pixel {
-    pub frame: ShadingFrame,
+    /// `cos theta_o` of the shading frame.
+    pub cos_o: f64,
     pub depth: f64,
     pub curvature: f64,
     /// The normal projected on the screen (x right, y down), unit, or zero when it faces the
@@ -306,15 +309,13 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
     let eye = scene.camera.eye().as_dvec3();
     let [_, right, up] = scene.camera.basis();
     let (w, h) = (gbuffer.width, gbuffer.height);
-    let frames: Vec<Option<ShadingFrame>> =
-        gbuffer.hits.par_iter().map(|hit| hit.as_ref().and_then(|hit| ShadingFrame::new(hit, eye))).collect();
-    let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|_| frames[y * w + x].is_some());
+    let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|hit| ShadingFrame::new(hit, eye).is_some());
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let (x, y) = (i % w, i / w);
-            let frame = frames[i]?;
-            let hit = at(x, y)?;
+            let hit = gbuffer.hits[i].as_ref()?;
+            let frame = ShadingFrame::new(hit, eye)?;
             // The curvature along one axis from the neighbours that are there (module docs).
             let axis = |a: Option<&crate::raster::Hit>, b: Option<&crate::raster::Hit>| {
                 let (a, b) = (a.unwrap_or(hit), b.unwrap_or(hit));
@@ -329,7 +330,7 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
             let screen_normal = if length > 1e-9 { [projected[0] / length, projected[1] / length] } else { [0.0; 2] };
             let wo = (eye - hit.position).normalize();
             Some(Pixel {
-                frame,
+                cos_o: frame.cos_o,
                 mirror: 2.0 * frame.n.dot(wo) * frame.n - wo,
                 depth: (eye - hit.position).length(),
                 curvature: horizontal.max(vertical),
@@ -337,6 +338,14 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
             })
         })
         .collect()
+}
+
+/// The shading frame of render pixel `i`, which [`pixels`] found shadeable.
+fn shading_frame(scene: &Scene, gbuffer: &GBuffer, i: usize) -> ShadingFrame {
+    gbuffer.hits[i]
+        .as_ref()
+        .and_then(|hit| ShadingFrame::new(hit, scene.camera.eye().as_dvec3()))
+        .expect("a shadeable pixel has a shading frame")
 }
 
 /// The bandwidth buffer's entry of one pixel (module docs, "The bandwidth buffer").
@@ -437,6 +446,9 @@ pub(crate) fn predict(
 
 /// What the prediction of a frame reads.
 pub(crate) struct Frame<'a> {
+    /// The render's scene and G-buffer.
+    pub scene: &'a Scene,
+    pub gbuffer: &'a GBuffer,
     pub material: &'a Material,
     pub lighting: &'a Lighting,
     pub bandwidths: &'a Bandwidths,
@@ -451,11 +463,12 @@ pub(crate) struct Frame<'a> {
 /// bandwidth (cycles per pixel) and variance.
 fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
     let Frame { material, lighting, bandwidths, settings, radians_per_pixel, .. } = *frame;
+    let shading = shading_frame(frame.scene, frame.gbuffer, i);
     let s = &material.samples;
     let level0 = lighting.mips.level(0);
     let n_b = settings.n_b.min(s.n_samples);
     let hashed_seed = pcg_hash(settings.seed ^ 0x9e37_79b9);
-    let k = slice_of(p.frame.theta_o(), s.n_slices);
+    let k = slice_of(shading.theta_o(), s.n_slices);
     let vector = pcg_hash(i as u32 ^ hashed_seed) as usize % s.n_vectors;
     let start = (k * s.n_vectors + vector) * s.n_samples;
     let (mut weight, mut weighted, mut variance) = (0.0, 0.0, 0.0);
@@ -465,15 +478,15 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
         if !(pdf > 0.0 && wi_local.z > 0.0) {
             continue;
         }
-        let f = merl::luminance(brdf(material, wi_local, p.frame.wo_local));
-        let wi = p.frame.to_world(wi_local);
+        let f = merl::luminance(brdf(material, wi_local, shading.wo_local));
+        let wi = shading.to_world(wi_local);
         // One map coordinate for the radiance and the bandwidth: the same texel grid.
         let (u, v) = envmap::uv(wi);
         let radiance = envmap::luminance(level0.lookup_uv(u, v).map(f64::from));
         let g = radiance * f * wi_local.z;
         let nu_env = bandwidths.environment.at_uv(u, v);
-        let rho = f64::from(bandwidths.brdf.lookup(wi_local, p.frame.wo_local));
-        let at_eye = bandwidth_at_eye(nu_env, rho, p.curvature, p.depth, p.frame.cos_o);
+        let rho = f64::from(bandwidths.brdf.lookup(wi_local, shading.wo_local));
+        let at_eye = bandwidth_at_eye(nu_env, rho, p.curvature, p.depth, shading.cos_o);
         weight += g / pdf;
         weighted += g / pdf * at_eye;
         variance += match settings.mode {
@@ -639,7 +652,7 @@ fn upsample_weights(
     };
     let (x0, fx) = axis(bx, parent.width);
     let (y0, fy) = axis(by, parent.height);
-    let cos_x = me.frame.cos_o.max(0.1);
+    let cos_x = me.cos_o.max(0.1);
     let mut out = [(0u32, 0f32); 4];
     let (mut count, mut total) = (0u8, 0.0f64);
     let mut weights = [0.0f64; 4];
@@ -664,7 +677,7 @@ fn upsample_weights(
         let across = -v[0] * ny + v[1] * nx;
         let g_a = (-(along * along / (cos_x * cos_x) + across * across)).exp();
         let g_lobe = sharpness.map_or(1.0, |rows| {
-            let lambda = |p: &Pixel| rows[(((1.0 - p.frame.cos_o) * rows.len() as f64) as usize).min(rows.len() - 1)];
+            let lambda = |p: &Pixel| rows[(((1.0 - p.cos_o) * rows.len() as f64) as usize).min(rows.len() - 1)];
             lobe_similarity(me.mirror, lambda(me), them.mirror, lambda(them))
         });
         let w = g_z * g_a * alpha * g_lobe;
@@ -1016,7 +1029,16 @@ pub fn render_with(
     let gbuffer_ms = lap();
     let top = top_level(width, height, settings.max_level);
     let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
-    let frame = Frame { material, lighting, bandwidths, settings, radians_per_pixel, top };
+    let frame = Frame {
+        scene: &render_scene,
+        gbuffer: &gbuffer,
+        material,
+        lighting,
+        bandwidths,
+        settings,
+        radians_per_pixel,
+        top,
+    };
     let mut predictions = predict(&pixels, (width, height), &frame, predictor)?;
     if let Some(oracle) = oracle {
         if oracle.len() != predictions.len() {
@@ -1072,9 +1094,9 @@ pub fn render_with(
         None => shaded
             .par_iter()
             .map(|&(pixel, samples)| {
-                let frame = &pixels[pixel as usize].as_ref().expect("a valid block's pixels are shadeable").frame;
+                let frame = shading_frame(&render_scene, &gbuffer, pixel as usize);
                 let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
-                shade(frame, pixel, material, lighting, &shading).map(|v| v as f32)
+                shade(&frame, pixel, material, lighting, &shading).map(|v| v as f32)
             })
             .collect(),
     };
