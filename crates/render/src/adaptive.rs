@@ -1137,11 +1137,11 @@ pub fn render_with(
         origin[k] = computed.iter().map(|c| c.1).collect();
     }
 
-    let level0 = lighting.mips.level(0);
+    let (level0, rays) = (lighting.mips.level(0), render_scene.camera.rays(width, height));
     let render_rgb: Vec<[f32; 3]> = (0..width * height)
         .into_par_iter()
         .map(|i| match (&gbuffer.hits[i], &pixels[i]) {
-            (None, _) => background(&render_scene, level0, i % width, i / width).map(|v| v as f32),
+            (None, _) => background(&rays, level0, i % width, i / width).map(|v| v as f32),
             (Some(_), None) => [0.0; 3],
             (Some(_), Some(_)) => values[0][i],
         })

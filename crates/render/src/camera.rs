@@ -122,11 +122,39 @@ impl Camera {
     /// `f = normalize(target - eye)`, `r = normalize(f x z)`, `u = r x f` (the basis of
     /// `look_at_rh`), `x_ndc = 2 (x + 1/2) / width - 1`, `y_ndc = 1 - 2 (y + 1/2) / height`.
     pub fn ray(&self, x: usize, y: usize, width: usize, height: usize) -> DVec3 {
-        let [forward, right, up] = self.basis();
-        let aspect = width as f64 / height as f64;
-        let tan_half = (0.5 * f64::from(self.fov_y)).tan();
-        let x_ndc = 2.0 * (x as f64 + 0.5) / width as f64 - 1.0;
-        let y_ndc = 1.0 - 2.0 * (y as f64 + 0.5) / height as f64;
+        self.rays(width, height).ray(x, y)
+    }
+
+    /// [`Camera::ray`] for every pixel of a `width x height` image, with the basis and the
+    /// tangent made once (they cost as much as the rest of a ray).
+    pub fn rays(&self, width: usize, height: usize) -> Rays {
+        Rays {
+            basis: self.basis(),
+            aspect: width as f64 / height as f64,
+            tan_half: (0.5 * f64::from(self.fov_y)).tan(),
+            width: width as f64,
+            height: height as f64,
+        }
+    }
+}
+
+/// The pixel rays of one camera and image size ([`Camera::rays`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Rays {
+    basis: [DVec3; 3],
+    aspect: f64,
+    tan_half: f64,
+    width: f64,
+    height: f64,
+}
+
+impl Rays {
+    /// [`Camera::ray`] through the centre of pixel `(x, y)`.
+    pub fn ray(&self, x: usize, y: usize) -> DVec3 {
+        let [forward, right, up] = self.basis;
+        let (aspect, tan_half) = (self.aspect, self.tan_half);
+        let x_ndc = 2.0 * (x as f64 + 0.5) / self.width - 1.0;
+        let y_ndc = 1.0 - 2.0 * (y as f64 + 0.5) / self.height;
         (forward + x_ndc * tan_half * aspect * right + y_ndc * tan_half * up).normalize()
     }
 }

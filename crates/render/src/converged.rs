@@ -54,6 +54,7 @@ pub fn converged(
     }
     let gbuffer = visibility(scene)?;
     let level0 = lighting.mips.level(0);
+    let rays = scene.camera.rays(scene.width, scene.height);
     let env = EnvSampler::new(level0);
     let eye = scene.camera.eye().as_dvec3();
     let width = scene.width;
@@ -68,7 +69,7 @@ pub fn converged(
                     }
                     None => [0.0; 3],
                 },
-                None => background(scene, level0, x, y),
+                None => background(&rays, level0, x, y),
             };
             out.copy_from_slice(&value.map(|v| v as f32));
         }

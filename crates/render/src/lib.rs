@@ -134,7 +134,7 @@ mod error;
 mod mesh;
 mod shade;
 
-pub use camera::Camera;
+pub use camera::{Camera, Rays};
 pub use error::Error;
 pub use mesh::Mesh;
 pub use shade::{Image, check_inputs, check_settings, render};

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::error::Error;
 use crate::raster::{self, GBuffer, Hit};
-use crate::{Lighting, Material, Mode, SampleSet, Scene, Settings, sample_range};
+use crate::{Lighting, Material, Mode, Rays, SampleSet, Scene, Settings, sample_range};
 
 /// A rendered image: linear RGB radiance, interleaved, row-major with row 0 at the top, and
 /// which pixels a triangle covers (the others show the environment).
@@ -30,6 +30,7 @@ pub fn render(scene: &Scene, material: &Material, lighting: &Lighting, settings:
     let gbuffer = visibility(scene)?;
     let eye = scene.camera.eye().as_dvec3();
     let level0 = lighting.mips.level(0);
+    let rays = scene.camera.rays(scene.width, scene.height);
     let width = scene.width;
     let mut rgb = vec![0.0f32; 3 * width * scene.height];
     rgb.par_chunks_mut(3 * width).enumerate().for_each(|(y, row)| {
@@ -39,7 +40,7 @@ pub fn render(scene: &Scene, material: &Material, lighting: &Lighting, settings:
                     Some(frame) => shade(&frame, (y * width + x) as u32, material, lighting, settings),
                     None => [0.0; 3],
                 },
-                None => background(scene, level0, x, y),
+                None => background(&rays, level0, x, y),
             };
             out.copy_from_slice(&value.map(|v| v as f32));
         }
@@ -58,8 +59,8 @@ pub(crate) fn visibility(scene: &Scene) -> Result<GBuffer, Error> {
 }
 
 /// The environment behind pixel `(x, y)`: level 0, bilinear, along the ray through its centre.
-pub(crate) fn background(scene: &Scene, level0: &EnvMap, x: usize, y: usize) -> [f64; 3] {
-    level0.lookup(scene.camera.ray(x, y, scene.width, scene.height)).map(f64::from)
+pub(crate) fn background(rays: &Rays, level0: &EnvMap, x: usize, y: usize) -> [f64; 3] {
+    level0.lookup(rays.ray(x, y)).map(f64::from)
 }
 
 /// The shading frame at a covered pixel (crate documentation, "The shading frame").
