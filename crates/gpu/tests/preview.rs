@@ -19,6 +19,7 @@ use merl::analytic::Analytic;
 use render::metrics::{psnr_db, relative_error, tonemap};
 use render::{Camera, Image, Lighting, Material, Mesh, Mode, SampleSet, Scene, Settings};
 
+use crate::fixtures::bandwidths;
 use crate::support::{gpu, log};
 
 /// PSNR of the tone-mapped GPU image against the CPU's, in dB, must reach this. The two differ by
@@ -522,29 +523,6 @@ fn inconsistent_settings_are_rejected_like_the_cpu_rejects_them() {
     assert!(matches!(error, GpuError::Scene(_)), "{error}");
 }
 
-/// Bandwidths for the adaptive frames: a smooth environment bandwidth (0.2 to 4.2 cycles per
-/// radian over latitude) and an atlas varying with the incident row, low enough for a 64-pixel
-/// image to shade at several levels.
-fn adaptive_bandwidths() -> render::adaptive::Bandwidths {
-    let (w, h) = (64, 32);
-    let values = (0..w * h).map(|i| 0.2 + 4.0 * ((i / w) as f32 * 0.4).sin().abs()).collect();
-    let environment = render::adaptive::EnvBandwidth::new(w, h, values).unwrap();
-    let (lobes, tile) = (8, 4);
-    let data =
-        (0..lobes * tile * lobes * tile).map(|i| 0.25 + 2.0 * ((i / (lobes * tile)) / tile) as f32 / 8.0).collect();
-    let brdf = brdf_atlas::Atlas {
-        lobes_x: lobes,
-        lobes_y: lobes,
-        tile,
-        data,
-        parameterization: brdf_atlas::Parameterization::IncidencePlaneEquidistant,
-        analysis_size: 16,
-        eps: 0.01,
-        c: 0.1767766952966369,
-    };
-    render::adaptive::Bandwidths { environment, brdf }
-}
-
 /// Issue 11: the bandwidth buffer predicted on the GPU (`Renderer::predict_blocks`) equals the
 /// CPU's (`render::adaptive`) to f32 rounding, for both estimators' variances, with and without
 /// anti-aliasing and per pixel or per block. Tolerance: the GPU works in f32 and reads the
@@ -554,7 +532,7 @@ fn adaptive_bandwidths() -> render::adaptive::Bandwidths {
 /// equal.
 #[test]
 fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
-    let (material, lighting, bandwidths) = (phong(), sky_lighting(), adaptive_bandwidths());
+    let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
     for (mode, supersample, predict_level) in
         [(Mode::Reference, 1, 0), (Mode::Prefiltered, 1, 0), (Mode::Reference, 2, 1), (Mode::Reference, 1, 2)]
@@ -602,7 +580,7 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
 /// without anti-aliasing, for both estimators.
 #[test]
 fn adaptive_frames_on_the_gpu_equal_the_cpu() {
-    let (material, lighting, bandwidths) = (phong(), sky_lighting(), adaptive_bandwidths());
+    let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
     for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 4), (Mode::Reference, 2, 4)] {
         let settings =

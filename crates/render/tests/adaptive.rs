@@ -2,35 +2,12 @@
 //! keep their invariants on real frames, and the plan reduces to the full-resolution renderer
 //! when it may not coarsen.
 
-use brdf_atlas::{Atlas, Parameterization};
 use rand::{Rng, SeedableRng, rngs::StdRng};
-use render::adaptive::{self, Action, Bandwidths, EnvBandwidth, Prediction};
+use render::adaptive::{self, Action, Prediction};
 use render::{Mode, Settings};
 
+use crate::fixtures::bandwidths;
 use crate::support::{phong, sky_lighting, sphere_scene};
-
-/// Bandwidths with structure, low enough for a small image to have pixels at every level: the
-/// environment's varies with latitude (0.2 to 4.2 cycles per radian), the atlas's with the
-/// incident row (0.25 to 2.25).
-fn bandwidths() -> Bandwidths {
-    let (w, h) = (64, 32);
-    let values = (0..w * h).map(|i| 0.2 + 4.0 * ((i / w) as f32 * 0.4).sin().abs()).collect();
-    let environment = EnvBandwidth::new(w, h, values).unwrap();
-    let (lobes, tile) = (8, 4);
-    let data =
-        (0..lobes * tile * lobes * tile).map(|i| 0.25 + 2.0 * ((i / (lobes * tile)) / tile) as f32 / 8.0).collect();
-    let brdf = Atlas {
-        lobes_x: lobes,
-        lobes_y: lobes,
-        tile,
-        data,
-        parameterization: Parameterization::IncidencePlaneEquidistant,
-        analysis_size: 16,
-        eps: 0.01,
-        c: 0.1767766952966369,
-    };
-    Bandwidths { environment, brdf }
-}
 
 #[test]
 fn eq_11_takes_the_nyquist_rate() {

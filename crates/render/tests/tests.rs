@@ -1,5 +1,7 @@
 //! The render crate's integration tests, one module per topic.
 
+#[path = "fixtures/bandwidths.rs"]
+mod fixtures;
 mod support;
 
 mod adaptive;
