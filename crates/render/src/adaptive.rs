@@ -309,7 +309,12 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
     let eye = scene.camera.eye().as_dvec3();
     let [_, right, up] = scene.camera.basis();
     let (w, h) = (gbuffer.width, gbuffer.height);
-    let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|hit| ShadingFrame::new(hit, eye).is_some());
+    let shadeable: Vec<bool> = gbuffer
+        .hits
+        .par_iter()
+        .map(|hit| hit.as_ref().is_some_and(|hit| ShadingFrame::new(hit, eye).is_some()))
+        .collect();
+    let at = |x: usize, y: usize| gbuffer.hits[y * w + x].as_ref().filter(|_| shadeable[y * w + x]);
     (0..w * h)
         .into_par_iter()
         .map(|i| {
