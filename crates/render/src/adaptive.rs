@@ -345,12 +345,9 @@ pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
         .collect()
 }
 
-/// The shading frame of render pixel `i`, which [`pixels`] found shadeable.
-fn shading_frame(scene: &Scene, gbuffer: &GBuffer, i: usize) -> ShadingFrame {
-    gbuffer.hits[i]
-        .as_ref()
-        .and_then(|hit| ShadingFrame::new(hit, scene.camera.eye().as_dvec3()))
-        .expect("a shadeable pixel has a shading frame")
+/// The shading frame of render pixel `i`, which [`pixels`] found shadeable, seen from `eye`.
+fn shading_frame(gbuffer: &GBuffer, eye: DVec3, i: usize) -> ShadingFrame {
+    gbuffer.hits[i].as_ref().and_then(|hit| ShadingFrame::new(hit, eye)).expect("a shadeable pixel has a shading frame")
 }
 
 /// The bandwidth buffer's entry of one pixel (module docs, "The bandwidth buffer").
@@ -451,9 +448,9 @@ pub(crate) fn predict(
 
 /// What the prediction of a frame reads.
 pub(crate) struct Frame<'a> {
-    /// The render's scene and G-buffer.
-    pub scene: &'a Scene,
+    /// The render's G-buffer and the camera's eye.
     pub gbuffer: &'a GBuffer,
+    pub eye: DVec3,
     pub material: &'a Material,
     pub lighting: &'a Lighting,
     pub bandwidths: &'a Bandwidths,
@@ -468,7 +465,7 @@ pub(crate) struct Frame<'a> {
 /// bandwidth (cycles per pixel) and variance.
 fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
     let Frame { material, lighting, bandwidths, settings, radians_per_pixel, .. } = *frame;
-    let shading = shading_frame(frame.scene, frame.gbuffer, i);
+    let shading = shading_frame(frame.gbuffer, frame.eye, i);
     let s = &material.samples;
     let level0 = lighting.mips.level(0);
     let n_b = settings.n_b.min(s.n_samples);
@@ -1035,8 +1032,8 @@ pub fn render_with(
     let top = top_level(width, height, settings.max_level);
     let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
     let frame = Frame {
-        scene: &render_scene,
         gbuffer: &gbuffer,
+        eye: render_scene.camera.eye().as_dvec3(),
         material,
         lighting,
         bandwidths,
@@ -1099,9 +1096,9 @@ pub fn render_with(
         None => shaded
             .par_iter()
             .map(|&(pixel, samples)| {
-                let frame = shading_frame(&render_scene, &gbuffer, pixel as usize);
+                let local = shading_frame(&gbuffer, frame.eye, pixel as usize);
                 let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
-                shade(&frame, pixel, material, lighting, &shading).map(|v| v as f32)
+                shade(&local, pixel, material, lighting, &shading).map(|v| v as f32)
             })
             .collect(),
     };
