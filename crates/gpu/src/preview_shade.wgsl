@@ -316,6 +316,32 @@ fn shading_frame(hit: Hit) -> MaybeFrame {
     return MaybeFrame(true, ShadingFrame(t, b, n, cos_o, wo_local));
 }
 
+// A pixel of the G-buffer (`render::adaptive::pixels`): its hit and shading frame where it is
+// shadeable (inside the image, covered, with a frame).
+struct Surface {
+    found: bool,
+    hit: Hit,
+    frame: ShadingFrame,
+}
+
+fn surface_at(x: i32, y: i32) -> Surface {
+    var none: Surface;
+    none.found = false;
+    if (x < 0 || y < 0 || x >= i32(shade.width) || y >= i32(shade.height)) {
+        return none;
+    }
+    let t = textureLoad(gbuffer_triangle, vec2<i32>(x, y), 0).x;
+    if (t == 0u) {
+        return none;
+    }
+    let hit = interpolate_hit(t - 1u, u32(x), u32(y));
+    let maybe = shading_frame(hit);
+    if (!maybe.valid) {
+        return none;
+    }
+    return Surface(true, hit, maybe.frame);
+}
+
 fn to_world(frame: ShadingFrame, local: vec3<f32>) -> vec3<f32> {
     return local.x * frame.t + local.y * frame.b + local.z * frame.n;
 }
@@ -535,15 +561,10 @@ fn shade_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let item = bitcast<vec4<u32>>(accumulation[i]);
     let pixel = item.x;
-    let x = pixel % shade.width;
-    let y = pixel / shade.width;
-    let triangle = textureLoad(gbuffer_triangle, vec2<i32>(i32(x), i32(y)), 0).x;
+    let surface = surface_at(i32(pixel % shade.width), i32(pixel / shade.width));
     var radiance = vec3<f32>(0.0);
-    if (triangle > 0u) {
-        let maybe = shading_frame(interpolate_hit(triangle - 1u, x, y));
-        if (maybe.valid) {
-            radiance = estimate(maybe.frame, pixel, 0u, item.y);
-        }
+    if (surface.found) {
+        radiance = estimate(surface.frame, pixel, 0u, item.y);
     }
     accumulation[i] = vec4<f32>(radiance, 1.0);
 }
@@ -626,32 +647,9 @@ fn bandwidth_at_eye(nu_env: f32, rho: f32, c: f32, depth: f32, cos_x: f32) -> f3
     return abs(nu.y);
 }
 
-// A neighbour of the G-buffer (`render::adaptive::pixels`): its hit where it is shadeable.
-struct Neighbour {
-    found: bool,
-    hit: Hit,
-}
-
-fn shadeable_hit(x: i32, y: i32) -> Neighbour {
-    var none: Neighbour;
-    none.found = false;
-    if (x < 0 || y < 0 || x >= i32(shade.width) || y >= i32(shade.height)) {
-        return none;
-    }
-    let t = textureLoad(gbuffer_triangle, vec2<i32>(x, y), 0).x;
-    if (t == 0u) {
-        return none;
-    }
-    let hit = interpolate_hit(t - 1u, u32(x), u32(y));
-    if (!shading_frame(hit).valid) {
-        return none;
-    }
-    return Neighbour(true, hit);
-}
-
 // The curvature along one screen axis from the neighbours that are there (`render::adaptive`,
 // "The G-buffer"): |n(a) - n(b)| / |p(a) - p(b)|, the pixel itself standing in for a missing one.
-fn curvature_axis(a: Neighbour, b: Neighbour, me: Hit) -> f32 {
+fn curvature_axis(a: Surface, b: Surface, me: Hit) -> f32 {
     var pa = me;
     var pb = me;
     if (a.found) {
@@ -671,20 +669,16 @@ fn curvature_axis(a: Neighbour, b: Neighbour, me: Hit) -> f32 {
 // pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the pre-convolved estimator) from the
 // first `n_b` samples of the pixel's vector; (-1, -1) where the pixel is not shadeable.
 fn predict_pixel(x: u32, y: u32) -> vec2<f32> {
-    let t = textureLoad(gbuffer_triangle, vec2<i32>(i32(x), i32(y)), 0).x;
-    if (t == 0u) {
-        return vec2<f32>(-1.0);
-    }
-    let hit = interpolate_hit(t - 1u, x, y);
-    let maybe = shading_frame(hit);
-    if (!maybe.valid) {
-        return vec2<f32>(-1.0);
-    }
-    let frame = maybe.frame;
     let xi = i32(x);
     let yi = i32(y);
-    let horizontal = curvature_axis(shadeable_hit(xi - 1, yi), shadeable_hit(xi + 1, yi), hit);
-    let vertical = curvature_axis(shadeable_hit(xi, yi - 1), shadeable_hit(xi, yi + 1), hit);
+    let me = surface_at(xi, yi);
+    if (!me.found) {
+        return vec2<f32>(-1.0);
+    }
+    let hit = me.hit;
+    let frame = me.frame;
+    let horizontal = curvature_axis(surface_at(xi - 1, yi), surface_at(xi + 1, yi), hit);
+    let vertical = curvature_axis(surface_at(xi, yi - 1), surface_at(xi, yi + 1), hit);
     let curvature = max(horizontal, vertical);
     let depth = length(shade.eye.xyz - hit.position);
     let pixel = y * shade.width + x;
