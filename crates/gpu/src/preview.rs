@@ -29,6 +29,7 @@
 //! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
 
 use std::cell::{Cell, RefCell};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -253,9 +254,10 @@ pub struct Renderer {
     /// `VERTEX_FLOATS` per vertex: the clip-space position and the snapped viewport coordinates
     /// with the current camera, the position and the normal (`rasterize` writes it).
     vertex_buffer: wgpu::Buffer,
-    /// The mesh's positions and normals.
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
+    mesh: render::Mesh,
+    /// What the current camera sees, for adaptive frames ([`Renderer::adaptive_geometry`]):
+    /// made at the first adaptive frame after a camera change, for one supersampling.
+    geometry: RefCell<Option<Arc<render::adaptive::Geometry>>>,
     raster_group: wgpu::BindGroup,
     triangle_target: wgpu::Texture,
     depth_target: wgpu::Texture,
@@ -560,8 +562,8 @@ impl Renderer {
                 n_indices: scene.mesh.indices.len() as u32,
                 raster_pipeline,
                 vertex_buffer,
-                positions: scene.mesh.positions.clone(),
-                normals: scene.mesh.normals.clone(),
+                mesh: scene.mesh.clone(),
+                geometry: RefCell::new(None),
                 raster_group,
                 triangle_target,
                 depth_target,
@@ -612,6 +614,7 @@ impl Renderer {
     /// image size stays.
     pub fn set_camera(&mut self, camera: &Camera) -> Result<(), GpuError> {
         self.camera = *camera;
+        *self.geometry.get_mut() = None;
         self.restart();
         self.rasterize()
     }
@@ -789,33 +792,43 @@ impl Renderer {
         Ok(())
     }
 
-    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) with its bandwidth
-    /// buffer predicted ([`Renderer::predict_blocks`], with the bandwidths of
+    /// What the current camera sees, for adaptive frames rendered at `supersample` times an output
+    /// image (`render::adaptive::Geometry`): the G-buffer on the CPU with its per-pixel
+    /// quantities. Made once per camera, as the raster pass is, and kept for its frames; made
+    /// again for another supersampling. The renderer's size must be `supersample` times the
+    /// output's.
+    pub fn adaptive_geometry(&self, supersample: usize) -> Result<Arc<render::adaptive::Geometry>, GpuError> {
+        let ss = supersample as u32;
+        if !matches!(supersample, 1 | 2 | 4) || !self.width.is_multiple_of(ss) || !self.height.is_multiple_of(ss) {
+            return Err(render::Error::Invalid(format!(
+                "the renderer draws {} x {}, which is no output image supersampled {supersample} times (1, 2 or 4)",
+                self.width, self.height
+            ))
+            .into());
+        }
+        if let Some(geometry) = self.geometry.borrow().as_ref().filter(|g| g.supersample() == supersample) {
+            return Ok(Arc::clone(geometry));
+        }
+        let size = ((self.width / ss) as usize, (self.height / ss) as usize);
+        let geometry = Arc::new(render::adaptive::Geometry::new(&self.mesh, &self.camera, size, supersample)?);
+        *self.geometry.borrow_mut() = Some(Arc::clone(&geometry));
+        Ok(geometry)
+    }
+
+    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) of the renderer's
+    /// mesh and camera, its output image `supersample` times smaller than the renderer's, with
+    /// its bandwidth buffer predicted ([`Renderer::predict_blocks`], with the bandwidths of
     /// [`Renderer::set_bandwidths`]) and its shaded blocks shaded ([`Renderer::shade_blocks`])
-    /// here, and the G-buffer, the pyramid, the plan and the up-sampling on the CPU. The renderer
-    /// must have been made for the frame's render size (`scene` times `settings.supersample`)
-    /// with `scene`'s camera.
+    /// here, and the G-buffer ([`Renderer::adaptive_geometry`]), the
+    /// pyramid, the plan, the up-sampling and the background on the CPU.
     pub fn render_adaptive(
         &self,
-        scene: &Scene,
         material: &Material,
         lighting: &Lighting,
         settings: &render::adaptive::Settings,
     ) -> Result<render::adaptive::Adaptive, GpuError> {
-        let ss = settings.supersample as u32;
-        if (self.width, self.height) != (scene.width as u32 * ss, scene.height as u32 * ss)
-            || self.camera != scene.camera
-        {
-            return Err(render::Error::Invalid(format!(
-                "the renderer draws {} x {}, the adaptive frame needs {} x {} with the scene's camera",
-                self.width,
-                self.height,
-                scene.width as u32 * ss,
-                scene.height as u32 * ss
-            ))
-            .into());
-        }
         let bandwidths = &self.prediction.as_ref().ok_or_else(no_bandwidths)?.bandwidths;
+        let geometry = self.adaptive_geometry(settings.supersample)?;
         let failure = RefCell::new(None);
         let fail = |e: GpuError, what: &str| {
             *failure.borrow_mut() = Some(e);
@@ -831,7 +844,7 @@ impl Renderer {
             shader: Some(&mut shader),
             ..Default::default()
         };
-        let frame = render::adaptive::render_with(scene, material, lighting, bandwidths, settings, hooks);
+        let frame = render::adaptive::render_with(&geometry, material, lighting, bandwidths, settings, hooks);
         match failure.into_inner() {
             Some(e) => Err(e),
             None => Ok(frame?),
@@ -891,11 +904,10 @@ impl Renderer {
             return Err(render::Error::Invalid(format!("{} blocks for {pixels} pixels", blocks.len())).into());
         }
         for &(pixel, samples) in blocks {
-            let settings = Settings { mode, spp: samples, frames: 1, seed };
             if u64::from(pixel) >= pixels {
                 return Err(render::Error::Invalid(format!("block pixel {pixel} is outside {pixels} pixels")).into());
             }
-            self.check_settings(&settings)?;
+            self.check_settings(&Settings { mode, spp: samples, frames: 1, seed })?;
         }
         if blocks.is_empty() {
             return Ok(Vec::new());
@@ -968,14 +980,15 @@ impl Renderer {
     fn rasterize(&self) -> Result<(), GpuError> {
         // The CPU's projection and snapping, which the passes read rather than compute
         // (`preview_shade.wgsl`).
-        let clip = render::raster::project(&self.positions, self.view_proj());
+        let clip = render::raster::project(&self.mesh.positions, self.view_proj());
         let (width, height) = (self.width(), self.height());
-        let vertices: Vec<[f32; VERTEX_FLOATS as usize]> = (clip.iter().zip(&self.positions).zip(&self.normals))
-            .map(|((&c, p), n)| {
-                let [x, y] = render::raster::snapped(c, width, height).map_or([0.0; 2], |v| v.map(|s| s as f32));
-                [c.x, c.y, c.z, c.w, x, y, p[0], p[1], p[2], n[0], n[1], n[2]]
-            })
-            .collect();
+        let vertices: Vec<[f32; VERTEX_FLOATS as usize]> =
+            (clip.iter().zip(&self.mesh.positions).zip(&self.mesh.normals))
+                .map(|((&c, p), n)| {
+                    let [x, y] = render::raster::snapped(c, width, height).map_or([0.0; 2], |v| v.map(|s| s as f32));
+                    [c.x, c.y, c.z, c.w, x, y, p[0], p[1], p[2], n[0], n[1], n[2]]
+                })
+                .collect();
         capture_errors(&self.device, || {
             self.queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&vertices));
             let mut encoder = self.device.create_command_encoder(&Default::default());

@@ -316,6 +316,20 @@ fn moving_the_camera_is_setting_up_with_that_camera() {
     let fresh = render_gpu(&mut renderer(&Scene { camera, ..scene.clone() }, phong(), sky_lighting()), &settings);
     assert!(after == fresh, "moving the camera differs from setting up with it");
     assert!(after != before, "the camera did not move");
+
+    // The adaptive frames' G-buffer, made once per camera, is made again for the new one.
+    let adaptive = render::adaptive::Settings { max_spp: 64, ..render::adaptive::Settings::new(Mode::Reference, 4) };
+    let frame = |r: &mut Renderer| {
+        r.set_bandwidths(&bandwidths()).unwrap();
+        r.render_adaptive(phong(), sky_lighting(), &adaptive).unwrap()
+    };
+    moved.set_camera(&scene.camera).unwrap();
+    let before = frame(&mut moved);
+    moved.set_camera(&camera).unwrap();
+    let after = frame(&mut moved);
+    let fresh = frame(&mut renderer(&Scene { camera, ..scene.clone() }, phong(), sky_lighting()));
+    assert!(after.image == fresh.image && after.plan.actions == fresh.plan.actions, "a stale adaptive G-buffer");
+    assert!(after.image != before.image, "the camera did not move");
 }
 
 #[test]
@@ -589,12 +603,13 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         let mut renderer = renderer(&render_scene, material, lighting);
         renderer.set_bandwidths(&bandwidths).unwrap();
         let gpu_frame = renderer
-            .render_adaptive(&scene, material, lighting, &settings)
+            .render_adaptive(material, lighting, &settings)
             .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
         let mut replay = render::adaptive::replay_predictor(&gpu_frame.predictions);
         let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let geometry = render::adaptive::Geometry::of_scene(&scene, settings.supersample).unwrap();
         let cpu_frame =
-            render::adaptive::render_with(&scene, material, lighting, &bandwidths, &settings, hooks).unwrap();
+            render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &settings, hooks).unwrap();
         assert_eq!(gpu_frame.plan.actions, cpu_frame.plan.actions, "the plans differ");
         let shaded: usize = cpu_frame.plan.shaded_per_level().iter().sum();
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
@@ -608,6 +623,6 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     // The prediction needs the bandwidths; without them the frame is an error that says so.
     let renderer = renderer(&scene, material, lighting);
     let settings = render::adaptive::Settings::new(Mode::Reference, 4);
-    let error = renderer.render_adaptive(&scene, material, lighting, &settings).expect_err("no bandwidths");
+    let error = renderer.render_adaptive(material, lighting, &settings).expect_err("no bandwidths");
     assert!(error.to_string().contains("set_bandwidths"), "{error}");
 }

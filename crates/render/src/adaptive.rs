@@ -16,7 +16,10 @@
 //! (radians of normal turn per unit of length: `|n(x+1) - n(x-1)| / |p(x+1) - p(x-1)|` over
 //! the covered neighbours, one-sided at the edges, the larger of the two screen axes; 1 / R on
 //! a sphere of radius R, 0 on a plane), and the material (one per scene: covered or not). A
-//! pixel is *shadeable* when it is covered and has a shading frame (crate docs).
+//! pixel is *shadeable* when it is covered and has a shading frame (crate docs). It depends on
+//! the camera alone: [`Geometry`] holds it, made once per camera and shared by that camera's
+//! frames, as a renderer draws its G-buffer once for the frames of a camera that does not move
+//! (`gpu::preview::Renderer` does both).
 //!
 //! # The bandwidth buffer (`001` eq. 3-6, 9-11)
 //!
@@ -136,8 +139,8 @@ use rayon::prelude::*;
 
 use crate::error::Error;
 use crate::raster::GBuffer;
-use crate::shade::{ShadingFrame, background, brdf, shade, slice_of, visibility};
-use crate::{Image, Lighting, Material, Mode, Scene, pcg_hash};
+use crate::shade::{ShadingFrame, background, brdf, shade, slice_of, visibility_of};
+use crate::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, pcg_hash};
 
 /// The environment's local angular bandwidth, in cycles per radian, on the environment's
 /// lat-long grid (`envmap`'s orientation): the bake's `env-bandwidth.exr`.
@@ -304,10 +307,87 @@ pub(crate) struct Pixel {
     pub mirror: DVec3,
 }
 
+/// What a camera sees, for its adaptive frames (module docs, "The G-buffer"): the G-buffer of
+/// the render (the output's size times the supersampling) and its pixels' quantities. Made once
+/// per camera; every frame of that camera and supersampling reads it.
+#[derive(Clone)]
+pub struct Geometry {
+    camera: Camera,
+    /// The output's size.
+    size: (usize, usize),
+    supersample: usize,
+    gbuffer: GBuffer,
+    pixels: Vec<Option<Pixel>>,
+    /// Per output pixel: whether a triangle covers any of its render pixels.
+    covered: Vec<bool>,
+    millis: f64,
+}
+
+impl Geometry {
+    /// `mesh` seen from `camera` by an output image of `width x height` rendered at
+    /// `supersample` (1, 2 or 4) times that size along each axis.
+    pub fn new(
+        mesh: &Mesh,
+        camera: &Camera,
+        (width, height): (usize, usize),
+        supersample: usize,
+    ) -> Result<Geometry, Error> {
+        if !matches!(supersample, 1 | 2 | 4) {
+            return Err(Error::Invalid(format!("supersample {supersample} must be 1, 2 or 4")));
+        }
+        let clock = std::time::Instant::now();
+        let (render_width, render_height) = (width * supersample, height * supersample);
+        let gbuffer = visibility_of(mesh, camera, render_width, render_height)?;
+        let pixels = pixels(camera, &gbuffer);
+        let covered = output_coverage(&gbuffer, width, height, supersample);
+        let millis = clock.elapsed().as_secs_f64() * 1e3;
+        Ok(Geometry { camera: *camera, size: (width, height), supersample, gbuffer, pixels, covered, millis })
+    }
+
+    /// The geometry of `scene` rendered at `supersample` times its size.
+    pub fn of_scene(scene: &Scene, supersample: usize) -> Result<Geometry, Error> {
+        Geometry::new(&scene.mesh, &scene.camera, (scene.width, scene.height), supersample)
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The output image's size.
+    pub fn size(&self) -> (usize, usize) {
+        self.size
+    }
+
+    pub fn supersample(&self) -> usize {
+        self.supersample
+    }
+
+    /// The render's size: the output's times the supersampling.
+    pub fn render_size(&self) -> (usize, usize) {
+        (self.gbuffer.width, self.gbuffer.height)
+    }
+
+    /// Wall time it took to make, in milliseconds.
+    pub fn millis(&self) -> f64 {
+        self.millis
+    }
+}
+
+impl std::fmt::Debug for Geometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Geometry")
+            .field("size", &self.size)
+            .field("supersample", &self.supersample)
+            .field("shadeable", &self.pixels.iter().filter(|p| p.is_some()).count())
+            .field("millis", &self.millis)
+            .finish_non_exhaustive()
+    }
+}
+
 /// The G-buffer's pixels, `None` where a pixel is not shadeable.
-pub(crate) fn pixels(scene: &Scene, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
-    let eye = scene.camera.eye().as_dvec3();
-    let [_, right, up] = scene.camera.basis();
+fn pixels(camera: &Camera, gbuffer: &GBuffer) -> Vec<Option<Pixel>> {
+    let eye = camera.eye().as_dvec3();
+    let [_, right, up] = camera.basis();
     let (w, h) = (gbuffer.width, gbuffer.height);
     let shadeable: Vec<bool> = gbuffer
         .hits
@@ -859,14 +939,17 @@ pub struct Adaptive {
     pub samples_per_pixel: Vec<f32>,
     /// Shadeable render pixels.
     pub shadeable: usize,
-    /// Wall time of the steps, in milliseconds: G-buffer, bandwidth buffer (prediction),
-    /// pyramid and plan, shading and up-sampling.
+    /// Wall time of the steps, in milliseconds: G-buffer (made once per camera: the
+    /// [`Geometry`]'s), bandwidth buffer (prediction), pyramid and plan, shading and
+    /// up-sampling.
     pub timings: Timings,
 }
 
 /// Wall time of an adaptive frame's steps, in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Timings {
+    /// The [`Geometry`]'s, made once per camera: not part of the frame's time when its camera
+    /// made frames before.
     pub gbuffer_ms: f64,
     pub predict_ms: f64,
     pub plan_ms: f64,
@@ -918,7 +1001,8 @@ pub fn top_level(width: usize, height: usize, max_level: Option<usize>) -> usize
     max_level.map_or(full, |m| m.min(full))
 }
 
-/// Renders one adaptive frame of `scene` (module docs for every step).
+/// Renders one adaptive frame of `scene` (module docs for every step), its [`Geometry`]
+/// included.
 pub fn render(
     scene: &Scene,
     material: &Material,
@@ -926,7 +1010,8 @@ pub fn render(
     bandwidths: &Bandwidths,
     settings: &Settings,
 ) -> Result<Adaptive, Error> {
-    render_with(scene, material, lighting, bandwidths, settings, Hooks::default())
+    let geometry = Geometry::of_scene(scene, settings.supersample)?;
+    render_with(&geometry, material, lighting, bandwidths, settings, Hooks::default())
 }
 
 /// What [`render_with`] may take from elsewhere instead of computing it here; the default takes
@@ -1003,15 +1088,17 @@ pub fn exact_shader(reference: &Image) -> impl FnMut(&[(u32, u32)]) -> Estimates
     }
 }
 
-/// [`render`], with what `hooks` gives instead of computing it here. `oracle` replaces the
-/// predicted bandwidths (the prediction still runs, for the variance). `predictor`: given the
+/// [`render`] from the `geometry` of the frame's camera (made for `settings.supersample`),
+/// with what `hooks` gives instead of computing it here. `oracle` replaces the predicted
+/// bandwidths (the prediction still runs, for the variance). `predictor`: given the
 /// [`prediction_pixels`], it returns their predictions. `shader`: given every shaded block's
 /// render pixel (row-major index at the render size) and samples, it returns each one's
 /// estimate in frame 0 with that many samples by `settings.mode`'s estimator, as
-/// [`crate::render`] computes it. Everything else (G-buffer, pyramid, plan, up-sampling) runs
-/// here, and the timings include the hooks'.
+/// [`crate::render`] computes it. Everything else (pyramid, plan, up-sampling, the environment
+/// behind the mesh) runs here, and the timings include the hooks'; [`Timings::gbuffer_ms`] is
+/// the geometry's.
 pub fn render_with(
-    scene: &Scene,
+    geometry: &Geometry,
     material: &Material,
     lighting: &Lighting,
     bandwidths: &Bandwidths,
@@ -1021,19 +1108,22 @@ pub fn render_with(
     let Hooks { oracle, predictor, shader } = hooks;
     crate::check_inputs(material, lighting)?;
     check_settings(settings, material, lighting)?;
-    let ss = settings.supersample;
-    let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
-    let (width, height) = (render_scene.width, render_scene.height);
+    if settings.supersample != geometry.supersample {
+        return Err(Error::Invalid(format!(
+            "a frame supersampled {} times from a geometry made for {}",
+            settings.supersample, geometry.supersample
+        )));
+    }
+    let (ss, (output_width, output_height)) = (geometry.supersample, geometry.size);
+    let (width, height) = geometry.render_size();
+    let (gbuffer, pixels) = (&geometry.gbuffer, &geometry.pixels);
     let clock = std::time::Instant::now();
     let lap = || clock.elapsed().as_secs_f64() * 1e3;
-    let gbuffer = visibility(&render_scene)?;
-    let pixels = pixels(&render_scene, &gbuffer);
-    let gbuffer_ms = lap();
     let top = top_level(width, height, settings.max_level);
-    let radians_per_pixel = f64::from(scene.camera.fov_y()) / height as f64;
+    let radians_per_pixel = f64::from(geometry.camera.fov_y()) / height as f64;
     let frame = Frame {
-        gbuffer: &gbuffer,
-        eye: render_scene.camera.eye().as_dvec3(),
+        gbuffer,
+        eye: geometry.camera.eye().as_dvec3(),
         material,
         lighting,
         bandwidths,
@@ -1041,7 +1131,7 @@ pub fn render_with(
         radians_per_pixel,
         top,
     };
-    let mut predictions = predict(&pixels, (width, height), &frame, predictor)?;
+    let mut predictions = predict(pixels, (width, height), &frame, predictor)?;
     if let Some(oracle) = oracle {
         if oracle.len() != predictions.len() {
             return Err(Error::Invalid(format!(
@@ -1057,15 +1147,14 @@ pub fn render_with(
     }
     let predict_ms = lap();
     let levels = pyramid(&predictions, width, height, top);
-    let covered = output_coverage(&gbuffer, scene.width, scene.height, ss);
-    let covered_output = covered.iter().filter(|&&c| c).count() as u64;
+    let covered_output = geometry.covered.iter().filter(|&&c| c).count() as u64;
     // The lobe weight's sharpness per view row: the exponent of the Phong layer the bake picks.
     let sharpness: Option<Vec<f64>> = settings
         .lobe_weight
         .then(|| material.view_layers.iter().map(|&l| f64::from(lighting.exponents[l as usize])).collect());
     let plan = plan(
         levels,
-        &pixels,
+        pixels,
         (width, height),
         u64::from(settings.spp) * covered_output,
         settings,
@@ -1096,7 +1185,7 @@ pub fn render_with(
         None => shaded
             .par_iter()
             .map(|&(pixel, samples)| {
-                let local = shading_frame(&gbuffer, frame.eye, pixel as usize);
+                let local = shading_frame(gbuffer, frame.eye, pixel as usize);
                 let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
                 shade(&local, pixel, material, lighting, &shading).map(|v| v as f32)
             })
@@ -1139,7 +1228,7 @@ pub fn render_with(
         origin[k] = computed.iter().map(|c| c.1).collect();
     }
 
-    let (level0, rays) = (lighting.mips.level(0), render_scene.camera.rays(width, height));
+    let (level0, rays) = (lighting.mips.level(0), geometry.camera.rays(width, height));
     let render_rgb: Vec<[f32; 3]> = (0..width * height)
         .into_par_iter()
         .map(|i| match (&gbuffer.hits[i], &pixels[i]) {
@@ -1148,11 +1237,11 @@ pub fn render_with(
             (Some(_), Some(_)) => values[0][i],
         })
         .collect();
-    let image = downsample(&render_rgb, covered, scene.width, scene.height, ss);
+    let image = downsample(&render_rgb, geometry.covered.clone(), output_width, output_height, ss);
     let shade_ms = lap();
     let timings = Timings {
-        gbuffer_ms,
-        predict_ms: predict_ms - gbuffer_ms,
+        gbuffer_ms: geometry.millis,
+        predict_ms,
         plan_ms: plan_ms - predict_ms,
         shade_ms: shade_ms - plan_ms,
     };
@@ -1215,7 +1304,8 @@ mod tests {
             let scene =
                 Scene { mesh: Mesh::sphere(radius, 256, 128), camera: Camera::default(), width: 96, height: 96 };
             let gbuffer = visibility(&scene).unwrap();
-            let mut curvature: Vec<f64> = pixels(&scene, &gbuffer).iter().flatten().map(|p| p.curvature).collect();
+            let mut curvature: Vec<f64> =
+                pixels(&scene.camera, &gbuffer).iter().flatten().map(|p| p.curvature).collect();
             curvature.sort_by(f64::total_cmp);
             let median = curvature[curvature.len() / 2];
             let expect = 1.0 / f64::from(radius);

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::error::Error;
 use crate::raster::{self, GBuffer, Hit};
-use crate::{Lighting, Material, Mode, Rays, SampleSet, Scene, Settings, sample_range};
+use crate::{Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, sample_range};
 
 /// A rendered image: linear RGB radiance, interleaved, row-major with row 0 at the top, and
 /// which pixels a triangle covers (the others show the environment).
@@ -50,12 +50,16 @@ pub fn render(scene: &Scene, material: &Material, lighting: &Lighting, settings:
 
 /// The G-buffer of a scene, after checking it.
 pub(crate) fn visibility(scene: &Scene) -> Result<GBuffer, Error> {
-    raster::check_size(scene.width, scene.height)?;
-    if (scene.width * scene.height) as u64 > u64::from(u32::MAX) {
-        return Err(Error::LimitExceeded(format!("{} x {} pixels do not fit a u32 index", scene.width, scene.height)));
+    visibility_of(&scene.mesh, &scene.camera, scene.width, scene.height)
+}
+
+/// The G-buffer of `mesh` seen from `camera` at `width x height`, after checking the size.
+pub(crate) fn visibility_of(mesh: &Mesh, camera: &Camera, width: usize, height: usize) -> Result<GBuffer, Error> {
+    raster::check_size(width, height)?;
+    if (width * height) as u64 > u64::from(u32::MAX) {
+        return Err(Error::LimitExceeded(format!("{width} x {height} pixels do not fit a u32 index")));
     }
-    let aspect = scene.width as f32 / scene.height as f32;
-    raster::rasterize(&scene.mesh, scene.camera.view_proj(aspect), scene.width, scene.height)
+    raster::rasterize(mesh, camera.view_proj(width as f32 / height as f32), width, height)
 }
 
 /// The environment behind pixel `(x, y)`: level 0, bilinear, along the ray through its centre.

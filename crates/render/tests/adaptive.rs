@@ -200,7 +200,7 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     let render_exact = |settings: &adaptive::Settings, reference: &render::Image| {
         let mut exact = adaptive::exact_shader(reference);
         adaptive::render_with(
-            &scene,
+            &adaptive::Geometry::of_scene(&scene, settings.supersample)?,
             material,
             &lighting,
             &bandwidths,
@@ -329,7 +329,8 @@ fn a_predictor_replaces_the_prediction_and_is_checked() {
     let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
     let with = |predictor: adaptive::Predictor| {
         let hooks = adaptive::Hooks { predictor: Some(predictor), ..Default::default() };
-        adaptive::render_with(&scene, material, &lighting, &bandwidths, &settings, hooks)
+        let geometry = adaptive::Geometry::of_scene(&scene, settings.supersample)?;
+        adaptive::render_with(&geometry, material, &lighting, &bandwidths, &settings, hooks)
     };
     let replayed = with(&mut adaptive::replay_predictor(&frame.predictions)).unwrap();
     assert_eq!(replayed.predictions, frame.predictions);

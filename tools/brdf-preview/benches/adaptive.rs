@@ -26,7 +26,9 @@
 //!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and the adaptive frames'
 //! bandwidth buffers are predicted and their shaded blocks shaded there too
-//! (`Renderer::predict_blocks`, `Renderer::shade_blocks`), as `brdf-preview` runs them.
+//! (`Renderer::predict_blocks`, `Renderer::shade_blocks`), as `brdf-preview` runs them. The
+//! G-buffer is then the camera's, made once before the frames (`Renderer::adaptive_geometry`),
+//! as the brute force's raster pass is; on the CPU both rasterize in every frame.
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
@@ -120,14 +122,14 @@ fn converged(name: &str, scene: &Scene, material: &Material, lighting: &Lighting
 /// An adaptive frame with what `hooks` gives (a function rather than a closure, whose one
 /// lifetime would make every call's hooks borrow for the same span).
 fn adaptive_frame(
-    scene: &Scene,
+    geometry: &adaptive::Geometry,
     material: &Material,
     lighting: &Lighting,
     bandwidths: &Bandwidths,
     settings: &adaptive::Settings,
     hooks: adaptive::Hooks,
 ) -> adaptive::Adaptive {
-    adaptive::render_with(scene, material, lighting, bandwidths, settings, hooks).expect("adaptive render")
+    adaptive::render_with(geometry, material, lighting, bandwidths, settings, hooks).expect("adaptive render")
 }
 
 /// The best of `runs` wall times of `f`, in milliseconds, and its last result.
@@ -296,6 +298,15 @@ fn main() {
                 let mut renderer = gpu.as_ref().map(|g| {
                     gpu::preview::Renderer::new(g, &scene, &loaded.material, lighting).expect("the GPU renderer")
                 });
+                // The camera's G-buffer. On the GPU it is made once per camera, as the raster
+                // pass the brute force reads is (at Renderer::new), and neither is in a frame's
+                // time; the CPU's brute force rasterizes in every frame, and so does its adaptive
+                // frame.
+                let geometry = renderer.as_ref().map(|r| r.adaptive_geometry(1).expect("the G-buffer"));
+                let frame_geometry = || match &geometry {
+                    Some(g) => std::borrow::Cow::Borrowed(&**g),
+                    None => std::borrow::Cow::Owned(adaptive::Geometry::of_scene(&scene, 1).expect("the G-buffer")),
+                };
                 let curve: Vec<(f64, f64)> = BRUTE_SPP
                     .iter()
                     .map(|&spp| {
@@ -369,7 +380,7 @@ fn main() {
                                     }
                                 });
                                 adaptive_frame(
-                                    &scene,
+                                    &frame_geometry(),
                                     &loaded.material,
                                     lighting,
                                     bandwidths,
@@ -386,7 +397,7 @@ fn main() {
                             // the up-sampling's error alone, the PSNR no budget can pass.
                             let ceiling = psnr(
                                 &adaptive_frame(
-                                    &scene,
+                                    &frame_geometry(),
                                     &loaded.material,
                                     lighting,
                                     bandwidths,
@@ -491,9 +502,9 @@ fn main() {
                         ..adaptive::Settings::new(Mode::Reference, 8)
                     };
                     match renderer {
-                        Some(r) => r
-                            .render_adaptive(&scene, &loaded.material, lighting, &settings)
-                            .expect("adaptive on the GPU"),
+                        Some(r) => {
+                            r.render_adaptive(&loaded.material, lighting, &settings).expect("adaptive on the GPU")
+                        }
                         None => {
                             adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
                                 .expect("adaptive")
@@ -550,10 +561,17 @@ fn main() {
     out(String::new());
     out("## Where the adaptive frames' time goes (paper reading; ms)".into());
     out(String::new());
-    out("Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). \
-         G-buffer, pyramid and plan run on the CPU; the prediction and `shading` (the shaded blocks, \
-         then the up-sampling on the CPU) on the renderer the rest ran on."
-        .into());
+    out(format!(
+        "Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). \
+         G-buffer, pyramid and plan run on the CPU; the prediction and `shading` (the shaded blocks, then the \
+         up-sampling and the background on the CPU) on the renderer the rest ran on. {}",
+        if gpu.is_some() {
+            "The G-buffer is the camera's, made once before its frames and not in `frame`, as the brute force's \
+             raster pass is not in its time."
+        } else {
+            "The G-buffer is made in every frame, as the brute force rasterizes in every frame."
+        }
+    ));
     out(String::new());
     out("| case | mode | budget spp | G-buffer | prediction | pyramid and plan | shading and up-sampling | frame | brute force at equal PSNR |".into());
     out("|---|---|---:|---:|---:|---:|---:|---:|---:|".into());

@@ -488,11 +488,13 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
     renderer.set_bandwidths(bandwidths)?;
     // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
-    // milliseconds): one pixel of each first, so that ms_per_frame times the frame.
+    // milliseconds): one pixel of each first, so that ms_per_frame times the frame. The
+    // G-buffer is the camera's, made once for all its frames as the other modes' raster pass is.
     renderer.predict_blocks(&settings, &[0])?;
     renderer.shade_blocks(mode, settings.seed, &[(0, 1)])?;
+    let geometry = renderer.adaptive_geometry(ss)?;
     let start = Instant::now();
-    let frame = renderer.render_adaptive(&scene, &loaded.material, lighting, &settings)?;
+    let frame = renderer.render_adaptive(&loaded.material, lighting, &settings)?;
     let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
@@ -520,16 +522,17 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     }
     let t = frame.timings;
     let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms (G-buffer {:.1} on the CPU, prediction {:.1} on the GPU, plan {:.1} \
-         on the CPU, shading on the GPU and up-sampling {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
+        "{}: {} on {} ({}), {ms_per_frame:.1} ms (prediction {:.1} on the GPU, plan {:.1} on the CPU, shading on \
+         the GPU and up-sampling {:.1}; the camera's G-buffer on the CPU before, once: {:.1}); shaded fraction {:.4}, \
+         {} samples of a budget of {}",
         out.display(),
         args.mode.name(),
         gpu.adapter_summary(),
         args.mesh,
-        t.gbuffer_ms,
         t.predict_ms,
         t.plan_ms,
         t.shade_ms,
+        t.gbuffer_ms,
         frame.shaded_fraction(),
         frame.plan.samples(),
         frame.plan.budget
@@ -561,7 +564,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         // predictions are read, so its blocks are not shaded.
         let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
         let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
-        let own = render::adaptive::render_with(&scene, &loaded.material, lighting, bandwidths, &settings, hooks)?;
+        let own = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
         let predicted = frame.predictions.iter().zip(&own.predictions).filter(|(g, _)| g.level >= 0);
         let (pixels, differ) =
             predicted.fold((0usize, 0usize), |(n, d), (g, c)| (n + 1, d + usize::from(g.level != c.level)));
@@ -569,7 +572,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         // the values equal to rounding.
         let mut replay = render::adaptive::replay_predictor(&frame.predictions);
         let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
-        let cpu = render::adaptive::render_with(&scene, &loaded.material, lighting, bandwidths, &settings, hooks)?;
+        let cpu = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
         let cpu_picture = metrics::tonemap(&cpu.image, &preview);
         let psnr = metrics::psnr_db(&picture, &cpu_picture);
         let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
@@ -625,7 +628,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
                 ..Default::default()
             };
             let ceiling =
-                render::adaptive::render_with(&scene, &loaded.material, lighting, bandwidths, &settings, hooks)?;
+                render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
             let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &preview), &converged_picture);
             report.push(format!(
                 "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
