@@ -932,7 +932,8 @@ impl Renderer {
         self.progress.set(None);
         let count = items.len() as u32;
         let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: count, frames: 1, seed });
-        let groups = count.div_ceil(64);
+        // A power of two of workgroups, taken in bit-reversed order (`item_index` in the WGSL).
+        let groups = count.div_ceil(64).next_power_of_two();
         let (x, y) = (groups.min(32768), groups.div_ceil(32768));
         capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));

@@ -549,13 +549,33 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
     accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));
 }
 
+// The item of invocation `local` of workgroup `group` in a list of items (`shade_blocks`,
+// `predict_blocks`) dispatched as a power of two of workgroups (`Renderer::run_items`): the
+// workgroups take their runs of 64 items in bit-reversed order. A driver that hands each thread
+// a contiguous range of workgroups (lavapipe does) then gives every thread an even share of any
+// contiguous run of items: an adaptive frame's shaded blocks come level by level, and a coarse
+// level's get many times the samples of a fine level's.
+fn item_index(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
+    let g = group.y * groups.x + group.x;
+    let bits = countTrailingZeros(groups.x * groups.y);
+    var run = 0u;
+    if (bits > 0u) {
+        run = reverseBits(g) >> (32u - bits);
+    }
+    return run * 64u + local;
+}
+
 // The shaded blocks of an adaptive frame (`render::adaptive`): item `i` of `shade.spp` items
 // arrives in `accumulation[i]` as the bits of (pixel, samples, 0, 0) and leaves as the pixel's
 // estimate in frame 0 with that many samples (`render::adaptive`'s shading, the same estimator
 // as `shade_frame`), w = 1. Each invocation reads and writes its own item only.
 @compute @workgroup_size(64)
-fn shade_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let i = gid.y * groups.x * 64u + gid.x;
+fn shade_blocks(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = item_index(group, local, groups);
     if (i >= shade.spp) {
         return;
     }
@@ -721,8 +741,12 @@ fn predict_pixel(x: u32, y: u32) -> vec2<f32> {
 // (`render::adaptive::prediction_pixels`): item `i` of `shade.spp` items arrives in
 // `accumulation[i]` as the bits of (pixel, 0, 0, 0) and leaves as (bandwidth, variance, 0, 1).
 @compute @workgroup_size(64)
-fn predict_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let i = gid.y * groups.x * 64u + gid.x;
+fn predict_blocks(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = item_index(group, local, groups);
     if (i >= shade.spp) {
         return;
     }
