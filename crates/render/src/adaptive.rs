@@ -320,6 +320,7 @@ pub struct Geometry {
     pixels: Vec<Option<Pixel>>,
     /// Per output pixel: whether a triangle covers any of its render pixels.
     covered: Vec<bool>,
+    /// Wall time it took to make, in milliseconds.
     millis: f64,
 }
 
@@ -349,15 +350,6 @@ impl Geometry {
         Geometry::new(&scene.mesh, &scene.camera, (scene.width, scene.height), supersample)
     }
 
-    pub fn camera(&self) -> &Camera {
-        &self.camera
-    }
-
-    /// The output image's size.
-    pub fn size(&self) -> (usize, usize) {
-        self.size
-    }
-
     pub fn supersample(&self) -> usize {
         self.supersample
     }
@@ -365,11 +357,6 @@ impl Geometry {
     /// The render's size: the output's times the supersampling.
     pub fn render_size(&self) -> (usize, usize) {
         (self.gbuffer.width, self.gbuffer.height)
-    }
-
-    /// Wall time it took to make, in milliseconds.
-    pub fn millis(&self) -> f64 {
-        self.millis
     }
 }
 
