@@ -74,11 +74,14 @@ install: build
 	install -m 755 $(addprefix $(BIN)/,$(TOOLS)) $(PREFIX)/bin/
 
 ## test: every unit, property, GPU (lavapipe) and end-to-end test. The test data is made first
-## (test-data), the tools are built once, and the end-to-end tests run those binaries. Without
-## incremental compilation (a clean run gains nothing from it and it costs a gigabyte of disk;
-## set CARGO_INCREMENTAL=1 to keep it).
+## (test-data), the tools and the tests are built once, and the end-to-end tests run those
+## binaries. The tools and the tests are built by one cargo command: built apart, the tools would
+## resolve their dependencies' features without the tests' dev-dependencies, and the tests would
+## then build wgpu, naga and a hundred other crates a second time (five minutes on 2 cores).
+## Without incremental compilation (a clean run gains nothing from it and it costs a gigabyte of
+## disk; set CARGO_INCREMENTAL=1 to keep it).
 test: setup test-data
-	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) build --workspace --bins
+	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) build --workspace --bins --tests
 	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) test --workspace
 
 ## test-data: the 20 real-derived MERL tables the tests read, made once under target/merl/ from

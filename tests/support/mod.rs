@@ -11,7 +11,10 @@ pub fn root() -> PathBuf {
 }
 
 /// Builds every tool once per test run (so the tests never run a stale binary) and returns the
-/// folder that holds them.
+/// folder that holds them. With `--tests`, as `make test` builds them: the tools are then resolved
+/// with the tests' dev-dependencies' features, so `cargo test` has already built them and this
+/// checks only; without it cargo would resolve the features again without them and rebuild wgpu
+/// and a hundred other crates for the tools alone.
 fn bin_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
@@ -20,12 +23,12 @@ fn bin_dir() -> &'static Path {
         let dir = exe.parent().and_then(Path::parent).expect("target/<profile>").to_path_buf();
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
         let mut cmd = Command::new(cargo);
-        cmd.current_dir(root()).args(["build", "--quiet", "--workspace", "--bins"]);
+        cmd.current_dir(root()).args(["build", "--quiet", "--workspace", "--bins", "--tests"]);
         if dir.file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
         }
         let status = cmd.status().expect("running cargo build");
-        assert!(status.success(), "cargo build --workspace --bins failed");
+        assert!(status.success(), "cargo build --workspace --bins --tests failed");
         dir
     })
 }
