@@ -3,8 +3,8 @@
 //! machine has (lavapipe in CI):
 //!
 //! - the GPU's reference mode equals the CPU's (same estimator, same samples) at 40 dB or more;
-//! - its mean luminance is within 2% of the independent converged estimate (no baked table), so
-//!   that a bug shared by both renderers shows;
+//! - its mean luminance is within 0.5% of the independent converged estimate (no baked table)
+//!   under potsdamer_platz, so that a bias shared by both renderers shows;
 //! - the other modes validate too, the contact sheet is written, and without an adapter the tool
 //!   exits 2 saying how to get one.
 
@@ -20,8 +20,8 @@ const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
 /// samples: a sun seen in chrome (quarry) is a handful of pixels whose brightness the samples of
 /// their slice must find. Measured on chrome under quarry against a converged estimate of 4096
 /// samples per strategy, three bake seeds each: 8 vectors (the default) -5.8%, -1.1%, -0.7%; 32
-/// vectors -2.4%, +0.8%, -1.0%; 128 vectors -1.0%, +0.2%, +0.5%. 128 keeps every case within
-/// half the 2% bar.
+/// vectors -2.4%, +0.8%, -1.0%; 128 vectors -1.0%, +0.2%, +0.5%. The benchmark's expectation
+/// table bakes the same 128 (the quarry cases are its, not a test's).
 const VECTORS: &str = "128";
 
 /// The folder of a case's bake, baked once per run (brdf-bake is incremental, so a rerun of the
@@ -54,7 +54,8 @@ fn bake(material: &str, environment: &str) -> PathBuf {
 
 fn preview(bake: &Path, out: &Path, args: &[&str]) -> serde_json::Value {
     let mut cmd = tool("brdf-preview");
-    cmd.arg(bake).arg("--out").arg(out).args(["--size", "128x128", "--json"]).args(args);
+    let size: &[&str] = if args.contains(&"--size") { &[] } else { &["--size", "128x128"] };
+    cmd.arg(bake).arg("--out").arg(out).args(size).arg("--json").args(args);
     let r = run(cmd, "").expect_code(0);
     serde_json::Value::Object(r.json_object())
 }
@@ -92,26 +93,37 @@ fn reference_mode_on_the_gpu_equals_the_cpu_on_six_cases() {
 
 /// Must show 2: every baked sample of each pixel's slice once (the estimator's expectation over
 /// the sample choice, no noise left from the choice itself) against the converged estimate of
-/// 1024 samples per strategy (its image mean repeats to 0.3% across seeds on the hardest case).
+/// 1024 samples per strategy: the image's mean luminance within 0.5%, on the three materials
+/// under the map without a sun, at 64 x 64 (measured deviations 0.00% to 0.03% over converged
+/// seeds 0, 7 and 123: the bar is far above the estimates' noise, so a bias either renderer shares,
+/// a wrong density, cosine or slice, shows).
+///
+/// Under quarry's sun what remains is the bake's finite sample set, a few samples of a slice
+/// finding the sun, and it depends on the pixels: gold-paint at 64 x 64 reads -1.5% whatever the
+/// converged seed, at 128 x 128 -0.2%. Those are the calibration of the bakes' vectors, not a test
+/// of the estimator: they are in the benchmark (`cargo bench -p brdf-preview --bench preview`, the
+/// expectation table, six cases at 128 x 128), which took 7 minutes of `make test` on 2 cores.
 #[test]
-fn reference_mode_agrees_with_the_converged_estimate_on_six_cases() {
+fn reference_mode_agrees_with_the_converged_estimate_on_three_cases() {
     let tmp = temp_dir();
     let mut failures = Vec::new();
     println!("case                              frames   mean luminance ratio   PSNR against it (dB)");
-    for (material, environment) in cases() {
+    for material in MATERIALS {
+        let environment = "potsdamer_platz_1k";
         let out = tmp.path().join(format!("{material}-{environment}.png"));
-        let json = preview(&bake(material, environment), &out, &["--spp", "256", "--converged", "1024"]);
+        let json =
+            preview(&bake(material, environment), &out, &["--size", "64x64", "--spp", "256", "--converged", "1024"]);
         let converged = &json["converged"];
         let ratio = converged["mean_luminance_ratio"].as_f64().unwrap();
         println!(
-            "{:<32} {:>7} {ratio:>22.4} {:>22.2}",
+            "{:<32} {:>7} {ratio:>22.5} {:>22.2}",
             format!("{material} / {environment}"),
             json["frames"],
             converged["psnr_db"].as_f64().unwrap_or(f64::INFINITY)
         );
         // The default frames use every sample of the bake: 128 vectors of 256 samples at 256 spp.
         assert_eq!(json["frames"], 128, "{json}");
-        if (ratio - 1.0).abs() > 0.02 {
+        if (ratio - 1.0).abs() > 0.005 {
             failures.push(format!("{material} / {environment}: mean luminance ratio {ratio}"));
         }
         png_decode(&tmp.path().join(format!("{material}-{environment}-converged.png")));
