@@ -989,7 +989,7 @@ pub fn top_level(width: usize, height: usize, max_level: Option<usize>) -> usize
 }
 
 /// Renders one adaptive frame of `scene` (module docs for every step), its [`Geometry`]
-/// included.
+/// included. The settings are checked before the scene is rasterized.
 pub fn render(
     scene: &Scene,
     material: &Material,
@@ -997,6 +997,7 @@ pub fn render(
     bandwidths: &Bandwidths,
     settings: &Settings,
 ) -> Result<Adaptive, Error> {
+    check_settings(settings, material, lighting)?;
     let geometry = Geometry::of_scene(scene, settings.supersample)?;
     render_with(&geometry, material, lighting, bandwidths, settings, Hooks::default())
 }

@@ -265,6 +265,16 @@ fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
     assert!(error.to_string().contains("raise spp"), "{error}");
 }
 
+/// A bad setting is reported as such before the scene is rasterized: here the scene (0 x 0) would
+/// be refused too, with another message.
+#[test]
+fn the_settings_are_checked_before_the_scene() {
+    let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
+    let settings = adaptive::Settings { supersample: 3, ..adaptive::Settings::new(Mode::Reference, 1) };
+    let error = adaptive::render(&sphere_scene(0, 0), material, &lighting, &bandwidths, &settings).unwrap_err();
+    assert!(error.to_string().contains("supersample (3) 1, 2 or 4"), "{error}");
+}
+
 /// The recursion the module docs describe, written out: block `(bx, by)` of level `k` predicts
 /// at its pixel when that pixel is shadeable (or at level 0), else splits into its quarters.
 fn sources_by_recursion(shadeable: &[bool], (w, h): (usize, usize), l: usize) -> Vec<Option<usize>> {
