@@ -24,6 +24,15 @@
 //! 5. where the adaptive frames' time goes (paper reading): G-buffer, prediction, pyramid and
 //!    plan, shading and up-sampling, against the brute force's whole frame.
 //!
+//! Under quarry_01 the brute force's curve flattens: BRDF importance sampling finds the map's
+//! small sun rarely, and its error falls slower than one over the samples until most pixels'
+//! samples find it. Measured with `brdf-preview --converged 1024` on gold-paint / quarry / torus,
+//! 256 x 256, 256 spp: 38.9, 40.1, 41.8 and 47.0 dB (whole image) at 1, 4, 16 and 128 frames (the
+//! last every baked sample once), 1.2 and 1.7 dB per 4x where an estimator without rare events
+//! gains 6, and the mean luminance within 3.4%, 0.1%, 1.0% and 0.2% of the converged estimate: it
+//! converges to it, slowly, no bias. On such a curve a tenth of a dB moves the brute force's spp
+//! at equal PSNR by 2x, and those rows' speed-ups say little either way.
+//!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and the adaptive frames'
 //! bandwidth buffers are predicted and their shaded blocks shaded there too
 //! (`Renderer::predict_blocks`, `Renderer::shade_blocks`), as `brdf-preview` runs them. The
