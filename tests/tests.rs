@@ -14,3 +14,4 @@ mod invalid_inputs;
 mod json_output;
 mod merl_info;
 mod preview;
+mod workspace;
