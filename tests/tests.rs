@@ -14,4 +14,3 @@ mod invalid_inputs;
 mod json_output;
 mod merl_info;
 mod preview;
-mod workspace;
