@@ -96,8 +96,10 @@ fn main() {
     if calibrate {
         calibration(&cases, &scene, &exponents, quick);
     }
-    modes(&cases, &scene, &exponents);
-    expectation(&cases, &scene);
+    // One adapter for both GPU tables.
+    let gpu = gpu::Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    modes(&gpu, &cases, &scene, &exponents);
+    expectation(&gpu, &cases, &scene);
 }
 
 /// Table 1: the prefiltered mode's PSNR against the converged estimate per analysis size and
@@ -154,8 +156,7 @@ fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<u32>, mode: Mode, spp: u
 }
 
 /// Table 2: every mode against the converged estimate at equal sample counts, timed on the GPU.
-fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
-    let gpu = gpu::Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+fn modes(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene, exponents: &[u32]) {
     println!("\nModes against the converged estimate on {} (128 x 128 sphere)", gpu.adapter_summary());
     println!(
         "{:<32} {:<12} {:>5} {:>7} {:>9} {:>10} {:>12} {:>10}",
@@ -173,7 +174,7 @@ fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
                 view_layers: selection.view_layer.clone(),
                 wavelet: None,
             };
-            let mut renderer = gpu::preview::Renderer::new(&gpu, scene, &material, &case.lighting).expect("renderer");
+            let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let runs = [
                 (Mode::Reference, 16, 1),
                 (Mode::Fis, 16, 1),
@@ -209,8 +210,7 @@ fn modes(cases: &[Case], scene: &Scene, exponents: &[u32]) {
 /// Table 3: the reference mode's expectation (256 spp, as many frames as use every sample of a
 /// pixel's slice once) against the converged estimate, with 128 importance vectors of 256
 /// samples, the end-to-end tests' bake.
-fn expectation(cases: &[Case], scene: &Scene) {
-    let gpu = gpu::Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+fn expectation(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene) {
     let config = importance::Config { n_vectors: 128, ..importance::Config::default() };
     println!(
         "\nThe reference mode's expectation (every baked sample once, {} vectors) against the converged estimate",
@@ -223,7 +223,7 @@ fn expectation(cases: &[Case], scene: &Scene) {
         for case in pair {
             let material =
                 Material { table: case.table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
-            let mut renderer = gpu::preview::Renderer::new(&gpu, scene, &material, &case.lighting).expect("renderer");
+            let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let spp = 256;
             let frames = render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp);
             let start = Instant::now();
