@@ -98,17 +98,17 @@ target/merl/%.binary:
 	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
 
 ## bench: timings against baselines measured in the same run (benchmarks, not tests). The last
-## one is issue 11's equal-quality benchmark of the adaptive modes against the brute force (CPU
-## renderer; about 10 minutes the first time, its bakes and converged images are kept under
-## target/bench-adaptive/).
-bench:
+## one is issue 11's equal-quality benchmark of the adaptive modes against the brute force, on the
+## GPU (lavapipe without one) at 512 x 512: about 50 minutes the first time on 2 cores (its
+## bakes and converged images are kept under target/bench-adaptive/), 12 after.
+bench: setup-gpu
 	$(CARGO) bench -p importance --bench build
 	$(CARGO) bench -p envmap --bench load
 	$(CARGO) bench -p bandwidth --bench bandwidth
 	$(CARGO) bench -p prefilter --bench prefilter
 	$(CARGO) bench -p brdf-atlas --bench atlas
 	$(CARGO) bench -p haar-brdf --bench table1
-	$(CARGO) bench -p brdf-preview --bench adaptive
+	$(CARGO) bench -p brdf-preview --bench adaptive -- --gpu
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
 ## procedural calibration sky), then render previews (pre-convolved; reference, validated against
