@@ -41,9 +41,11 @@
 //! G-buffer is then the camera's, made once before the frames (`Renderer::adaptive_geometry`),
 //! as the brute force's raster pass is; on the CPU both rasterize in every frame.
 //!
-//! Measured on lavapipe (`-- --gpu --no-extras`, 2 cores), paper reading: `adaptive` median 14.1x,
-//! 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 8.5x, 11 of 24 at 10x or more.
-//! Chrome misses in all its 16 rows (0.8x to 2.5x): its frames stop at their ceiling (34.9 to
+//! Measured on lavapipe (`-- --gpu`, 2 cores, two runs), paper reading: `adaptive` median 14.1x
+//! and 12.3x, 15 of 24 rows at 4x or more in both; `adaptive-prefiltered` median 8.5x and 8.2x,
+//! 11 and 8 of 24 at 10x or more (the other readings lower: level-normalized 2.1x to 2.2x and 1.7x
+//! to 1.8x, the FFT oracle 4.4x to 4.6x and 4.2x to 5.2x, shading 10 to 98% of the pixels).
+//! Chrome misses in all its 16 rows (0.6x to 2.5x): its frames stop at their ceiling (34.9 to
 //! 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it shade
 //! 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 16 spp in 215 to 385 ms, while
 //! an adaptive frame spends 45 to 100 ms on prediction and plan before it shades a pixel. The
@@ -53,7 +55,7 @@
 //! than at 2 spp, where they pass, for 1.5x and 1.8x the time).
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
 //! minutes each on the CPU), a rerun about 12 (a minute a case; `--no-extras` 40 s). At this size
-//! 16x anti-aliasing costs 5x the time of none (gold-paint / potsdamer / torus, lavapipe).
+//! 16x anti-aliasing costs 4.3x to 6.6x the time of none on lavapipe.
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
@@ -76,9 +78,9 @@ const MESHES: [&str; 2] = ["sphere", "torus"];
 /// The default render size (`--size N`): the paper's (`001` Fig. 11). The speed-ups depend on it:
 /// a frame's fixed costs (prediction, plan, up-sampling) grow with the pixels as the brute
 /// force's do, but the shaded pixels do not, as an image's bandwidth in cycles per pixel halves
-/// when its width doubles. On lavapipe (`--gpu --no-extras`), paper reading, the `adaptive`
-/// median over the twelve cases went from 3.45x and 3.9x (two runs) at 256 x 256 to 14.1x at
-/// 512 x 512, where the frames cost 90 to 420 ms against the brute force's 6 to 9 s at 256 spp.
+/// when its width doubles. On lavapipe (`--gpu`), paper reading, the `adaptive` median over the
+/// twelve cases went from 3.45x and 3.9x (two runs) at 256 x 256 to 14.1x and 12.3x at
+/// 512 x 512, where the frames cost 90 to 420 ms against the brute force's 5 to 9 s at 256 spp.
 const SIZE: usize = 512;
 const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
 
