@@ -48,7 +48,7 @@
 //! Chrome misses in all its 16 rows (0.6x to 2.5x): its frames stop at their ceiling (34.9 to
 //! 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it shade
 //! 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 16 spp in 215 to 385 ms, while
-//! an adaptive frame spends 45 to 100 ms on prediction and plan before it shades a pixel. The
+//! an adaptive frame spends 40 to 95 ms on prediction and plan before it shades a pixel. The
 //! others that miss: white-paint / quarry / torus (2.4x to 3.9x in three rows; its brute-force
 //! curve is on the sun's plateau, above), white-paint / quarry / sphere pre-filtered at 2 spp
 //! (5.5x), and gold-paint / potsdamer pre-filtered at 8 spp (7.4x, 8.5x: 0.15 and 1.3 dB more
