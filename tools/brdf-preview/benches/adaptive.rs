@@ -49,10 +49,10 @@
 //! 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it shade
 //! 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 16 spp in 215 to 385 ms, while
 //! an adaptive frame spends 40 to 95 ms on prediction and plan before it shades a pixel. The
-//! others that miss: white-paint / quarry / torus (2.4x to 3.9x in three rows; its brute-force
-//! curve is on the sun's plateau, above), white-paint / quarry / sphere pre-filtered at 2 spp
-//! (5.5x), and gold-paint / potsdamer pre-filtered at 8 spp (7.4x, 8.5x: 0.15 and 1.3 dB more
-//! than at 2 spp, where they pass, for 1.5x and 1.8x the time).
+//! others that miss in the first run: white-paint / quarry / torus (2.4x to 3.9x in three rows;
+//! its brute-force curve is on the sun's plateau, above), white-paint / quarry / sphere
+//! pre-filtered at 2 spp (5.5x), and gold-paint / potsdamer pre-filtered at 8 spp (7.4x, 8.5x:
+//! 0.15 and 1.3 dB more than at 2 spp, where they pass, for 1.5x and 1.8x the time).
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
 //! minutes each on the CPU), a rerun about 12 (a minute a case; `--no-extras` 40 s). At this size
 //! 16x anti-aliasing costs 4.3x to 6.6x the time of none on lavapipe.
