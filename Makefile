@@ -80,19 +80,21 @@ install: build
 ## then build wgpu, naga and a hundred other crates a second time (five minutes on 2 cores).
 ## Without incremental compilation (a clean run gains nothing from it and it costs a gigabyte of
 ## disk; set CARGO_INCREMENTAL=1 to keep it).
-test: setup test-data
+test: setup
+	@$(MAKE) --no-print-directory -j2 test-data
 	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) build --workspace --bins --tests
 	CARGO_INCREMENTAL=$${CARGO_INCREMENTAL:-0} $(CARGO) test --workspace
 
 ## test-data: the 20 real-derived MERL tables the tests read, made once under target/merl/ from
-## ../shared/data/nbrdf (35 MB and about a second each; kept between runs).
+## ../shared/data/nbrdf (35 MB and about 1.5 s each on one core, two at a time under make test;
+## kept between runs).
 MATERIALS := color-changing-paint3 gold-paint red-metallic-paint green-metallic-paint blue-rubber \
   white-marble white-paint chrome nickel pink-fabric brass blue-acrylic gray-plastic yellow-paint \
   steel alum-bronze black-obsidian cherry-235 teflon silver-metallic-paint
 MERL_TABLES := $(addprefix target/merl/,$(addsuffix .binary,$(MATERIALS)))
 test-data: setup-python $(MERL_TABLES)
 
-target/merl/%.binary:
+target/merl/%.binary: | setup-python
 	@test -f ../shared/tools/nbrdf2merl.py || { echo "error: ../shared is missing: the tests need the project's shared/ folder beside this checkout"; exit 2; }
 	@echo "making $@ (nbrdf2merl.py)"
 	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
