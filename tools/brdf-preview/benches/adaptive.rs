@@ -78,9 +78,9 @@ const MESHES: [&str; 2] = ["sphere", "torus"];
 /// The default render size (`--size N`): the paper's (`001` Fig. 11). The speed-ups depend on it:
 /// a frame's fixed costs (prediction, plan, up-sampling) grow with the pixels as the brute
 /// force's do, but the shaded pixels do not, as an image's bandwidth in cycles per pixel halves
-/// when its width doubles. On lavapipe (`--gpu`), paper reading, the `adaptive` median over the
-/// twelve cases went from 3.45x and 3.9x (two runs) at 256 x 256 to 14.1x and 12.3x at
-/// 512 x 512, where the frames cost 90 to 420 ms against the brute force's 5 to 9 s at 256 spp.
+/// when its width doubles. On lavapipe (`--gpu`), paper reading, the `adaptive` median was 3.45x
+/// and 3.9x (two runs) at 256 x 256; at 512 x 512 see the module docs (adaptive frames 90 to
+/// 420 ms there, the brute force's 5 to 9 s at 256 spp).
 const SIZE: usize = 512;
 const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
 
