@@ -40,8 +40,10 @@ use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
 use crate::merl_lookup::{MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, read_back, table_bytes};
 
+mod adaptive;
 mod present;
 
+pub use adaptive::FrameOptions;
 pub use present::{PREVIEW_PRESENT_WGSL, Presenter};
 
 /// The raster pass: vertex and fragment entry points `raster_vertex`, `raster_fragment`.
@@ -49,6 +51,11 @@ pub const PREVIEW_RASTER_WGSL: &str = include_str!("preview_raster.wgsl");
 
 /// The shading pass, compiled after [`MERL_LOOKUP_WGSL`]: entry point `shade_frame`.
 pub const PREVIEW_SHADE_WGSL: &str = include_str!("preview_shade.wgsl");
+
+/// An adaptive frame after its prediction, compiled after [`PREVIEW_SHADE_WGSL`]: entry points
+/// `adaptive_levels`, `adaptive_reduce`, `adaptive_plan`, `adaptive_scatter`, `adaptive_upsample`,
+/// `adaptive_output` (`Renderer::render_adaptive`).
+pub const PREVIEW_ADAPTIVE_WGSL: &str = include_str!("preview_adaptive.wgsl");
 
 /// The wavelet BRDF decoder (`haar_brdf::WaveletBrdf::eval` in WGSL) and `material_brdf`, the BRDF
 /// the shading pass reads.
@@ -269,6 +276,11 @@ pub struct Renderer {
     predict_pipeline: wgpu::ComputePipeline,
     predict_layout: wgpu::BindGroupLayout,
     prediction: Option<Prediction>,
+    /// The passes of an adaptive frame after its prediction, group 3 from `adaptive_layout`.
+    adaptive_pipelines: adaptive::Pipelines,
+    adaptive_layout: wgpu::BindGroupLayout,
+    /// The adaptive frames' state on the GPU, for the last geometry and settings.
+    adaptive: RefCell<Option<adaptive::State>>,
     /// For the limit errors of later uploads.
     adapter_info: wgpu::AdapterInfo,
     table_group: wgpu::BindGroup,
@@ -432,7 +444,8 @@ impl Renderer {
             let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_shade.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(
-                    format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}").into(),
+                    format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}\n{PREVIEW_ADAPTIVE_WGSL}")
+                        .into(),
                 ),
             });
             let shade_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -472,6 +485,27 @@ impl Renderer {
                 entry_point: Some("predict_blocks"),
                 compilation_options: Default::default(),
                 cache: None,
+            });
+            let adaptive_layout = adaptive::layout(&device);
+            let adaptive_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("adaptive"),
+                bind_group_layouts: &[
+                    Some(&table_layout),
+                    Some(&bake_layout),
+                    Some(&render_layout),
+                    Some(&adaptive_layout),
+                ],
+                immediate_size: 0,
+            });
+            let adaptive_pipelines = adaptive::Pipelines::new(|entry| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&adaptive_pipeline_layout),
+                    module: &shade_module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
             });
 
             let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -572,6 +606,9 @@ impl Renderer {
                 predict_pipeline,
                 predict_layout,
                 prediction: None,
+                adaptive_pipelines,
+                adaptive_layout,
+                adaptive: RefCell::new(None),
                 adapter_info: info.clone(),
                 table_group,
                 bake_group,
@@ -815,42 +852,6 @@ impl Renderer {
         Ok(geometry)
     }
 
-    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) of the renderer's
-    /// mesh and camera, its output image `supersample` times smaller than the renderer's, with
-    /// its bandwidth buffer predicted ([`Renderer::predict_blocks`], with the bandwidths of
-    /// [`Renderer::set_bandwidths`]) and its shaded blocks shaded ([`Renderer::shade_blocks`])
-    /// here, and the G-buffer ([`Renderer::adaptive_geometry`]), the
-    /// pyramid, the plan, the up-sampling and the background on the CPU.
-    pub fn render_adaptive(
-        &self,
-        material: &Material,
-        lighting: &Lighting,
-        settings: &render::adaptive::Settings,
-    ) -> Result<render::adaptive::Adaptive, GpuError> {
-        let bandwidths = &self.prediction.as_ref().ok_or_else(no_bandwidths)?.bandwidths;
-        let geometry = self.adaptive_geometry(settings.supersample)?;
-        let failure = RefCell::new(None);
-        let fail = |e: GpuError, what: &str| {
-            *failure.borrow_mut() = Some(e);
-            render::Error::Invalid(format!("{what} on the GPU failed"))
-        };
-        let mut predictor =
-            |pixels: &[u32]| self.predict_blocks(settings, pixels).map_err(|e| fail(e, "the prediction"));
-        let mut shader = |blocks: &[(u32, u32)]| {
-            self.shade_blocks(settings.mode, settings.seed, blocks).map_err(|e| fail(e, "shading"))
-        };
-        let hooks = render::adaptive::Hooks {
-            predictor: Some(&mut predictor),
-            shader: Some(&mut shader),
-            ..Default::default()
-        };
-        let frame = render::adaptive::render_with(&geometry, material, lighting, bandwidths, settings, hooks);
-        match failure.into_inner() {
-            Some(e) => Err(e),
-            None => Ok(frame?),
-        }
-    }
-
     /// Predicts the bandwidth buffer of an adaptive frame at `pixels` (its
     /// `render::adaptive::prediction_pixels`, row-major indices of the renderer's image) as
     /// `render::adaptive` does on the CPU, with `settings`' `n_b`, seed and estimator and the
@@ -874,6 +875,15 @@ impl Renderer {
         if pixels.is_empty() {
             return Ok(Vec::new());
         }
+        capture_errors(&self.device, || self.write_predict_uniform(prediction, settings))?;
+        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        let values =
+            self.run_items(&self.predict_pipeline, Some(&prediction.group), settings.mode, settings.seed, &items)?;
+        Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
+    }
+
+    /// Writes the prediction's uniform for `settings` (`n_b`) and the current camera.
+    fn write_predict_uniform(&self, prediction: &Prediction, settings: &render::adaptive::Settings) {
         let (environment, atlas) = (&prediction.bandwidths.environment, &prediction.bandwidths.brdf);
         let uniform = PredictUniform {
             n_b: settings.n_b.min(u32::MAX as usize) as u32,
@@ -885,39 +895,10 @@ impl Renderer {
             radians_per_pixel: (f64::from(self.camera.fov_y()) / f64::from(self.height)) as f32,
             _pad: 0,
         };
-        capture_errors(&self.device, || {
-            self.queue.write_buffer(&prediction.uniform, 0, bytemuck::bytes_of(&uniform));
-        })?;
-        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
-        let values =
-            self.run_items(&self.predict_pipeline, Some(&prediction.group), settings.mode, settings.seed, &items)?;
-        Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
+        self.queue.write_buffer(&prediction.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// Shades the blocks of an adaptive frame (`render::adaptive::render_with`'s shader):
-    /// each `(pixel, samples)` of the renderer's image, in frame 0 with `seed`, by `mode`'s
-    /// estimator, as `render::adaptive` shades them on the CPU. The accumulation buffer carries
-    /// the items in and the estimates out (so it holds nothing to continue afterwards).
-    pub fn shade_blocks(&self, mode: Mode, seed: u32, blocks: &[(u32, u32)]) -> Result<Vec<[f32; 3]>, GpuError> {
-        let pixels = self.pixels();
-        if blocks.len() as u64 > pixels {
-            return Err(render::Error::Invalid(format!("{} blocks for {pixels} pixels", blocks.len())).into());
-        }
-        for &(pixel, samples) in blocks {
-            if u64::from(pixel) >= pixels {
-                return Err(render::Error::Invalid(format!("block pixel {pixel} is outside {pixels} pixels")).into());
-            }
-            self.check_settings(&Settings { mode, spp: samples, frames: 1, seed })?;
-        }
-        if blocks.is_empty() {
-            return Ok(Vec::new());
-        }
-        let items: Vec<[u32; 4]> = blocks.iter().map(|&(pixel, samples)| [pixel, samples, 0, 0]).collect();
-        let sums = self.run_items(&self.blocks_pipeline, None, mode, seed, &items)?;
-        Ok(sums.iter().map(|s| [s[0], s[1], s[2]]).collect())
-    }
-
-    /// Runs an entry that takes a list of items (`shade_blocks`, `predict_blocks`): the items
+    /// Runs an entry that takes a list of items (`predict_blocks`): the items
     /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
     /// count in the shade uniform's `spp`, with `mode` and `seed`; `extra` is group 3. Returns
     /// the first `items.len()` entries the pass leaves.
@@ -932,9 +913,7 @@ impl Renderer {
         self.progress.set(None);
         let count = items.len() as u32;
         let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: count, frames: 1, seed });
-        // A power of two of workgroups, taken in bit-reversed order (`item_index` in the WGSL).
-        let groups = count.div_ceil(64).next_power_of_two();
-        let (x, y) = (groups.min(32768), groups.div_ceil(32768));
+        let (x, y) = item_groups(count);
         capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
@@ -1068,6 +1047,13 @@ impl Renderer {
     fn check_settings(&self, settings: &Settings) -> Result<(), GpuError> {
         Ok(render::check_settings(settings, self.n_samples as usize, self.n_layers, &self.view_layers)?)
     }
+}
+
+/// The workgroups of a list of `count` items (`shade_blocks`, `predict_blocks`): a power of two of
+/// workgroups, taken in bit-reversed order (`item_index` in the WGSL), as `(x, y)`.
+fn item_groups(count: u32) -> (u32, u32) {
+    let groups = count.div_ceil(64).next_power_of_two();
+    (groups.min(32768), groups.div_ceil(32768))
 }
 
 fn no_bandwidths() -> GpuError {

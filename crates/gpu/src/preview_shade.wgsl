@@ -478,12 +478,17 @@ fn debug_index(frame: ShadingFrame) -> vec3<f32> {
 // One frame's estimate at a covered pixel: 1 / spp sum_j f(wi_j, wo) L(wi_j) cos(theta_j) / pdf_j
 // over the pixel's samples; a sample with pdf <= 0, wi below the horizon or no table data adds 0.
 fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
+    return estimate_sum(frame, pixel, f, spp, 0u, spp) / f32(spp);
+}
+
+// The sum of `estimate`'s terms `first .. first + count` of the pixel's `spp` samples in frame `f`.
+fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, count: u32) -> vec3<f32> {
     let k = slice_of(frame);
     let map = source_map(frame);
     let range = sample_range(pixel, f, spp);
     let start = (k * shade.n_vectors + range.x) * shade.n_samples + range.y;
     var sum = vec3<f32>(0.0);
-    for (var j = 0u; j < spp; j++) {
+    for (var j = first; j < first + count; j++) {
         let texel = samples[start + j];
         let wi_local = texel.xyz;
         let pdf = texel.w;
@@ -498,7 +503,7 @@ fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
         let radiance = incident_radiance(map, to_world(frame, wi_local), pdf);
         sum += brdf * radiance * (wi_local.z / pdf);
     }
-    return sum / f32(spp);
+    return sum;
 }
 
 // `render::Camera::ray`: the ray from the eye through the centre of pixel (x, y), row 0 at the
@@ -565,10 +570,13 @@ fn item_index(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
     return run * 64u + local;
 }
 
-// The shaded blocks of an adaptive frame (`render::adaptive`): item `i` of `shade.spp` items
-// arrives in `accumulation[i]` as the bits of (pixel, samples, 0, 0) and leaves as the pixel's
-// estimate in frame 0 with that many samples (`render::adaptive`'s shading, the same estimator
-// as `shade_frame`), w = 1. Each invocation reads and writes its own item only.
+// The shaded blocks of an adaptive frame (`render::adaptive`), in parts: item `i` of `shade.spp`
+// items arrives in `accumulation[i]` as the bits of (pixel, samples, first, count) and leaves as
+// terms `first .. first + count` of the pixel's estimate in frame 0 with that many samples
+// (`render::adaptive`'s shading, the same estimator as `shade_frame`) over `samples`, w = 1: the
+// parts of a block sum to its estimate. A block's samples in several parts run side by side
+// rather than one after another in one invocation. Each invocation reads and writes its own
+// item only.
 @compute @workgroup_size(64)
 fn shade_blocks(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -584,7 +592,7 @@ fn shade_blocks(
     let surface = surface_at(i32(pixel % shade.width), i32(pixel / shade.width));
     var radiance = vec3<f32>(0.0);
     if (surface.found) {
-        radiance = estimate(surface.frame, pixel, 0u, item.y);
+        radiance = estimate_sum(surface.frame, pixel, 0u, item.y, item.z, item.w) / f32(item.y);
     }
     accumulation[i] = vec4<f32>(radiance, 1.0);
 }

@@ -321,14 +321,17 @@ fn moving_the_camera_is_setting_up_with_that_camera() {
     let adaptive = render::adaptive::Settings { max_spp: 64, ..render::adaptive::Settings::new(Mode::Reference, 4) };
     let frame = |r: &mut Renderer| {
         r.set_bandwidths(&bandwidths()).unwrap();
-        r.render_adaptive(phong(), sky_lighting(), &adaptive).unwrap()
+        r.render_adaptive(phong(), sky_lighting(), &adaptive, details()).unwrap()
     };
     moved.set_camera(&scene.camera).unwrap();
     let before = frame(&mut moved);
     moved.set_camera(&camera).unwrap();
     let after = frame(&mut moved);
     let fresh = frame(&mut renderer(&Scene { camera, ..scene.clone() }, phong(), sky_lighting()));
-    assert!(after.image == fresh.image && after.plan.actions == fresh.plan.actions, "a stale adaptive G-buffer");
+    assert!(
+        after.image == fresh.image && after.details().plan.actions == fresh.details().plan.actions,
+        "a stale adaptive G-buffer"
+    );
     assert!(after.image != before.image, "the camera did not move");
 }
 
@@ -562,14 +565,14 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
         renderer.set_bandwidths(&bandwidths).unwrap();
         let cpu = render::adaptive::render(&scene, material, lighting, &bandwidths, &settings).unwrap();
         let (w, h) = (render_scene.width, render_scene.height);
-        let shadeable: Vec<bool> = cpu.predictions.iter().map(|p| p.level >= 0).collect();
+        let shadeable: Vec<bool> = cpu.details().predictions.iter().map(|p| p.level >= 0).collect();
         let top = render::adaptive::top_level(w, h, None);
         let (pixels, _) = render::adaptive::prediction_pixels(&shadeable, (w, h), settings.prediction_level(top));
         let gpu = renderer.predict_blocks(&settings, &pixels).unwrap();
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-3 * a.abs().max(b.abs()).max(1e-12);
         let (mut near, mut same_level, mut worst) = (0, 0, 0.0f64);
         for (&i, &[bandwidth, variance]) in pixels.iter().zip(&gpu) {
-            let p = cpu.predictions[i as usize];
+            let p = cpu.details().predictions[i as usize];
             if close(bandwidth, p.bandwidth) && close(variance, p.variance) {
                 near += 1;
             }
@@ -588,41 +591,73 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
     }
 }
 
-/// Issue 11: an adaptive frame predicted and shaded on the GPU (`Renderer::render_adaptive`)
-/// equals the CPU's frame with the same predictions (`render::adaptive::replay_predictor`): the
-/// same plan, and the shaded values within the full-resolution modes' tolerances, with and
-/// without anti-aliasing, for both estimators.
+/// Issue 11: an adaptive frame on the GPU (`Renderer::render_adaptive`: prediction, pyramids,
+/// plan, shading, up-sampling and output there) equals the CPU's frame with the same predictions
+/// (`render::adaptive::replay_predictor`): the same plan (every block's action, parents and
+/// samples; the weights, which the GPU computes in f32, within 1e-5 of the CPU's f64 ones
+/// rounded to f32: a few f32 ulps of each factor), and the image within the full-resolution
+/// modes' tolerances, with and without anti-aliasing, for both estimators, with the lobe weight
+/// and with the oracle's bandwidths in place of the prediction's.
 #[test]
 fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
-    for (mode, supersample, spp) in [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 4), (Mode::Reference, 2, 4)] {
-        let settings =
-            render::adaptive::Settings { supersample, max_spp: 64, ..render::adaptive::Settings::new(mode, spp) };
+    for (mode, supersample, spp, lobe_weight, oracle) in [
+        (Mode::Reference, 1, 8, false, false),
+        (Mode::Prefiltered, 1, 4, false, false),
+        (Mode::Reference, 2, 4, false, false),
+        (Mode::Reference, 1, 8, true, false),
+        (Mode::Reference, 1, 8, false, true),
+    ] {
+        let settings = render::adaptive::Settings {
+            supersample,
+            max_spp: 64,
+            lobe_weight,
+            ..render::adaptive::Settings::new(mode, spp)
+        };
         let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
+        let (w, h) = (render_scene.width, render_scene.height);
+        // An oracle that asks for every level somewhere: a ramp over the image.
+        let ramp: Vec<f64> = (0..w * h).map(|i| 0.6 * ((i % w) as f64 / w as f64).powi(3)).collect();
         let mut renderer = renderer(&render_scene, material, lighting);
         renderer.set_bandwidths(&bandwidths).unwrap();
+        let options = gpu::preview::FrameOptions { oracle: oracle.then_some(&ramp[..]), details: true };
         let gpu_frame = renderer
-            .render_adaptive(material, lighting, &settings)
+            .render_adaptive(material, lighting, &settings, options)
             .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
-        let mut replay = render::adaptive::replay_predictor(&gpu_frame.predictions);
-        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let mut replay = render::adaptive::replay_predictor(&gpu_frame.details().predictions);
+        let hooks = render::adaptive::Hooks {
+            predictor: Some(&mut replay),
+            oracle: oracle.then_some(&ramp[..]),
+            ..Default::default()
+        };
         let geometry = render::adaptive::Geometry::of_scene(&scene, settings.supersample).unwrap();
         let cpu_frame =
             render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &settings, hooks).unwrap();
-        assert_eq!(gpu_frame.plan.actions, cpu_frame.plan.actions, "the plans differ");
-        let shaded: usize = cpu_frame.plan.shaded_per_level().iter().sum();
+        let worst = gpu_frame.details().plan.compare(&cpu_frame.details().plan, 1e-5).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(gpu_frame.shaded_per_level, cpu_frame.shaded_per_level);
+        assert_eq!((gpu_frame.samples, gpu_frame.budget), (cpu_frame.samples, cpu_frame.budget));
+        let shaded: usize = cpu_frame.shaded_per_level.iter().sum();
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
         let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
         log(&format!(
-            "adaptive {} {supersample}x{supersample}: {shaded} shaded blocks, PSNR {psnr:.2} dB, relative error {relative:.2e}",
-            mode.name()
+            "adaptive {} {supersample}x{supersample}{}{}: {shaded} shaded blocks, levels {:?}, worst weight difference \
+             {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}",
+            mode.name(),
+            if lobe_weight { " lobe weight" } else { "" },
+            if oracle { " oracle" } else { "" },
+            cpu_frame.shaded_per_level,
         ));
         assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
     }
     // The prediction needs the bandwidths; without them the frame is an error that says so.
     let renderer = renderer(&scene, material, lighting);
     let settings = render::adaptive::Settings::new(Mode::Reference, 4);
-    let error = renderer.render_adaptive(material, lighting, &settings).expect_err("no bandwidths");
+    let error = renderer.render_adaptive(material, lighting, &settings, details()).expect_err("no bandwidths");
     assert!(error.to_string().contains("set_bandwidths"), "{error}");
+}
+
+/// Frame options that keep the frame's buffers.
+fn details() -> gpu::preview::FrameOptions<'static> {
+    gpu::preview::FrameOptions { details: true, ..Default::default() }
 }

@@ -3,11 +3,12 @@
 //! only the pixels of a pyramid whose level the prediction asks for, with a fixed total budget
 //! of samples spread by the predicted variance; up-sample the rest from coarser shaded pixels.
 //!
-//! Everything here is a specification as much as code. The bandwidth buffer may be predicted
-//! and the shaded blocks shaded by another renderer ([`render_with`]'s [`Hooks`]:
-//! `gpu::preview::Renderer::render_adaptive` does both on the GPU and is held to this module);
-//! the G-buffer, the plan and the up-sampling are ported next, step for step, as `gpu::preview`
-//! follows [`crate::render`].
+//! Everything here is a specification as much as code. `gpu::preview::Renderer::render_adaptive`
+//! runs the whole frame on the GPU, step for step, from this module's G-buffer ([`Geometry`])
+//! and with its allocation of the samples ([`allocation`]), in `f32`; it is held to this module
+//! by planning a frame again from the GPU's predictions ([`render_with`]'s [`Hooks`]:
+//! [`replay_predictor`]), the plans compared by [`Plan::compare`]. The hooks also give the
+//! checks an oracle's bandwidths and exact shading ([`exact_shader`]: the plan's ceiling).
 //!
 //! # The G-buffer
 //!
@@ -94,8 +95,11 @@
 //!   selection picks for its view (`exp(n (cos - 1))` is the SG of `cos^n`): parents whose
 //!   reflections point elsewhere, relative to the lobe's width, count less.
 //!
-//! A block whose weights all vanish (every parent at another depth), or sum to at most
-//! [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel
+//! A parent whose weight `w_i` is below [`MIN_WEIGHT`] (`2^-100`) does not count: the weights
+//! are products of exponentials, which underflow at another depth in `f32` (`g_z` at a 26% depth
+//! difference) long before they do in `f64` (76%), and a renderer that weights in `f32` must
+//! count the same parents. A block whose weights all vanish (every parent at another depth), or
+//! sum to at most [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel
 //! therefore ends shaded at its level or up-sampled from shaded parents, and the plan is fixed
 //! by the G-buffer alone, before any shading.
 //!
@@ -295,7 +299,7 @@ impl Settings {
 /// frame is made again where a pixel is shaded or predicted ([`shading_frame`]). Kept small: a
 /// frame allocates one per render pixel, and fresh memory costs more than the arithmetic.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Pixel {
+pub struct Pixel {
     /// `cos theta_o` of the shading frame.
     pub cos_o: f64,
     pub depth: f64,
@@ -352,6 +356,31 @@ impl Geometry {
 
     pub fn supersample(&self) -> usize {
         self.supersample
+    }
+
+    /// The output's size.
+    pub fn size(&self) -> (usize, usize) {
+        self.size
+    }
+
+    /// Per render pixel, row-major: its G-buffer, `None` where it is not shadeable.
+    pub fn pixels(&self) -> &[Option<Pixel>] {
+        &self.pixels
+    }
+
+    /// Whether a triangle covers render pixel `i` (shadeable or not).
+    pub fn covers(&self, i: usize) -> bool {
+        self.gbuffer.hits[i].is_some()
+    }
+
+    /// Per output pixel: whether a triangle covers any of its render pixels.
+    pub fn output_coverage(&self) -> &[bool] {
+        &self.covered
+    }
+
+    /// Wall time it took to make, in milliseconds.
+    pub fn millis(&self) -> f64 {
+        self.millis
     }
 
     /// The render's size: the output's times the supersampling.
@@ -680,6 +709,35 @@ impl Plan {
         self.actions.iter().map(|a| a.iter().filter(|a| matches!(a, Action::Shade { .. })).count()).collect()
     }
 
+    /// Checks that `other` is this plan to `f32` rounding: the same pyramid, every block the same
+    /// action with the same parents and samples, the weights within `tolerance` of each other
+    /// (`gpu::preview` plans in `f32`). Returns the largest weight difference, or the first
+    /// difference in words.
+    pub fn compare(&self, other: &Plan, tolerance: f32) -> Result<f32, String> {
+        if self.levels != other.levels {
+            return Err("the pyramids differ".into());
+        }
+        let mut worst = 0.0f32;
+        for (k, (a, b)) in self.actions.iter().zip(&other.actions).enumerate() {
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                let same = match (x, y) {
+                    (Action::Upsample { parents: p, count: m }, Action::Upsample { parents: q, count: n }) => {
+                        worst = p.iter().zip(q).fold(worst, |w, (u, v)| w.max((u.1 - v.1).abs()));
+                        m == n && p.iter().zip(q).all(|(u, v)| u.0 == v.0)
+                    }
+                    _ => x == y,
+                };
+                if !same {
+                    return Err(format!("level {k} block {i}: {x:?} against {y:?}"));
+                }
+            }
+        }
+        if worst > tolerance {
+            return Err(format!("up-sampling weights differ by {worst:e}"));
+        }
+        Ok(worst)
+    }
+
     /// The samples the plan spends.
     pub fn samples(&self) -> u64 {
         self.actions
@@ -692,6 +750,11 @@ impl Plan {
             .sum()
     }
 }
+
+/// The least weight a parent counts with (module docs, "Coarse to fine"): `2^-100`, far above
+/// the underflow of `f32` (`2^-126`), so that a renderer weighting in `f32` counts the same
+/// parents as this one in `f64`.
+pub const MIN_WEIGHT: f64 = 7.888609052210118e-31;
 
 /// The up-sampling weights of block `(bx, by)` of `child` from the valid blocks of `parent`
 /// (module docs); `None` when they all vanish.
@@ -750,7 +813,7 @@ fn upsample_weights(
             lobe_similarity(me.mirror, lambda(me), them.mirror, lambda(them))
         });
         let w = g_z * g_a * alpha * g_lobe;
-        if w > 0.0 {
+        if w >= MIN_WEIGHT {
             out[count as usize] = (b as u32, 0.0);
             weights[count as usize] = w;
             total += w;
@@ -840,7 +903,6 @@ fn shares(variance: &[f64], budget: f64, cap: f64) -> Vec<f64> {
 
 /// Gives every shaded block its samples (module docs, "Samples").
 fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings: &Settings) -> Result<(), Error> {
-    let max_spp = settings.max_spp;
     // (level, block, variance)
     let shaded: Vec<(usize, usize, f64)> = actions
         .iter()
@@ -852,15 +914,31 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
                 .map(move |(b, _)| (k, b, levels[k].max_variance[b]))
         })
         .collect();
-    let count = shaded.len() as u64;
+    let blocks: Vec<(usize, f64)> = shaded.iter().map(|&(k, _, variance)| (k, variance)).collect();
+    let samples = allocation(&blocks, budget, settings)?;
+    for ((k, b, _), n) in shaded.into_iter().zip(samples) {
+        if let Action::Shade { samples, .. } = &mut actions[k][b] {
+            *samples = n;
+        }
+    }
+    Ok(())
+}
+
+/// The samples of each shaded block (module docs, "Samples"), given as `(level, max variance)`
+/// in the plan's order: by level, finest first, then by block index. `budget` samples in all.
+/// A renderer that plans elsewhere (`gpu::preview`) allocates with this, so that its blocks get
+/// exactly the samples the CPU's plan gives them.
+pub fn allocation(blocks: &[(usize, f64)], budget: u64, settings: &Settings) -> Result<Vec<u32>, Error> {
+    let max_spp = settings.max_spp;
+    let count = blocks.len() as u64;
     if count > budget {
         return Err(Error::Invalid(format!(
             "a budget of {budget} samples is less than one for each of the {count} shaded pixels: raise spp"
         )));
     }
-    let weights: Vec<f64> = shaded
+    let weights: Vec<f64> = blocks
         .iter()
-        .map(|&(k, _, variance)| {
+        .map(|&(k, variance)| {
             let area = (1u64 << (2 * k)) as f64;
             match settings.allocation {
                 Allocation::Variance => variance,
@@ -876,7 +954,7 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
     };
     let mut samples: Vec<u32> = ideal.iter().map(|&x| floor_pow2(x)).collect();
     let mut left = budget - samples.iter().map(|&n| u64::from(n)).sum::<u64>();
-    let mut order: Vec<usize> = (0..shaded.len()).collect();
+    let mut order: Vec<usize> = (0..blocks.len()).collect();
     order.sort_by(|&a, &b| {
         (ideal[b] / f64::from(samples[b])).total_cmp(&(ideal[a] / f64::from(samples[a]))).then(a.cmp(&b))
     });
@@ -886,12 +964,7 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
             samples[i] *= 2;
         }
     }
-    for ((k, b, _), n) in shaded.into_iter().zip(samples) {
-        if let Action::Shade { samples, .. } = &mut actions[k][b] {
-            *samples = n;
-        }
-    }
-    Ok(())
+    Ok(samples)
 }
 
 /// The inner product of two normalized spherical Gaussians `exp(lambda (xi . w - 1))` (`003`
@@ -907,8 +980,8 @@ pub fn lobe_similarity(xi_i: DVec3, lambda_i: f64, xi_j: DVec3, lambda_j: f64) -
     4.0 * (alpha(lambda_i) * alpha(lambda_j)).sqrt() * sinh_over
 }
 
-/// What an adaptive frame made: the picture and everything the debug views and the figures
-/// read.
+/// What an adaptive frame made: the picture, its figures, and (where kept) everything the debug
+/// views and the checks read.
 #[derive(Clone, Debug)]
 pub struct Adaptive {
     /// The output image (the render averaged over `supersample^2` pixels).
@@ -916,6 +989,25 @@ pub struct Adaptive {
     /// The render size (the output size times `supersample`).
     pub width: usize,
     pub height: usize,
+    /// Shadeable render pixels.
+    pub shadeable: usize,
+    /// The blocks shaded at each level, level 0 first.
+    pub shaded_per_level: Vec<usize>,
+    /// The samples the frame spent, and its budget.
+    pub samples: u64,
+    pub budget: u64,
+    /// Wall time of the steps, in milliseconds: G-buffer (made once per camera: the
+    /// [`Geometry`]'s), bandwidth buffer (prediction), pyramid and plan, shading and
+    /// up-sampling.
+    pub timings: Timings,
+    /// The frame's buffers: always here from [`render_with`]; a renderer that keeps them where
+    /// it computed them (`gpu::preview`) reads them back only when asked.
+    pub details: Option<Details>,
+}
+
+/// An adaptive frame's buffers, per render pixel and per block.
+#[derive(Clone, Debug)]
+pub struct Details {
     /// The bandwidth buffer, per render pixel.
     pub predictions: Vec<Prediction>,
     pub plan: Plan,
@@ -924,12 +1016,33 @@ pub struct Adaptive {
     pub shaded_level: Vec<i32>,
     /// Per render pixel: the samples of that block over its area in render pixels.
     pub samples_per_pixel: Vec<f32>,
-    /// Shadeable render pixels.
-    pub shadeable: usize,
-    /// Wall time of the steps, in milliseconds: G-buffer (made once per camera: the
-    /// [`Geometry`]'s), bandwidth buffer (prediction), pyramid and plan, shading and
-    /// up-sampling.
-    pub timings: Timings,
+}
+
+impl Details {
+    /// The per-pixel views of `plan` over a `width`-wide render: for each render pixel, the
+    /// level its value comes from (through the up-sampling's first parents, the same block
+    /// [`render_with`] follows) and that block's samples over its area; -1 and 0 where the
+    /// pixel is not shadeable.
+    pub fn origins(plan: &Plan) -> (Vec<i32>, Vec<f32>) {
+        let top = plan.levels.len() - 1;
+        let mut origin: Vec<(i32, f32)> = Vec::new();
+        for k in (0..=top).rev() {
+            let level = &plan.levels[k];
+            let coarser = origin;
+            origin = plan.actions[k]
+                .iter()
+                .enumerate()
+                .map(|(b, action)| match *action {
+                    Action::Skip => (-1, 0.0),
+                    Action::Shade { samples, .. } => (k as i32, samples as f32 / (1u64 << (2 * k)) as f32),
+                    Action::Upsample { .. } => {
+                        coarser[(b / level.width / 2) * plan.levels[k + 1].width + (b % level.width) / 2]
+                    }
+                })
+                .collect();
+        }
+        origin.into_iter().unzip()
+    }
 }
 
 /// Wall time of an adaptive frame's steps, in milliseconds.
@@ -946,8 +1059,14 @@ pub struct Timings {
 impl Adaptive {
     /// Shaded blocks over shadeable render pixels: 1 when every pixel is shaded on its own.
     pub fn shaded_fraction(&self) -> f64 {
-        let shaded: usize = self.plan.shaded_per_level().iter().sum();
+        let shaded: usize = self.shaded_per_level.iter().sum();
         if self.shadeable == 0 { 0.0 } else { shaded as f64 / self.shadeable as f64 }
+    }
+
+    /// The frame's buffers ([`Adaptive::details`]). Panics where the renderer was not asked to
+    /// keep them: a caller that reads them asks.
+    pub fn details(&self) -> &Details {
+        self.details.as_ref().expect("an adaptive frame rendered without its details")
     }
 }
 
@@ -1010,9 +1129,10 @@ pub struct Hooks<'a> {
     /// predicted: the benchmark's oracle, a windowed FFT of the converged image (`001` Fig.
     /// 12); the variance is predicted as usual.
     pub oracle: Option<&'a [f64]>,
-    /// The predictions made elsewhere (the GPU's: `gpu::preview::Renderer::predict_blocks`).
+    /// The predictions made elsewhere ([`replay_predictor`]: an earlier frame's, such as the
+    /// GPU's).
     pub predictor: Option<Predictor<'a>>,
-    /// The shaded blocks shaded elsewhere (the GPU's: `gpu::preview::Renderer::shade_blocks`).
+    /// The shaded blocks shaded elsewhere ([`exact_shader`]: a reference image's values).
     pub shader: Option<Shader<'a>>,
 }
 
@@ -1187,19 +1307,14 @@ pub fn render_with(
         )));
     }
     let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
-    let mut origin: Vec<Vec<(i32, f32)>> = vec![Vec::new(); top + 1];
     for k in (0..=top).rev() {
-        let level = &plan.levels[k];
-        let (coarser, coarser_origin) =
-            if k < top { (&values[k + 1], &origin[k + 1]) } else { (&Vec::new(), &Vec::new()) };
-        let computed: Vec<([f32; 3], (i32, f32))> = plan.actions[k]
+        let coarser = if k < top { &values[k + 1] } else { &Vec::new() };
+        values[k] = plan.actions[k]
             .par_iter()
             .enumerate()
             .map(|(b, action)| match *action {
-                Action::Skip => ([0.0; 3], (-1, 0.0)),
-                Action::Shade { samples, .. } => {
-                    (estimates[slot[k][b] as usize], (k as i32, samples as f32 / (1u64 << (2 * k)) as f32))
-                }
+                Action::Skip => [0.0; 3],
+                Action::Shade { .. } => estimates[slot[k][b] as usize],
                 Action::Upsample { parents, count } => {
                     let mut value = [0.0f32; 3];
                     for &(i, w) in &parents[..count as usize] {
@@ -1207,13 +1322,10 @@ pub fn render_with(
                             value[c] += w * coarser[i as usize][c];
                         }
                     }
-                    let own = (b / level.width / 2) * plan.levels[k + 1].width + (b % level.width) / 2;
-                    (value, coarser_origin[own])
+                    value
                 }
             })
             .collect();
-        values[k] = computed.iter().map(|c| c.0).collect();
-        origin[k] = computed.iter().map(|c| c.1).collect();
     }
 
     let (level0, rays) = (lighting.mips.level(0), geometry.camera.rays(width, height));
@@ -1233,16 +1345,17 @@ pub fn render_with(
         plan_ms: plan_ms - predict_ms,
         shade_ms: shade_ms - plan_ms,
     };
+    let (shaded_level, samples_per_pixel) = Details::origins(&plan);
     Ok(Adaptive {
         timings,
         image,
         width,
         height,
-        predictions,
-        shaded_level: origin[0].iter().map(|o| o.0).collect(),
-        samples_per_pixel: origin[0].iter().map(|o| o.1).collect(),
         shadeable: pixels.iter().filter(|p| p.is_some()).count(),
-        plan,
+        shaded_per_level: plan.shaded_per_level(),
+        samples: plan.samples(),
+        budget: plan.budget,
+        details: Some(Details { predictions, plan, shaded_level, samples_per_pixel }),
     })
 }
 

@@ -80,7 +80,7 @@ fn the_min_pyramid_is_conservative() {
 /// gets a value from a block no coarser than its own level; the samples are powers of two within
 /// the cap and within the budget.
 fn check_plan(frame: &adaptive::Adaptive, settings: &adaptive::Settings) {
-    let plan = &frame.plan;
+    let plan = &frame.details().plan;
     let top = plan.levels.len() - 1;
     for (k, (level, actions)) in plan.levels.iter().zip(&plan.actions).enumerate() {
         assert_eq!(actions.len(), level.width * level.height);
@@ -109,14 +109,14 @@ fn check_plan(frame: &adaptive::Adaptive, settings: &adaptive::Settings) {
             }
         }
     }
-    for (p, prediction) in frame.predictions.iter().enumerate() {
+    for (p, prediction) in frame.details().predictions.iter().enumerate() {
         let action = plan.actions[0][p];
         if prediction.level < 0 {
             assert_eq!(action, Action::Skip);
-            assert_eq!(frame.shaded_level[p], -1);
+            assert_eq!(frame.details().shaded_level[p], -1);
         } else {
             assert_ne!(action, Action::Skip, "shadeable pixel {p} is neither shaded nor up-sampled");
-            let shaded = frame.shaded_level[p];
+            let shaded = frame.details().shaded_level[p];
             assert!(
                 (0..=prediction.level).contains(&shaded),
                 "pixel {p}: shaded at {shaded}, needs {}",
@@ -143,10 +143,10 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
                 adaptive::Settings { supersample, predict_level, allocation, ..adaptive::Settings::new(mode, spp) };
             let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
             check_plan(&frame, &settings);
-            let per_level = frame.plan.shaded_per_level();
+            let per_level = &frame.shaded_per_level;
             coarse_levels += per_level[1..].iter().filter(|&&n| n > 0).count();
             // The budget is used: rounding to powers of two loses less than half.
-            assert!(2 * frame.plan.samples() > frame.plan.budget, "{} of {}", frame.plan.samples(), frame.plan.budget);
+            assert!(2 * frame.samples > frame.budget, "{} of {}", frame.samples, frame.budget);
             println!(
                 "{} ss {supersample} predict {predict_level} {}: shaded {:.3}, per level {per_level:?}",
                 mode.name(),
@@ -164,8 +164,14 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
         adaptive::Settings { lobe_weight: true, rescue_below: 0.3, ..adaptive::Settings::new(Mode::Prefiltered, 4) };
     let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
     check_plan(&frame, &settings);
-    let rescued =
-        frame.plan.actions.iter().flatten().filter(|a| matches!(a, Action::Shade { rescued: true, .. })).count();
+    let rescued = frame
+        .details()
+        .plan
+        .actions
+        .iter()
+        .flatten()
+        .filter(|a| matches!(a, Action::Shade { rescued: true, .. }))
+        .count();
     assert!(rescued > 0, "no block rescued");
 }
 
@@ -210,13 +216,14 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     };
     let fine = adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Mode::Reference, 8) };
     let frame = render_exact(&fine, &reference).unwrap();
-    for i in (0..40 * 30).filter(|&i| frame.predictions[i].level >= 0) {
+    for i in (0..40 * 30).filter(|&i| frame.details().predictions[i].level >= 0) {
         assert_eq!(frame.image.rgb[3 * i], reference.rgb[3 * i], "pixel {i}");
     }
     let coarse = adaptive::Settings::new(Mode::Reference, 8);
     let frame = render_exact(&coarse, &reference).unwrap();
     let is_exact = |i: usize| frame.image.rgb[3 * i] == reference.rgb[3 * i];
-    let from = |level: fn(i32) -> bool| (0..40 * 30).filter(|&i| level(frame.shaded_level[i])).collect::<Vec<_>>();
+    let from =
+        |level: fn(i32) -> bool| (0..40 * 30).filter(|&i| level(frame.details().shaded_level[i])).collect::<Vec<_>>();
     let (own, upsampled) = (from(|l| l == 0), from(|l| l > 0));
     assert!(own.iter().all(|&i| is_exact(i)), "pixels shaded on their own take their reference value");
     assert!(!upsampled.is_empty(), "the plan shades coarse blocks");
@@ -240,7 +247,7 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
     let top = frame(4);
     // Every shadeable pixel has a prediction, and blocks whose pixel is off the sphere share
     // theirs by quarters rather than predicting every pixel.
-    let shadeable: Vec<&Prediction> = top.predictions.iter().filter(|p| p.level >= 0).collect();
+    let shadeable: Vec<&Prediction> = top.details().predictions.iter().filter(|p| p.level >= 0).collect();
     let mut distinct: Vec<(u64, u64)> =
         shadeable.iter().map(|p| (p.bandwidth.to_bits(), p.variance.to_bits())).collect();
     distinct.sort_unstable();
@@ -251,7 +258,7 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
     assert!(distinct.len() <= 16, "{} predictions for {} pixels", distinct.len(), shadeable.len());
     for predict_level in [5, 40, 64, usize::MAX] {
         let f = frame(predict_level);
-        assert_eq!(f.predictions, top.predictions, "predict level {predict_level}");
+        assert_eq!(f.details().predictions, top.details().predictions, "predict level {predict_level}");
         assert_eq!(f.image.rgb, top.image.rgb, "predict level {predict_level}");
     }
 }
@@ -342,15 +349,15 @@ fn a_predictor_replaces_the_prediction_and_is_checked() {
         let geometry = adaptive::Geometry::of_scene(&scene, settings.supersample)?;
         adaptive::render_with(&geometry, material, &lighting, &bandwidths, &settings, hooks)
     };
-    let replayed = with(&mut adaptive::replay_predictor(&frame.predictions)).unwrap();
-    assert_eq!(replayed.predictions, frame.predictions);
-    assert_eq!(replayed.plan.actions, frame.plan.actions);
+    let replayed = with(&mut adaptive::replay_predictor(&frame.details().predictions)).unwrap();
+    assert_eq!(replayed.details().predictions, frame.details().predictions);
+    assert_eq!(replayed.details().plan.actions, frame.details().plan.actions);
     assert_eq!(replayed.image.rgb, frame.image.rgb);
     let short = with(&mut |pixels: &[u32]| Ok(vec![[0.1, 1.0]; pixels.len() - 1])).unwrap_err().to_string();
     assert!(short.contains("predictions for"), "{short}");
     let nan = with(&mut |pixels: &[u32]| Ok(vec![[f64::NAN, 1.0]; pixels.len()])).unwrap_err().to_string();
     assert!(nan.contains("render pixel") && nan.contains("NaN"), "{nan}");
-    let none = vec![adaptive::Prediction { level: -1, ..Default::default() }; frame.predictions.len()];
+    let none = vec![adaptive::Prediction { level: -1, ..Default::default() }; frame.details().predictions.len()];
     let missing = with(&mut adaptive::replay_predictor(&none)).unwrap_err().to_string();
     assert!(missing.contains("no prediction to replay"), "{missing}");
 }

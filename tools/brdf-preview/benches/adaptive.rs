@@ -273,7 +273,7 @@ fn main() {
     out(format!(
         "# Adaptive shading: equal-quality benchmark ({})",
         match &gpu {
-            Some(g) => format!("prediction and shading on {}, G-buffer and plan on the CPU", g.adapter_summary()),
+            Some(g) => format!("on {}, the G-buffer and the samples on the CPU", g.adapter_summary()),
             None => "CPU renderer".to_string(),
         }
     ));
@@ -401,29 +401,28 @@ fn main() {
                             };
                             let oracle = variant.oracle.as_deref();
                             let bandwidths = &variant.bandwidths;
-                            let (ms, frame) = timed(3, || {
-                                let gpu_error = |e: gpu::GpuError| render::Error::Invalid(e.to_string());
-                                let mut predict = renderer.as_ref().map(|r| {
-                                    move |pixels: &[u32]| r.predict_blocks(&settings, pixels).map_err(gpu_error)
-                                });
-                                let mut shade = renderer.as_ref().map(|r| {
-                                    move |blocks: &[(u32, u32)]| {
-                                        r.shade_blocks(mode, settings.seed, blocks).map_err(gpu_error)
-                                    }
-                                });
-                                adaptive_frame(
-                                    &frame_geometry(),
-                                    &loaded.material,
-                                    lighting,
-                                    bandwidths,
-                                    &settings,
-                                    adaptive::Hooks {
-                                        oracle,
-                                        predictor: predict.as_mut().map(|p| p as adaptive::Predictor),
-                                        shader: shade.as_mut().map(|s| s as adaptive::Shader),
-                                    },
-                                )
-                            });
+                            let (ms, frame) = match renderer.as_ref() {
+                                Some(r) => {
+                                    let frame = |details| {
+                                        let options = gpu::preview::FrameOptions { oracle, details };
+                                        r.render_adaptive(&loaded.material, lighting, &settings, options)
+                                            .expect("adaptive on the GPU")
+                                    };
+                                    // Timed without the frame's buffers, then once more (the
+                                    // same frame) with them for the ceiling.
+                                    (timed(3, || frame(false)).0, frame(true))
+                                }
+                                None => timed(3, || {
+                                    adaptive_frame(
+                                        &frame_geometry(),
+                                        &loaded.material,
+                                        lighting,
+                                        bandwidths,
+                                        &settings,
+                                        adaptive::Hooks { oracle, ..Default::default() },
+                                    )
+                                }),
+                            };
                             let p = psnr(&frame.image);
                             // The same plan with every shaded block given its converged value:
                             // the up-sampling's error alone, the PSNR no budget can pass.
@@ -436,7 +435,7 @@ fn main() {
                                     &settings,
                                     adaptive::Hooks {
                                         oracle,
-                                        predictor: Some(&mut adaptive::replay_predictor(&frame.predictions)),
+                                        predictor: Some(&mut adaptive::replay_predictor(&frame.details().predictions)),
                                         shader: Some(&mut adaptive::exact_shader(&reference)),
                                     },
                                 )
@@ -452,7 +451,7 @@ fn main() {
                                 variant.name,
                                 millis(ms),
                                 frame.shaded_fraction(),
-                                frame.plan.samples(),
+                                frame.samples,
                                 millis(brute_ms),
                                 if lower_bound { ">" } else { "" }
                             ));
@@ -494,17 +493,20 @@ fn main() {
                             let (cx, cy) = fft.centre(i, j);
                             let (x0, y0) = (cx - fft.window() / 2, cy - fft.window() / 2);
                             let inside = (0..fft.window() * fft.window()).all(|k| {
-                                frame.predictions[(y0 + k / fft.window()) * size + x0 + k % fft.window()].level >= 0
+                                frame.details().predictions[(y0 + k / fft.window()) * size + x0 + k % fft.window()]
+                                    .level
+                                    >= 0
                             });
                             if inside {
-                                predicted.push(frame.predictions[cy * size + cx].bandwidth);
+                                predicted.push(frame.details().predictions[cy * size + cx].bandwidth);
                                 measured.push(fft.frequency_at(i, j));
                             }
                         }
                     }
                     let bandwidth_rho = bandwidth::spearman(&predicted, &measured).unwrap_or(f64::NAN);
-                    let shadeable: Vec<usize> = (0..size * size).filter(|&i| frame.predictions[i].level >= 0).collect();
-                    let pv: Vec<f64> = shadeable.iter().map(|&i| frame.predictions[i].variance).collect();
+                    let shadeable: Vec<usize> =
+                        (0..size * size).filter(|&i| frame.details().predictions[i].level >= 0).collect();
+                    let pv: Vec<f64> = shadeable.iter().map(|&i| frame.details().predictions[i].variance).collect();
                     let mv: Vec<f64> = shadeable.iter().map(|&i| measured_variance[i]).collect();
                     correlations.push((
                         name.clone(),
@@ -534,9 +536,9 @@ fn main() {
                         ..adaptive::Settings::new(Mode::Reference, 8)
                     };
                     match renderer {
-                        Some(r) => {
-                            r.render_adaptive(&loaded.material, lighting, &settings).expect("adaptive on the GPU")
-                        }
+                        Some(r) => r
+                            .render_adaptive(&loaded.material, lighting, &settings, Default::default())
+                            .expect("adaptive on the GPU"),
                         None => {
                             adaptive::render(&scene, &loaded.material, lighting, &variants[0].bandwidths, &settings)
                                 .expect("adaptive")
@@ -545,7 +547,7 @@ fn main() {
                 };
                 let (plain_ms, plain) = timed(3, || frame(1, renderer.as_ref()));
                 let (aa_ms, aa) = timed(3, || frame(4, aa_renderer.as_ref()));
-                let shaded = |f: &adaptive::Adaptive| f.plan.shaded_per_level().iter().sum::<usize>();
+                let shaded = |f: &adaptive::Adaptive| f.shaded_per_level.iter().sum::<usize>();
                 aa_rows.push((name.clone(), plain_ms, aa_ms, shaded(&plain), shaded(&aa)));
             }
         }
@@ -594,18 +596,23 @@ fn main() {
     out("## Where the adaptive frames' time goes (paper reading; ms)".into());
     out(String::new());
     out(format!(
-        "Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). \
-         G-buffer, pyramid and plan run on the CPU; the prediction and `shading` (the shaded blocks, then the \
-         up-sampling and the background on the CPU) on the renderer the rest ran on. {}",
+        "Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). {}",
         if gpu.is_some() {
-            "The G-buffer is the camera's, made once before its frames and not in `frame`, as the brute force's \
-             raster pass is not in its time."
+            "On the GPU the frame is two submissions with the allocation of the samples on the CPU between them; \
+             each submission's time includes its read-back (the list of shaded blocks, then the image). The \
+             G-buffer is the camera's, made once on the CPU before its frames and not in `frame`, as the brute \
+             force's raster pass is not in its time."
         } else {
             "The G-buffer is made in every frame, as the brute force rasterizes in every frame."
         }
     ));
     out(String::new());
-    out("| case | mode | budget spp | G-buffer | prediction | pyramid and plan | shading and up-sampling | frame | brute force at equal PSNR |".into());
+    out(if gpu.is_some() {
+        "| case | mode | budget spp | G-buffer | prediction, pyramids, plan | samples | shading, up-sampling, output | frame | brute force at equal PSNR |"
+    } else {
+        "| case | mode | budget spp | G-buffer | prediction | pyramids, plan, samples | shading, up-sampling, background | frame | brute force at equal PSNR |"
+    }
+    .into());
     out("|---|---|---:|---:|---:|---:|---:|---:|---:|".into());
     for (name, label, spp, t, ms, brute_ms) in &stages {
         out(format!(

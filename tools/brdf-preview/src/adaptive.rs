@@ -1,5 +1,5 @@
 //! `--mode adaptive` and `--mode adaptive-prefiltered`: one frame of bandwidth-driven
-//! multi-resolution shading (`render::adaptive`, on the CPU) and its debug views.
+//! multi-resolution shading (`render::adaptive`, on the GPU) and its debug views.
 
 use picture::colormap::{Scale, inferno, viridis};
 use picture::layout::{Axis, Grid as Panels, caption, heat_map, stack};
@@ -20,15 +20,16 @@ pub fn debug_views(
     title: &str,
 ) -> Canvas {
     let (w, h) = (frame.width, frame.height);
+    let details = frame.details();
     let (ow, oh) = (frame.image.width, frame.image.height);
     let zoom = (256 / w.max(h)).max(1);
     let axes = (Axis::new("x, pixels", 0.0, w as f64), Axis::new("y, pixels", 0.0, h as f64));
-    let shadeable = |i: usize| frame.predictions[i].level >= 0;
-    let top = frame.plan.levels.len() - 1;
+    let shadeable = |i: usize| details.predictions[i].level >= 0;
+    let top = details.plan.levels.len() - 1;
 
     let levels = Scale::linear(0.0, top.max(1) as f64);
     let level_image = Canvas::from_fn(w, h, |x, y| {
-        let l = frame.shaded_level[y * w + x];
+        let l = details.shaded_level[y * w + x];
         if l < 0 { NONE } else { viridis(levels.position(f64::from(l))) }
     });
     let positive = |values: Vec<f64>| -> Vec<f64> { values.into_iter().filter(|v| *v > 0.0).collect() };
@@ -43,11 +44,11 @@ pub fn debug_views(
             if !shadeable(i) || v <= 0.0 { NONE } else { map(scale.position(v).clamp(0.0, 1.0)) }
         })
     };
-    let spp: Vec<f64> = positive(frame.samples_per_pixel.iter().map(|&s| f64::from(s)).collect());
+    let spp: Vec<f64> = positive(details.samples_per_pixel.iter().map(|&s| f64::from(s)).collect());
     let spp_scale = log_scale(&spp, 4.0);
-    let bandwidth: Vec<f64> = positive(frame.predictions.iter().map(|p| p.bandwidth).collect());
+    let bandwidth: Vec<f64> = positive(details.predictions.iter().map(|p| p.bandwidth).collect());
     let bandwidth_scale = Scale::log(1e-3, 1.0);
-    let variance: Vec<f64> = positive(frame.predictions.iter().map(|p| p.variance).collect());
+    let variance: Vec<f64> = positive(details.predictions.iter().map(|p| p.variance).collect());
     let variance_scale = log_scale(&variance, 6.0);
 
     let mut panels = Panels::new(3);
@@ -56,19 +57,19 @@ pub fn debug_views(
     panels.add(heat_map(&image, zoom, &axes.0, &axes.1), "the frame");
     panels.add(heat_map(&level_image, zoom, &axes.0, &axes.1), "level each pixel was shaded at");
     panels.add(
-        heat_map(&heat(&|i| f64::from(frame.samples_per_pixel[i]), &spp_scale, inferno), zoom, &axes.0, &axes.1),
+        heat_map(&heat(&|i| f64::from(details.samples_per_pixel[i]), &spp_scale, inferno), zoom, &axes.0, &axes.1),
         "samples per pixel",
     );
     panels.add(
-        heat_map(&heat(&|i| frame.predictions[i].bandwidth, &bandwidth_scale, inferno), zoom, &axes.0, &axes.1),
+        heat_map(&heat(&|i| details.predictions[i].bandwidth, &bandwidth_scale, inferno), zoom, &axes.0, &axes.1),
         "predicted image bandwidth",
     );
     panels.add(
-        heat_map(&heat(&|i| frame.predictions[i].variance, &variance_scale, viridis), zoom, &axes.0, &axes.1),
+        heat_map(&heat(&|i| details.predictions[i].variance, &variance_scale, viridis), zoom, &axes.0, &axes.1),
         "predicted variance",
     );
     let width = panels.width();
-    let shaded = frame.plan.shaded_per_level();
+    let shaded = &frame.shaded_per_level;
     let per_level: Vec<String> =
         shaded.iter().enumerate().filter(|(_, n)| **n > 0).map(|(k, n)| format!("{n} at {k}")).collect();
     let text = format!(
@@ -79,8 +80,8 @@ pub fn debug_views(
          floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). \
          A shaded block's samples: {}. Black: background or silhouette.",
         per_level.join(", "),
-        frame.plan.samples(),
-        frame.plan.budget,
+        frame.samples,
+        frame.budget,
         format_number((frame.shaded_fraction() * 1e4).round() / 1e4),
         match allocation {
             render::adaptive::Allocation::Variance => "in proportion to the variance",

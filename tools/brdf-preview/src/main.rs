@@ -28,9 +28,9 @@ mod window;
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
 ///                variance; only the pixels of a pyramid whose level the prediction asks for are
 ///                shaded (reference estimator), a budget of --spp samples per pixel on average
-///                is shared among them (--allocation), the rest is up-sampled; one frame: the
-///                prediction and the shaded pixels on the GPU, the G-buffer, the plan and the
-///                up-sampling on the CPU (crate render, module adaptive)
+///                is shared among them (--allocation), the rest is up-sampled; one frame on the
+///                GPU, its G-buffer (once per camera) and the samples' allocation on the CPU
+///                (crate render, module adaptive, is the specification)
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
@@ -457,7 +457,8 @@ struct Step {
     value: serde_json::Value,
 }
 
-/// `--mode adaptive` and `--mode adaptive-prefiltered`: one frame on the CPU renderer.
+/// `--mode adaptive` and `--mode adaptive-prefiltered`: one frame on the GPU
+/// (`gpu::preview::Renderer::render_adaptive`).
 fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighting, out: &Path) -> Result<Step> {
     let bandwidths = loaded.bandwidths.as_ref().ok_or_else(|| {
         anyhow!(
@@ -488,14 +489,16 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
     renderer.set_bandwidths(bandwidths)?;
     // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
-    // milliseconds): one pixel of each first, so that ms_per_frame times the frame. The
-    // G-buffer is the camera's, made once for all its frames as the other modes' raster pass is.
-    renderer.predict_blocks(&settings, &[0])?;
-    renderer.shade_blocks(mode, settings.seed, &[(0, 1)])?;
+    // milliseconds): a frame first, so that ms_per_frame times the frame. The G-buffer and its
+    // upload are the camera's, made once for all its frames as the other modes' raster pass is.
+    renderer.render_adaptive(&loaded.material, lighting, &settings, Default::default())?;
     let geometry = renderer.adaptive_geometry(ss)?;
-    let start = Instant::now();
-    let frame = renderer.render_adaptive(&loaded.material, lighting, &settings)?;
-    let ms_per_frame = start.elapsed().as_secs_f64() * 1e3;
+    // The frame's buffers come back after its timings, for the views and the checks that read them.
+    let details = args.debug_views || args.validate || args.converged.is_some();
+    let options = gpu::preview::FrameOptions { details, ..Default::default() };
+    let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
+    let t = frame.timings;
+    let ms_per_frame = t.predict_ms + t.plan_ms + t.shade_ms;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
     let caption = format!(
@@ -503,7 +506,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         names(&loaded.manifest),
         args.mode.name(),
         settings.spp,
-        frame.plan.samples(),
+        frame.samples,
         frame.shaded_fraction(),
         scene.width,
         scene.height,
@@ -520,11 +523,10 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         );
         files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
-    let t = frame.timings;
     let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms (prediction {:.1} on the GPU, plan {:.1} on the CPU, shading on \
-         the GPU and up-sampling {:.1}; the camera's G-buffer on the CPU before, once: {:.1}); shaded fraction {:.4}, \
-         {} samples of a budget of {}",
+        "{}: {} on {} ({}), {ms_per_frame:.1} ms (prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on \
+         the CPU, shading, up-sampling and output {:.1} on the GPU; the camera's G-buffer on the CPU before, once: \
+         {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
         out.display(),
         args.mode.name(),
         gpu.adapter_summary(),
@@ -534,8 +536,8 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         t.shade_ms,
         t.gbuffer_ms,
         frame.shaded_fraction(),
-        frame.plan.samples(),
-        frame.plan.budget
+        frame.samples,
+        frame.budget
     )];
     let mut value = json!({
         "bake": args.bake.display().to_string(),
@@ -550,11 +552,11 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "height": scene.height,
         "exposure_ev": preview.exposure_ev,
         "ms_per_frame": ms_per_frame,
-        "timings_ms": {"gbuffer": t.gbuffer_ms, "prediction": t.predict_ms, "plan": t.plan_ms, "shading": t.shade_ms},
+        "timings_ms": {"gbuffer": t.gbuffer_ms, "prediction_and_plan": t.predict_ms, "samples": t.plan_ms, "shading": t.shade_ms},
         "shaded_fraction": frame.shaded_fraction(),
-        "shaded_per_level": frame.plan.shaded_per_level(),
-        "samples": frame.plan.samples(),
-        "budget": frame.plan.budget,
+        "shaded_per_level": frame.shaded_per_level,
+        "samples": frame.samples,
+        "budget": frame.budget,
         "mean_luminance": metrics::mean_luminance(&frame.image),
     });
     let mut problems = Vec::new();
@@ -565,22 +567,27 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
         let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
         let own = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let predicted = frame.predictions.iter().zip(&own.predictions).filter(|(g, _)| g.level >= 0);
+        let predicted =
+            frame.details().predictions.iter().zip(&own.details().predictions).filter(|(g, _)| g.level >= 0);
         let (pixels, differ) =
             predicted.fold((0usize, 0usize), |(n, d), (g, c)| (n + 1, d + usize::from(g.level != c.level)));
-        // The same frame with the GPU's predictions and the CPU's shading: the plan is the same,
-        // the values equal to rounding.
-        let mut replay = render::adaptive::replay_predictor(&frame.predictions);
+        // The same frame with the GPU's predictions on the CPU: the plan is the same (the weights
+        // to f32 rounding: the GPU's are f32), the values equal to rounding.
+        let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
         let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
         let cpu = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
         let cpu_picture = metrics::tonemap(&cpu.image, &preview);
         let psnr = metrics::psnr_db(&picture, &cpu_picture);
         let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
-        let same_plan = cpu.plan.actions == frame.plan.actions;
+        let plan = frame.details().plan.compare(&cpu.details().plan, 1e-5);
+        let same_plan = plan.is_ok();
         report.push(format!(
             "against the CPU: {differ} of {pixels} pixels predicted at another level than the CPU predicts; \
-             with the GPU's predictions (the same plan{}): PSNR {} dB, relative error {relative:.2e}",
-            if same_plan { "" } else { ": NOT the same plan" },
+             with the GPU's predictions ({}): PSNR {} dB, relative error {relative:.2e}",
+            match &plan {
+                Ok(worst) => format!("the same plan, weights within {worst:.1e}"),
+                Err(e) => format!("NOT the same plan: {e}"),
+            },
             db(psnr)
         ));
         value["cpu"] = json!({
@@ -621,7 +628,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
             // error alone, the PSNR no budget can pass (render pixels are the converged
             // estimate's pixels only without anti-aliasing).
             let mut exact = render::adaptive::exact_shader(&converged);
-            let mut replay = render::adaptive::replay_predictor(&frame.predictions);
+            let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
             let hooks = render::adaptive::Hooks {
                 predictor: Some(&mut replay),
                 shader: Some(&mut exact),

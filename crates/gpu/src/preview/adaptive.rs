@@ -1,0 +1,738 @@
+//! An adaptive frame (`render::adaptive`) on the GPU, whole: the camera's G-buffer records are
+//! uploaded once (from `render::adaptive::Geometry`, the CPU's, so that both renderers plan
+//! from the same surfaces), and each frame then runs in two submissions:
+//!
+//! 1. the prediction at the prediction pixels (`predict_blocks`), the levels of the bandwidth
+//!    buffer, the min and max pyramids and the plan of every block (`preview_adaptive.wgsl`),
+//!    which appends the shaded blocks to a list; the list comes back (a few thousand blocks);
+//! 2. the host sorts it into the plan's order and gives the blocks their samples with
+//!    `render::adaptive::allocation` (the CPU's code: the same samples), then the shaded blocks
+//!    (`shade_blocks`), their estimates put in place, the up-sampling level by level from the
+//!    top, and the output image, which comes back.
+//!
+//! The plan is the CPU's in `f32`: the weights agree to `f32` rounding, and the decisions
+//! (valid, shaded, rescued, up-sampled) are the same wherever no weight or sum sits within
+//! rounding of a threshold (`render::adaptive::MIN_WEIGHT`, `rescue_below`) and no lobe
+//! sharpness row boundary is crossed; eq. 11's levels are exact comparisons with powers of two,
+//! which give the CPU's levels for the same `f32` bandwidths. The tests hold a frame's plan to
+//! the CPU's from the same predictions. The frame's buffers (predictions, pyramid, plan) stay on
+//! the GPU unless [`FrameOptions::details`] asks for them.
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use render::adaptive::{Action, Adaptive, Details, Geometry, Level, Plan, Prediction, Timings};
+use render::{Image, Lighting, Material};
+
+use super::{Renderer, no_bandwidths};
+use crate::context::check_buffer_fits;
+use crate::error::GpuError;
+use crate::merl_lookup::{capture_errors, read_back};
+
+/// `AdaptivePass` of `preview_adaptive.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(super) struct AdaptivePass {
+    level: u32,
+    top: u32,
+    width: u32,
+    height: u32,
+    out_width: u32,
+    out_height: u32,
+    ss: u32,
+    count: u32,
+    records: u32,
+    levels: u32,
+    plan: u32,
+    values: u32,
+    list: u32,
+    level_table: u32,
+    sharpness: u32,
+    bandwidth: u32,
+    n_rows: u32,
+    oracle: u32,
+    depth_sigma: f32,
+    rescue_below: f32,
+    candidates: u32,
+    _pad: [u32; 3],
+}
+
+/// `NONE` of the WGSL: a render pixel without a prediction (not shadeable).
+const NONE: u32 = u32::MAX;
+
+/// What an adaptive frame on the GPU may take besides its settings.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameOptions<'a> {
+    /// The image bandwidth of every render pixel (cycles per pixel, row-major) instead of the
+    /// prediction's, as `render::adaptive::Hooks::oracle`: uploaded with the frame.
+    pub oracle: Option<&'a [f64]>,
+    /// Read the frame's buffers back into [`Adaptive::details`] (after the frame's timings).
+    pub details: bool,
+}
+
+/// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
+/// and pyramid top: the sections of `preview_adaptive.wgsl`'s `state`, in words.
+#[derive(Debug)]
+pub(super) struct State {
+    geometry: Arc<Geometry>,
+    key: (usize, usize, usize),
+    /// `(width, height, first block)` per level.
+    levels: Vec<(u32, u32, u32)>,
+    blocks: u32,
+    /// Blocks that hold a shadeable pixel, per level, and in all (`preview_adaptive.wgsl`).
+    candidates_per_level: Vec<u32>,
+    candidates: u32,
+    /// The pass uniform with the sections' offsets (the per-pass fields zero).
+    base: AdaptivePass,
+    /// The prediction pixels (`render::adaptive::prediction_pixels`), as `predict_blocks`'
+    /// items.
+    items: wgpu::Buffer,
+    n_items: u32,
+    /// Shadeable render pixels, and output pixels a triangle covers.
+    shadeable: usize,
+    covered_output: u64,
+    state: wgpu::Buffer,
+    counter: wgpu::Buffer,
+    uniform: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    /// For the frame's read-backs (the count, the list, the image), kept from frame to frame.
+    readback: wgpu::Buffer,
+}
+
+/// Slots of the pass uniform: levels, `top` reductions, plan, scatter, `top` up-samplings,
+/// output.
+fn slots(top: usize) -> u64 {
+    2 * top as u64 + 4
+}
+
+/// The samples of one part of a shaded block, at most (`shade_blocks`): a block's samples run in
+/// parts side by side, since one invocation that takes a coarse block's hundreds of samples one
+/// after another would hold the whole frame up.
+const PART: u32 = 16;
+
+/// `shade_blocks`' items for the shaded blocks of `list` (in the plan's order) with their
+/// `samples`: each block's samples in parts of `PART` (or, where that would make more items
+/// than the accumulation buffer's `capacity` entries, of the least power of two that does not);
+/// and the list's entries for `adaptive_scatter`: the block's index among every level's blocks,
+/// its first part, the number of parts.
+fn parts(
+    list: &[[u32; 4]],
+    samples: &[u32],
+    levels: &[(u32, u32, u32)],
+    capacity: usize,
+) -> (Vec<[u32; 4]>, Vec<[u32; 4]>) {
+    let count = |part: u32| samples.iter().map(|&n| n.div_ceil(part) as usize).sum::<usize>();
+    let mut part = PART;
+    while count(part) > capacity && part < u32::MAX / 2 {
+        part *= 2;
+    }
+    let mut items = Vec::with_capacity(count(part));
+    let mut targets = Vec::with_capacity(list.len());
+    for (e, &n) in list.iter().zip(samples) {
+        let first = items.len() as u32;
+        for start in (0..n).step_by(part as usize) {
+            items.push([e[3], n, start, part.min(n - start)]);
+        }
+        targets.push([levels[e[0] as usize].2 + e[1], first, items.len() as u32 - first, 0]);
+    }
+    (items, targets)
+}
+
+/// Dispatches one of the adaptive passes over `count` items, with the pass uniform's slot at
+/// byte `offset`.
+fn dispatch(cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, state: &State, offset: u64, count: u32) {
+    cpass.set_pipeline(pipeline);
+    cpass.set_bind_group(3, &state.group, &[offset as u32]);
+    let (x, y) = groups(count);
+    cpass.dispatch_workgroups(x, y, 1);
+}
+
+/// Bytes between the pass uniform's slots: its size rounded up to the dynamic-offset alignment.
+fn slot_stride(alignment: u64) -> u64 {
+    (size_of::<AdaptivePass>() as u64).div_ceil(alignment) * alignment
+}
+
+/// Workgroups of 64 for `count` items, as `(x, y)` within the dispatch limits.
+fn groups(count: u32) -> (u32, u32) {
+    let groups = count.div_ceil(64).max(1);
+    (groups.min(32768), groups.div_ceil(32768))
+}
+
+impl Renderer {
+    /// The state for `geometry` and `settings`, made and uploaded when the geometry, the
+    /// prediction level or the top changed since the last frame.
+    fn adaptive_state(
+        &self,
+        geometry: &Arc<Geometry>,
+        settings: &render::adaptive::Settings,
+        material: &Material,
+        lighting: &Lighting,
+    ) -> Result<(), GpuError> {
+        let (width, height) = geometry.render_size();
+        let top = render::adaptive::top_level(width, height, settings.max_level);
+        let l = settings.prediction_level(top);
+        let key = (settings.supersample, l, top);
+        if let Some(state) = self.adaptive.borrow().as_ref()
+            && Arc::ptr_eq(&state.geometry, geometry)
+            && state.key == key
+        {
+            return Ok(());
+        }
+        let pixels = geometry.pixels();
+        let shadeable: Vec<bool> = pixels.iter().map(Option::is_some).collect();
+        let (at, of_pixel) = render::adaptive::prediction_pixels(&shadeable, (width, height), l);
+        let mut levels = Vec::with_capacity(top + 1);
+        let (mut w, mut h, mut blocks) = (width as u32, height as u32, 0u32);
+        for _ in 0..=top {
+            levels.push((w, h, blocks));
+            blocks += w * h;
+            (w, h) = (w.div_ceil(2), h.div_ceil(2));
+        }
+        // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
+        // (`check_settings` holds the rows in range where the lobe weight is on).
+        let sharpness: Vec<f32> = material
+            .view_layers
+            .iter()
+            .map(|&l| lighting.exponents.get(l as usize).map_or(0.0, |&n| n as f32))
+            .collect();
+        let p = (width * height) as u32;
+        let records = 0;
+        let bandwidth = records + 8 * p;
+        let levels_at = bandwidth + p;
+        let plan = levels_at + 4 * blocks;
+        let values = plan + 8 * blocks;
+        let list = values + 4 * blocks;
+        let level_table = list + 4 * blocks;
+        // The candidates: blocks that hold a shadeable pixel, level by level.
+        let mut any_shadeable: Vec<bool> = shadeable.clone();
+        let mut candidates: Vec<u32> = (0..p).filter(|&i| shadeable[i as usize]).collect();
+        let mut candidates_per_level = vec![candidates.len() as u32];
+        for k in 1..levels.len() {
+            let ((w, h, first), (cw, ch, _)) = (levels[k], levels[k - 1]);
+            let child = &any_shadeable;
+            let mine: Vec<bool> = (0..w * h)
+                .map(|b| {
+                    let (bx, by) = (b % w, b / w);
+                    (0..4).any(|j| {
+                        let (cx, cy) = (2 * bx + j % 2, 2 * by + j / 2);
+                        cx < cw && cy < ch && child[(cy * cw + cx) as usize]
+                    })
+                })
+                .collect();
+            let before = candidates.len();
+            candidates.extend((0..w * h).filter(|&b| mine[b as usize]).map(|b| first + b));
+            candidates_per_level.push((candidates.len() - before) as u32);
+            any_shadeable = mine;
+        }
+        let n_candidates = candidates.len() as u32;
+        let candidates_at = level_table + 4 * (levels.len() as u32 + 1);
+        let sharpness_at = candidates_at + n_candidates.max(1);
+        let words = u64::from(sharpness_at) + sharpness.len().max(1) as u64;
+        let limits = self.device.limits();
+        check_buffer_fits(&limits, &self.adapter_info, 4 * words, "an adaptive frame's buffers")?;
+        let base = AdaptivePass {
+            top: top as u32,
+            width: width as u32,
+            height: height as u32,
+            out_width: geometry.size().0 as u32,
+            out_height: geometry.size().1 as u32,
+            ss: settings.supersample as u32,
+            records,
+            levels: levels_at,
+            plan,
+            values,
+            list,
+            level_table,
+            sharpness: sharpness_at,
+            bandwidth,
+            n_rows: sharpness.len() as u32,
+            candidates: candidates_at,
+            ..Default::default()
+        };
+        let mut record_words = vec![0u32; 8 * p as usize];
+        for (i, r) in record_words.chunks_exact_mut(8).enumerate() {
+            let f = |v: f64| (v as f32).to_bits();
+            match &pixels[i] {
+                Some(px) => {
+                    let m = px.mirror;
+                    r.copy_from_slice(&[
+                        f(px.depth),
+                        f(px.cos_o),
+                        f(px.screen_normal[0]),
+                        f(px.screen_normal[1]),
+                        f(m.x),
+                        f(m.y),
+                        f(m.z),
+                        of_pixel[i],
+                    ]);
+                }
+                None => {
+                    r[0] = if geometry.covers(i) { 0f32 } else { -1f32 }.to_bits();
+                    r[7] = NONE;
+                }
+            }
+        }
+        let mut first_candidate = 0;
+        let mut table: Vec<u32> = Vec::with_capacity(4 * (levels.len() + 1));
+        for (&(w, h, first), &n) in levels.iter().zip(&candidates_per_level) {
+            table.extend([w, h, first, first_candidate]);
+            first_candidate += n;
+        }
+        table.extend([0, 0, blocks, first_candidate]);
+        // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
+        let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
+        let items: Vec<[u32; 4]> = at.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        let state = capture_errors(&self.device, || {
+            use wgpu::util::DeviceExt;
+            let state = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive state"),
+                size: 4 * words,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.queue.write_buffer(&state, 4 * u64::from(records), bytemuck::cast_slice(&record_words));
+            self.queue.write_buffer(&state, 4 * u64::from(level_table), bytemuck::cast_slice(&table));
+            self.queue.write_buffer(&state, 4 * u64::from(levels_at), bytemuck::cast_slice(&idle));
+            if !candidates.is_empty() {
+                self.queue.write_buffer(&state, 4 * u64::from(candidates_at), bytemuck::cast_slice(&candidates));
+            }
+            if !sharpness.is_empty() {
+                self.queue.write_buffer(&state, 4 * u64::from(sharpness_at), bytemuck::cast_slice(&sharpness));
+            }
+            let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("adaptive prediction pixels"),
+                contents: bytemuck::cast_slice(if items.is_empty() { &[[0u32; 4]][..] } else { &items }),
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
+            let counter = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive shaded count"),
+                size: 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive passes"),
+                size: slot_stride(self.frame_stride) * slots(top),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("adaptive"),
+                layout: &self.adaptive_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &uniform,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
+                        }),
+                    },
+                    wgpu::BindGroupEntry { binding: 3, resource: state.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: counter.as_entire_binding() },
+                ],
+            });
+            let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
+            let readback = self.readback_buffer((16 * u64::from(blocks)).max(16 * out_pixels));
+            State {
+                readback,
+                geometry: Arc::clone(geometry),
+                key,
+                levels,
+                blocks,
+                candidates_per_level,
+                candidates: n_candidates,
+                base,
+                items: items_buffer,
+                n_items: at.len() as u32,
+                shadeable: shadeable.iter().filter(|&&s| s).count(),
+                covered_output: geometry.output_coverage().iter().filter(|&&c| c).count() as u64,
+                state,
+                counter,
+                uniform,
+                group,
+            }
+        })?;
+        *self.adaptive.borrow_mut() = Some(state);
+        Ok(())
+    }
+
+    /// One adaptive frame (`render::adaptive`, `brdf-preview --mode adaptive`) of the renderer's
+    /// mesh and camera, its output image `supersample` times smaller than the renderer's, with
+    /// the bandwidths of [`Renderer::set_bandwidths`], on the GPU whole (module docs): the same
+    /// frame as `render::adaptive::render_with` computes on the CPU, to `f32` rounding. The
+    /// G-buffer is the camera's ([`Renderer::adaptive_geometry`], made once per camera). The
+    /// timings: `predict_ms` the first submission (prediction, pyramids, plan and the list of
+    /// shaded blocks read back), `plan_ms` the host's allocation, `shade_ms` the second
+    /// submission (shading, up-sampling, output and its read-back).
+    pub fn render_adaptive(
+        &self,
+        material: &Material,
+        lighting: &Lighting,
+        settings: &render::adaptive::Settings,
+        options: FrameOptions,
+    ) -> Result<Adaptive, GpuError> {
+        let prediction = self.prediction.as_ref().ok_or_else(no_bandwidths)?;
+        render::adaptive::check_settings(settings, material, lighting)?;
+        let geometry = self.adaptive_geometry(settings.supersample)?;
+        let (width, height) = geometry.render_size();
+        if let Some(oracle) = options.oracle
+            && oracle.len() != width * height
+        {
+            return Err(render::Error::Invalid(format!(
+                "an oracle of {} values for {width} x {height} render pixels",
+                oracle.len()
+            ))
+            .into());
+        }
+        self.adaptive_state(&geometry, settings, material, lighting)?;
+        let borrowed = self.adaptive.borrow();
+        let state = borrowed.as_ref().expect("made above");
+        let top = state.levels.len() - 1;
+        let (out_width, out_height) = geometry.size();
+        let clock = std::time::Instant::now();
+        let lap = || clock.elapsed().as_secs_f64() * 1e3;
+
+        // Submission 1: prediction, levels, pyramids, plan.
+        let stride = slot_stride(self.frame_stride);
+        let pass = |slot: u64, fields: AdaptivePass| {
+            self.queue.write_buffer(&state.uniform, slot * stride, bytemuck::bytes_of(&fields));
+        };
+        let base = AdaptivePass {
+            depth_sigma: settings.depth_sigma as f32,
+            rescue_below: settings.rescue_below as f32,
+            n_rows: if settings.lobe_weight { state.base.n_rows } else { 0 },
+            oracle: u32::from(options.oracle.is_some()),
+            ..state.base
+        };
+        let (levels_slot, plan_slot, scatter_slot) = (0, 1 + top as u64, 2 + top as u64);
+        let blocks = state.blocks;
+        let shaded = capture_errors(&self.device, || {
+            self.progress.set(None);
+            self.write_predict_uniform(prediction, settings);
+            let shade = self.shade_uniform(
+                super::mode_index(settings.mode),
+                &render::Settings { mode: settings.mode, spp: state.n_items, frames: 1, seed: settings.seed },
+            );
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
+            self.queue.write_buffer(&state.counter, 0, &[0u8; 4]);
+            if let Some(oracle) = options.oracle {
+                let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
+                self.queue.write_buffer(&state.state, 4 * u64::from(base.bandwidth), bytemuck::cast_slice(&values));
+            }
+            pass(levels_slot, base);
+            for k in 1..=top {
+                pass(k as u64, AdaptivePass { level: k as u32, ..base });
+            }
+            pass(plan_slot, AdaptivePass { count: state.candidates, ..base });
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
+            {
+                let mut cpass = self.begin_adaptive_pass(&mut encoder);
+                if state.n_items > 0 {
+                    cpass.set_pipeline(&self.predict_pipeline);
+                    cpass.set_bind_group(3, &prediction.group, &[]);
+                    let (x, y) = super::item_groups(state.n_items);
+                    cpass.dispatch_workgroups(x, y, 1);
+                }
+                let mut run = |pipeline, slot: u64, count| dispatch(&mut cpass, pipeline, state, slot * stride, count);
+                let pipelines = &self.adaptive_pipelines;
+                let candidates = &state.candidates_per_level;
+                run(&pipelines.levels, levels_slot, candidates[0]);
+                for (k, &n) in candidates.iter().enumerate().skip(1) {
+                    run(&pipelines.reduce, k as u64, n);
+                }
+                run(&pipelines.plan, plan_slot, state.candidates);
+            }
+            encoder
+        })
+        .and_then(|mut encoder| {
+            encoder.copy_buffer_to_buffer(&state.counter, 0, &state.readback, 0, 4);
+            self.queue.submit([encoder.finish()]);
+            let count: Vec<u32> = read_back(&self.device, &state.readback, 4)?;
+            let bytes = 16 * u64::from(count[0].min(blocks));
+            if bytes == 0 {
+                return Ok(Vec::new());
+            }
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(&state.state, 4 * u64::from(base.list), &state.readback, 0, bytes);
+            self.queue.submit([encoder.finish()]);
+            read_back(&self.device, &state.readback, bytes)
+        })?;
+        let predict_ms = lap();
+
+        // The host: the list in the plan's order, the samples.
+        let mut list: Vec<[u32; 4]> = shaded.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        list.sort_unstable_by_key(|e| (e[0], e[1]));
+        let budget = u64::from(settings.spp) * state.covered_output;
+        let blocks_in: Vec<(usize, f64)> =
+            list.iter().map(|e| (e[0] as usize, f64::from(f32::from_bits(e[2])))).collect();
+        let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
+        let (items, targets) = parts(&list, &samples, &state.levels, width * height);
+        let plan_ms = lap();
+
+        // Submission 2: shading, estimates in place, up-sampling, output.
+        let n_shaded = targets.len() as u32;
+        let n_parts = items.len() as u32;
+        let out_pixels = (out_width * out_height) as u64;
+        let rgba: Vec<[f32; 4]> = capture_errors(&self.device, || {
+            let shade = self.shade_uniform(
+                super::mode_index(settings.mode),
+                &render::Settings { mode: settings.mode, spp: n_parts, frames: 1, seed: settings.seed },
+            );
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            if !items.is_empty() {
+                self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
+                self.queue.write_buffer(&state.state, 4 * u64::from(base.list), bytemuck::cast_slice(&targets));
+            }
+            pass(scatter_slot, AdaptivePass { count: n_shaded, ..base });
+            for k in 0..top {
+                pass(scatter_slot + 1 + k as u64, AdaptivePass { level: k as u32, ..base });
+            }
+            let output_slot = scatter_slot + 1 + top as u64;
+            pass(output_slot, base);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let mut cpass = self.begin_adaptive_pass(&mut encoder);
+                if n_parts > 0 {
+                    cpass.set_pipeline(&self.blocks_pipeline);
+                    let (x, y) = super::item_groups(n_parts);
+                    cpass.dispatch_workgroups(x, y, 1);
+                }
+                let mut run = |pipeline, slot: u64, count| dispatch(&mut cpass, pipeline, state, slot * stride, count);
+                let pipelines = &self.adaptive_pipelines;
+                run(&pipelines.scatter, scatter_slot, n_shaded);
+                for k in (0..top).rev() {
+                    run(&pipelines.upsample, scatter_slot + 1 + k as u64, state.candidates_per_level[k]);
+                }
+                run(&pipelines.output, output_slot, out_pixels as u32);
+            }
+            encoder
+        })
+        .and_then(|mut encoder| {
+            encoder.copy_buffer_to_buffer(&self.accumulation, 0, &state.readback, 0, 16 * out_pixels);
+            self.queue.submit([encoder.finish()]);
+            read_back(&self.device, &state.readback, 16 * out_pixels)
+        })?;
+        let shade_ms = lap();
+        let image = Image {
+            width: out_width,
+            height: out_height,
+            rgb: rgba.iter().flat_map(|v| [v[0], v[1], v[2]]).collect(),
+            covered: geometry.output_coverage().to_vec(),
+        };
+        let mut shaded_per_level = vec![0usize; top + 1];
+        for e in &list {
+            shaded_per_level[e[0] as usize] += 1;
+        }
+        let details = if options.details { Some(self.adaptive_details(state, &list, &samples, budget)?) } else { None };
+        Ok(Adaptive {
+            image,
+            width,
+            height,
+            shadeable: state.shadeable,
+            shaded_per_level,
+            samples: samples.iter().map(|&n| u64::from(n)).sum(),
+            budget,
+            timings: Timings {
+                gbuffer_ms: geometry.millis(),
+                predict_ms,
+                plan_ms: plan_ms - predict_ms,
+                shade_ms: shade_ms - plan_ms,
+            },
+            details,
+        })
+    }
+
+    /// The frame's buffers read back (`Adaptive::details`): the predictions, the pyramid and
+    /// the plan, with the samples the host gave the shaded blocks (`list`, in the plan's order).
+    fn adaptive_details(
+        &self,
+        state: &State,
+        list: &[[u32; 4]],
+        samples: &[u32],
+        budget: u64,
+    ) -> Result<Details, GpuError> {
+        let base = &state.base;
+        let pixels = (base.width * base.height) as usize;
+        let bandwidth = self.read_words(&state.state, base.bandwidth, pixels as u32)?;
+        let levels_words = self.read_words(&state.state, base.levels, 4 * state.blocks)?;
+        let plan_words = self.read_words(&state.state, base.plan, 8 * state.blocks)?;
+        let mut given = std::collections::HashMap::new();
+        for (e, &n) in list.iter().zip(samples) {
+            given.insert((e[0] as usize, e[1] as usize), n);
+        }
+        let mut levels = Vec::with_capacity(state.levels.len());
+        let mut actions = Vec::with_capacity(state.levels.len());
+        for (k, &(w, h, first)) in state.levels.iter().enumerate() {
+            let range = first as usize..(first + w * h) as usize;
+            levels.push(Level {
+                level: k,
+                width: w as usize,
+                height: h as usize,
+                min_level: range.clone().map(|b| levels_words[4 * b] as i32).collect(),
+                max_variance: range.clone().map(|b| f64::from(f32::from_bits(levels_words[4 * b + 1]))).collect(),
+            });
+            actions.push(
+                range
+                    .enumerate()
+                    .map(|(b, block)| {
+                        let action = levels_words[4 * block + 2];
+                        let samples = || given.get(&(k, b)).copied().unwrap_or(0);
+                        match action & 0xff {
+                            1 => Action::Shade { samples: samples(), rescued: false },
+                            2 => Action::Shade { samples: samples(), rescued: true },
+                            3 => {
+                                let p = &plan_words[8 * block..8 * block + 8];
+                                let parents = std::array::from_fn(|m| (p[m], f32::from_bits(p[4 + m])));
+                                Action::Upsample { parents, count: (action >> 8) as u8 }
+                            }
+                            _ => Action::Skip,
+                        }
+                    })
+                    .collect(),
+            );
+        }
+        // A pixel that is not shadeable has no prediction (its bandwidth word may hold an oracle's).
+        let predictions = (0..pixels)
+            .map(|p| match levels[0].min_level[p] {
+                -1 => Prediction { level: -1, ..Prediction::default() },
+                level => Prediction {
+                    bandwidth: f64::from(f32::from_bits(bandwidth[p])),
+                    variance: levels[0].max_variance[p],
+                    level,
+                },
+            })
+            .collect();
+        let plan = Plan { levels, actions, budget };
+        let (shaded_level, samples_per_pixel) = Details::origins(&plan);
+        Ok(Details { predictions, plan, shaded_level, samples_per_pixel })
+    }
+
+    /// A compute pass with the shading pass's groups 0 to 2 set.
+    fn begin_adaptive_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::ComputePass<'e> {
+        let mut cpass = encoder.begin_compute_pass(&Default::default());
+        cpass.set_bind_group(0, &self.table_group, &[]);
+        cpass.set_bind_group(1, &self.bake_group, &[]);
+        cpass.set_bind_group(2, &self.render_group, &[0]);
+        cpass
+    }
+
+    /// A buffer to map for reading, of `bytes`.
+    fn readback_buffer(&self, bytes: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("adaptive readback"),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// `count` words of `buffer` from word `offset`, read back.
+    fn read_words(&self, buffer: &wgpu::Buffer, offset: u32, count: u32) -> Result<Vec<u32>, GpuError> {
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let bytes = 4 * u64::from(count);
+        let readback = capture_errors(&self.device, || {
+            let readback = self.readback_buffer(bytes);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(buffer, 4 * u64::from(offset), &readback, 0, bytes);
+            self.queue.submit([encoder.finish()]);
+            readback
+        })?;
+        read_back(&self.device, &readback, bytes)
+    }
+}
+
+/// The adaptive frame's pipelines (`preview_adaptive.wgsl`), group 3 from
+/// [`Renderer`]'s `adaptive_layout`.
+#[derive(Debug)]
+pub(super) struct Pipelines {
+    pub levels: wgpu::ComputePipeline,
+    pub reduce: wgpu::ComputePipeline,
+    pub plan: wgpu::ComputePipeline,
+    pub scatter: wgpu::ComputePipeline,
+    pub upsample: wgpu::ComputePipeline,
+    pub output: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    pub(super) fn new(make: impl Fn(&'static str) -> wgpu::ComputePipeline) -> Pipelines {
+        Pipelines {
+            levels: make("adaptive_levels"),
+            reduce: make("adaptive_reduce"),
+            plan: make("adaptive_plan"),
+            scatter: make("adaptive_scatter"),
+            upsample: make("adaptive_upsample"),
+            output: make("adaptive_output"),
+        }
+    }
+}
+
+/// The layout of group 3 of the adaptive passes: bindings 2 (the pass uniform, one slot per
+/// pass), 3 (the state) and 4 (the count of shaded blocks).
+pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("adaptive"),
+        entries: &[
+            super::uniform_entry(2, compute, true),
+            super::storage_entry(3, compute, false),
+            super::storage_entry(4, compute, false),
+        ],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{AdaptivePass, PART, parts};
+    use crate::preview::PREVIEW_ADAPTIVE_WGSL;
+
+    #[test]
+    fn the_pass_uniform_and_the_constants_match_the_wgsl() {
+        // `AdaptivePass`: 4-byte scalars only, so the host struct is the WGSL's field for field.
+        let body = PREVIEW_ADAPTIVE_WGSL.split("struct AdaptivePass {").nth(1).unwrap().split('}').next().unwrap();
+        let fields: Vec<&str> = body
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.starts_with("//") && l.contains(':'))
+            .map(|l| l.split(':').nth(1).unwrap().trim().trim_end_matches(','))
+            .collect();
+        assert!(fields.iter().all(|t| *t == "u32" || *t == "f32"), "{fields:?}");
+        assert_eq!(size_of::<AdaptivePass>(), 4 * fields.len());
+        assert_eq!(
+            std::mem::offset_of!(AdaptivePass, depth_sigma),
+            4 * fields.iter().position(|t| *t == "f32").unwrap()
+        );
+        let weight = format!("const MIN_WEIGHT: f32 = {:e};", render::adaptive::MIN_WEIGHT);
+        let declared = PREVIEW_ADAPTIVE_WGSL.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
+        let value: f64 = declared.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
+        assert_eq!(value, render::adaptive::MIN_WEIGHT, "{declared} against {weight}");
+        assert!(PREVIEW_ADAPTIVE_WGSL.contains("const NONE: u32 = 0xffffffffu;"));
+    }
+
+    #[test]
+    fn a_blocks_parts_cover_its_samples_once() {
+        let levels = [(8, 8, 0), (4, 4, 64), (2, 2, 80)];
+        let list = [[0, 5, 0, 5], [1, 3, 0, 7], [2, 1, 0, 9]];
+        let samples = [1, 40, 256];
+        for (capacity, part) in [(1000, PART), (10, 128)] {
+            let (items, targets) = parts(&list, &samples, &levels, capacity);
+            assert!(items.len() <= capacity, "{} items", items.len());
+            assert_eq!(targets.iter().map(|t| t[0]).collect::<Vec<_>>(), [5, 67, 81]);
+            for (t, (e, &n)) in targets.iter().zip(list.iter().zip(&samples)) {
+                let mine = &items[t[1] as usize..(t[1] + t[2]) as usize];
+                // Consecutive ranges from 0 to n, each at most a part, all of the block's pixel.
+                let mut next = 0;
+                for item in mine {
+                    assert_eq!([item[0], item[1], item[2]], [e[3], n, next]);
+                    assert!(item[3] >= 1 && item[3] <= part, "{item:?}");
+                    next += item[3];
+                }
+                assert_eq!(next, n);
+            }
+        }
+    }
+}
