@@ -4,10 +4,10 @@
 // put in place, the up-sampling from coarse to fine and the output image. `Renderer::render_adaptive`
 // (`preview/adaptive.rs`) records the passes and allocates the samples between them.
 //
-// Group 3, bindings 2 to 4 (bindings 0 and 1 are the prediction's): one uniform slot per pass, the
-// frame's state in one storage buffer of words (sections at the offsets the uniform gives, so
-// that the passes stay within the storage buffers an adapter offers per stage), and the count of
-// shaded blocks.
+// Group 3, bindings 2 and up (bindings 0 and 1 are the prediction's): one uniform slot per pass,
+// then the frame's state, one buffer per kind so that each stays within the adapter's largest
+// binding (128 MiB on lavapipe: a 2048 x 2048 render's records take 64 MiB each), and the count
+// of shaded blocks.
 
 struct AdaptivePass {
     // The pass's level (`adaptive_reduce`, `adaptive_upsample`) and the pyramid's top.
@@ -21,15 +21,9 @@ struct AdaptivePass {
     ss: u32,
     // Items of the pass (pixels, blocks or shaded blocks).
     count: u32,
-    // Word offsets of the sections in `state`.
-    records: u32,
-    levels: u32,
-    plan: u32,
-    values: u32,
-    list: u32,
+    // Word offsets in `tables`.
     level_table: u32,
     sharpness: u32,
-    bandwidth: u32,
     // Rows of the lobe weight's sharpness (0: no lobe weight).
     n_rows: u32,
     // 1: the bandwidth section holds an oracle's bandwidths, read instead of the prediction's.
@@ -37,34 +31,39 @@ struct AdaptivePass {
     depth_sigma: f32,
     rescue_below: f32,
     candidates: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    _pad: u32,
 }
 
-// Sections of `state`, per render pixel or per block of every level (blocks of level k start at
-// the level table's offset for k):
-// - records, 8 words per render pixel: depth (-1 where no triangle covers it), cos theta_o, the
-//   screen-projected normal (x, y), the mirror direction (x, y, z), the index of its prediction
-//   (`NONE` where it is not shadeable);
-// - bandwidth, 1 word per render pixel: its image bandwidth (cycles per pixel);
-// - levels, 4 words per block: the min pyramid (i32), the max pyramid of the variance, the
-//   action (`ACTION_*`, with the parents' count in bits 8 and up), unused;
-// - plan, 8 words per block: the parents' block indices in the next level, their weights;
-// - values, 4 words per block: its value (RGB) once shaded or up-sampled;
-// - list, 4 words per block: the shaded blocks (level, block, max variance, pixel) in the order
+// The state, per render pixel or per block of every level (blocks of level k start at the level
+// table's offset for k):
+// - records, per render pixel: its depth (-1 where no triangle covers it), cos theta_o and the
+//   screen-projected normal (x, y); and its mirror direction (x, y, z) with the index of its
+//   prediction (`NONE` where it is not shadeable);
+// - bandwidths, per render pixel: its image bandwidth (cycles per pixel);
+// - levels, per block: the min pyramid (i32), the max pyramid of the variance, the action
+//   (`ACTION_*`, with the parents' count in bits 8 and up), unused;
+// - parents and weights, per block: the parents' block indices in the next level, their weights;
+// - values, per block: its value (RGB) once shaded or up-sampled;
+// - list, per block: the shaded blocks (level, block, max variance, pixel) in the order
 //   `adaptive_plan` finds them; then, from the host, in the plan's order: the block, the first of
 //   its parts in `shade_blocks`' items and their count;
-// - level table, 4 words per level and one more: width and height in blocks, the offset of its
-//   first block, the offset of its first candidate (the last row's: the candidates' count);
-// - candidates, 1 word per block that holds a shadeable pixel, level by level: its index among
-//   every level's blocks. The other blocks have no variance and are never valid: the host writes
-//   their min level (-1) and action (skipped) once per geometry, and the passes run over the
-//   candidates only;
-// - sharpness: `n_rows` lobe sharpnesses per view row.
+// - tables: the level table, 4 words per level and one more (width and height in blocks, the
+//   offset of its first block, the offset of its first candidate; the last row's: the
+//   candidates' count); the candidates, 1 word per block that holds a shadeable pixel, level by
+//   level: its index among every level's blocks (the other blocks have no variance and are never
+//   valid: the host writes their min level (-1) and action (skipped) once per geometry, and the
+//   passes run over the candidates only); `n_rows` lobe sharpnesses per view row.
 @group(3) @binding(2) var<uniform> adapt: AdaptivePass;
-@group(3) @binding(3) var<storage, read_write> state: array<u32>;
-@group(3) @binding(4) var<storage, read_write> shaded_count: array<atomic<u32>>;
+@group(3) @binding(3) var<storage, read> records_surface: array<vec4<f32>>;
+@group(3) @binding(4) var<storage, read> records_lobe: array<vec4<u32>>;
+@group(3) @binding(5) var<storage, read_write> bandwidths: array<f32>;
+@group(3) @binding(6) var<storage, read_write> levels: array<vec4<u32>>;
+@group(3) @binding(7) var<storage, read_write> parents: array<vec4<u32>>;
+@group(3) @binding(8) var<storage, read_write> weights: array<vec4<f32>>;
+@group(3) @binding(9) var<storage, read_write> values: array<vec4<f32>>;
+@group(3) @binding(10) var<storage, read_write> list: array<vec4<u32>>;
+@group(3) @binding(11) var<storage, read> tables: array<u32>;
+@group(3) @binding(12) var<storage, read_write> shaded_count: array<atomic<u32>>;
 
 const NONE: u32 = 0xffffffffu;
 const ACTION_SKIP: u32 = 0u;
@@ -88,26 +87,27 @@ struct Record {
 }
 
 fn record(pixel: u32) -> Record {
-    let i = adapt.records + 8u * pixel;
+    let a = records_surface[pixel];
+    let b = records_lobe[pixel];
     var r: Record;
-    r.depth = bitcast<f32>(state[i]);
-    r.cos_o = bitcast<f32>(state[i + 1u]);
-    r.screen_normal = vec2<f32>(bitcast<f32>(state[i + 2u]), bitcast<f32>(state[i + 3u]));
-    r.mirror = vec3<f32>(bitcast<f32>(state[i + 4u]), bitcast<f32>(state[i + 5u]), bitcast<f32>(state[i + 6u]));
-    r.prediction = state[i + 7u];
+    r.depth = a.x;
+    r.cos_o = a.y;
+    r.screen_normal = a.zw;
+    r.mirror = bitcast<vec3<f32>>(b.xyz);
+    r.prediction = b.w;
     return r;
 }
 
 // Level k's width, height and first block.
 fn level_info(k: u32) -> vec3<u32> {
     let i = adapt.level_table + 4u * k;
-    return vec3<u32>(state[i], state[i + 1u], state[i + 2u]);
+    return vec3<u32>(tables[i], tables[i + 1u], tables[i + 2u]);
 }
 
 // Level k's first candidate and their count.
 fn level_candidates(k: u32) -> vec2<u32> {
     let i = adapt.level_table + 4u * k + 3u;
-    return vec2<u32>(state[i], state[i + 4u] - state[i]);
+    return vec2<u32>(tables[i], tables[i + 4u] - tables[i]);
 }
 
 // Candidate `i` of level k, as the index of the block within its level; NONE past the last.
@@ -116,24 +116,11 @@ fn candidate(k: u32, i: u32) -> u32 {
     if (i >= range.y) {
         return NONE;
     }
-    return state[adapt.candidates + range.x + i] - level_info(k).z;
-}
-
-// A block's value (the values section).
-fn value(block: u32) -> vec3<f32> {
-    let v = adapt.values + 4u * block;
-    return vec3<f32>(bitcast<f32>(state[v]), bitcast<f32>(state[v + 1u]), bitcast<f32>(state[v + 2u]));
-}
-
-fn set_value(block: u32, rgb: vec3<f32>) {
-    let v = adapt.values + 4u * block;
-    state[v] = bitcast<u32>(rgb.x);
-    state[v + 1u] = bitcast<u32>(rgb.y);
-    state[v + 2u] = bitcast<u32>(rgb.z);
+    return tables[adapt.candidates + range.x + i] - level_info(k).z;
 }
 
 fn min_level(block: u32) -> i32 {
-    return bitcast<i32>(state[adapt.levels + 4u * block]);
+    return bitcast<i32>(levels[block].x);
 }
 
 // `render::adaptive::level_of` of an f32 bandwidth: the largest level k <= top with bandwidth <=
@@ -180,13 +167,11 @@ fn adaptive_levels(
         variance = 0.0;
     }
     if (adapt.oracle != 0u) {
-        bandwidth = bitcast<f32>(state[adapt.bandwidth + p]);
+        bandwidth = bandwidths[p];
     }
     let level = level_of(bandwidth, adapt.top);
-    state[adapt.bandwidth + p] = bitcast<u32>(bandwidth);
-    let i = adapt.levels + 4u * p;
-    state[i] = bitcast<u32>(level);
-    state[i + 1u] = bitcast<u32>(variance);
+    bandwidths[p] = bandwidth;
+    levels[p] = vec4<u32>(bitcast<u32>(level), bitcast<u32>(variance), 0u, 0u);
 }
 
 // Level `adapt.level` of the pyramids from the level below: the least level and the largest
@@ -211,14 +196,12 @@ fn adaptive_reduce(
         let cx = 2u * bx + j % 2u;
         let cy = 2u * by + j / 2u;
         if (cx < child.x && cy < child.y) {
-            let c = adapt.levels + 4u * (child.z + cy * child.x + cx);
-            level = min(level, bitcast<i32>(state[c]));
-            variance = max(variance, bitcast<f32>(state[c + 1u]));
+            let c = levels[child.z + cy * child.x + cx];
+            level = min(level, bitcast<i32>(c.x));
+            variance = max(variance, bitcast<f32>(c.y));
         }
     }
-    let i = adapt.levels + 4u * (me.z + b);
-    state[i] = bitcast<u32>(level);
-    state[i + 1u] = bitcast<u32>(variance);
+    levels[me.z + b] = vec4<u32>(bitcast<u32>(level), bitcast<u32>(variance), 0u, 0u);
 }
 
 // `render::adaptive::lobe_similarity` in f32, with `d - (l_i + l_j)` written as
@@ -240,7 +223,7 @@ fn lobe_similarity(xi_i: vec3<f32>, l_i: f32, xi_j: vec3<f32>, l_j: f32) -> f32 
 
 fn sharpness(r: Record) -> f32 {
     let row = min(u32((1.0 - r.cos_o) * f32(adapt.n_rows)), adapt.n_rows - 1u);
-    return bitcast<f32>(state[adapt.sharpness + row]);
+    return bitcast<f32>(tables[adapt.sharpness + row]);
 }
 
 // A block's pixel centre along one axis: b 2^k + floor(2^k / 2) + 1/2.
@@ -275,8 +258,8 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
     if (n.x == 0.0 && n.y == 0.0) {
         n = vec2<f32>(1.0, 0.0);
     }
-    var parents = array<u32, 4>(0u, 0u, 0u, 0u);
-    var weights = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    var chosen = array<u32, 4>(0u, 0u, 0u, 0u);
+    var w = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
     var count = 0u;
     var total = 0.0;
     for (var j = 0u; j < 4u; j++) {
@@ -288,7 +271,7 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
         let b = py * parent.x + px;
         var seen = false;
         for (var m = 0u; m < count; m++) {
-            seen = seen || parents[m] == b;
+            seen = seen || chosen[m] == b;
         }
         if (alpha <= 0.0 || min_level(parent.z + b) < i32(k + 1u) || seen) {
             continue;
@@ -308,22 +291,19 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
         if (adapt.n_rows > 0u) {
             g_lobe = lobe_similarity(me.mirror, sharpness(me), them.mirror, sharpness(them));
         }
-        let w = g_z * g_a * alpha * g_lobe;
-        if (w >= MIN_WEIGHT) {
-            parents[count] = b;
-            weights[count] = w;
-            total += w;
+        let weight = g_z * g_a * alpha * g_lobe;
+        if (weight >= MIN_WEIGHT) {
+            chosen[count] = b;
+            w[count] = weight;
+            total += weight;
             count += 1u;
         }
     }
     if (count == 0u || !(total > adapt.rescue_below)) {
         return 0u;
     }
-    let i = adapt.plan + 8u * block;
-    for (var m = 0u; m < 4u; m++) {
-        state[i + m] = parents[m];
-        state[i + 4u + m] = bitcast<u32>(weights[m] / total);
-    }
+    parents[block] = vec4<u32>(chosen[0], chosen[1], chosen[2], chosen[3]);
+    weights[block] = vec4<f32>(w[0], w[1], w[2], w[3]) / total;
     return count;
 }
 
@@ -339,7 +319,7 @@ fn adaptive_plan(
     if (c >= adapt.count) {
         return;
     }
-    let block = state[adapt.candidates + c];
+    let block = tables[adapt.candidates + c];
     var k = 0u;
     while (k < adapt.top && block >= level_info(k + 1u).z) {
         k += 1u;
@@ -348,9 +328,9 @@ fn adaptive_plan(
     let b = block - me.z;
     let bx = b % me.x;
     let by = b / me.x;
-    let i = adapt.levels + 4u * block;
+    let entry = levels[block];
     var action = ACTION_SKIP;
-    if (bitcast<i32>(state[i]) >= i32(k)) {
+    if (bitcast<i32>(entry.x) >= i32(k)) {
         action = ACTION_SHADE;
         if (k < adapt.top) {
             let parent = level_info(k + 1u);
@@ -360,14 +340,10 @@ fn adaptive_plan(
             }
         }
         if (action == ACTION_SHADE || action == ACTION_RESCUED) {
-            let slot = adapt.list + 4u * atomicAdd(&shaded_count[0], 1u);
-            state[slot] = k;
-            state[slot + 1u] = b;
-            state[slot + 2u] = state[i + 1u];
-            state[slot + 3u] = block_pixel(k, bx, by);
+            list[atomicAdd(&shaded_count[0], 1u)] = vec4<u32>(k, b, entry.y, block_pixel(k, bx, by));
         }
     }
-    state[i + 2u] = action;
+    levels[block].z = action;
 }
 
 // The shaded blocks' estimates in place: the sum of each one's parts (`accumulation`, as
@@ -382,12 +358,12 @@ fn adaptive_scatter(
     if (i >= adapt.count) {
         return;
     }
-    let entry = adapt.list + 4u * i;
+    let entry = list[i];
     var estimate = vec3<f32>(0.0);
-    for (var m = 0u; m < state[entry + 2u]; m++) {
-        estimate += accumulation[state[entry + 1u] + m].xyz;
+    for (var m = 0u; m < entry.z; m++) {
+        estimate += accumulation[entry.y + m].xyz;
     }
-    set_value(state[entry], estimate);
+    values[entry.x] = vec4<f32>(estimate, 0.0);
 }
 
 // Level `adapt.level`'s up-sampled blocks: the weighted means of their parents' values.
@@ -402,17 +378,18 @@ fn adaptive_upsample(
         return;
     }
     let block = level_info(adapt.level).z + b;
-    let action = state[adapt.levels + 4u * block + 2u];
+    let action = levels[block].z;
     if ((action & 0xffu) != ACTION_UPSAMPLE) {
         return;
     }
-    let parent = level_info(adapt.level + 1u);
-    let i = adapt.plan + 8u * block;
+    let first = level_info(adapt.level + 1u).z;
+    let p = parents[block];
+    let w = weights[block];
     var mean = vec3<f32>(0.0);
     for (var m = 0u; m < (action >> 8u); m++) {
-        mean += bitcast<f32>(state[i + 4u + m]) * value(parent.z + state[i + m]);
+        mean += w[m] * values[first + p[m]].xyz;
     }
-    set_value(block, mean);
+    values[block] = vec4<f32>(mean, 0.0);
 }
 
 // The output image into `accumulation`: each output pixel the mean of its ss x ss render
@@ -442,7 +419,7 @@ fn adaptive_output(
         } else {
             covered = 1.0;
             if (r.prediction != NONE) {
-                sum += value(p);
+                sum += values[p].xyz;
             }
         }
     }

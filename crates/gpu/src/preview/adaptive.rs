@@ -41,20 +41,14 @@ pub(super) struct AdaptivePass {
     out_height: u32,
     ss: u32,
     count: u32,
-    records: u32,
-    levels: u32,
-    plan: u32,
-    values: u32,
-    list: u32,
     level_table: u32,
     sharpness: u32,
-    bandwidth: u32,
     n_rows: u32,
     oracle: u32,
     depth_sigma: f32,
     rescue_below: f32,
     candidates: u32,
-    _pad: [u32; 3],
+    _pad: u32,
 }
 
 /// `NONE` of the WGSL: a render pixel without a prediction (not shadeable).
@@ -71,7 +65,7 @@ pub struct FrameOptions<'a> {
 }
 
 /// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
-/// and pyramid top: the sections of `preview_adaptive.wgsl`'s `state`, in words.
+/// and pyramid top: `preview_adaptive.wgsl`'s state.
 #[derive(Debug)]
 pub(super) struct State {
     geometry: Arc<Geometry>,
@@ -82,7 +76,7 @@ pub(super) struct State {
     /// Blocks that hold a shadeable pixel, per level, and in all (`preview_adaptive.wgsl`).
     candidates_per_level: Vec<u32>,
     candidates: u32,
-    /// The pass uniform with the sections' offsets (the per-pass fields zero).
+    /// The pass uniform with the tables' offsets (the per-pass fields zero).
     base: AdaptivePass,
     /// The prediction pixels (`render::adaptive::prediction_pixels`), as `predict_blocks`'
     /// items.
@@ -91,12 +85,43 @@ pub(super) struct State {
     /// Shadeable render pixels, and output pixels a triangle covers.
     shadeable: usize,
     covered_output: u64,
-    state: wgpu::Buffer,
-    counter: wgpu::Buffer,
+    buffers: Buffers,
     uniform: wgpu::Buffer,
     group: wgpu::BindGroup,
     /// For the frame's read-backs (the count, the list, the image), kept from frame to frame.
     readback: wgpu::Buffer,
+}
+
+/// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
+#[derive(Debug)]
+struct Buffers {
+    records_surface: wgpu::Buffer,
+    records_lobe: wgpu::Buffer,
+    bandwidths: wgpu::Buffer,
+    levels: wgpu::Buffer,
+    parents: wgpu::Buffer,
+    weights: wgpu::Buffer,
+    values: wgpu::Buffer,
+    list: wgpu::Buffer,
+    tables: wgpu::Buffer,
+    counter: wgpu::Buffer,
+}
+
+impl Buffers {
+    fn in_binding_order(&self) -> [&wgpu::Buffer; 10] {
+        [
+            &self.records_surface,
+            &self.records_lobe,
+            &self.bandwidths,
+            &self.levels,
+            &self.parents,
+            &self.weights,
+            &self.values,
+            &self.list,
+            &self.tables,
+            &self.counter,
+        ]
+    }
 }
 
 /// Slots of the pass uniform: levels, `top` reductions, plan, scatter, `top` up-samplings,
@@ -196,13 +221,6 @@ impl Renderer {
             .map(|&l| lighting.exponents.get(l as usize).map_or(0.0, |&n| n as f32))
             .collect();
         let p = (width * height) as u32;
-        let records = 0;
-        let bandwidth = records + 8 * p;
-        let levels_at = bandwidth + p;
-        let plan = levels_at + 4 * blocks;
-        let values = plan + 8 * blocks;
-        let list = values + 4 * blocks;
-        let level_table = list + 4 * blocks;
         // The candidates: blocks that hold a shadeable pixel, level by level.
         let mut any_shadeable: Vec<bool> = shadeable.clone();
         let mut candidates: Vec<u32> = (0..p).filter(|&i| shadeable[i as usize]).collect();
@@ -225,11 +243,13 @@ impl Renderer {
             any_shadeable = mine;
         }
         let n_candidates = candidates.len() as u32;
-        let candidates_at = level_table + 4 * (levels.len() as u32 + 1);
-        let sharpness_at = candidates_at + n_candidates.max(1);
-        let words = u64::from(sharpness_at) + sharpness.len().max(1) as u64;
+        let candidates_at = 4 * (levels.len() as u32 + 1);
+        let sharpness_at = candidates_at + n_candidates;
         let limits = self.device.limits();
-        check_buffer_fits(&limits, &self.adapter_info, 4 * words, "an adaptive frame's buffers")?;
+        // The largest of the buffers: a vec4 per block.
+        let fits = |bytes: u64| check_buffer_fits(&limits, &self.adapter_info, bytes, "an adaptive frame's buffers");
+        fits(16 * u64::from(blocks))?;
+        fits(16 * u64::from(p))?;
         let base = AdaptivePass {
             top: top as u32,
             width: width as u32,
@@ -237,38 +257,24 @@ impl Renderer {
             out_width: geometry.size().0 as u32,
             out_height: geometry.size().1 as u32,
             ss: settings.supersample as u32,
-            records,
-            levels: levels_at,
-            plan,
-            values,
-            list,
-            level_table,
+            level_table: 0,
             sharpness: sharpness_at,
-            bandwidth,
             n_rows: sharpness.len() as u32,
             candidates: candidates_at,
             ..Default::default()
         };
-        let mut record_words = vec![0u32; 8 * p as usize];
-        for (i, r) in record_words.chunks_exact_mut(8).enumerate() {
+        let (mut surface, mut lobe) = (vec![[0f32; 4]; p as usize], vec![[0u32; 4]; p as usize]);
+        for (i, (s, l)) in surface.iter_mut().zip(&mut lobe).enumerate() {
             let f = |v: f64| (v as f32).to_bits();
             match &pixels[i] {
                 Some(px) => {
-                    let m = px.mirror;
-                    r.copy_from_slice(&[
-                        f(px.depth),
-                        f(px.cos_o),
-                        f(px.screen_normal[0]),
-                        f(px.screen_normal[1]),
-                        f(m.x),
-                        f(m.y),
-                        f(m.z),
-                        of_pixel[i],
-                    ]);
+                    let [nx, ny] = px.screen_normal;
+                    *s = [px.depth, px.cos_o, nx, ny].map(|v| v as f32);
+                    *l = [f(px.mirror.x), f(px.mirror.y), f(px.mirror.z), of_pixel[i]];
                 }
                 None => {
-                    r[0] = if geometry.covers(i) { 0f32 } else { -1f32 }.to_bits();
-                    r[7] = NONE;
+                    s[0] = if geometry.covers(i) { 0.0 } else { -1.0 };
+                    l[3] = NONE;
                 }
             }
         }
@@ -279,36 +285,45 @@ impl Renderer {
             first_candidate += n;
         }
         table.extend([0, 0, blocks, first_candidate]);
+        table.extend(&candidates);
+        table.extend(sharpness.iter().map(|v| v.to_bits()));
         // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
         let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
         let items: Vec<[u32; 4]> = at.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
         let state = capture_errors(&self.device, || {
+            use wgpu::BufferUsages as U;
             use wgpu::util::DeviceExt;
-            let state = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("adaptive state"),
-                size: 4 * words,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            self.queue.write_buffer(&state, 4 * u64::from(records), bytemuck::cast_slice(&record_words));
-            self.queue.write_buffer(&state, 4 * u64::from(level_table), bytemuck::cast_slice(&table));
-            self.queue.write_buffer(&state, 4 * u64::from(levels_at), bytemuck::cast_slice(&idle));
-            if !candidates.is_empty() {
-                self.queue.write_buffer(&state, 4 * u64::from(candidates_at), bytemuck::cast_slice(&candidates));
-            }
-            if !sharpness.is_empty() {
-                self.queue.write_buffer(&state, 4 * u64::from(sharpness_at), bytemuck::cast_slice(&sharpness));
-            }
+            let init = |label: &str, contents: &[u8]| {
+                self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                })
+            };
+            let empty = |label: &str, bytes: u64| {
+                self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes.max(16),
+                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
+            let buffers = Buffers {
+                records_surface: init("adaptive records", bytemuck::cast_slice(&surface)),
+                records_lobe: init("adaptive records", bytemuck::cast_slice(&lobe)),
+                bandwidths: empty("adaptive bandwidths", 4 * u64::from(p)),
+                levels: init("adaptive levels", bytemuck::cast_slice(&idle)),
+                parents: empty("adaptive parents", 16 * u64::from(blocks)),
+                weights: empty("adaptive weights", 16 * u64::from(blocks)),
+                values: empty("adaptive values", 16 * u64::from(blocks)),
+                list: empty("adaptive list", 16 * u64::from(blocks)),
+                tables: init("adaptive tables", bytemuck::cast_slice(&table)),
+                counter: empty("adaptive shaded count", 4),
+            };
             let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("adaptive prediction pixels"),
                 contents: bytemuck::cast_slice(if items.is_empty() { &[[0u32; 4]][..] } else { &items }),
                 usage: wgpu::BufferUsages::COPY_SRC,
-            });
-            let counter = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("adaptive shaded count"),
-                size: 4,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
             });
             let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("adaptive passes"),
@@ -316,21 +331,21 @@ impl Renderer {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
+                }),
+            }];
+            for (binding, buffer) in (3..).zip(buffers.in_binding_order()) {
+                entries.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
+            }
             let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("adaptive"),
                 layout: &self.adaptive_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &uniform,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
-                        }),
-                    },
-                    wgpu::BindGroupEntry { binding: 3, resource: state.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: counter.as_entire_binding() },
-                ],
+                entries: &entries,
             });
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
             let readback = self.readback_buffer((16 * u64::from(blocks)).max(16 * out_pixels));
@@ -347,8 +362,7 @@ impl Renderer {
                 n_items: at.len() as u32,
                 shadeable: shadeable.iter().filter(|&&s| s).count(),
                 covered_output: geometry.output_coverage().iter().filter(|&&c| c).count() as u64,
-                state,
-                counter,
+                buffers,
                 uniform,
                 group,
             }
@@ -416,10 +430,10 @@ impl Renderer {
             );
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
-            self.queue.write_buffer(&state.counter, 0, &[0u8; 4]);
+            self.queue.write_buffer(&state.buffers.counter, 0, &[0u8; 4]);
             if let Some(oracle) = options.oracle {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
-                self.queue.write_buffer(&state.state, 4 * u64::from(base.bandwidth), bytemuck::cast_slice(&values));
+                self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
             }
             pass(levels_slot, base);
             for k in 1..=top {
@@ -448,7 +462,7 @@ impl Renderer {
             encoder
         })
         .and_then(|mut encoder| {
-            encoder.copy_buffer_to_buffer(&state.counter, 0, &state.readback, 0, 4);
+            encoder.copy_buffer_to_buffer(&state.buffers.counter, 0, &state.readback, 0, 4);
             self.queue.submit([encoder.finish()]);
             let count: Vec<u32> = read_back(&self.device, &state.readback, 4)?;
             let bytes = 16 * u64::from(count[0].min(blocks));
@@ -456,7 +470,7 @@ impl Renderer {
                 return Ok(Vec::new());
             }
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            encoder.copy_buffer_to_buffer(&state.state, 4 * u64::from(base.list), &state.readback, 0, bytes);
+            encoder.copy_buffer_to_buffer(&state.buffers.list, 0, &state.readback, 0, bytes);
             self.queue.submit([encoder.finish()]);
             read_back(&self.device, &state.readback, bytes)
         })?;
@@ -484,7 +498,7 @@ impl Renderer {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             if !items.is_empty() {
                 self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
-                self.queue.write_buffer(&state.state, 4 * u64::from(base.list), bytemuck::cast_slice(&targets));
+                self.queue.write_buffer(&state.buffers.list, 0, bytemuck::cast_slice(&targets));
             }
             pass(scatter_slot, AdaptivePass { count: n_shaded, ..base });
             for k in 0..top {
@@ -554,11 +568,12 @@ impl Renderer {
         samples: &[u32],
         budget: u64,
     ) -> Result<Details, GpuError> {
-        let base = &state.base;
+        let (base, buffers) = (&state.base, &state.buffers);
         let pixels = (base.width * base.height) as usize;
-        let bandwidth = self.read_words(&state.state, base.bandwidth, pixels as u32)?;
-        let levels_words = self.read_words(&state.state, base.levels, 4 * state.blocks)?;
-        let plan_words = self.read_words(&state.state, base.plan, 8 * state.blocks)?;
+        let bandwidth = self.read_words(&buffers.bandwidths, pixels as u32)?;
+        let levels_words = self.read_words(&buffers.levels, 4 * state.blocks)?;
+        let parents = self.read_words(&buffers.parents, 4 * state.blocks)?;
+        let weights = self.read_words(&buffers.weights, 4 * state.blocks)?;
         let mut given = std::collections::HashMap::new();
         for (e, &n) in list.iter().zip(samples) {
             given.insert((e[0] as usize, e[1] as usize), n);
@@ -584,8 +599,9 @@ impl Renderer {
                             1 => Action::Shade { samples: samples(), rescued: false },
                             2 => Action::Shade { samples: samples(), rescued: true },
                             3 => {
-                                let p = &plan_words[8 * block..8 * block + 8];
-                                let parents = std::array::from_fn(|m| (p[m], f32::from_bits(p[4 + m])));
+                                let parents = std::array::from_fn(|m| {
+                                    (parents[4 * block + m], f32::from_bits(weights[4 * block + m]))
+                                });
                                 Action::Upsample { parents, count: (action >> 8) as u8 }
                             }
                             _ => Action::Skip,
@@ -629,8 +645,8 @@ impl Renderer {
         })
     }
 
-    /// `count` words of `buffer` from word `offset`, read back.
-    fn read_words(&self, buffer: &wgpu::Buffer, offset: u32, count: u32) -> Result<Vec<u32>, GpuError> {
+    /// The first `count` words of `buffer`, read back.
+    fn read_words(&self, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<u32>, GpuError> {
         if count == 0 {
             return Ok(Vec::new());
         }
@@ -638,7 +654,7 @@ impl Renderer {
         let readback = capture_errors(&self.device, || {
             let readback = self.readback_buffer(bytes);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            encoder.copy_buffer_to_buffer(buffer, 4 * u64::from(offset), &readback, 0, bytes);
+            encoder.copy_buffer_to_buffer(buffer, 0, &readback, 0, bytes);
             self.queue.submit([encoder.finish()]);
             readback
         })?;
@@ -671,18 +687,13 @@ impl Pipelines {
     }
 }
 
-/// The layout of group 3 of the adaptive passes: bindings 2 (the pass uniform, one slot per
-/// pass), 3 (the state) and 4 (the count of shaded blocks).
+/// The layout of group 3 of the adaptive passes: binding 2 the pass uniform (one slot per pass),
+/// 3 to 12 the state's buffers ([`Buffers`]; the records and the tables read-only).
 pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let compute = wgpu::ShaderStages::COMPUTE;
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("adaptive"),
-        entries: &[
-            super::uniform_entry(2, compute, true),
-            super::storage_entry(3, compute, false),
-            super::storage_entry(4, compute, false),
-        ],
-    })
+    let mut entries = vec![super::uniform_entry(2, compute, true)];
+    entries.extend((3..=12).map(|binding| super::storage_entry(binding, compute, matches!(binding, 3 | 4 | 11))));
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("adaptive"), entries: &entries })
 }
 
 #[cfg(test)]
