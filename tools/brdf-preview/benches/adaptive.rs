@@ -51,21 +51,22 @@
 //! `adaptive` (1 of 24 rows at 4x), 1.2x pre-filtered (none at 10x). On such a GPU the frame is
 //! bound by its three waits on the device, not by its arithmetic.
 //!
-//! Measured on lavapipe (`-- --gpu`, 2 cores, two runs), paper reading: `adaptive` median 14.1x
-//! and 12.3x, 15 of 24 rows at 4x or more in both; `adaptive-prefiltered` median 8.5x and 8.2x,
-//! 11 and 8 of 24 at 10x or more (the other readings lower: level-normalized 2.1x to 2.2x and 1.7x
-//! to 1.8x, the FFT oracle 4.4x to 4.6x and 4.2x to 5.2x, shading 10 to 98% of the pixels).
-//! Chrome misses in all its 16 rows (0.6x to 2.5x): its frames stop at their ceiling (34.9 to
-//! 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it shade
-//! 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 16 spp in 215 to 385 ms, while
-//! an adaptive frame spends 40 to 95 ms on prediction and plan before it shades a pixel. The
-//! others that miss in the first run: white-paint / quarry / torus (2.4x to 3.9x in three rows;
-//! its brute-force curve is on the sun's plateau, above), white-paint / quarry / sphere
-//! pre-filtered at 2 spp (5.5x), and gold-paint / potsdamer pre-filtered at 8 spp (7.4x, 8.5x:
-//! 0.15 and 1.3 dB more than at 2 spp, where they pass, for 1.5x and 1.8x the time).
+//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, with the frame on the GPU whole:
+//! `adaptive` median 11.9x, 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 7.4x, 7 of
+//! 24 at 10x or more (the other readings lower: level-normalized 1.9x and 1.4x, the FFT oracle
+//! 3.3x and 3.7x). When the plan and the up-sampling ran on the CPU (two runs, the last stop) the
+//! medians were 12.3x to 14.1x and 8.2x to 8.5x with the same rows passing: on lavapipe the "GPU"
+//! is the same two cores, and the plan's passes cost there about what Rust's did (prediction,
+//! pyramids and plan 61 to 172 ms against 55 to 95). Chrome misses in all its 16 rows (0.6x to
+//! 1.7x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a mirror's reflection
+//! loses its detail, and the readings that keep it shade 34 to 98% of the pixels), a PSNR the
+//! brute force reaches at 4 to 16 spp in 0.2 to 0.5 s. The others that miss:
+//! white-paint / quarry / torus (2.1x to 3.5x in three rows; its brute-force curve is on the
+//! sun's plateau, above), white-paint / quarry / sphere pre-filtered (4.1x, 8.7x), and
+//! pre-filtered rows of gold-paint and white-paint under potsdamer (4.9x to 9.6x).
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
 //! minutes each on the CPU), a rerun about 12 (a minute a case; `--no-extras` 40 s). At this size
-//! 16x anti-aliasing costs 4.3x to 6.6x the time of none on lavapipe.
+//! 16x anti-aliasing costs 4.3x to 6.7x the time of none on lavapipe.
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
