@@ -57,7 +57,7 @@
 //! 3.3x and 3.7x). When the plan and the up-sampling ran on the CPU (two runs, the last stop) the
 //! medians were 12.3x to 14.1x and 8.2x to 8.5x with the same rows passing: on lavapipe the "GPU"
 //! is the same two cores, and the plan's passes cost there about what Rust's did (prediction,
-//! pyramids and plan 61 to 172 ms against 55 to 95). Chrome misses in all its 16 rows (0.6x to
+//! pyramids and plan 49 to 172 ms against 55 to 95). Chrome misses in all its 16 rows (0.6x to
 //! 1.7x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a mirror's reflection
 //! loses its detail, and the readings that keep it shade 34 to 98% of the pixels), a PSNR the
 //! brute force reaches at 4 to 16 spp in 0.2 to 0.5 s. The others that miss:
