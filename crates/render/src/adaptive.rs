@@ -99,9 +99,9 @@
 //! are products of exponentials, which underflow at another depth in `f32` (`g_z` at a 26% depth
 //! difference) long before they do in `f64` (76%), and a renderer that weights in `f32` must
 //! count the same parents. A block whose weights all vanish (every parent at another depth), or
-//! sum to at most [`Settings::rescue_below`] before normalization, is shaded instead (*rescued*). Every pixel
-//! therefore ends shaded at its level or up-sampled from shaded parents, and the plan is fixed
-//! by the G-buffer alone, before any shading.
+//! sum to at most [`Settings::rescue_below`] before normalization, is shaded instead
+//! (*rescued*). Every pixel therefore ends shaded at its level or up-sampled from shaded
+//! parents, and the plan is fixed by the G-buffer alone, before any shading.
 //!
 //! # Samples
 //!
@@ -1051,8 +1051,14 @@ pub struct Timings {
     /// The [`Geometry`]'s, made once per camera: not part of the frame's time when its camera
     /// made frames before.
     pub gbuffer_ms: f64,
+    /// [`render_with`]: the prediction; `gpu::preview`: its first submission (prediction,
+    /// pyramids, plan and the list of shaded blocks read back).
     pub predict_ms: f64,
+    /// [`render_with`]: the pyramids and the plan with its samples; `gpu::preview`: the
+    /// allocation of the samples on the CPU.
     pub plan_ms: f64,
+    /// [`render_with`]: shading, up-sampling and the background; `gpu::preview`: its second
+    /// submission (the same, and the image read back).
     pub shade_ms: f64,
 }
 
@@ -1390,7 +1396,9 @@ fn downsample(rgb: &[[f32; 3]], covered: Vec<bool>, width: usize, height: usize,
 
 #[cfg(test)]
 mod tests {
-    use super::{Action, Allocation, Level, Settings, allocate, lobe_similarity, pixels, shares};
+    use super::{
+        Action, Allocation, Level, Pixel, Settings, allocate, lobe_similarity, pixels, shares, upsample_weights,
+    };
     use crate::Mode;
     use crate::shade::visibility;
     use crate::{Camera, Mesh, Scene};
@@ -1469,6 +1477,34 @@ mod tests {
                 _ => unreachable!(),
             });
             assert_eq!(got, expect, "{} with variances 3 and {variance_2}", allocation.name());
+        }
+    }
+
+    #[test]
+    fn a_parent_weighted_below_the_least_weight_does_not_count() {
+        // A 2 x 1 child level under a 1 x 1 parent: the child block (0, 0) up-samples from the
+        // one parent with g_z = exp(-dz^2 / 2), dz = depth difference / (sigma depth). At a
+        // difference of 0.25 (dz 12.5: g_z about 1e-34, below 2^-100 though f64 holds it) the
+        // parent does not count and the block is rescued; at 0.2 (dz 10: g_z about 2e-22) it
+        // counts, with weight 1.
+        let pixel = |depth: f64| Pixel { cos_o: 1.0, depth, curvature: 0.0, screen_normal: [0.0; 2], mirror: DVec3::Z };
+        let level = |k: usize, width: usize| Level {
+            level: k,
+            width,
+            height: 1,
+            min_level: vec![1; width],
+            max_variance: vec![0.0; width],
+        };
+        let (child, parent) = (level(0, 2), level(1, 1));
+        let settings = Settings::new(Mode::Reference, 1);
+        for (difference, counts) in [(0.25, false), (0.2, true)] {
+            // The child block's pixel is (0, 0); the parent's is (1, 0).
+            let pixels = [Some(pixel(1.0)), Some(pixel(1.0 + difference))];
+            let weights = upsample_weights(&child, &parent, (0, 0), &pixels, (2, 1), &settings, None);
+            assert_eq!(weights.is_some(), counts, "depth difference {difference}");
+            if let Some((parents, count)) = weights {
+                assert_eq!((count, parents[0]), (1, (0, 1.0)));
+            }
         }
     }
 
