@@ -448,65 +448,32 @@ impl Renderer {
                         .into(),
                 ),
             });
-            let shade_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("preview shade"),
-                bind_group_layouts: &[Some(&table_layout), Some(&bake_layout), Some(&render_layout)],
-                immediate_size: 0,
-            });
-            let compute_pipeline = |entry: &'static str| {
+            // A pipeline of the shading module: groups 0 to 2, and `group3` where the entry has one.
+            let compute_pipeline = |group3: Option<&wgpu::BindGroupLayout>, entry: &'static str| {
+                let layouts = [Some(&table_layout), Some(&bake_layout), Some(&render_layout), group3];
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(entry),
+                    bind_group_layouts: &layouts[..3 + usize::from(group3.is_some())],
+                    immediate_size: 0,
+                });
                 device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
-                    layout: Some(&shade_layout),
+                    layout: Some(&layout),
                     module: &shade_module,
                     entry_point: Some(entry),
                     compilation_options: Default::default(),
                     cache: None,
                 })
             };
-            let shade_pipeline = compute_pipeline("shade_frame");
-            let blocks_pipeline = compute_pipeline("shade_blocks");
+            let shade_pipeline = compute_pipeline(None, "shade_frame");
+            let blocks_pipeline = compute_pipeline(None, "shade_blocks");
             let predict_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview predict"),
                 entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
             });
-            let predict_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("predict_blocks"),
-                layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("preview predict"),
-                    bind_group_layouts: &[
-                        Some(&table_layout),
-                        Some(&bake_layout),
-                        Some(&render_layout),
-                        Some(&predict_layout),
-                    ],
-                    immediate_size: 0,
-                })),
-                module: &shade_module,
-                entry_point: Some("predict_blocks"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+            let predict_pipeline = compute_pipeline(Some(&predict_layout), "predict_blocks");
             let adaptive_layout = adaptive::layout(&device);
-            let adaptive_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("adaptive"),
-                bind_group_layouts: &[
-                    Some(&table_layout),
-                    Some(&bake_layout),
-                    Some(&render_layout),
-                    Some(&adaptive_layout),
-                ],
-                immediate_size: 0,
-            });
-            let adaptive_pipelines = adaptive::Pipelines::new(|entry| {
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&adaptive_pipeline_layout),
-                    module: &shade_module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            });
+            let adaptive_pipelines = adaptive::Pipelines::new(|entry| compute_pipeline(Some(&adaptive_layout), entry));
 
             let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("merl dims"),
@@ -877,8 +844,7 @@ impl Renderer {
         }
         capture_errors(&self.device, || self.write_predict_uniform(prediction, settings))?;
         let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
-        let values =
-            self.run_items(&self.predict_pipeline, Some(&prediction.group), settings.mode, settings.seed, &items)?;
+        let values = self.run_items(&self.predict_pipeline, &prediction.group, settings.mode, settings.seed, &items)?;
         Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
 
@@ -900,12 +866,12 @@ impl Renderer {
 
     /// Runs an entry that takes a list of items (`predict_blocks`): the items
     /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
-    /// count in the shade uniform's `spp`, with `mode` and `seed`; `extra` is group 3. Returns
+    /// count in the shade uniform's `spp`, with `mode` and `seed`; `group` is group 3. Returns
     /// the first `items.len()` entries the pass leaves.
     fn run_items(
         &self,
         pipeline: &wgpu::ComputePipeline,
-        extra: Option<&wgpu::BindGroup>,
+        group: &wgpu::BindGroup,
         mode: Mode,
         seed: u32,
         items: &[[u32; 4]],
@@ -914,46 +880,69 @@ impl Renderer {
         let count = items.len() as u32;
         let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: count, frames: 1, seed });
         let (x, y) = item_groups(count);
-        capture_errors(&self.device, || {
+        let encoder = capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
             self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(items));
             let mut encoder = self.device.create_command_encoder(&Default::default());
             {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("adaptive items"),
-                    timestamp_writes: None,
-                });
+                let mut pass = self.begin_pass(&mut encoder);
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &self.table_group, &[]);
-                pass.set_bind_group(1, &self.bake_group, &[]);
-                pass.set_bind_group(2, &self.render_group, &[0]);
-                if let Some(group) = extra {
-                    pass.set_bind_group(3, group, &[]);
-                }
+                pass.set_bind_group(3, group, &[]);
                 pass.dispatch_workgroups(x, y, 1);
             }
-            self.queue.submit([encoder.finish()]);
+            encoder
         })?;
-        self.read_accumulation(u64::from(count))
+        let bytes = 16 * u64::from(count);
+        self.submit_and_read(encoder, &self.accumulation, &self.readback_buffer(bytes), bytes)
     }
 
     /// The accumulation buffer's first `entries` sums, read back.
     fn read_accumulation(&self, entries: u64) -> Result<Vec<[f32; 4]>, GpuError> {
         let bytes = 16 * entries;
-        let readback = capture_errors(&self.device, || {
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            encoder.copy_buffer_to_buffer(&self.accumulation, 0, &readback, 0, bytes);
+        let encoder = self.device.create_command_encoder(&Default::default());
+        self.submit_and_read(encoder, &self.accumulation, &self.readback_buffer(bytes), bytes)
+    }
+
+    /// Submits `encoder` with a copy of `source`'s first `bytes` into `readback` (a buffer of
+    /// [`Renderer::readback_buffer`]'s kind, at least that large) and reads them back; nothing
+    /// to read when `bytes` is 0.
+    fn submit_and_read<T: Pod>(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        readback: &wgpu::Buffer,
+        bytes: u64,
+    ) -> Result<Vec<T>, GpuError> {
+        capture_errors(&self.device, || {
+            if bytes > 0 {
+                encoder.copy_buffer_to_buffer(source, 0, readback, 0, bytes);
+            }
             self.queue.submit([encoder.finish()]);
-            readback
         })?;
-        read_back(&self.device, &readback, bytes)
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        read_back(&self.device, readback, bytes)
+    }
+
+    /// A buffer to map for reading, of `bytes`.
+    fn readback_buffer(&self, bytes: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview readback"),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// A compute pass with the shading pass's groups 0 to 2 set.
+    fn begin_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::ComputePass<'e> {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_bind_group(0, &self.table_group, &[]);
+        pass.set_bind_group(1, &self.bake_group, &[]);
+        pass.set_bind_group(2, &self.render_group, &[0]);
+        pass
     }
 
     /// Draws the G-buffer with the current camera.

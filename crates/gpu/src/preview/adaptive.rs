@@ -27,7 +27,7 @@ use render::{Image, Lighting, Material};
 use super::{Renderer, no_bandwidths};
 use crate::context::check_buffer_fits;
 use crate::error::GpuError;
-use crate::merl_lookup::{capture_errors, read_back};
+use crate::merl_lookup::capture_errors;
 
 /// `AdaptivePass` of `preview_adaptive.wgsl`.
 #[repr(C)]
@@ -69,13 +69,13 @@ pub struct FrameOptions<'a> {
 #[derive(Debug)]
 pub(super) struct State {
     geometry: Arc<Geometry>,
-    key: (usize, usize, usize),
+    /// The prediction level and the pyramid's top.
+    key: (usize, usize),
     /// `(width, height, first block)` per level.
     levels: Vec<(u32, u32, u32)>,
     blocks: u32,
-    /// Blocks that hold a shadeable pixel, per level, and in all (`preview_adaptive.wgsl`).
+    /// Blocks that hold a shadeable pixel, per level (`preview_adaptive.wgsl`'s candidates).
     candidates_per_level: Vec<u32>,
-    candidates: u32,
     /// The pass uniform with the tables' offsets (the per-pass fields zero).
     base: AdaptivePass,
     /// The prediction pixels (`render::adaptive::prediction_pixels`), as `predict_blocks`'
@@ -196,7 +196,8 @@ impl Renderer {
         let (width, height) = geometry.render_size();
         let top = render::adaptive::top_level(width, height, settings.max_level);
         let l = settings.prediction_level(top);
-        let key = (settings.supersample, l, top);
+        // The geometry is one supersampling's: it and these two fix the state.
+        let key = (l, top);
         if let Some(state) = self.adaptive.borrow().as_ref()
             && Arc::ptr_eq(&state.geometry, geometry)
             && state.key == key
@@ -356,7 +357,6 @@ impl Renderer {
                 levels,
                 blocks,
                 candidates_per_level,
-                candidates: n_candidates,
                 base,
                 items: items_buffer,
                 n_items: at.len() as u32,
@@ -420,7 +420,7 @@ impl Renderer {
             ..state.base
         };
         let (levels_slot, plan_slot, scatter_slot) = (0, 1 + top as u64, 2 + top as u64);
-        let blocks = state.blocks;
+        let (blocks, candidates) = (state.blocks, state.candidates_per_level.iter().sum());
         let shaded = capture_errors(&self.device, || {
             self.progress.set(None);
             self.write_predict_uniform(prediction, settings);
@@ -439,11 +439,11 @@ impl Renderer {
             for k in 1..=top {
                 pass(k as u64, AdaptivePass { level: k as u32, ..base });
             }
-            pass(plan_slot, AdaptivePass { count: state.candidates, ..base });
+            pass(plan_slot, AdaptivePass { count: candidates, ..base });
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
             {
-                let mut cpass = self.begin_adaptive_pass(&mut encoder);
+                let mut cpass = self.begin_pass(&mut encoder);
                 if state.n_items > 0 {
                     cpass.set_pipeline(&self.predict_pipeline);
                     cpass.set_bind_group(3, &prediction.group, &[]);
@@ -452,27 +452,20 @@ impl Renderer {
                 }
                 let mut run = |pipeline, slot: u64, count| dispatch(&mut cpass, pipeline, state, slot * stride, count);
                 let pipelines = &self.adaptive_pipelines;
-                let candidates = &state.candidates_per_level;
-                run(&pipelines.levels, levels_slot, candidates[0]);
-                for (k, &n) in candidates.iter().enumerate().skip(1) {
+                let per_level = &state.candidates_per_level;
+                run(&pipelines.levels, levels_slot, per_level[0]);
+                for (k, &n) in per_level.iter().enumerate().skip(1) {
                     run(&pipelines.reduce, k as u64, n);
                 }
-                run(&pipelines.plan, plan_slot, state.candidates);
+                run(&pipelines.plan, plan_slot, candidates);
             }
             encoder
         })
-        .and_then(|mut encoder| {
-            encoder.copy_buffer_to_buffer(&state.buffers.counter, 0, &state.readback, 0, 4);
-            self.queue.submit([encoder.finish()]);
-            let count: Vec<u32> = read_back(&self.device, &state.readback, 4)?;
+        .and_then(|encoder| {
+            let count: Vec<u32> = self.submit_and_read(encoder, &state.buffers.counter, &state.readback, 4)?;
             let bytes = 16 * u64::from(count[0].min(blocks));
-            if bytes == 0 {
-                return Ok(Vec::new());
-            }
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            encoder.copy_buffer_to_buffer(&state.buffers.list, 0, &state.readback, 0, bytes);
-            self.queue.submit([encoder.finish()]);
-            read_back(&self.device, &state.readback, bytes)
+            let encoder = self.device.create_command_encoder(&Default::default());
+            self.submit_and_read(encoder, &state.buffers.list, &state.readback, bytes)
         })?;
         let predict_ms = lap();
 
@@ -508,7 +501,7 @@ impl Renderer {
             pass(output_slot, base);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             {
-                let mut cpass = self.begin_adaptive_pass(&mut encoder);
+                let mut cpass = self.begin_pass(&mut encoder);
                 if n_parts > 0 {
                     cpass.set_pipeline(&self.blocks_pipeline);
                     let (x, y) = super::item_groups(n_parts);
@@ -524,11 +517,7 @@ impl Renderer {
             }
             encoder
         })
-        .and_then(|mut encoder| {
-            encoder.copy_buffer_to_buffer(&self.accumulation, 0, &state.readback, 0, 16 * out_pixels);
-            self.queue.submit([encoder.finish()]);
-            read_back(&self.device, &state.readback, 16 * out_pixels)
-        })?;
+        .and_then(|encoder| self.submit_and_read(encoder, &self.accumulation, &state.readback, 16 * out_pixels))?;
         let shade_ms = lap();
         let image = Image {
             width: out_width,
@@ -626,39 +615,11 @@ impl Renderer {
         Ok(Details { predictions, plan, shaded_level, samples_per_pixel })
     }
 
-    /// A compute pass with the shading pass's groups 0 to 2 set.
-    fn begin_adaptive_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::ComputePass<'e> {
-        let mut cpass = encoder.begin_compute_pass(&Default::default());
-        cpass.set_bind_group(0, &self.table_group, &[]);
-        cpass.set_bind_group(1, &self.bake_group, &[]);
-        cpass.set_bind_group(2, &self.render_group, &[0]);
-        cpass
-    }
-
-    /// A buffer to map for reading, of `bytes`.
-    fn readback_buffer(&self, bytes: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("adaptive readback"),
-            size: bytes.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    }
-
     /// The first `count` words of `buffer`, read back.
     fn read_words(&self, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<u32>, GpuError> {
-        if count == 0 {
-            return Ok(Vec::new());
-        }
         let bytes = 4 * u64::from(count);
-        let readback = capture_errors(&self.device, || {
-            let readback = self.readback_buffer(bytes);
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            encoder.copy_buffer_to_buffer(buffer, 0, &readback, 0, bytes);
-            self.queue.submit([encoder.finish()]);
-            readback
-        })?;
-        read_back(&self.device, &readback, bytes)
+        let encoder = self.device.create_command_encoder(&Default::default());
+        self.submit_and_read(encoder, buffer, &self.readback_buffer(bytes), bytes)
     }
 }
 
