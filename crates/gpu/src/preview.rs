@@ -894,29 +894,32 @@ impl Renderer {
             encoder
         })?;
         let bytes = 16 * u64::from(count);
-        self.submit_and_read(encoder, &self.accumulation, &self.readback_buffer(bytes), bytes)
+        self.submit_and_read(encoder, &[(&self.accumulation, bytes)], &self.readback_buffer(bytes))
     }
 
     /// The accumulation buffer's first `entries` sums, read back.
     fn read_accumulation(&self, entries: u64) -> Result<Vec<[f32; 4]>, GpuError> {
         let bytes = 16 * entries;
         let encoder = self.device.create_command_encoder(&Default::default());
-        self.submit_and_read(encoder, &self.accumulation, &self.readback_buffer(bytes), bytes)
+        self.submit_and_read(encoder, &[(&self.accumulation, bytes)], &self.readback_buffer(bytes))
     }
 
-    /// Submits `encoder` with a copy of `source`'s first `bytes` into `readback` (a buffer of
-    /// [`Renderer::readback_buffer`]'s kind, at least that large) and reads them back; nothing
-    /// to read when `bytes` is 0.
+    /// Submits `encoder` with copies of the first bytes of each source, one after another,
+    /// into `readback` (a buffer of [`Renderer::readback_buffer`]'s kind, large enough) and
+    /// reads them back; nothing to read when there are no bytes.
     fn submit_and_read<T: Pod>(
         &self,
         mut encoder: wgpu::CommandEncoder,
-        source: &wgpu::Buffer,
+        sources: &[(&wgpu::Buffer, u64)],
         readback: &wgpu::Buffer,
-        bytes: u64,
     ) -> Result<Vec<T>, GpuError> {
+        let mut bytes = 0;
         capture_errors(&self.device, || {
-            if bytes > 0 {
-                encoder.copy_buffer_to_buffer(source, 0, readback, 0, bytes);
+            for &(source, size) in sources {
+                if size > 0 {
+                    encoder.copy_buffer_to_buffer(source, 0, readback, bytes, size);
+                }
+                bytes += size;
             }
             self.queue.submit([encoder.finish()]);
         })?;

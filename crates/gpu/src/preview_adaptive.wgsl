@@ -6,8 +6,8 @@
 //
 // Group 3, bindings 2 and up (bindings 0 and 1 are the prediction's): one uniform slot per pass,
 // then the frame's state, one buffer per kind so that each stays within the adapter's largest
-// binding (128 MiB on lavapipe: a 2048 x 2048 render's records take 64 MiB each), and the count
-// of shaded blocks.
+// binding (128 MiB on lavapipe: a 2048 x 2048 render's records take 64 MiB each), and the control
+// words (counts, the allocation, the list's prefix sums).
 
 struct AdaptivePass {
     // The pass's level (`adaptive_reduce`, `adaptive_upsample`) and the pyramid's top.
@@ -31,6 +31,14 @@ struct AdaptivePass {
     depth_sigma: f32,
     rescue_below: f32,
     candidates: u32,
+    // The frame's samples, and at most this many per block (a power of two, at most 2^16).
+    budget: u32,
+    max_spp: u32,
+    // `shade_blocks`' items at most (the accumulation buffer's entries).
+    capacity: u32,
+    // 1: `adaptive_allocate` gives the samples (`render::adaptive::area_allocation`) and
+    // `adaptive_list` writes `shade_blocks`' items; 0: the host does both from the list.
+    allocate: u32,
     _pad: u32,
 }
 
@@ -44,9 +52,9 @@ struct AdaptivePass {
 //   (`ACTION_*`, with the parents' count in bits 8 and up), unused;
 // - parents and weights, per block: the parents' block indices in the next level, their weights;
 // - values, per block: its value (RGB) once shaded or up-sampled;
-// - list, per block: the shaded blocks (level, block, max variance, pixel) in the order
-//   `adaptive_plan` finds them; then, from the host, in the plan's order: the block, the first of
-//   its parts in `shade_blocks`' items and their count;
+// - list, per block: the shaded blocks in the plan's order (`adaptive_list`), as (level, block,
+//   max variance, pixel) for the host to allocate, then as (the block's index among every
+//   level's blocks, the first of its parts in `shade_blocks`' items, their count, its samples);
 // - tables: the level table, 4 words per level and one more (width and height in blocks, the
 //   offset of its first block, the offset of its first candidate; the last row's: the
 //   candidates' count); the candidates, 1 word per block that holds a shadeable pixel, level by
@@ -63,7 +71,26 @@ struct AdaptivePass {
 @group(3) @binding(9) var<storage, read_write> values: array<vec4<f32>>;
 @group(3) @binding(10) var<storage, read_write> list: array<vec4<u32>>;
 @group(3) @binding(11) var<storage, read> tables: array<u32>;
-@group(3) @binding(12) var<storage, read_write> shaded_count: array<atomic<u32>>;
+@group(3) @binding(12) var<storage, read_write> control: array<atomic<u32>>;
+
+// The control words, zero at the start of a frame (the host clears the first CONTROL_CHUNKS):
+// shaded blocks in all, the status (1: the budget is below a sample per shaded block), the
+// samples given, `shade_blocks`' items, their workgroups (x, y, 1) and the list's (x, y, 1), the
+// samples per part; from CONTROL_COUNTS the shaded blocks per level; from CONTROL_LEVELS per
+// level its samples, how many of its blocks get twice that, its first item and its first rank
+// in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per chunk of
+// CHUNK, then the shaded candidates before each chunk (`adaptive_chunks`, `adaptive_offsets`).
+const CONTROL_SHADED: u32 = 0u;
+const CONTROL_STATUS: u32 = 1u;
+const CONTROL_SAMPLES: u32 = 2u;
+const CONTROL_PARTS: u32 = 3u;
+const CONTROL_ARGS: u32 = 4u;
+const CONTROL_PART: u32 = 10u;
+const CONTROL_COUNTS: u32 = 16u;
+const CONTROL_LEVELS: u32 = 32u;
+const CONTROL_CHUNKS: u32 = 96u;
+const MAX_LEVELS: u32 = 16u;
+const CHUNK: u32 = 256u;
 
 const NONE: u32 = 0xffffffffu;
 const ACTION_SKIP: u32 = 0u;
@@ -102,6 +129,20 @@ fn record(pixel: u32) -> Record {
 fn level_info(k: u32) -> vec3<u32> {
     let i = adapt.level_table + 4u * k;
     return vec3<u32>(tables[i], tables[i + 1u], tables[i + 2u]);
+}
+
+// The candidates of every level.
+fn candidates_total() -> u32 {
+    return tables[adapt.level_table + 4u * (adapt.top + 1u) + 3u];
+}
+
+// The level of block `block` (its index among every level's blocks).
+fn level_of_block(block: u32) -> u32 {
+    var k = 0u;
+    while (k < adapt.top && block >= level_info(k + 1u).z) {
+        k += 1u;
+    }
+    return k;
 }
 
 // Level k's first candidate and their count.
@@ -320,10 +361,7 @@ fn adaptive_plan(
         return;
     }
     let block = tables[adapt.candidates + c];
-    var k = 0u;
-    while (k < adapt.top && block >= level_info(k + 1u).z) {
-        k += 1u;
-    }
+    let k = level_of_block(block);
     let me = level_info(k);
     let b = block - me.z;
     let bx = b % me.x;
@@ -340,14 +378,303 @@ fn adaptive_plan(
             }
         }
         if (action == ACTION_SHADE || action == ACTION_RESCUED) {
-            list[atomicAdd(&shaded_count[0], 1u)] = vec4<u32>(k, b, entry.y, block_pixel(k, bx, by));
+            atomicAdd(&control[CONTROL_SHADED], 1u);
+            atomicAdd(&control[CONTROL_COUNTS + k], 1u);
         }
     }
     levels[block].z = action;
 }
 
+// The allocation's 64-bit values, `preview_shade.wgsl`'s `Wide`, all below 2^63: every factor
+// but a count is a power of two, so shifts, sums and comparisons do.
+fn wide(x: u32) -> Wide {
+    return Wide(0u, x);
+}
+
+fn wide_shl(a: Wide, s: u32) -> Wide {
+    if (s == 0u) {
+        return a;
+    }
+    if (s >= 32u) {
+        return Wide(a.lo << (s - 32u), 0u);
+    }
+    return Wide((a.hi << s) | (a.lo >> (32u - s)), a.lo << s);
+}
+
+fn wide_sub(a: Wide, b: Wide) -> Wide {
+    return wide_add(a, wide_negate(b));
+}
+
+// a <= b, for values below 2^63.
+fn wide_le(a: Wide, b: Wide) -> bool {
+    return a.hi < b.hi || (a.hi == b.hi && a.lo <= b.lo);
+}
+
+fn control_word(i: u32) -> u32 {
+    return atomicLoad(&control[i]);
+}
+
+fn set_control(i: u32, value: u32) {
+    atomicStore(&control[i], value);
+}
+
+// Workgroups of 64 for `count` items as (x, y), at least one: `groups` of `preview/adaptive.rs`,
+// and with `power_of_two` the power of two of `item_groups` (`item_index`'s order).
+fn set_groups(at: u32, count: u32, power_of_two: bool) {
+    var n = max((count + 63u) / 64u, 1u);
+    if (power_of_two && n > 1u) {
+        n = 1u << (32u - countLeadingZeros(n - 1u));
+    }
+    set_control(at, min(n, 32768u));
+    set_control(at + 1u, (n + 32767u) / 32768u);
+    set_control(at + 2u, 1u);
+}
+
+// `render::adaptive::area_allocation` of the shaded blocks per level (`adaptive_plan`'s counts),
+// step for step in integers, and `preview/adaptive.rs`'s `parts` of its samples: the samples per
+// part, each level's first item and first rank, the items in all and the workgroups of
+// `shade_blocks` and of the list's passes. One invocation: a few levels.
+@compute @workgroup_size(1)
+fn adaptive_allocate() {
+    var counts: array<u32, MAX_LEVELS>;
+    var capped: array<bool, MAX_LEVELS>;
+    var shift: array<u32, MAX_LEVELS>;
+    var doubled: array<u32, MAX_LEVELS>;
+    let levels_n = adapt.top + 1u;
+    var n = 0u;
+    for (var k = 0u; k < levels_n; k++) {
+        counts[k] = control_word(CONTROL_COUNTS + k);
+        n += counts[k];
+    }
+    if (n > adapt.budget) {
+        set_control(CONTROL_STATUS, 1u);
+        return;
+    }
+    let cap_shift = countTrailingZeros(adapt.max_spp);
+    // The water filling: spare 2^k >= (max_spp - 1) W fills level k.
+    var spare = adapt.budget - n;
+    var total = 0u;
+    var sharing = false;
+    loop {
+        total = 0u;
+        for (var k = 0u; k < levels_n; k++) {
+            if (counts[k] > 0u && !capped[k]) {
+                total += counts[k] << k;
+            }
+        }
+        if (spare == 0u || total == 0u) {
+            break;
+        }
+        let bar = wide_sub(wide_shl(wide(total), cap_shift), wide(total));
+        var full = array<bool, MAX_LEVELS>();
+        var some_full = false;
+        for (var k = 0u; k < levels_n; k++) {
+            full[k] = counts[k] > 0u && !capped[k] && wide_le(bar, wide_shl(wide(spare), k));
+            some_full = some_full || full[k];
+        }
+        if (!some_full) {
+            sharing = true;
+            break;
+        }
+        for (var k = 0u; k < levels_n; k++) {
+            if (full[k]) {
+                spare -= counts[k] * (adapt.max_spp - 1u);
+                capped[k] = true;
+            }
+        }
+    }
+    // Each level's power of two below its share (total + spare 2^k over total where shared).
+    var left = adapt.budget;
+    for (var k = 0u; k < levels_n; k++) {
+        if (capped[k]) {
+            shift[k] = cap_shift;
+        } else if (sharing && counts[k] > 0u) {
+            let share = wide_add(wide(total), wide_shl(wide(spare), k));
+            while (shift[k] < cap_shift && wide_le(wide_shl(wide(total), shift[k] + 1u), share)) {
+                shift[k] += 1u;
+            }
+        }
+        left -= counts[k] << shift[k];
+    }
+    // Doubling, furthest below the share first (the lesser level among equals): only the shared
+    // levels can (a capped level is at max_spp; without a shared round nothing is left).
+    if (sharing) {
+        var done = array<bool, MAX_LEVELS>();
+        loop {
+            var best = MAX_LEVELS;
+            for (var k = 0u; k < levels_n; k++) {
+                if (capped[k] || counts[k] == 0u || done[k]) {
+                    continue;
+                }
+                if (best == MAX_LEVELS) {
+                    best = k;
+                    continue;
+                }
+                // share_k / 2^shift_k > share_best / 2^shift_best
+                let mine = wide_shl(wide_add(wide(total), wide_shl(wide(spare), k)), shift[best]);
+                let theirs = wide_shl(wide_add(wide(total), wide_shl(wide(spare), best)), shift[k]);
+                if (!wide_le(mine, theirs)) {
+                    best = k;
+                }
+            }
+            if (best == MAX_LEVELS) {
+                break;
+            }
+            done[best] = true;
+            if (shift[best] < cap_shift) {
+                doubled[best] = min(counts[best], left >> shift[best]);
+                left -= doubled[best] << shift[best];
+            }
+        }
+    }
+    // The parts: PART samples each, or the least power of two above that keeps the items
+    // within the capacity.
+    var part = 16u;
+    var items = 0u;
+    loop {
+        items = 0u;
+        for (var k = 0u; k < levels_n; k++) {
+            let samples = 1u << shift[k];
+            items += doubled[k] * ((2u * samples + part - 1u) / part) + (counts[k] - doubled[k]) * ((samples + part - 1u) / part);
+        }
+        if (items <= adapt.capacity || part >= 0x7fffffffu) {
+            break;
+        }
+        part *= 2u;
+    }
+    var first_item = 0u;
+    var first_rank = 0u;
+    for (var k = 0u; k < levels_n; k++) {
+        let at = CONTROL_LEVELS + 4u * k;
+        let samples = 1u << shift[k];
+        set_control(at, samples);
+        set_control(at + 1u, doubled[k]);
+        set_control(at + 2u, first_item);
+        set_control(at + 3u, first_rank);
+        first_item += doubled[k] * ((2u * samples + part - 1u) / part) + (counts[k] - doubled[k]) * ((samples + part - 1u) / part);
+        first_rank += counts[k];
+    }
+    set_control(CONTROL_SAMPLES, adapt.budget - left);
+    set_control(CONTROL_PARTS, items);
+    set_control(CONTROL_PART, part);
+    set_groups(CONTROL_ARGS, items, true);
+    set_groups(CONTROL_ARGS + 3u, n, false);
+}
+
+var<workgroup> scan_words: array<u32, CHUNK>;
+
+// The inclusive prefix sum of `value` over the workgroup's invocations (Hillis and Steele).
+fn workgroup_scan(local: u32, value: u32) -> u32 {
+    scan_words[local] = value;
+    workgroupBarrier();
+    for (var d = 1u; d < CHUNK; d *= 2u) {
+        var add = 0u;
+        if (local >= d) {
+            add = scan_words[local - d];
+        }
+        workgroupBarrier();
+        scan_words[local] += add;
+        workgroupBarrier();
+    }
+    return scan_words[local];
+}
+
+// Whether candidate `c` (in the plan's order: level by level, by block) is shaded.
+fn shaded_candidate(c: u32) -> bool {
+    if (c >= candidates_total()) {
+        return false;
+    }
+    let action = levels[tables[adapt.candidates + c]].z & 0xffu;
+    return action == ACTION_SHADE || action == ACTION_RESCUED;
+}
+
+fn chunk_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return group.y * groups.x + group.x;
+}
+
+// The list in the plan's order, step 1 of 3: the shaded candidates of each chunk of CHUNK.
+@compute @workgroup_size(256)
+fn adaptive_chunks(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let chunk = chunk_index(group, groups);
+    let sum = workgroup_scan(local, u32(shaded_candidate(chunk * CHUNK + local)));
+    if (local == CHUNK - 1u && chunk * CHUNK < candidates_total()) {
+        set_control(CONTROL_CHUNKS + chunk, sum);
+    }
+}
+
+// Step 2, one workgroup: the shaded candidates before each chunk, in place of its own.
+@compute @workgroup_size(256)
+fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
+    let chunks = (candidates_total() + CHUNK - 1u) / CHUNK;
+    let per = (chunks + CHUNK - 1u) / CHUNK;
+    let first = min(local * per, chunks);
+    let last = min(first + per, chunks);
+    var sum = 0u;
+    for (var i = first; i < last; i++) {
+        sum += control_word(CONTROL_CHUNKS + i);
+    }
+    var before = workgroup_scan(local, sum) - sum;
+    for (var i = first; i < last; i++) {
+        let mine = control_word(CONTROL_CHUNKS + i);
+        set_control(CONTROL_CHUNKS + i, before);
+        before += mine;
+    }
+}
+
+// Step 3: each shaded candidate's entry at its rank. Where the GPU allocates, also its samples
+// (the first of its level that `adaptive_allocate` doubled get twice its level's) and its parts
+// in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
+@compute @workgroup_size(256)
+fn adaptive_list(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let chunk = chunk_index(group, groups);
+    let c = chunk * CHUNK + local;
+    let shaded = shaded_candidate(c);
+    let inclusive = workgroup_scan(local, u32(shaded));
+    if (!shaded || control_word(CONTROL_STATUS) != 0u) {
+        return;
+    }
+    let rank = control_word(CONTROL_CHUNKS + chunk) + inclusive - 1u;
+    let block = tables[adapt.candidates + c];
+    let k = level_of_block(block);
+    let me = level_info(k);
+    let b = block - me.z;
+    let pixel = block_pixel(k, b % me.x, b / me.x);
+    if (adapt.allocate == 0u) {
+        list[rank] = vec4<u32>(k, b, levels[block].y, pixel);
+        return;
+    }
+    let at = CONTROL_LEVELS + 4u * k;
+    let samples = control_word(at);
+    let doubled = control_word(at + 1u);
+    let part = control_word(CONTROL_PART);
+    let r = rank - control_word(at + 3u);
+    let parts_doubled = (2u * samples + part - 1u) / part;
+    var n = samples;
+    var first = control_word(at + 2u) + r * parts_doubled;
+    if (r >= doubled) {
+        first = control_word(at + 2u) + doubled * parts_doubled + (r - doubled) * ((samples + part - 1u) / part);
+    } else {
+        n = 2u * samples;
+    }
+    let count = (n + part - 1u) / part;
+    for (var m = 0u; m < count; m++) {
+        let start = m * part;
+        accumulation[first + m] = bitcast<vec4<f32>>(vec4<u32>(pixel, n, start, min(part, n - start)));
+    }
+    list[rank] = vec4<u32>(block, first, count, n);
+}
+
 // The shaded blocks' estimates in place: the sum of each one's parts (`accumulation`, as
 // `shade_blocks` leaves them; the list's entry `i` holds the block, its first part and their count).
+// Dispatched for the list (`CONTROL_ARGS` + 3 where the GPU allocates).
 @compute @workgroup_size(64)
 fn adaptive_scatter(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -355,7 +682,7 @@ fn adaptive_scatter(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let i = adaptive_item(group, local, groups);
-    if (i >= adapt.count) {
+    if (i >= atomicLoad(&control[CONTROL_SHADED])) {
         return;
     }
     let entry = list[i];

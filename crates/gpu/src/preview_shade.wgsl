@@ -149,7 +149,8 @@ fn inside_clip_volume(c: vec4<f32>) -> bool {
 // A signed 64-bit integer, two's complement: the edge functions' exact values. Snapped
 // coordinates relative to the pixel centre stay below 2^25 in magnitude (within the guard band of
 // an image of up to 16384 pixels), so the products need 51 bits: f32 would round them, and a
-// sliver's small edge function is the difference of two large products.
+// sliver's small edge function is the difference of two large products. (Also the adaptive
+// frame's allocation's sums: `preview_adaptive.wgsl`.)
 struct Wide {
     hi: u32,
     lo: u32,

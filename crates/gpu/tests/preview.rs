@@ -597,22 +597,29 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
 /// samples; the weights, which the GPU computes in f32, within 1e-5 of the CPU's f64 ones
 /// rounded to f32: a few f32 ulps of each factor), and the image within the full-resolution
 /// modes' tolerances, with and without anti-aliasing, for both estimators, with the lobe weight
-/// and with the oracle's bandwidths in place of the prediction's.
+/// and with the oracle's bandwidths in place of the prediction's; with the samples allocated on
+/// the GPU (the area allocation: one submission; at 64 samples per pixel levels reach the cap
+/// of 64) and on the host (the variance and the standard deviation). A budget below a sample
+/// per shaded block is the same error on either.
 #[test]
 fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
-    for (mode, supersample, spp, lobe_weight, oracle) in [
-        (Mode::Reference, 1, 8, false, false),
-        (Mode::Prefiltered, 1, 4, false, false),
-        (Mode::Reference, 2, 4, false, false),
-        (Mode::Reference, 1, 8, true, false),
-        (Mode::Reference, 1, 8, false, true),
+    use render::adaptive::Allocation::{Area, StdDev, Variance};
+    for (mode, supersample, spp, lobe_weight, oracle, allocation) in [
+        (Mode::Reference, 1, 8, false, false, Area),
+        (Mode::Prefiltered, 1, 4, false, false, Area),
+        (Mode::Reference, 2, 4, false, false, Area),
+        (Mode::Reference, 1, 8, true, false, Variance),
+        (Mode::Reference, 1, 8, false, true, Area),
+        (Mode::Reference, 1, 64, false, false, Area),
+        (Mode::Prefiltered, 1, 4, false, false, StdDev),
     ] {
         let settings = render::adaptive::Settings {
             supersample,
             max_spp: 64,
             lobe_weight,
+            allocation,
             ..render::adaptive::Settings::new(mode, spp)
         };
         let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
@@ -641,14 +648,33 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
         let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
         log(&format!(
-            "adaptive {} {supersample}x{supersample}{}{}: {shaded} shaded blocks, levels {:?}, worst weight difference \
-             {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}",
+            "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples, \
+             worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}",
             mode.name(),
+            allocation.name(),
             if lobe_weight { " lobe weight" } else { "" },
             if oracle { " oracle" } else { "" },
             cpu_frame.shaded_per_level,
+            cpu_frame.samples,
         ));
         assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
+    }
+    // Every render pixel at level 0 (an oracle at the Nyquist rate) with 2 x 2 anti-aliasing
+    // shades about 4 blocks per output pixel: 1 sample per output pixel cannot pay for them.
+    let render_scene = Scene { width: SIZE * 2, height: SIZE * 2, ..scene.clone() };
+    let mut renderer_2 = renderer(&render_scene, material, lighting);
+    renderer_2.set_bandwidths(&bandwidths).unwrap();
+    let nyquist = vec![0.5; 4 * SIZE * SIZE];
+    for allocation in [Area, Variance] {
+        let settings = render::adaptive::Settings {
+            supersample: 2,
+            max_spp: 64,
+            allocation,
+            ..render::adaptive::Settings::new(Mode::Reference, 1)
+        };
+        let options = gpu::preview::FrameOptions { oracle: Some(&nyquist), details: false };
+        let error = renderer_2.render_adaptive(material, lighting, &settings, options).expect_err("over budget");
+        assert!(error.to_string().contains("less than one for each"), "{}: {error}", allocation.name());
     }
     // The prediction needs the bandwidths; without them the frame is an error that says so.
     let renderer = renderer(&scene, material, lighting);

@@ -926,35 +926,61 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
 
 /// The samples of each shaded block (module docs, "Samples"), given as `(level, max variance)`
 /// in the plan's order: by level, finest first, then by block index. `budget` samples in all.
-/// A renderer that plans elsewhere (`gpu::preview`) allocates with this, so that its blocks get
-/// exactly the samples the CPU's plan gives them.
+/// A renderer that plans elsewhere (`gpu::preview`) allocates with this, or with
+/// [`area_allocation`], so that its blocks get exactly the samples the CPU's plan gives them.
 pub fn allocation(blocks: &[(usize, f64)], budget: u64, settings: &Settings) -> Result<Vec<u32>, Error> {
     let max_spp = settings.max_spp;
-    let count = blocks.len() as u64;
-    if count > budget {
-        return Err(Error::Invalid(format!(
-            "a budget of {budget} samples is less than one for each of the {count} shaded pixels: raise spp"
-        )));
+    check_budget(blocks.len() as u64, budget)?;
+    if settings.allocation == Allocation::Area {
+        let top = blocks.iter().map(|&(k, _)| k).max().unwrap_or(0);
+        let mut counts = vec![0u64; top + 1];
+        for &(k, _) in blocks {
+            counts[k] += 1;
+        }
+        let per_level = area_allocation(&counts, budget, max_spp)?;
+        let first = |k: usize| blocks.partition_point(|&(j, _)| j < k) as u64;
+        return Ok(blocks
+            .iter()
+            .enumerate()
+            .map(|(i, &(k, _))| {
+                let LevelSamples { samples, doubled } = per_level[k];
+                if (i as u64 - first(k)) < doubled { 2 * samples } else { samples }
+            })
+            .collect());
     }
     let weights: Vec<f64> = blocks
         .iter()
-        .map(|&(k, variance)| {
-            let area = (1u64 << (2 * k)) as f64;
-            match settings.allocation {
-                Allocation::Variance => variance,
-                Allocation::StdDev => (area * variance).sqrt(),
-                Allocation::Area => area.sqrt(),
-            }
+        .map(|&(k, variance)| match settings.allocation {
+            Allocation::Variance => variance,
+            Allocation::StdDev => ((1u64 << (2 * k)) as f64 * variance).sqrt(),
+            Allocation::Area => unreachable!("allocated per level above"),
         })
         .collect();
-    let ideal = shares(&weights, budget as f64, f64::from(max_spp));
+    Ok(weighted_allocation(&weights, budget, max_spp))
+}
+
+/// A frame's budget must give every shaded block a sample.
+pub fn check_budget(shaded: u64, budget: u64) -> Result<(), Error> {
+    if shaded > budget {
+        return Err(Error::Invalid(format!(
+            "a budget of {budget} samples is less than one for each of the {shaded} shaded pixels: raise spp"
+        )));
+    }
+    Ok(())
+}
+
+/// The samples of blocks of the given weights (module docs, "Samples"): the water-filled
+/// shares, each rounded down to a power of two, then the rest handed out by doubling the blocks
+/// furthest below their share, in order, while it fits.
+fn weighted_allocation(weights: &[f64], budget: u64, max_spp: u32) -> Vec<u32> {
+    let ideal = shares(weights, budget as f64, f64::from(max_spp));
     let floor_pow2 = |x: f64| -> u32 {
         let x = x.min(f64::from(max_spp)).max(1.0);
         1u32 << (x.log2().floor() as u32)
     };
     let mut samples: Vec<u32> = ideal.iter().map(|&x| floor_pow2(x)).collect();
     let mut left = budget - samples.iter().map(|&n| u64::from(n)).sum::<u64>();
-    let mut order: Vec<usize> = (0..blocks.len()).collect();
+    let mut order: Vec<usize> = (0..weights.len()).collect();
     order.sort_by(|&a, &b| {
         (ideal[b] / f64::from(samples[b])).total_cmp(&(ideal[a] / f64::from(samples[a]))).then(a.cmp(&b))
     });
@@ -964,7 +990,93 @@ pub fn allocation(blocks: &[(usize, f64)], budget: u64, settings: &Settings) -> 
             samples[i] *= 2;
         }
     }
-    Ok(samples)
+    samples
+}
+
+/// The samples of one level's shaded blocks under [`Allocation::Area`]: the first `doubled`
+/// blocks of the level, in the plan's order, get `2 samples`, the others `samples`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LevelSamples {
+    pub samples: u32,
+    pub doubled: u64,
+}
+
+/// [`Allocation::Area`]'s samples from the count of shaded blocks per level alone (level 0
+/// first), in exact integer arithmetic: every block of a level has the same weight `2^k`, so the
+/// same share, the same power of two below it, and the blocks that double are the first of
+/// their level that fit (module docs, "Samples"). The water filling: a level is full when
+/// `1 + spare 2^k / W >= max_spp` (`W` the open levels' `sum n_k 2^k`), that is when
+/// `spare 2^k >= (max_spp - 1) W`; full levels take `max_spp` and leave the rest to the others
+/// until none is full; a level's samples are then the largest power of two `2^m <= max_spp`
+/// with `2^m W <= W + spare 2^k`, and the levels below their share double, furthest below
+/// first (the least level first among equals), while their samples fit what is left. `gpu::preview` computes the same in
+/// `preview_adaptive.wgsl`'s `adaptive_allocate`, with 64-bit sums of shifts for the products
+/// (every factor but the counts a power of two). `max_spp` is a power of two
+/// ([`check_settings`]).
+pub fn area_allocation(counts: &[u64], budget: u64, max_spp: u32) -> Result<Vec<LevelSamples>, Error> {
+    debug_assert!(max_spp.is_power_of_two());
+    check_budget(counts.iter().sum(), budget)?;
+    let cap = u128::from(max_spp);
+    let weight = |k: usize| u128::from(counts[k]) << k;
+    let mut capped = vec![false; counts.len()];
+    let open = |capped: &[bool]| -> Vec<usize> { (0..counts.len()).filter(|&k| counts[k] > 0 && !capped[k]).collect() };
+    let mut spare = u128::from(budget - counts.iter().sum::<u64>());
+    // The last round's spare and W, where it shared among open levels.
+    let mut shared = None;
+    loop {
+        let open = open(&capped);
+        let total: u128 = open.iter().map(|&k| weight(k)).sum();
+        if spare == 0 || total == 0 {
+            break;
+        }
+        let full: Vec<usize> = open.into_iter().filter(|&k| spare << k >= (cap - 1) * total).collect();
+        if full.is_empty() {
+            shared = Some((spare, total));
+            break;
+        }
+        for k in full {
+            spare -= u128::from(counts[k]) * (cap - 1);
+            capped[k] = true;
+        }
+    }
+    // Each level's ideal share as a fraction, and its power of two.
+    let ideal = |k: usize| -> (u128, u128) {
+        match shared {
+            _ if capped[k] => (cap, 1),
+            Some((spare, total)) => (total + (spare << k), total),
+            None => (1, 1),
+        }
+    };
+    let mut levels: Vec<LevelSamples> = (0..counts.len())
+        .map(|k| {
+            let (num, den) = ideal(k);
+            let mut samples = 1u128;
+            while 2 * samples <= cap && 2 * samples * den <= num {
+                samples *= 2;
+            }
+            LevelSamples { samples: samples as u32, doubled: 0 }
+        })
+        .collect();
+    let mut left = budget - (0..counts.len()).map(|k| counts[k] * u64::from(levels[k].samples)).sum::<u64>();
+    // Furthest below the share first: ideal / samples descending, the lesser level first.
+    let mut order: Vec<usize> = (0..counts.len()).filter(|&k| counts[k] > 0).collect();
+    let below = |k: usize| {
+        let (num, den) = ideal(k);
+        (num, den * u128::from(levels[k].samples))
+    };
+    order.sort_by(|&a, &b| {
+        let ((na, da), (nb, db)) = (below(a), below(b));
+        (nb * da).cmp(&(na * db)).then(a.cmp(&b))
+    });
+    for k in order {
+        let samples = u64::from(levels[k].samples);
+        if levels[k].samples < max_spp {
+            let doubled = counts[k].min(left / samples);
+            left -= doubled * samples;
+            levels[k].doubled = doubled;
+        }
+    }
+    Ok(levels)
 }
 
 /// The inner product of two normalized spherical Gaussians `exp(lambda (xi . w - 1))` (`003`
@@ -1051,14 +1163,15 @@ pub struct Timings {
     /// The [`Geometry`]'s, made once per camera: not part of the frame's time when its camera
     /// made frames before.
     pub gbuffer_ms: f64,
-    /// [`render_with`]: the prediction; `gpu::preview`: its first submission (prediction,
-    /// pyramids, plan and the list of shaded blocks read back).
+    /// [`render_with`]: the prediction; `gpu::preview` in two submissions (the variance and
+    /// the standard-deviation allocations): its first (prediction, pyramids, plan and the list
+    /// of shaded blocks read back); in one (the area allocation): 0.
     pub predict_ms: f64,
     /// [`render_with`]: the pyramids and the plan with its samples; `gpu::preview`: the
-    /// allocation of the samples on the CPU.
+    /// allocation of the samples on the CPU where it allocates there, else 0.
     pub plan_ms: f64,
     /// [`render_with`]: shading, up-sampling and the background; `gpu::preview`: its second
-    /// submission (the same, and the image read back).
+    /// submission (the same, and the image read back), or its only one, the whole frame.
     pub shade_ms: f64,
 }
 
@@ -1397,7 +1510,8 @@ fn downsample(rgb: &[[f32; 3]], covered: Vec<bool>, width: usize, height: usize,
 #[cfg(test)]
 mod tests {
     use super::{
-        Action, Allocation, Level, Pixel, Settings, allocate, lobe_similarity, pixels, shares, upsample_weights,
+        Action, Allocation, Level, LevelSamples, Pixel, Settings, allocate, allocation, area_allocation,
+        lobe_similarity, pixels, shares, upsample_weights, weighted_allocation,
     };
     use crate::Mode;
     use crate::shade::visibility;
@@ -1478,6 +1592,54 @@ mod tests {
             });
             assert_eq!(got, expect, "{} with variances 3 and {variance_2}", allocation.name());
         }
+    }
+
+    #[test]
+    fn the_area_allocation_per_level_is_the_water_filling_of_every_block() {
+        // Independent reference: `weighted_allocation` over every block with the weight 2^k, in
+        // f64, against `allocation`'s Area path (per level, in integers); random levels, counts,
+        // budgets (at most 300 samples per block) and caps, with empty levels and budgets at
+        // exactly one sample per block among them.
+        let mut state = 7u32;
+        let mut next = |n: u32| {
+            state = crate::pcg_hash(state);
+            state % n
+        };
+        let (mut doubled, mut capped) = (0, 0);
+        for case in 0..2000 {
+            let levels = 1 + next(7) as usize;
+            let counts: Vec<u64> = (0..levels).map(|_| u64::from(next(4).min(1) * next(40))).collect();
+            let n: u64 = counts.iter().sum();
+            if n == 0 {
+                continue;
+            }
+            let budget = if case % 10 == 0 { n } else { n + u64::from(next(300)) * n / u64::from(1 + next(8)) };
+            let max_spp = 1 << next(9);
+            let blocks: Vec<(usize, f64)> =
+                counts.iter().enumerate().flat_map(|(k, &c)| (0..c).map(move |_| (k, 0.0))).collect();
+            let weights: Vec<f64> = blocks.iter().map(|&(k, _)| (1u64 << k) as f64).collect();
+            let expect = weighted_allocation(&weights, budget, max_spp);
+            let settings = Settings { allocation: Allocation::Area, max_spp, ..Settings::new(Mode::Reference, 1) };
+            let got = allocation(&blocks, budget, &settings).unwrap();
+            assert_eq!(got, expect, "counts {counts:?}, budget {budget}, max_spp {max_spp}");
+            assert!(got.iter().map(|&s| u64::from(s)).sum::<u64>() <= budget);
+            let per_level = area_allocation(&counts, budget, max_spp).unwrap();
+            doubled += usize::from(per_level.iter().any(|l| l.doubled > 0));
+            capped += usize::from(per_level.iter().any(|l| l.samples == max_spp && max_spp > 1));
+        }
+        // The cases reach both the doubling and the cap.
+        assert!(doubled > 500 && capped > 100, "{doubled} cases doubled, {capped} capped");
+        // Levels 0 and 2 tie (ideal over samples 3 / 2: shares 1.5, 2, 3 of 13 samples, W = 14,
+        // spare 7): the lesser level doubles first, both its blocks, and the 1 sample left
+        // doubles neither of level 2's (taking level 2 first would double one of each).
+        let tie = area_allocation(&[2, 2, 2], 13, 8).unwrap();
+        let expect = [(1, 2), (2, 0), (2, 0)].map(|(samples, doubled)| LevelSamples { samples, doubled });
+        assert_eq!(tie, expect);
+        let weights = [1.0, 1.0, 2.0, 2.0, 4.0, 4.0];
+        assert_eq!(weighted_allocation(&weights, 13, 8), [2, 2, 2, 2, 2, 2]);
+        // A budget below a sample per block is the same error either way.
+        let error = area_allocation(&[3, 1], 3, 4).unwrap_err().to_string();
+        assert!(error.contains("less than one for each of the 4 shaded"), "{error}");
     }
 
     #[test]

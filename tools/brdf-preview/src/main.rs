@@ -28,9 +28,10 @@ mod window;
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
 ///                variance; only the pixels of a pyramid whose level the prediction asks for are
 ///                shaded (reference estimator), a budget of --spp samples per pixel on average
-///                is shared among them (--allocation), the rest is up-sampled; one frame on the
-///                GPU, its G-buffer (once per camera) and the samples' allocation on the CPU
-///                (crate render, module adaptive, is the specification)
+///                is shared among them (--allocation), the rest is up-sampled; one frame is one
+///                submission on the GPU (two with the samples allocated on the CPU between them
+///                for --allocation variance or std-dev), its G-buffer made on the CPU once per
+///                camera (crate render, module adaptive, is the specification)
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
@@ -523,17 +524,23 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         );
         files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
+    // One submission (the samples allocated on the GPU) has no steps timed apart.
+    let steps = if t.predict_ms == 0.0 && t.plan_ms == 0.0 {
+        "one submission on the GPU".to_string()
+    } else {
+        format!(
+            "prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on the CPU, shading, up-sampling and output \
+             {:.1} on the GPU",
+            t.predict_ms, t.plan_ms, t.shade_ms
+        )
+    };
     let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms (prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on \
-         the CPU, shading, up-sampling and output {:.1} on the GPU; the camera's G-buffer on the CPU before, once: \
-         {:.1}); shaded fraction {:.4}, {} samples of a budget of {}",
+        "{}: {} on {} ({}), {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU before, once: {:.1}); \
+         shaded fraction {:.4}, {} samples of a budget of {}",
         out.display(),
         args.mode.name(),
         gpu.adapter_summary(),
         args.mesh,
-        t.predict_ms,
-        t.plan_ms,
-        t.shade_ms,
         t.gbuffer_ms,
         frame.shaded_fraction(),
         frame.samples,

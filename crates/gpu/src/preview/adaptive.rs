@@ -1,14 +1,25 @@
 //! An adaptive frame (`render::adaptive`) on the GPU, whole: the camera's G-buffer records are
 //! uploaded once (from `render::adaptive::Geometry`, the CPU's, so that both renderers plan
-//! from the same surfaces), and each frame then runs in two submissions:
+//! from the same surfaces), and each frame then runs as one submission, one wait:
 //!
 //! 1. the prediction at the prediction pixels (`predict_blocks`), the levels of the bandwidth
 //!    buffer, the min and max pyramids and the plan of every block (`preview_adaptive.wgsl`),
-//!    which appends the shaded blocks to a list; the list comes back (a few thousand blocks);
-//! 2. the host sorts it into the plan's order and gives the blocks their samples with
-//!    `render::adaptive::allocation` (the CPU's code: the same samples), then the shaded blocks
-//!    (`shade_blocks`), their estimates put in place, the up-sampling level by level from the
-//!    top, and the output image, which comes back.
+//!    which counts the shaded blocks per level;
+//! 2. their samples (`adaptive_allocate`, one invocation: `render::adaptive::area_allocation`
+//!    from the counts per level, in integers, so the CPU's samples exactly), and the list of
+//!    shaded blocks in the plan's order, by a prefix sum over the candidates (`adaptive_chunks`,
+//!    `adaptive_offsets`, `adaptive_list`), each with its samples and its parts of at most
+//!    [`PART`] samples in `shade_blocks`' items;
+//! 3. the parts (`shade_blocks`, dispatched with the counts the allocation left: an indirect
+//!    dispatch, and the count copied into the shading uniform), their sums put in place, the
+//!    up-sampling level by level from the top, and the output image, which comes back with the
+//!    control words (the counts, the samples, the status).
+//!
+//! That is the area allocation, the previewer's default, wherever the budget fits 32 bits and
+//! `max_spp` 2^16. The variance and the standard-deviation allocations weight every block by
+//! its own variance, which needs a sort by share rather than counts: there the list comes back
+//! after step 2's prefix sum, the host allocates with `render::adaptive::allocation` and lays
+//! out the parts ([`parts`]), and step 3 is a second submission.
 //!
 //! The plan is the CPU's in `f32`: the weights agree to `f32` rounding, and the decisions
 //! (valid, shaded, rescued, up-sampled) are the same wherever no weight or sum sits within
@@ -21,7 +32,7 @@
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
-use render::adaptive::{Action, Adaptive, Details, Geometry, Level, Plan, Prediction, Timings};
+use render::adaptive::{Action, Adaptive, Allocation, Details, Geometry, Level, Plan, Prediction, Timings};
 use render::{Image, Lighting, Material};
 
 use super::{Renderer, no_bandwidths};
@@ -48,11 +59,30 @@ pub(super) struct AdaptivePass {
     depth_sigma: f32,
     rescue_below: f32,
     candidates: u32,
+    budget: u32,
+    max_spp: u32,
+    capacity: u32,
+    allocate: u32,
     _pad: u32,
 }
 
 /// `NONE` of the WGSL: a render pixel without a prediction (not shadeable).
 const NONE: u32 = u32::MAX;
+
+/// The WGSL's control words (`preview_adaptive.wgsl`): shaded blocks in all, the status, the
+/// samples given, `shade_blocks`' items, the indirect dispatches' workgroups, shaded blocks
+/// per level; the first `CONTROL_CHUNKS` are cleared each frame and read back.
+const CONTROL_SHADED: u32 = 0;
+const CONTROL_STATUS: u32 = 1;
+const CONTROL_SAMPLES: u32 = 2;
+const CONTROL_PARTS: u32 = 3;
+const CONTROL_ARGS: u32 = 4;
+const CONTROL_COUNTS: u32 = 16;
+const CONTROL_CHUNKS: u32 = 96;
+/// Levels the control words have room for (`MAX_LEVELS`): a render up to 65535 pixels a side.
+const MAX_LEVELS: usize = 16;
+/// Candidates per workgroup of the list's prefix sums (`CHUNK`).
+const CHUNK: u32 = 256;
 
 /// What an adaptive frame on the GPU may take besides its settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -88,8 +118,12 @@ pub(super) struct State {
     buffers: Buffers,
     uniform: wgpu::Buffer,
     group: wgpu::BindGroup,
-    /// For the frame's read-backs (the count, the list, the image), kept from frame to frame.
+    /// For the frame's read-backs (the control words, the list, the image), kept from frame to
+    /// frame.
     readback: wgpu::Buffer,
+    /// The workgroups of `shade_blocks` and of `adaptive_scatter` where the GPU allocates,
+    /// copied from the control words: an indirect dispatch's buffer may not be bound beside it.
+    indirect: wgpu::Buffer,
 }
 
 /// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
@@ -104,7 +138,7 @@ struct Buffers {
     values: wgpu::Buffer,
     list: wgpu::Buffer,
     tables: wgpu::Buffer,
-    counter: wgpu::Buffer,
+    control: wgpu::Buffer,
 }
 
 impl Buffers {
@@ -119,7 +153,7 @@ impl Buffers {
             &self.values,
             &self.list,
             &self.tables,
-            &self.counter,
+            &self.control,
         ]
     }
 }
@@ -139,7 +173,8 @@ const PART: u32 = 16;
 /// `samples`: each block's samples in parts of `PART` (or, where that would make more items
 /// than the accumulation buffer's `capacity` entries, of the least power of two that does not);
 /// and the list's entries for `adaptive_scatter`: the block's index among every level's blocks,
-/// its first part, the number of parts.
+/// its first part, the number of parts, its samples. `adaptive_allocate` and `adaptive_list`
+/// lay out the same where the GPU allocates.
 fn parts(
     list: &[[u32; 4]],
     samples: &[u32],
@@ -158,17 +193,22 @@ fn parts(
         for start in (0..n).step_by(part as usize) {
             items.push([e[3], n, start, part.min(n - start)]);
         }
-        targets.push([levels[e[0] as usize].2 + e[1], first, items.len() as u32 - first, 0]);
+        targets.push([levels[e[0] as usize].2 + e[1], first, items.len() as u32 - first, n]);
     }
     (items, targets)
 }
 
-/// Dispatches one of the adaptive passes over `count` items, with the pass uniform's slot at
+/// Dispatches one of the adaptive passes in `(x, y)` workgroups, with the pass uniform's slot at
 /// byte `offset`.
-fn dispatch(cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, state: &State, offset: u64, count: u32) {
+fn dispatch(
+    cpass: &mut wgpu::ComputePass,
+    pipeline: &wgpu::ComputePipeline,
+    state: &State,
+    offset: u64,
+    (x, y): (u32, u32),
+) {
     cpass.set_pipeline(pipeline);
     cpass.set_bind_group(3, &state.group, &[offset as u32]);
-    let (x, y) = groups(count);
     cpass.dispatch_workgroups(x, y, 1);
 }
 
@@ -179,8 +219,12 @@ fn slot_stride(alignment: u64) -> u64 {
 
 /// Workgroups of 64 for `count` items, as `(x, y)` within the dispatch limits.
 fn groups(count: u32) -> (u32, u32) {
-    let groups = count.div_ceil(64).max(1);
-    (groups.min(32768), groups.div_ceil(32768))
+    chunk_groups(count.div_ceil(64).max(1))
+}
+
+/// `n` workgroups as `(x, y)` within the dispatch limits.
+fn chunk_groups(n: u32) -> (u32, u32) {
+    (n.min(32768), n.div_ceil(32768))
 }
 
 impl Renderer {
@@ -262,6 +306,7 @@ impl Renderer {
             sharpness: sharpness_at,
             n_rows: sharpness.len() as u32,
             candidates: candidates_at,
+            capacity: p,
             ..Default::default()
         };
         let (mut surface, mut lobe) = (vec![[0f32; 4]; p as usize], vec![[0u32; 4]; p as usize]);
@@ -291,6 +336,13 @@ impl Renderer {
         // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
         let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
         let items: Vec<[u32; 4]> = at.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        if levels.len() > MAX_LEVELS {
+            return Err(render::Error::Invalid(format!(
+                "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
+                levels.len()
+            ))
+            .into());
+        }
         let state = capture_errors(&self.device, || {
             use wgpu::BufferUsages as U;
             use wgpu::util::DeviceExt;
@@ -319,7 +371,7 @@ impl Renderer {
                 values: empty("adaptive values", 16 * u64::from(blocks)),
                 list: empty("adaptive list", 16 * u64::from(blocks)),
                 tables: init("adaptive tables", bytemuck::cast_slice(&table)),
-                counter: empty("adaptive shaded count", 4),
+                control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(CHUNK))),
             };
             let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("adaptive prediction pixels"),
@@ -349,9 +401,17 @@ impl Renderer {
                 entries: &entries,
             });
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
-            let readback = self.readback_buffer((16 * u64::from(blocks)).max(16 * out_pixels));
+            let readback =
+                self.readback_buffer((16 * u64::from(blocks)).max(16 * out_pixels + 4 * u64::from(CONTROL_CHUNKS)));
+            let indirect = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive indirect dispatches"),
+                size: 24,
+                usage: U::INDIRECT | U::COPY_DST,
+                mapped_at_creation: false,
+            });
             State {
                 readback,
+                indirect,
                 geometry: Arc::clone(geometry),
                 key,
                 levels,
@@ -376,9 +436,10 @@ impl Renderer {
     /// the bandwidths of [`Renderer::set_bandwidths`], on the GPU whole (module docs): the same
     /// frame as `render::adaptive::render_with` computes on the CPU, to `f32` rounding. The
     /// G-buffer is the camera's ([`Renderer::adaptive_geometry`], made once per camera). The
-    /// timings: `predict_ms` the first submission (prediction, pyramids, plan and the list of
-    /// shaded blocks read back), `plan_ms` the host's allocation, `shade_ms` the second
-    /// submission (shading, up-sampling, output and its read-back).
+    /// timings: in one submission (the area allocation) all of it in `shade_ms`; in two,
+    /// `predict_ms` the first (prediction, pyramids, plan and the list of shaded blocks read
+    /// back), `plan_ms` the host's allocation, `shade_ms` the second (shading, up-sampling,
+    /// output and its read-back).
     pub fn render_adaptive(
         &self,
         material: &Material,
@@ -407,7 +468,11 @@ impl Renderer {
         let clock = std::time::Instant::now();
         let lap = || clock.elapsed().as_secs_f64() * 1e3;
 
-        // Submission 1: prediction, levels, pyramids, plan.
+        // The frame's samples: on the GPU under the area allocation, where 32-bit words hold the
+        // budget and 64-bit sums of shifts its products (module docs); otherwise on the host.
+        let budget = u64::from(settings.spp) * state.covered_output;
+        let on_gpu =
+            settings.allocation == Allocation::Area && budget <= u64::from(u32::MAX) && settings.max_spp <= 1 << 16;
         let stride = slot_stride(self.frame_stride);
         let pass = |slot: u64, fields: AdaptivePass| {
             self.queue.write_buffer(&state.uniform, slot * stride, bytemuck::bytes_of(&fields));
@@ -417,11 +482,49 @@ impl Renderer {
             rescue_below: settings.rescue_below as f32,
             n_rows: if settings.lobe_weight { state.base.n_rows } else { 0 },
             oracle: u32::from(options.oracle.is_some()),
+            budget: budget.min(u64::from(u32::MAX)) as u32,
+            max_spp: settings.max_spp,
+            allocate: u32::from(on_gpu),
             ..state.base
         };
         let (levels_slot, plan_slot, scatter_slot) = (0, 1 + top as u64, 2 + top as u64);
-        let (blocks, candidates) = (state.blocks, state.candidates_per_level.iter().sum());
-        let shaded = capture_errors(&self.device, || {
+        let output_slot = scatter_slot + 1 + top as u64;
+        let candidates: u32 = state.candidates_per_level.iter().sum();
+        let chunks = candidates.div_ceil(CHUNK).max(1);
+        let out_pixels = (out_width * out_height) as u64;
+        let pipelines = &self.adaptive_pipelines;
+        // The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling
+        // and the output: `Some(count)` dispatches a known count, `None` the counts
+        // `adaptive_allocate` left in the indirect buffer.
+        let shading = |cpass: &mut wgpu::ComputePass, parts: Option<u32>, shaded: Option<u32>| {
+            cpass.set_pipeline(&self.blocks_pipeline);
+            match parts {
+                Some(0) => {}
+                Some(n) => {
+                    let (x, y) = super::item_groups(n);
+                    cpass.dispatch_workgroups(x, y, 1);
+                }
+                None => cpass.dispatch_workgroups_indirect(&state.indirect, 0),
+            }
+            match shaded {
+                Some(n) => dispatch(cpass, &pipelines.scatter, state, scatter_slot * stride, groups(n)),
+                None => {
+                    cpass.set_pipeline(&pipelines.scatter);
+                    cpass.set_bind_group(3, &state.group, &[(scatter_slot * stride) as u32]);
+                    cpass.dispatch_workgroups_indirect(&state.indirect, 12);
+                }
+            }
+            for k in (0..top).rev() {
+                let slot = scatter_slot + 1 + k as u64;
+                dispatch(cpass, &pipelines.upsample, state, slot * stride, groups(state.candidates_per_level[k]));
+            }
+            dispatch(cpass, &pipelines.output, state, output_slot * stride, groups(out_pixels as u32));
+        };
+
+        // Submission 1: prediction, levels, pyramids, plan, the list of shaded blocks in the
+        // plan's order; on the GPU also the samples and all of submission 2.
+        let control_bytes = 4 * u64::from(CONTROL_CHUNKS);
+        let words: Vec<u32> = capture_errors(&self.device, || {
             self.progress.set(None);
             self.write_predict_uniform(prediction, settings);
             let shade = self.shade_uniform(
@@ -430,7 +533,7 @@ impl Renderer {
             );
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
-            self.queue.write_buffer(&state.buffers.counter, 0, &[0u8; 4]);
+            self.queue.write_buffer(&state.buffers.control, 0, &vec![0u8; control_bytes as usize]);
             if let Some(oracle) = options.oracle {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
                 self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
@@ -440,6 +543,10 @@ impl Renderer {
                 pass(k as u64, AdaptivePass { level: k as u32, ..base });
             }
             pass(plan_slot, AdaptivePass { count: candidates, ..base });
+            for slot in scatter_slot..=output_slot {
+                let level = (slot - scatter_slot).saturating_sub(1) as u32;
+                pass(slot, AdaptivePass { level, ..base });
+            }
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
             {
@@ -450,74 +557,92 @@ impl Renderer {
                     let (x, y) = super::item_groups(state.n_items);
                     cpass.dispatch_workgroups(x, y, 1);
                 }
-                let mut run = |pipeline, slot: u64, count| dispatch(&mut cpass, pipeline, state, slot * stride, count);
-                let pipelines = &self.adaptive_pipelines;
+                let mut run =
+                    |pipeline, slot: u64, groups| dispatch(&mut cpass, pipeline, state, slot * stride, groups);
                 let per_level = &state.candidates_per_level;
-                run(&pipelines.levels, levels_slot, per_level[0]);
+                run(&pipelines.levels, levels_slot, groups(per_level[0]));
                 for (k, &n) in per_level.iter().enumerate().skip(1) {
-                    run(&pipelines.reduce, k as u64, n);
+                    run(&pipelines.reduce, k as u64, groups(n));
                 }
-                run(&pipelines.plan, plan_slot, candidates);
+                run(&pipelines.plan, plan_slot, groups(candidates));
+                if on_gpu {
+                    run(&pipelines.allocate, plan_slot, (1, 1));
+                }
+                run(&pipelines.chunks, plan_slot, chunk_groups(chunks));
+                run(&pipelines.offsets, plan_slot, (1, 1));
+                run(&pipelines.list, plan_slot, chunk_groups(chunks));
+            }
+            if on_gpu {
+                let spp_at = std::mem::offset_of!(super::ShadeUniform, spp) as u64;
+                encoder.copy_buffer_to_buffer(
+                    &state.buffers.control,
+                    4 * u64::from(CONTROL_PARTS),
+                    &self.shade_uniform,
+                    spp_at,
+                    4,
+                );
+                encoder.copy_buffer_to_buffer(
+                    &state.buffers.control,
+                    4 * u64::from(CONTROL_ARGS),
+                    &state.indirect,
+                    0,
+                    24,
+                );
+                let mut cpass = self.begin_pass(&mut encoder);
+                shading(&mut cpass, None, None);
             }
             encoder
         })
         .and_then(|encoder| {
-            let count: Vec<u32> = self.submit_and_read(encoder, &state.buffers.counter, &state.readback, 4)?;
-            let bytes = 16 * u64::from(count[0].min(blocks));
-            let encoder = self.device.create_command_encoder(&Default::default());
-            self.submit_and_read(encoder, &state.buffers.list, &state.readback, bytes)
+            let image = if on_gpu { 16 * out_pixels } else { 0 };
+            self.submit_and_read(
+                encoder,
+                &[(&self.accumulation, image), (&state.buffers.control, control_bytes)],
+                &state.readback,
+            )
         })?;
         let predict_ms = lap();
+        let (image_words, control) = words.split_at(words.len() - CONTROL_CHUNKS as usize);
+        let n_shaded = control[CONTROL_SHADED as usize];
+        let counts = &control[CONTROL_COUNTS as usize..][..=top];
+        let shaded_per_level: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
+        if control[CONTROL_STATUS as usize] != 0 {
+            render::adaptive::check_budget(u64::from(n_shaded), budget)?;
+        }
 
-        // The host: the list in the plan's order, the samples.
-        let mut list: Vec<[u32; 4]> = shaded.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-        list.sort_unstable_by_key(|e| (e[0], e[1]));
-        let budget = u64::from(settings.spp) * state.covered_output;
-        let blocks_in: Vec<(usize, f64)> =
-            list.iter().map(|e| (e[0] as usize, f64::from(f32::from_bits(e[2])))).collect();
-        let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
-        let (items, targets) = parts(&list, &samples, &state.levels, width * height);
-        let plan_ms = lap();
-
-        // Submission 2: shading, estimates in place, up-sampling, output.
-        let n_shaded = targets.len() as u32;
-        let n_parts = items.len() as u32;
-        let out_pixels = (out_width * out_height) as u64;
-        let rgba: Vec<[f32; 4]> = capture_errors(&self.device, || {
-            let shade = self.shade_uniform(
-                super::mode_index(settings.mode),
-                &render::Settings { mode: settings.mode, spp: n_parts, frames: 1, seed: settings.seed },
-            );
-            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
-            if !items.is_empty() {
-                self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
-                self.queue.write_buffer(&state.buffers.list, 0, bytemuck::cast_slice(&targets));
-            }
-            pass(scatter_slot, AdaptivePass { count: n_shaded, ..base });
-            for k in 0..top {
-                pass(scatter_slot + 1 + k as u64, AdaptivePass { level: k as u32, ..base });
-            }
-            let output_slot = scatter_slot + 1 + top as u64;
-            pass(output_slot, base);
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            {
-                let mut cpass = self.begin_pass(&mut encoder);
-                if n_parts > 0 {
-                    cpass.set_pipeline(&self.blocks_pipeline);
-                    let (x, y) = super::item_groups(n_parts);
-                    cpass.dispatch_workgroups(x, y, 1);
+        let (rgba, samples, plan_ms): (Vec<[f32; 4]>, u64, f64) = if on_gpu {
+            (bytemuck::cast_slice(image_words).to_vec(), u64::from(control[CONTROL_SAMPLES as usize]), predict_ms)
+        } else {
+            // The host: the samples, then submission 2: shading, estimates in place,
+            // up-sampling, output.
+            let encoder = self.device.create_command_encoder(&Default::default());
+            let shaded: Vec<u32> =
+                self.submit_and_read(encoder, &[(&state.buffers.list, 16 * u64::from(n_shaded))], &state.readback)?;
+            let list: Vec<[u32; 4]> = shaded.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+            let blocks_in: Vec<(usize, f64)> =
+                list.iter().map(|e| (e[0] as usize, f64::from(f32::from_bits(e[2])))).collect();
+            let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
+            let (items, targets) = parts(&list, &samples, &state.levels, width * height);
+            let plan_ms = lap();
+            let rgba = capture_errors(&self.device, || {
+                let shade = self.shade_uniform(
+                    super::mode_index(settings.mode),
+                    &render::Settings { mode: settings.mode, spp: items.len() as u32, frames: 1, seed: settings.seed },
+                );
+                self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+                if !items.is_empty() {
+                    self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
+                    self.queue.write_buffer(&state.buffers.list, 0, bytemuck::cast_slice(&targets));
                 }
-                let mut run = |pipeline, slot: u64, count| dispatch(&mut cpass, pipeline, state, slot * stride, count);
-                let pipelines = &self.adaptive_pipelines;
-                run(&pipelines.scatter, scatter_slot, n_shaded);
-                for k in (0..top).rev() {
-                    run(&pipelines.upsample, scatter_slot + 1 + k as u64, state.candidates_per_level[k]);
-                }
-                run(&pipelines.output, output_slot, out_pixels as u32);
-            }
-            encoder
-        })
-        .and_then(|encoder| self.submit_and_read(encoder, &self.accumulation, &state.readback, 16 * out_pixels))?;
+                let mut encoder = self.device.create_command_encoder(&Default::default());
+                shading(&mut self.begin_pass(&mut encoder), Some(items.len() as u32), Some(n_shaded));
+                encoder
+            })
+            .and_then(|encoder| {
+                self.submit_and_read(encoder, &[(&self.accumulation, 16 * out_pixels)], &state.readback)
+            })?;
+            (rgba, samples.iter().map(|&n| u64::from(n)).sum(), plan_ms)
+        };
         let shade_ms = lap();
         let image = Image {
             width: out_width,
@@ -525,48 +650,41 @@ impl Renderer {
             rgb: rgba.iter().flat_map(|v| [v[0], v[1], v[2]]).collect(),
             covered: geometry.output_coverage().to_vec(),
         };
-        let mut shaded_per_level = vec![0usize; top + 1];
-        for e in &list {
-            shaded_per_level[e[0] as usize] += 1;
-        }
-        let details = if options.details { Some(self.adaptive_details(state, &list, &samples, budget)?) } else { None };
+        let details = if options.details { Some(self.adaptive_details(state, n_shaded, budget)?) } else { None };
         Ok(Adaptive {
             image,
             width,
             height,
             shadeable: state.shadeable,
             shaded_per_level,
-            samples: samples.iter().map(|&n| u64::from(n)).sum(),
+            samples,
             budget,
-            timings: Timings {
-                gbuffer_ms: geometry.millis(),
-                predict_ms,
-                plan_ms: plan_ms - predict_ms,
-                shade_ms: shade_ms - plan_ms,
+            // One submission has no steps to time apart: all of it is the shading's.
+            timings: if on_gpu {
+                Timings { gbuffer_ms: geometry.millis(), predict_ms: 0.0, plan_ms: 0.0, shade_ms }
+            } else {
+                Timings {
+                    gbuffer_ms: geometry.millis(),
+                    predict_ms,
+                    plan_ms: plan_ms - predict_ms,
+                    shade_ms: shade_ms - plan_ms,
+                }
             },
             details,
         })
     }
 
     /// The frame's buffers read back (`Adaptive::details`): the predictions, the pyramid and
-    /// the plan, with the samples the host gave the shaded blocks (`list`, in the plan's order).
-    fn adaptive_details(
-        &self,
-        state: &State,
-        list: &[[u32; 4]],
-        samples: &[u32],
-        budget: u64,
-    ) -> Result<Details, GpuError> {
+    /// the plan, with the samples of the `n_shaded` shaded blocks (the list's entries).
+    fn adaptive_details(&self, state: &State, n_shaded: u32, budget: u64) -> Result<Details, GpuError> {
         let (base, buffers) = (&state.base, &state.buffers);
         let pixels = (base.width * base.height) as usize;
         let bandwidth = self.read_words(&buffers.bandwidths, pixels as u32)?;
         let levels_words = self.read_words(&buffers.levels, 4 * state.blocks)?;
         let parents = self.read_words(&buffers.parents, 4 * state.blocks)?;
         let weights = self.read_words(&buffers.weights, 4 * state.blocks)?;
-        let mut given = std::collections::HashMap::new();
-        for (e, &n) in list.iter().zip(samples) {
-            given.insert((e[0] as usize, e[1] as usize), n);
-        }
+        let list = self.read_words(&buffers.list, 4 * n_shaded)?;
+        let given: std::collections::HashMap<u32, u32> = list.chunks_exact(4).map(|e| (e[0], e[3])).collect();
         let mut levels = Vec::with_capacity(state.levels.len());
         let mut actions = Vec::with_capacity(state.levels.len());
         for (k, &(w, h, first)) in state.levels.iter().enumerate() {
@@ -580,10 +698,9 @@ impl Renderer {
             });
             actions.push(
                 range
-                    .enumerate()
-                    .map(|(b, block)| {
+                    .map(|block| {
                         let action = levels_words[4 * block + 2];
-                        let samples = || given.get(&(k, b)).copied().unwrap_or(0);
+                        let samples = || given.get(&(block as u32)).copied().unwrap_or(0);
                         match action & 0xff {
                             1 => Action::Shade { samples: samples(), rescued: false },
                             2 => Action::Shade { samples: samples(), rescued: true },
@@ -619,7 +736,7 @@ impl Renderer {
     fn read_words(&self, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<u32>, GpuError> {
         let bytes = 4 * u64::from(count);
         let encoder = self.device.create_command_encoder(&Default::default());
-        self.submit_and_read(encoder, buffer, &self.readback_buffer(bytes), bytes)
+        self.submit_and_read(encoder, &[(buffer, bytes)], &self.readback_buffer(bytes))
     }
 }
 
@@ -633,6 +750,10 @@ pub(super) struct Pipelines {
     pub scatter: wgpu::ComputePipeline,
     pub upsample: wgpu::ComputePipeline,
     pub output: wgpu::ComputePipeline,
+    pub allocate: wgpu::ComputePipeline,
+    pub chunks: wgpu::ComputePipeline,
+    pub offsets: wgpu::ComputePipeline,
+    pub list: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -644,6 +765,10 @@ impl Pipelines {
             scatter: make("adaptive_scatter"),
             upsample: make("adaptive_upsample"),
             output: make("adaptive_output"),
+            allocate: make("adaptive_allocate"),
+            chunks: make("adaptive_chunks"),
+            offsets: make("adaptive_offsets"),
+            list: make("adaptive_list"),
         }
     }
 }
@@ -659,7 +784,10 @@ pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 
 #[cfg(test)]
 mod tests {
-    use super::{AdaptivePass, PART, parts};
+    use super::{
+        AdaptivePass, CHUNK, CONTROL_ARGS, CONTROL_CHUNKS, CONTROL_COUNTS, CONTROL_PARTS, CONTROL_SAMPLES,
+        CONTROL_SHADED, CONTROL_STATUS, MAX_LEVELS, PART, parts,
+    };
     use crate::preview::PREVIEW_ADAPTIVE_WGSL;
 
     #[test]
@@ -683,6 +811,23 @@ mod tests {
         let value: f64 = declared.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
         assert_eq!(value, render::adaptive::MIN_WEIGHT, "{declared} against {weight}");
         assert!(PREVIEW_ADAPTIVE_WGSL.contains("const NONE: u32 = 0xffffffffu;"));
+        for (name, value) in [
+            ("CONTROL_SHADED", CONTROL_SHADED),
+            ("CONTROL_STATUS", CONTROL_STATUS),
+            ("CONTROL_SAMPLES", CONTROL_SAMPLES),
+            ("CONTROL_PARTS", CONTROL_PARTS),
+            ("CONTROL_ARGS", CONTROL_ARGS),
+            ("CONTROL_COUNTS", CONTROL_COUNTS),
+            ("CONTROL_CHUNKS", CONTROL_CHUNKS),
+            ("MAX_LEVELS", MAX_LEVELS as u32),
+            ("CHUNK", CHUNK),
+        ] {
+            let line = format!("const {name}: u32 = {value}u;");
+            assert!(PREVIEW_ADAPTIVE_WGSL.contains(&line), "the WGSL lacks {line}");
+        }
+        // Per level 4 words from CONTROL_LEVELS, for every level, before the chunks.
+        assert!(PREVIEW_ADAPTIVE_WGSL.contains("const CONTROL_LEVELS: u32 = 32u;"));
+        assert!(32 + 4 * MAX_LEVELS as u32 <= CONTROL_CHUNKS && CONTROL_COUNTS as usize + MAX_LEVELS <= 32);
     }
 
     #[test]
@@ -694,6 +839,7 @@ mod tests {
             let (items, targets) = parts(&list, &samples, &levels, capacity);
             assert!(items.len() <= capacity, "{} items", items.len());
             assert_eq!(targets.iter().map(|t| t[0]).collect::<Vec<_>>(), [5, 67, 81]);
+            assert_eq!(targets.iter().map(|t| t[3]).collect::<Vec<_>>(), samples);
             for (t, (e, &n)) in targets.iter().zip(list.iter().zip(&samples)) {
                 let mine = &items[t[1] as usize..(t[1] + t[2]) as usize];
                 // Consecutive ranges from 0 to n, each at most a part, all of the block's pixel.
