@@ -430,6 +430,11 @@ fn set_groups(at: u32, count: u32, power_of_two: bool) {
     set_control(at + 2u, 1u);
 }
 
+// The parts of a level's `count` blocks of `samples` samples, the first `doubled` of twice that.
+fn level_items(count: u32, doubled: u32, samples: u32, part: u32) -> u32 {
+    return doubled * ((2u * samples + part - 1u) / part) + (count - doubled) * ((samples + part - 1u) / part);
+}
+
 // `render::adaptive::area_allocation` of the shaded blocks per level (`adaptive_plan`'s counts),
 // step for step in integers, and `preview/adaptive.rs`'s `parts` of its samples: the samples per
 // part, each level's first item and first rank, the items in all and the workgroups of
@@ -534,8 +539,7 @@ fn adaptive_allocate() {
     loop {
         items = 0u;
         for (var k = 0u; k < levels_n; k++) {
-            let samples = 1u << shift[k];
-            items += doubled[k] * ((2u * samples + part - 1u) / part) + (counts[k] - doubled[k]) * ((samples + part - 1u) / part);
+            items += level_items(counts[k], doubled[k], 1u << shift[k], part);
         }
         if (items <= adapt.capacity || part >= 0x7fffffffu) {
             break;
@@ -551,7 +555,7 @@ fn adaptive_allocate() {
         set_control(at + 1u, doubled[k]);
         set_control(at + 2u, first_item);
         set_control(at + 3u, first_rank);
-        first_item += doubled[k] * ((2u * samples + part - 1u) / part) + (counts[k] - doubled[k]) * ((samples + part - 1u) / part);
+        first_item += level_items(counts[k], doubled[k], samples, part);
         first_rank += counts[k];
     }
     set_control(CONTROL_SAMPLES, adapt.budget - left);
