@@ -63,6 +63,9 @@ impl Gpu {
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("gpu"),
+                // Timestamps where the adapter has them: the adaptive frame's stages
+                // (`preview::Renderer::render_adaptive`).
+                required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
                 required_limits: limits,
                 ..Default::default()
             })

@@ -941,7 +941,16 @@ impl Renderer {
 
     /// A compute pass with the shading pass's groups 0 to 2 set.
     fn begin_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::ComputePass<'e> {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
+        self.begin_timed_pass(encoder, None)
+    }
+
+    /// [`Renderer::begin_pass`] with timestamps written at its beginning and end where asked.
+    fn begin_timed_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
+    ) -> wgpu::ComputePass<'e> {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes });
         pass.set_bind_group(0, &self.table_group, &[]);
         pass.set_bind_group(1, &self.bake_group, &[]);
         pass.set_bind_group(2, &self.render_group, &[0]);

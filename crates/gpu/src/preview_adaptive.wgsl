@@ -385,8 +385,10 @@ fn adaptive_plan(
     levels[block].z = action;
 }
 
-// The allocation's 64-bit values, `preview_shade.wgsl`'s `Wide`, all below 2^63: every factor
-// but a count is a power of two, so shifts, sums and comparisons do.
+// The allocation's 64-bit values, `preview_shade.wgsl`'s `Wide` read as unsigned: every factor
+// but a count is a power of two, so shifts, sums and comparisons do. The largest, a share's
+// numerator (`W + spare 2^k`: the budget below 2^32, k at most 15) times 2^16, stays below
+// 2^64.
 fn wide(x: u32) -> Wide {
     return Wide(0u, x);
 }
@@ -405,7 +407,7 @@ fn wide_sub(a: Wide, b: Wide) -> Wide {
     return wide_add(a, wide_negate(b));
 }
 
-// a <= b, for values below 2^63.
+// a <= b, unsigned.
 fn wide_le(a: Wide, b: Wide) -> bool {
     return a.hi < b.hi || (a.hi == b.hi && a.lo <= b.lo);
 }

@@ -644,18 +644,34 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         let worst = gpu_frame.details().plan.compare(&cpu_frame.details().plan, 1e-5).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(gpu_frame.shaded_per_level, cpu_frame.shaded_per_level);
         assert_eq!((gpu_frame.samples, gpu_frame.budget), (cpu_frame.samples, cpu_frame.budget));
+        // One submission under the area allocation, its stages on the GPU's clock (where the
+        // adapter has one) within the frame's wall time; two otherwise.
+        let t = gpu_frame.timings;
+        assert_eq!(t.submissions, if allocation == Area { 1 } else { 2 });
+        let stages = t.predict_ms + t.plan_ms + t.shade_ms;
+        assert!(stages > 0.0 && stages <= t.total_ms, "stages {stages} ms of a frame of {} ms", t.total_ms);
+        if t.gpu_clock {
+            assert!(t.predict_ms > 0.0 && t.plan_ms > 0.0 && t.shade_ms > 0.0, "{t:?}");
+        }
         let shaded: usize = cpu_frame.shaded_per_level.iter().sum();
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
         let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
         log(&format!(
             "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples, \
-             worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}",
+             worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}, {} submissions, \
+             stages {:.2} + {:.2} + {:.2} ms of {:.2} (GPU clock: {})",
             mode.name(),
             allocation.name(),
             if lobe_weight { " lobe weight" } else { "" },
             if oracle { " oracle" } else { "" },
             cpu_frame.shaded_per_level,
             cpu_frame.samples,
+            t.submissions,
+            t.predict_ms,
+            t.plan_ms,
+            t.shade_ms,
+            t.total_ms,
+            t.gpu_clock,
         ));
         assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
     }

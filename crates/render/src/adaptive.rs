@@ -120,7 +120,9 @@
 //!   brdf-preview --bench adaptive`, which measures the three) it is the best: eq. 9's bound
 //!   ranks the pixels' noise moderately well but not its size, and weighting by it (or, tried
 //!   and dropped, by it in display space or by the sample variance of the `n_b` directions)
-//!   did not beat the area alone;
+//!   did not beat the area alone. Every block of a level then has the same share, so the
+//!   samples follow from the shaded blocks per level alone: [`area_allocation`] computes them
+//!   in exact integers (as `gpu::preview` does on the GPU, without a sort);
 //!
 //! at most `max_spp` (what a capped block cannot
 //! take goes to the others), rounded down to a power of two (the baked vectors are read in
@@ -1163,16 +1165,26 @@ pub struct Timings {
     /// The [`Geometry`]'s, made once per camera: not part of the frame's time when its camera
     /// made frames before.
     pub gbuffer_ms: f64,
-    /// [`render_with`]: the prediction; `gpu::preview` in two submissions (the variance and
-    /// the standard-deviation allocations): its first (prediction, pyramids, plan and the list
-    /// of shaded blocks read back); in one (the area allocation): 0.
+    /// [`render_with`]: the prediction; `gpu::preview` in one submission (the area
+    /// allocation): the prediction, pyramids and plan on the GPU's clock (0 on an adapter
+    /// without timestamp queries); in two (the variance and std-dev allocations): the first's
+    /// wall time (the same, and the list of shaded blocks read back).
     pub predict_ms: f64,
-    /// [`render_with`]: the pyramids and the plan with its samples; `gpu::preview`: the
-    /// allocation of the samples on the CPU where it allocates there, else 0.
+    /// [`render_with`]: the pyramids and the plan with its samples; `gpu::preview` in one
+    /// submission: the samples and the list of shaded blocks on the GPU's clock (0 without
+    /// timestamps); in two: the allocation of the samples on the CPU.
     pub plan_ms: f64,
-    /// [`render_with`]: shading, up-sampling and the background; `gpu::preview`: its second
-    /// submission (the same, and the image read back), or its only one, the whole frame.
+    /// [`render_with`]: shading, up-sampling and the background; `gpu::preview` in one
+    /// submission: the shading, up-sampling and output on the GPU's clock (without timestamps:
+    /// the whole frame); in two: the second's wall time (the same, and the image read back).
     pub shade_ms: f64,
+    /// The frame's wall time: the steps and, on the GPU, what lies between and around them
+    /// (recording, submission, waiting, read-back). Not the G-buffer's.
+    pub total_ms: f64,
+    /// The GPU submissions of the frame (`gpu::preview`: 1 or 2; [`render_with`]: 0), and
+    /// whether the steps were timed on the GPU's clock.
+    pub submissions: u32,
+    pub gpu_clock: bool,
 }
 
 impl Adaptive {
@@ -1463,6 +1475,9 @@ pub fn render_with(
         predict_ms,
         plan_ms: plan_ms - predict_ms,
         shade_ms: shade_ms - plan_ms,
+        total_ms: shade_ms,
+        submissions: 0,
+        gpu_clock: false,
     };
     let (shaded_level, samples_per_pixel) = Details::origins(&plan);
     Ok(Adaptive {

@@ -268,9 +268,8 @@ fn main() {
         Some(other) => panic!("--allocation {other}: variance, std-dev or area"),
     };
     let extras = !args.iter().any(|a| a == "--no-extras");
-    // --gpu: the brute force and the adaptive frames' prediction and shading on the GPU (lavapipe
-    // in CI), the adaptive frames' G-buffer, plan and up-sampling on the CPU as brdf-preview runs
-    // them.
+    // --gpu: the brute force and the adaptive frames on the GPU (lavapipe in CI), the adaptive
+    // frames' G-buffer made on the CPU once per camera, as brdf-preview runs them.
     let gpu = args.iter().any(|a| a == "--gpu").then(|| gpu::Gpu::new().expect("a GPU adapter (make setup-gpu)"));
     let rescue_below: f64 = option("--rescue-below").map_or(0.0, |v| v.parse().expect("--rescue-below W"));
     let converged_samples = if quick { 256 } else { 1024 };
@@ -284,7 +283,7 @@ fn main() {
     out(format!(
         "# Adaptive shading: equal-quality benchmark ({})",
         match &gpu {
-            Some(g) => format!("on {}, the G-buffer and the samples on the CPU", g.adapter_summary()),
+            Some(g) => format!("on {}, the G-buffer on the CPU once per camera", g.adapter_summary()),
             None => "CPU renderer".to_string(),
         }
     ));
@@ -609,10 +608,14 @@ fn main() {
     out(format!(
         "Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). {}",
         if gpu.is_some() {
-            "On the GPU the frame is two submissions with the allocation of the samples on the CPU between them; \
-             each submission's time includes its read-back (the list of shaded blocks, then the image). The \
-             G-buffer is the camera's, made once on the CPU before its frames and not in `frame`, as the brute \
-             force's raster pass is not in its time."
+            "On the GPU under the area allocation the frame is one submission: its stages on the GPU's clock \
+             (timestamp queries; where the adapter has none, all of the frame in the last column), `samples` the \
+             allocation and the list of shaded blocks there, and `frame` the wall time (recording, submission, the \
+             wait and the image's read-back besides). Under the variance or std-dev allocation it is two \
+             submissions, wall times, with the allocation of the samples on the CPU between them, each \
+             submission's time with its read-back (the list of shaded blocks, then the image). The G-buffer is the \
+             camera's, made once on the CPU before its frames and not in `frame`, as the brute force's raster pass \
+             is not in its time."
         } else {
             "The G-buffer is made in every frame, as the brute force rasterizes in every frame."
         }

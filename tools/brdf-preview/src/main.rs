@@ -499,7 +499,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let options = gpu::preview::FrameOptions { details, ..Default::default() };
     let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
     let t = frame.timings;
-    let ms_per_frame = t.predict_ms + t.plan_ms + t.shade_ms;
+    let ms_per_frame = t.total_ms;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
     let caption = format!(
@@ -524,15 +524,18 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         );
         files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
-    // One submission (the samples allocated on the GPU) has no steps timed apart.
-    let steps = if t.predict_ms == 0.0 && t.plan_ms == 0.0 {
-        "one submission on the GPU".to_string()
-    } else {
-        format!(
+    let steps = match (t.submissions, t.gpu_clock) {
+        (1, true) => format!(
+            "one submission; on the GPU's clock prediction, pyramids and plan {:.1}, samples and list {:.1}, shading, \
+             up-sampling and output {:.1}",
+            t.predict_ms, t.plan_ms, t.shade_ms
+        ),
+        (1, false) => "one submission".to_string(),
+        _ => format!(
             "prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on the CPU, shading, up-sampling and output \
              {:.1} on the GPU",
             t.predict_ms, t.plan_ms, t.shade_ms
-        )
+        ),
     };
     let mut report = vec![format!(
         "{}: {} on {} ({}), {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU before, once: {:.1}); \
@@ -559,7 +562,14 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "height": scene.height,
         "exposure_ev": preview.exposure_ev,
         "ms_per_frame": ms_per_frame,
-        "timings_ms": {"gbuffer": t.gbuffer_ms, "prediction_and_plan": t.predict_ms, "samples": t.plan_ms, "shading": t.shade_ms},
+        "timings_ms": {
+            "gbuffer": t.gbuffer_ms,
+            "prediction_and_plan": t.predict_ms,
+            "samples": t.plan_ms,
+            "shading": t.shade_ms,
+            "submissions": t.submissions,
+            "gpu_clock": t.gpu_clock,
+        },
         "shaded_fraction": frame.shaded_fraction(),
         "shaded_per_level": frame.shaded_per_level,
         "samples": frame.samples,

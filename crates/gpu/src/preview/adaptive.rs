@@ -124,7 +124,20 @@ pub(super) struct State {
     /// The workgroups of `shade_blocks` and of `adaptive_scatter` where the GPU allocates,
     /// copied from the control words: an indirect dispatch's buffer may not be bound beside it.
     indirect: wgpu::Buffer,
+    /// Where the adapter has timestamp queries: the one-submission frame's stages.
+    clock: Option<Clock>,
 }
+
+/// Four timestamps of a one-submission frame (the starts of its three passes and the end of the
+/// last), and the buffer they resolve into.
+#[derive(Debug)]
+struct Clock {
+    set: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+}
+
+/// Bytes of [`Clock`]'s timestamps.
+const CLOCK_BYTES: u64 = 4 * 8;
 
 /// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
 #[derive(Debug)]
@@ -401,8 +414,22 @@ impl Renderer {
                 entries: &entries,
             });
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
-            let readback =
-                self.readback_buffer((16 * u64::from(blocks)).max(16 * out_pixels + 4 * u64::from(CONTROL_CHUNKS)));
+            let readback = self.readback_buffer(
+                (16 * u64::from(blocks)).max(16 * out_pixels + 4 * u64::from(CONTROL_CHUNKS) + CLOCK_BYTES),
+            );
+            let clock = self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Clock {
+                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("adaptive stages"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 4,
+                }),
+                resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("adaptive stages"),
+                    size: CLOCK_BYTES,
+                    usage: U::QUERY_RESOLVE | U::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+            });
             let indirect = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("adaptive indirect dispatches"),
                 size: 24,
@@ -412,6 +439,7 @@ impl Renderer {
             State {
                 readback,
                 indirect,
+                clock,
                 geometry: Arc::clone(geometry),
                 key,
                 levels,
@@ -549,28 +577,40 @@ impl Renderer {
             }
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
+            // The one-submission frame's passes start with timestamps where the adapter has them.
+            let stamp = |start: u32, end: Option<u32>| {
+                let clock = state.clock.as_ref().filter(|_| on_gpu)?;
+                Some(wgpu::ComputePassTimestampWrites {
+                    query_set: &clock.set,
+                    beginning_of_pass_write_index: Some(start),
+                    end_of_pass_write_index: end,
+                })
+            };
             {
-                let mut cpass = self.begin_pass(&mut encoder);
+                let mut cpass = self.begin_timed_pass(&mut encoder, stamp(0, None));
                 if state.n_items > 0 {
                     cpass.set_pipeline(&self.predict_pipeline);
                     cpass.set_bind_group(3, &prediction.group, &[]);
                     let (x, y) = super::item_groups(state.n_items);
                     cpass.dispatch_workgroups(x, y, 1);
                 }
-                let mut run =
-                    |pipeline, slot: u64, groups| dispatch(&mut cpass, pipeline, state, slot * stride, groups);
+                let run = |cpass: &mut wgpu::ComputePass, pipeline, slot: u64, groups| {
+                    dispatch(cpass, pipeline, state, slot * stride, groups)
+                };
                 let per_level = &state.candidates_per_level;
-                run(&pipelines.levels, levels_slot, groups(per_level[0]));
+                run(&mut cpass, &pipelines.levels, levels_slot, groups(per_level[0]));
                 for (k, &n) in per_level.iter().enumerate().skip(1) {
-                    run(&pipelines.reduce, k as u64, groups(n));
+                    run(&mut cpass, &pipelines.reduce, k as u64, groups(n));
                 }
-                run(&pipelines.plan, plan_slot, groups(candidates));
+                run(&mut cpass, &pipelines.plan, plan_slot, groups(candidates));
                 if on_gpu {
-                    run(&pipelines.allocate, plan_slot, (1, 1));
+                    drop(cpass);
+                    cpass = self.begin_timed_pass(&mut encoder, stamp(1, None));
+                    run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
                 }
-                run(&pipelines.chunks, plan_slot, chunk_groups(chunks));
-                run(&pipelines.offsets, plan_slot, (1, 1));
-                run(&pipelines.list, plan_slot, chunk_groups(chunks));
+                run(&mut cpass, &pipelines.chunks, plan_slot, chunk_groups(chunks));
+                run(&mut cpass, &pipelines.offsets, plan_slot, (1, 1));
+                run(&mut cpass, &pipelines.list, plan_slot, chunk_groups(chunks));
             }
             if on_gpu {
                 let spp_at = std::mem::offset_of!(super::ShadeUniform, spp) as u64;
@@ -588,20 +628,25 @@ impl Renderer {
                     0,
                     24,
                 );
-                let mut cpass = self.begin_pass(&mut encoder);
-                shading(&mut cpass, None, None);
+                shading(&mut self.begin_timed_pass(&mut encoder, stamp(2, Some(3))), None, None);
+                if let Some(clock) = state.clock.as_ref() {
+                    encoder.resolve_query_set(&clock.set, 0..4, &clock.resolved, 0);
+                }
             }
             encoder
         })
         .and_then(|encoder| {
             let image = if on_gpu { 16 * out_pixels } else { 0 };
-            self.submit_and_read(
-                encoder,
-                &[(&self.accumulation, image), (&state.buffers.control, control_bytes)],
-                &state.readback,
-            )
+            let stamps = match &state.clock {
+                Some(clock) if on_gpu => (&clock.resolved, CLOCK_BYTES),
+                _ => (&state.buffers.control, 0),
+            };
+            let sources = [(&self.accumulation, image), (&state.buffers.control, control_bytes), stamps];
+            self.submit_and_read(encoder, &sources, &state.readback)
         })?;
         let predict_ms = lap();
+        let stamp_words = if on_gpu && state.clock.is_some() { CLOCK_BYTES as usize / 4 } else { 0 };
+        let (words, stamps) = words.split_at(words.len() - stamp_words);
         let (image_words, control) = words.split_at(words.len() - CONTROL_CHUNKS as usize);
         let n_shaded = control[CONTROL_SHADED as usize];
         let counts = &control[CONTROL_COUNTS as usize..][..=top];
@@ -659,15 +704,31 @@ impl Renderer {
             shaded_per_level,
             samples,
             budget,
-            // One submission has no steps to time apart: all of it is the shading's.
             timings: if on_gpu {
-                Timings { gbuffer_ms: geometry.millis(), predict_ms: 0.0, plan_ms: 0.0, shade_ms }
+                // The stages on the GPU's clock; without one, all of it is the shading's.
+                let ticks: Vec<u64> = stamps.chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
+                let period_ms = f64::from(self.queue.get_timestamp_period()) * 1e-6;
+                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period_ms;
+                let (predict_ms, plan_ms, stages_ms) =
+                    if ticks.len() == 4 { (ms(0, 1), ms(1, 2), ms(2, 3)) } else { (0.0, 0.0, shade_ms) };
+                Timings {
+                    gbuffer_ms: geometry.millis(),
+                    predict_ms,
+                    plan_ms,
+                    shade_ms: stages_ms,
+                    total_ms: shade_ms,
+                    submissions: 1,
+                    gpu_clock: ticks.len() == 4,
+                }
             } else {
                 Timings {
                     gbuffer_ms: geometry.millis(),
                     predict_ms,
                     plan_ms: plan_ms - predict_ms,
                     shade_ms: shade_ms - plan_ms,
+                    total_ms: shade_ms,
+                    submissions: 2,
+                    gpu_clock: false,
                 }
             },
             details,
