@@ -244,6 +244,18 @@ fn binding(buffer: &wgpu::Buffer, bytes: u64) -> wgpu::BindingResource<'_> {
 
 /// Maps the first `bytes` of `buffer`, waits for the GPU, and copies them out.
 pub(crate) fn read_back<T: Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<T>, GpuError> {
+    // Copies through an aligned vector: the mapped bytes carry no alignment promise.
+    read_back_with(device, buffer, bytes, bytemuck::pod_collect_to_vec)
+}
+
+/// `f` of the first `bytes` of `buffer` (`MAP_READ`), mapped once the device is done with it:
+/// a reader that converts as it copies reads the bytes once.
+pub(crate) fn read_back_with<R>(
+    device: &wgpu::Device,
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+    f: impl FnOnce(&[u8]) -> R,
+) -> Result<R, GpuError> {
     let slice = buffer.slice(..bytes);
     let (sender, receiver) = mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {
@@ -257,8 +269,7 @@ pub(crate) fn read_back<T: Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer, by
         .map_err(|e| GpuError::Readback(e.to_string()))?;
     let values = {
         let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-        // Copies through an aligned vector: the mapped bytes carry no alignment promise.
-        bytemuck::pod_collect_to_vec(&view)
+        f(&view)
     };
     buffer.unmap();
     Ok(values)

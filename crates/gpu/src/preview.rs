@@ -38,7 +38,9 @@ use wgpu::util::DeviceExt;
 
 use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
-use crate::merl_lookup::{MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, read_back, table_bytes};
+use crate::merl_lookup::{
+    MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, read_back_with, table_bytes,
+};
 
 mod adaptive;
 mod present;
@@ -683,14 +685,14 @@ impl Renderer {
         if frames == 0 {
             return Err(GpuError::Scene(render::Error::Invalid("no frame has been accumulated".into())));
         }
-        let sums = self.read_accumulation(self.pixels())?;
-        let frames = frames as f32;
-        Ok(Image {
-            width: self.width(),
-            height: self.height(),
-            rgb: sums.iter().flat_map(|s| [s[0] / frames, s[1] / frames, s[2] / frames]).collect(),
-            covered: sums.iter().map(|s| s[3] > 0.0).collect(),
-        })
+        let bytes = 16 * self.pixels();
+        let encoder = self.device.create_command_encoder(&Default::default());
+        let (rgb, covered) =
+            self.submit_and_map(encoder, &[(&self.accumulation, bytes)], &self.readback_buffer(bytes), |sums| {
+                let covered = sums.chunks_exact(16).map(|s| f32::from_le_bytes([s[12], s[13], s[14], s[15]]) > 0.0);
+                (rgb_of(sums, frames as f32), covered.collect())
+            })?;
+        Ok(Image { width: self.width(), height: self.height(), rgb, covered })
     }
 
     /// The visible surface at every pixel centre, as the shading pass interpolates it.
@@ -909,10 +911,22 @@ impl Renderer {
     /// reads them back; nothing to read when there are no bytes.
     fn submit_and_read<T: Pod>(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         sources: &[(&wgpu::Buffer, u64)],
         readback: &wgpu::Buffer,
     ) -> Result<Vec<T>, GpuError> {
+        self.submit_and_map(encoder, sources, readback, bytemuck::pod_collect_to_vec)
+    }
+
+    /// [`Renderer::submit_and_read`] with `f` of the mapped bytes (`f` of none where there are
+    /// no bytes) in place of a copy.
+    fn submit_and_map<R>(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        sources: &[(&wgpu::Buffer, u64)],
+        readback: &wgpu::Buffer,
+        f: impl FnOnce(&[u8]) -> R,
+    ) -> Result<R, GpuError> {
         let mut bytes = 0;
         capture_errors(&self.device, || {
             for &(source, size) in sources {
@@ -924,9 +938,9 @@ impl Renderer {
             self.queue.submit([encoder.finish()]);
         })?;
         if bytes == 0 {
-            return Ok(Vec::new());
+            return Ok(f(&[]));
         }
-        read_back(&self.device, readback, bytes)
+        read_back_with(&self.device, readback, bytes, f)
     }
 
     /// A buffer to map for reading, of `bytes`.
@@ -1055,6 +1069,17 @@ impl Renderer {
 fn item_groups(count: u32) -> (u32, u32) {
     let groups = count.div_ceil(64).next_power_of_two();
     (groups.min(32768), groups.div_ceil(32768))
+}
+
+/// The RGB of RGBA `f32` values (little-endian bytes, as a buffer maps), over `divisor`.
+fn rgb_of(rgba: &[u8], divisor: f32) -> Vec<f32> {
+    let mut rgb = Vec::with_capacity(rgba.len() / 16 * 3);
+    for v in rgba.chunks_exact(16) {
+        for c in 0..3 {
+            rgb.push(f32::from_le_bytes([v[4 * c], v[4 * c + 1], v[4 * c + 2], v[4 * c + 3]]) / divisor);
+        }
+    }
+    rgb
 }
 
 fn no_bandwidths() -> GpuError {

@@ -502,9 +502,6 @@ impl Renderer {
         let on_gpu =
             settings.allocation == Allocation::Area && budget <= u64::from(u32::MAX) && settings.max_spp <= 1 << 16;
         let stride = slot_stride(self.frame_stride);
-        let pass = |slot: u64, fields: AdaptivePass| {
-            self.queue.write_buffer(&state.uniform, slot * stride, bytemuck::bytes_of(&fields));
-        };
         let base = AdaptivePass {
             depth_sigma: settings.depth_sigma as f32,
             rescue_below: settings.rescue_below as f32,
@@ -552,7 +549,7 @@ impl Renderer {
         // Submission 1: prediction, levels, pyramids, plan, the list of shaded blocks in the
         // plan's order; on the GPU also the samples and all of submission 2.
         let control_bytes = 4 * u64::from(CONTROL_CHUNKS);
-        let words: Vec<u32> = capture_errors(&self.device, || {
+        let read = capture_errors(&self.device, || {
             self.progress.set(None);
             self.write_predict_uniform(prediction, settings);
             let shade = self.shade_uniform(
@@ -561,11 +558,16 @@ impl Renderer {
             );
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
-            self.queue.write_buffer(&state.buffers.control, 0, &vec![0u8; control_bytes as usize]);
             if let Some(oracle) = options.oracle {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
                 self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
             }
+            // The pass uniform's slots, written at once.
+            let mut uniform = vec![0u8; (stride * slots(top)) as usize];
+            let mut pass = |slot: u64, fields: AdaptivePass| {
+                uniform[(slot * stride) as usize..][..size_of::<AdaptivePass>()]
+                    .copy_from_slice(bytemuck::bytes_of(&fields));
+            };
             pass(levels_slot, base);
             for k in 1..=top {
                 pass(k as u64, AdaptivePass { level: k as u32, ..base });
@@ -575,7 +577,9 @@ impl Renderer {
                 let level = (slot - scatter_slot).saturating_sub(1) as u32;
                 pass(slot, AdaptivePass { level, ..base });
             }
+            self.queue.write_buffer(&state.uniform, 0, &uniform);
             let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.clear_buffer(&state.buffers.control, 0, Some(control_bytes));
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
             // The one-submission frame's passes start with timestamps where the adapter has them.
             let stamp = |start: u32, end: Option<u32>| {
@@ -642,12 +646,16 @@ impl Renderer {
                 _ => (&state.buffers.control, 0),
             };
             let sources = [(&self.accumulation, image), (&state.buffers.control, control_bytes), stamps];
-            self.submit_and_read(encoder, &sources, &state.readback)
+            // The image's RGB, the control words, the timestamps.
+            self.submit_and_map(encoder, &sources, &state.readback, |bytes| {
+                let (image, rest) = bytes.split_at(image as usize);
+                let words: Vec<u32> = bytemuck::pod_collect_to_vec(rest);
+                let (control, stamps) = words.split_at(CONTROL_CHUNKS as usize);
+                (super::rgb_of(image, 1.0), control.to_vec(), stamps.to_vec())
+            })
         })?;
         let predict_ms = lap();
-        let stamp_words = if on_gpu && state.clock.is_some() { CLOCK_BYTES as usize / 4 } else { 0 };
-        let (words, stamps) = words.split_at(words.len() - stamp_words);
-        let (image_words, control) = words.split_at(words.len() - CONTROL_CHUNKS as usize);
+        let (image_rgb, control, stamps) = read;
         let n_shaded = control[CONTROL_SHADED as usize];
         let counts = &control[CONTROL_COUNTS as usize..][..=top];
         let shaded_per_level: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
@@ -655,8 +663,8 @@ impl Renderer {
             render::adaptive::check_budget(u64::from(n_shaded), budget)?;
         }
 
-        let (rgba, samples, plan_ms): (Vec<[f32; 4]>, u64, f64) = if on_gpu {
-            (bytemuck::cast_slice(image_words).to_vec(), u64::from(control[CONTROL_SAMPLES as usize]), predict_ms)
+        let (rgb, samples, plan_ms) = if on_gpu {
+            (image_rgb, u64::from(control[CONTROL_SAMPLES as usize]), predict_ms)
         } else {
             // The host: the samples, then submission 2: shading, estimates in place,
             // up-sampling, output.
@@ -669,7 +677,7 @@ impl Renderer {
             let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
             let (items, targets) = parts(&list, &samples, &state.levels, width * height);
             let plan_ms = lap();
-            let rgba = capture_errors(&self.device, || {
+            let rgb = capture_errors(&self.device, || {
                 let shade = self.shade_uniform(
                     super::mode_index(settings.mode),
                     &render::Settings { mode: settings.mode, spp: items.len() as u32, frames: 1, seed: settings.seed },
@@ -684,17 +692,13 @@ impl Renderer {
                 encoder
             })
             .and_then(|encoder| {
-                self.submit_and_read(encoder, &[(&self.accumulation, 16 * out_pixels)], &state.readback)
+                let sources = [(&self.accumulation, 16 * out_pixels)];
+                self.submit_and_map(encoder, &sources, &state.readback, |rgba| super::rgb_of(rgba, 1.0))
             })?;
-            (rgba, samples.iter().map(|&n| u64::from(n)).sum(), plan_ms)
+            (rgb, samples.iter().map(|&n| u64::from(n)).sum(), plan_ms)
         };
         let shade_ms = lap();
-        let image = Image {
-            width: out_width,
-            height: out_height,
-            rgb: rgba.iter().flat_map(|v| [v[0], v[1], v[2]]).collect(),
-            covered: geometry.output_coverage().to_vec(),
-        };
+        let image = Image { width: out_width, height: out_height, rgb, covered: geometry.output_coverage().to_vec() };
         let details = if options.details { Some(self.adaptive_details(state, n_shaded, budget)?) } else { None };
         Ok(Adaptive {
             image,
