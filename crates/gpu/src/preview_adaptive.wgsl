@@ -78,8 +78,8 @@ struct AdaptivePass {
 // samples given, `shade_blocks`' items, their workgroups (x, y, 1) and the list's (x, y, 1), the
 // samples per part; from CONTROL_COUNTS the shaded blocks per level; from CONTROL_LEVELS per
 // level its samples, how many of its blocks get twice that, its first item and its first rank
-// in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per chunk of
-// CHUNK, then the shaded candidates before each chunk (`adaptive_chunks`, `adaptive_offsets`).
+// in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per run of RUN,
+// then the shaded candidates before each run (`adaptive_chunks`, `adaptive_offsets`).
 const CONTROL_SHADED: u32 = 0u;
 const CONTROL_STATUS: u32 = 1u;
 const CONTROL_SAMPLES: u32 = 2u;
@@ -90,7 +90,7 @@ const CONTROL_COUNTS: u32 = 16u;
 const CONTROL_LEVELS: u32 = 32u;
 const CONTROL_CHUNKS: u32 = 96u;
 const MAX_LEVELS: u32 = 16u;
-const CHUNK: u32 = 256u;
+const RUN: u32 = 64u;
 
 const NONE: u32 = 0xffffffffu;
 const ACTION_SKIP: u32 = 0u;
@@ -567,13 +567,13 @@ fn adaptive_allocate() {
     set_groups(CONTROL_ARGS + 3u, n, false);
 }
 
-var<workgroup> scan_words: array<u32, CHUNK>;
+var<workgroup> scan_words: array<u32, 256>;
 
-// The inclusive prefix sum of `value` over the workgroup's invocations (Hillis and Steele).
+// The inclusive prefix sum of `value` over a workgroup of 256 invocations (Hillis and Steele).
 fn workgroup_scan(local: u32, value: u32) -> u32 {
     scan_words[local] = value;
     workgroupBarrier();
-    for (var d = 1u; d < CHUNK; d *= 2u) {
+    for (var d = 1u; d < 256u; d *= 2u) {
         var add = 0u;
         if (local >= d) {
             add = scan_words[local - d];
@@ -587,38 +587,45 @@ fn workgroup_scan(local: u32, value: u32) -> u32 {
 
 // Whether candidate `c` (in the plan's order: level by level, by block) is shaded.
 fn shaded_candidate(c: u32) -> bool {
-    if (c >= candidates_total()) {
-        return false;
-    }
     let action = levels[tables[adapt.candidates + c]].z & 0xffu;
     return action == ACTION_SHADE || action == ACTION_RESCUED;
 }
 
-fn chunk_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
-    return group.y * groups.x + group.x;
+// The candidates of run `r`: RUN of them, the last run fewer.
+fn run_range(r: u32) -> vec2<u32> {
+    let total = candidates_total();
+    return vec2<u32>(min(r * RUN, total), min(r * RUN + RUN, total));
 }
 
-// The list in the plan's order, step 1 of 3: the shaded candidates of each chunk of CHUNK.
-@compute @workgroup_size(256)
+// The list in the plan's order, step 1 of 3: the shaded candidates of each run of RUN, one
+// invocation a run (no workgroup barriers: lavapipe runs those slowly).
+@compute @workgroup_size(64)
 fn adaptive_chunks(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let chunk = chunk_index(group, groups);
-    let sum = workgroup_scan(local, u32(shaded_candidate(chunk * CHUNK + local)));
-    if (local == CHUNK - 1u && chunk * CHUNK < candidates_total()) {
-        set_control(CONTROL_CHUNKS + chunk, sum);
+    let r = adaptive_item(group, local, groups);
+    let range = run_range(r);
+    if (range.x >= range.y) {
+        return;
     }
+    var sum = 0u;
+    for (var c = range.x; c < range.y; c++) {
+        sum += u32(shaded_candidate(c));
+    }
+    set_control(CONTROL_CHUNKS + r, sum);
 }
 
-// Step 2, one workgroup: the shaded candidates before each chunk, in place of its own.
+// Step 2, one workgroup of 256: the shaded candidates before each run, in place of its own
+// (each invocation sums a stretch of runs, a prefix sum over the stretches, then each goes
+// through its stretch again).
 @compute @workgroup_size(256)
 fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
-    let chunks = (candidates_total() + CHUNK - 1u) / CHUNK;
-    let per = (chunks + CHUNK - 1u) / CHUNK;
-    let first = min(local * per, chunks);
-    let last = min(first + per, chunks);
+    let runs = (candidates_total() + RUN - 1u) / RUN;
+    let per = (runs + 255u) / 256u;
+    let first = min(local * per, runs);
+    let last = min(first + per, runs);
     var sum = 0u;
     for (var i = first; i < last; i++) {
         sum += control_word(CONTROL_CHUNKS + i);
@@ -631,24 +638,32 @@ fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
     }
 }
 
-// Step 3: each shaded candidate's entry at its rank. Where the GPU allocates, also its samples
-// (the first of its level that `adaptive_allocate` doubled get twice its level's) and its parts
-// in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
-@compute @workgroup_size(256)
+// Step 3, one invocation a run: each shaded candidate's entry at its rank. Where the GPU
+// allocates, also its samples (the first of its level that `adaptive_allocate` doubled get
+// twice its level's) and its parts in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts`
+// lays them out.
+@compute @workgroup_size(64)
 fn adaptive_list(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let chunk = chunk_index(group, groups);
-    let c = chunk * CHUNK + local;
-    let shaded = shaded_candidate(c);
-    let inclusive = workgroup_scan(local, u32(shaded));
-    if (!shaded || control_word(CONTROL_STATUS) != 0u) {
+    let r = adaptive_item(group, local, groups);
+    let range = run_range(r);
+    if (range.x >= range.y || control_word(CONTROL_STATUS) != 0u) {
         return;
     }
-    let rank = control_word(CONTROL_CHUNKS + chunk) + inclusive - 1u;
-    let block = tables[adapt.candidates + c];
+    var rank = control_word(CONTROL_CHUNKS + r);
+    for (var c = range.x; c < range.y; c++) {
+        if (shaded_candidate(c)) {
+            list_entry(tables[adapt.candidates + c], rank);
+            rank += 1u;
+        }
+    }
+}
+
+// Shaded block `block`'s entry in the list, at `rank`.
+fn list_entry(block: u32, rank: u32) {
     let k = level_of_block(block);
     let me = level_info(k);
     let b = block - me.z;
