@@ -78,8 +78,8 @@ struct AdaptivePass {
 // samples given, `shade_blocks`' items, their workgroups (x, y, 1) and the list's (x, y, 1), the
 // samples per part; from CONTROL_COUNTS the shaded blocks per level; from CONTROL_LEVELS per
 // level its samples, how many of its blocks get twice that, its first item and its first rank
-// in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per run of RUN,
-// then the shaded candidates before each run (`adaptive_chunks`, `adaptive_offsets`).
+// in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per chunk of
+// CHUNK, then the shaded candidates before each chunk (`adaptive_chunks`, `adaptive_offsets`).
 const CONTROL_SHADED: u32 = 0u;
 const CONTROL_STATUS: u32 = 1u;
 const CONTROL_SAMPLES: u32 = 2u;
@@ -90,7 +90,8 @@ const CONTROL_COUNTS: u32 = 16u;
 const CONTROL_LEVELS: u32 = 32u;
 const CONTROL_CHUNKS: u32 = 96u;
 const MAX_LEVELS: u32 = 16u;
-const RUN: u32 = 64u;
+const CHUNK: u32 = 256u;
+const RUN: u32 = 4u;
 
 const NONE: u32 = 0xffffffffu;
 const ACTION_SKIP: u32 = 0u;
@@ -569,11 +570,12 @@ fn adaptive_allocate() {
 
 var<workgroup> scan_words: array<u32, 256>;
 
-// The inclusive prefix sum of `value` over a workgroup of 256 invocations (Hillis and Steele).
-fn workgroup_scan(local: u32, value: u32) -> u32 {
+// The inclusive prefix sum of `value` over a workgroup of `size` (at most 256) invocations
+// (Hillis and Steele).
+fn workgroup_scan(local: u32, value: u32, size: u32) -> u32 {
     scan_words[local] = value;
     workgroupBarrier();
-    for (var d = 1u; d < 256u; d *= 2u) {
+    for (var d = 1u; d < size; d *= 2u) {
         var add = 0u;
         if (local >= d) {
             add = scan_words[local - d];
@@ -591,46 +593,51 @@ fn shaded_candidate(c: u32) -> bool {
     return action == ACTION_SHADE || action == ACTION_RESCUED;
 }
 
-// The candidates of run `r`: RUN of them, the last run fewer.
-fn run_range(r: u32) -> vec2<u32> {
-    let total = candidates_total();
-    return vec2<u32>(min(r * RUN, total), min(r * RUN + RUN, total));
+// The shaded candidates among invocation `local`'s RUN of chunk `chunk`'s CHUNK candidates.
+fn run_count(chunk: u32, local: u32) -> u32 {
+    let first = chunk * CHUNK + local * RUN;
+    let last = min(first + RUN, candidates_total());
+    var sum = 0u;
+    for (var c = first; c < last; c++) {
+        sum += u32(shaded_candidate(c));
+    }
+    return sum;
 }
 
-// The list in the plan's order, step 1 of 3: the shaded candidates of each run of RUN, one
-// invocation a run (no workgroup barriers: lavapipe runs those slowly).
+fn chunk_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return group.y * groups.x + group.x;
+}
+
+// The list in the plan's order, step 1 of 3: the shaded candidates of each chunk of CHUNK, a
+// workgroup of 64 a chunk and RUN candidates an invocation (few barriers: lavapipe runs them
+// slowly; many invocations: a GPU hides its memory's latency with them).
 @compute @workgroup_size(64)
 fn adaptive_chunks(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let r = adaptive_item(group, local, groups);
-    let range = run_range(r);
-    if (range.x >= range.y) {
-        return;
+    let chunk = chunk_index(group, groups);
+    let sum = workgroup_scan(local, run_count(chunk, local), 64u);
+    if (local == 63u && chunk * CHUNK < candidates_total()) {
+        set_control(CONTROL_CHUNKS + chunk, sum);
     }
-    var sum = 0u;
-    for (var c = range.x; c < range.y; c++) {
-        sum += u32(shaded_candidate(c));
-    }
-    set_control(CONTROL_CHUNKS + r, sum);
 }
 
-// Step 2, one workgroup of 256: the shaded candidates before each run, in place of its own
-// (each invocation sums a stretch of runs, a prefix sum over the stretches, then each goes
+// Step 2, one workgroup of 256: the shaded candidates before each chunk, in place of its own
+// (each invocation sums a stretch of chunks, a prefix sum over the stretches, then each goes
 // through its stretch again).
 @compute @workgroup_size(256)
 fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
-    let runs = (candidates_total() + RUN - 1u) / RUN;
-    let per = (runs + 255u) / 256u;
-    let first = min(local * per, runs);
-    let last = min(first + per, runs);
+    let chunks = (candidates_total() + CHUNK - 1u) / CHUNK;
+    let per = (chunks + 255u) / 256u;
+    let first = min(local * per, chunks);
+    let last = min(first + per, chunks);
     var sum = 0u;
     for (var i = first; i < last; i++) {
         sum += control_word(CONTROL_CHUNKS + i);
     }
-    var before = workgroup_scan(local, sum) - sum;
+    var before = workgroup_scan(local, sum, 256u) - sum;
     for (var i = first; i < last; i++) {
         let mine = control_word(CONTROL_CHUNKS + i);
         set_control(CONTROL_CHUNKS + i, before);
@@ -638,23 +645,25 @@ fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
     }
 }
 
-// Step 3, one invocation a run: each shaded candidate's entry at its rank. Where the GPU
-// allocates, also its samples (the first of its level that `adaptive_allocate` doubled get
-// twice its level's) and its parts in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts`
-// lays them out.
+// Step 3, as step 1: each shaded candidate's entry at its rank. Where the GPU allocates, also
+// its samples (the first of its level that `adaptive_allocate` doubled get twice its level's)
+// and its parts in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
 @compute @workgroup_size(64)
 fn adaptive_list(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let r = adaptive_item(group, local, groups);
-    let range = run_range(r);
-    if (range.x >= range.y || control_word(CONTROL_STATUS) != 0u) {
+    let chunk = chunk_index(group, groups);
+    let mine = run_count(chunk, local);
+    let inclusive = workgroup_scan(local, mine, 64u);
+    if (mine == 0u || control_word(CONTROL_STATUS) != 0u) {
         return;
     }
-    var rank = control_word(CONTROL_CHUNKS + r);
-    for (var c = range.x; c < range.y; c++) {
+    var rank = control_word(CONTROL_CHUNKS + chunk) + inclusive - mine;
+    let first = chunk * CHUNK + local * RUN;
+    let last = min(first + RUN, candidates_total());
+    for (var c = first; c < last; c++) {
         if (shaded_candidate(c)) {
             list_entry(tables[adapt.candidates + c], rank);
             rank += 1u;

@@ -81,8 +81,8 @@ const CONTROL_COUNTS: u32 = 16;
 const CONTROL_CHUNKS: u32 = 96;
 /// Levels the control words have room for (`MAX_LEVELS`): a render up to 65535 pixels a side.
 const MAX_LEVELS: usize = 16;
-/// Candidates per invocation of the list's prefix sums (`RUN`).
-const RUN: u32 = 64;
+/// Candidates per workgroup of the list's prefix sums (`CHUNK`: 64 invocations of `RUN` 4).
+const CHUNK: u32 = 256;
 
 /// What an adaptive frame on the GPU may take besides its settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -380,7 +380,7 @@ impl Renderer {
                 values: empty("adaptive values", 16 * u64::from(blocks)),
                 list: empty("adaptive list", 16 * u64::from(blocks)),
                 tables: init("adaptive tables", bytemuck::cast_slice(&table)),
-                control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(RUN))),
+                control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(CHUNK))),
             };
             let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("adaptive prediction pixels"),
@@ -511,7 +511,7 @@ impl Renderer {
         let (levels_slot, plan_slot, scatter_slot) = (0, 1 + top as u64, 2 + top as u64);
         let output_slot = scatter_slot + 1 + top as u64;
         let candidates: u32 = state.candidates_per_level.iter().sum();
-        let runs = candidates.div_ceil(RUN).max(1);
+        let chunks = candidates.div_ceil(CHUNK).max(1);
         let out_pixels = (out_width * out_height) as u64;
         let pipelines = &self.adaptive_pipelines;
         // The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling
@@ -608,9 +608,9 @@ impl Renderer {
                     cpass = self.begin_timed_pass(&mut encoder, stamp(1, None));
                     run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
                 }
-                run(&mut cpass, &pipelines.chunks, plan_slot, groups(runs));
+                run(&mut cpass, &pipelines.chunks, plan_slot, (chunks.min(32768), chunks.div_ceil(32768)));
                 run(&mut cpass, &pipelines.offsets, plan_slot, (1, 1));
-                run(&mut cpass, &pipelines.list, plan_slot, groups(runs));
+                run(&mut cpass, &pipelines.list, plan_slot, (chunks.min(32768), chunks.div_ceil(32768)));
             }
             if on_gpu {
                 let spp_at = std::mem::offset_of!(super::ShadeUniform, spp) as u64;
@@ -846,8 +846,8 @@ pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 #[cfg(test)]
 mod tests {
     use super::{
-        AdaptivePass, CONTROL_ARGS, CONTROL_CHUNKS, CONTROL_COUNTS, CONTROL_PARTS, CONTROL_SAMPLES, CONTROL_SHADED,
-        CONTROL_STATUS, MAX_LEVELS, PART, RUN, parts,
+        AdaptivePass, CHUNK, CONTROL_ARGS, CONTROL_CHUNKS, CONTROL_COUNTS, CONTROL_PARTS, CONTROL_SAMPLES,
+        CONTROL_SHADED, CONTROL_STATUS, MAX_LEVELS, PART, parts,
     };
     use crate::preview::PREVIEW_ADAPTIVE_WGSL;
 
@@ -881,7 +881,8 @@ mod tests {
             ("CONTROL_COUNTS", CONTROL_COUNTS),
             ("CONTROL_CHUNKS", CONTROL_CHUNKS),
             ("MAX_LEVELS", MAX_LEVELS as u32),
-            ("RUN", RUN),
+            ("CHUNK", CHUNK),
+            ("RUN", CHUNK / 64),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
             assert!(PREVIEW_ADAPTIVE_WGSL.contains(&line), "the WGSL lacks {line}");
