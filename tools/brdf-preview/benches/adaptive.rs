@@ -36,37 +36,43 @@
 //! at equal PSNR by 2x, and those rows' speed-ups say little either way.
 //!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and so do the adaptive
-//! frames, whole (`Renderer::render_adaptive`, as `brdf-preview` runs them; the allocation of the
-//! samples between its two submissions on the CPU), timed without reading their buffers back
-//! and then rendered once more with them for the ceiling. The G-buffer is then the camera's,
+//! frames, whole (`Renderer::render_adaptive`, as `brdf-preview` runs them: one submission
+//! under the area allocation, the default), timed without reading their buffers back and then
+//! rendered once more with them for the ceiling. The G-buffer is then the camera's,
 //! made once before the frames (`Renderer::adaptive_geometry`), as the brute force's raster pass
 //! is; on the CPU both rasterize in every frame.
 //!
-//! On an NVIDIA H100 (`--gpu --no-extras`) the adaptive frames take 3.2 to 6.2 ms (they took 21
-//! to 29 ms when the plan and the up-sampling ran on the CPU, measured in the same session), of
-//! which about 1.1 ms is the prediction, pyramids and plan with the list's read-back, 0.2 to 1.3
-//! ms the allocation on the CPU, and 1.3 to 2.2 ms the shading, up-sampling and output with the
-//! image's read-back. The brute force draws a whole frame at 1 spp in 1.7 to 2.6 ms and at 256
-//! spp in 8.7 to 15 ms, and reaches the adaptive frames' PSNR in 2.2 to 15 ms: median speed-up 1.7x for
-//! `adaptive` (1 of 24 rows at 4x), 1.2x pre-filtered (none at 10x). On such a GPU the frame is
-//! bound by its three waits on the device, not by its arithmetic.
+//! On an NVIDIA H100 (`--gpu --no-extras`, all twelve cases) the adaptive frames take 2.5 to
+//! 5.5 ms, of which the GPU is busy 1.1 to 1.5 ms by its clock (0.5 ms prediction, pyramids and
+//! plan; 0.25 ms samples and list; 0.4 to 0.8 ms shading, up-sampling and output): the rest is
+//! the submission, the wait and the image's read-back, about what the brute force's frame
+//! costs whole at 1 spp (1.6 to 3.7 ms; 7.6 to 15 ms at 256 spp). Median speed-up 2.3x for
+//! `adaptive` (5 of 24 rows at 4x, the best 5.1x), 1.4x pre-filtered (none at 10x). When the
+//! frame was two submissions with the allocation on the CPU between them (stop 24, another
+//! H100) its frames took 3.2 to 6.2 ms and the medians were 1.7x and 1.2x; with its plan and
+//! up-sampling on the CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the
+//! next (the brute force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of
+//! the same run.
 //!
-//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, with the frame on the GPU whole:
-//! `adaptive` median 11.9x, 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 7.4x, 7 of
-//! 24 at 10x or more (the other readings lower: level-normalized 1.9x and 1.4x, the FFT oracle
-//! 3.3x and 3.7x). When the plan and the up-sampling ran on the CPU (two runs, the last stop) the
-//! medians were 12.3x to 14.1x and 8.2x to 8.5x with the same rows passing: on lavapipe the "GPU"
-//! is the same two cores, and the plan's passes cost there about what Rust's did (prediction,
-//! pyramids and plan 49 to 172 ms against 55 to 95). Chrome misses in all its 16 rows (0.6x to
-//! 1.7x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a mirror's reflection
-//! loses its detail, and the readings that keep it shade 34 to 98% of the pixels), a PSNR the
-//! brute force reaches at 4 to 16 spp in 0.2 to 0.5 s. The others that miss:
-//! white-paint / quarry / torus (2.1x to 3.5x in three rows; its brute-force curve is on the
-//! sun's plateau, above), white-paint / quarry / sphere pre-filtered (4.1x, 8.7x), and
-//! pre-filtered rows of gold-paint and white-paint under potsdamer (4.9x to 9.6x).
+//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, the frame one submission:
+//! `adaptive` median 11.8x, 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 6.2x, 6
+//! of 24 at 10x or more (the other readings lower: level-normalized 1.9x and 1.5x, the FFT
+//! oracle 4.2x and 3.9x). In two submissions (stop 24) the medians were 11.9x and 7.4x, and with
+//! the plan and the up-sampling on the CPU (two runs, stop 23) 12.3x to 14.1x and 8.2x to 8.5x,
+//! with the same rows passing: on lavapipe the "GPU" is the same two cores, and a frame's time is
+//! its work, not its waits (by lavapipe's clock prediction, pyramids and plan 19 to 37 ms,
+//! samples and list 4 to 11 ms, shading, up-sampling and output 25 to 142 ms, of frames of 51 to
+//! 178 ms; the brute force's frame at 1 spp takes 41 to 54 ms). Chrome misses in all its 16 rows
+//! (0.6x to 1.6x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a mirror's
+//! reflection loses its detail, and the readings that keep it shade 34 to 98% of the pixels), a
+//! PSNR the brute force reaches at 4 to 32 spp in 82 to 152 ms. The others that miss:
+//! white-paint / quarry / torus (1.9x to 3.0x in three rows; its brute-force curve is on the
+//! sun's plateau, above), white-paint / quarry / sphere pre-filtered (3.9x, 8.4x), and
+//! pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to 8.8x), where the
+//! prediction (a third of a pre-filtered frame at 2 spp) costs about what the shading does.
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
-//! minutes each on the CPU), a rerun about 12 (a minute a case; `--no-extras` 40 s). At this size
-//! 16x anti-aliasing costs 4.3x to 6.7x the time of none on lavapipe.
+//! minutes each on the CPU), a rerun about 15 (a minute a case; `--no-extras` 40 s). At this size
+//! 16x anti-aliasing costs 3.5x to 5.5x the time of none on lavapipe (4.3x to 6.7x in stop 24).
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
