@@ -70,6 +70,9 @@
 //! sun's plateau, above), white-paint / quarry / sphere pre-filtered (3.9x, 8.4x), and
 //! pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to 8.8x), where the
 //! prediction (a third of a pre-filtered frame at 2 spp) costs about what the shading does.
+//! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
+//! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.5x (14 rows at 4x)
+//! and the pre-filtered one stays at 6.3x (7 at 10x); the default stays 2.
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
 //! minutes each on the CPU), a rerun about 15 (a minute a case; `--no-extras` 40 s). At this size
 //! 16x anti-aliasing costs 3.5x to 5.5x the time of none on lavapipe (4.3x to 6.7x in stop 24).
