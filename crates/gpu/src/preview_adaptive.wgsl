@@ -1,8 +1,10 @@
 // An adaptive frame on the GPU after its prediction (`render::adaptive`, step for step; compiled
 // after `preview_shade.wgsl`, whose background, camera ray and accumulation buffer it uses): the
-// levels of the bandwidth buffer, the min and max pyramids, the plan, the shaded blocks' estimates
-// put in place, the up-sampling from coarse to fine and the output image. `Renderer::render_adaptive`
-// (`preview/adaptive.rs`) records the passes and allocates the samples between them.
+// levels of the bandwidth buffer, the min and max pyramids, the plan, the samples (the area
+// allocation) and the list of shaded blocks, the shaded blocks' estimates put in place, the
+// up-sampling from coarse to fine and the output image. `Renderer::render_adaptive`
+// (`preview/adaptive.rs`) records the passes (and, for the other allocations, allocates the
+// samples on the host between two submissions).
 //
 // Group 3, bindings 2 and up (bindings 0 and 1 are the prediction's): one uniform slot per pass,
 // then the frame's state, one buffer per kind so that each stays within the adapter's largest
