@@ -1165,13 +1165,13 @@ pub struct Timings {
     /// The [`Geometry`]'s, made once per camera: not part of the frame's time when its camera
     /// made frames before.
     pub gbuffer_ms: f64,
-    /// [`render_with`]: the prediction; `gpu::preview` in one submission (the area
-    /// allocation): the prediction, pyramids and plan on the GPU's clock (0 on an adapter
-    /// without timestamp queries); in two (the variance and std-dev allocations): the first's
-    /// wall time (the same, and the list of shaded blocks read back).
+    /// The prediction: [`render_with`]'s, or `gpu::preview`'s in one submission (the area
+    /// allocation) on the GPU's clock (0 on an adapter without timestamp queries); in two (the
+    /// variance and std-dev allocations): the first submission's wall time (the prediction,
+    /// the pyramids and the plan, and the list of shaded blocks read back).
     pub predict_ms: f64,
-    /// [`render_with`]: the pyramids and the plan with its samples; `gpu::preview` in one
-    /// submission: the samples and the list of shaded blocks on the GPU's clock (0 without
+    /// The pyramids and the plan with its samples: [`render_with`]'s, or `gpu::preview`'s in
+    /// one submission on the GPU's clock (with the list of shaded blocks; 0 without
     /// timestamps); in two: the allocation of the samples on the CPU.
     pub plan_ms: f64,
     /// [`render_with`]: shading, up-sampling and the background; `gpu::preview` in one

@@ -618,11 +618,11 @@ fn main() {
         "Stages of the frame whose PSNR the table above reports (its last run; `frame` is the best of 3). {}",
         if gpu.is_some() {
             "On the GPU under the area allocation the frame is one submission: its stages on the GPU's clock \
-             (timestamp queries; where the adapter has none, all of the frame in the last column), `samples` the \
-             allocation and the list of shaded blocks there, and `frame` the wall time (recording, submission, the \
-             wait and the image's read-back besides). Under the variance or std-dev allocation it is two \
-             submissions, wall times, with the allocation of the samples on the CPU between them, each \
-             submission's time with its read-back (the list of shaded blocks, then the image). The G-buffer is the \
+             (timestamp queries; where the adapter has none, all of the frame in the last column), the samples \
+             with the list of shaded blocks, and `frame` the wall time (recording, submission, the wait and the \
+             image's read-back besides). Under the variance or std-dev allocation it is two submissions, wall \
+             times: the first (prediction, pyramids, plan, and the list read back) in the prediction's column, the \
+             allocation of the samples on the CPU in the next, the second with the image's read-back in the last. The G-buffer is the \
              camera's, made once on the CPU before its frames and not in `frame`, as the brute force's raster pass \
              is not in its time."
         } else {
@@ -631,7 +631,7 @@ fn main() {
     ));
     out(String::new());
     out(if gpu.is_some() {
-        "| case | mode | budget spp | G-buffer | prediction, pyramids, plan | samples | shading, up-sampling, output | frame | brute force at equal PSNR |"
+        "| case | mode | budget spp | G-buffer | prediction | pyramids, plan, samples | shading, up-sampling, output | frame | brute force at equal PSNR |"
     } else {
         "| case | mode | budget spp | G-buffer | prediction | pyramids, plan, samples | shading, up-sampling, background | frame | brute force at equal PSNR |"
     }

@@ -526,7 +526,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     }
     let steps = match (t.submissions, t.gpu_clock) {
         (1, true) => format!(
-            "one submission; on the GPU's clock prediction, pyramids and plan {:.1}, samples and list {:.1}, shading, \
+            "one submission; on the GPU's clock prediction {:.1}, pyramids, plan and samples {:.1}, shading, \
              up-sampling and output {:.1}",
             t.predict_ms, t.plan_ms, t.shade_ms
         ),
@@ -564,8 +564,8 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         "ms_per_frame": ms_per_frame,
         "timings_ms": {
             "gbuffer": t.gbuffer_ms,
-            "prediction_and_plan": t.predict_ms,
-            "samples": t.plan_ms,
+            "prediction": t.predict_ms,
+            "plan_and_samples": t.plan_ms,
             "shading": t.shade_ms,
             "submissions": t.submissions,
             "gpu_clock": t.gpu_clock,
