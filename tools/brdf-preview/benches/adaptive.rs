@@ -48,12 +48,12 @@
 //! the submission, the wait and the image's read-back, about what the brute force's frame
 //! costs whole at 1 spp (1.8 to 2.6 ms; 8.7 to 15 ms at 256 spp). Median speed-up 2.5x for
 //! `adaptive` (6 of 24 rows at 4x, the best 5.1x), 1.1x pre-filtered (none at 10x); an earlier
-//! run of the same code on another H100 gave 2.3x (5 rows) and 1.4x. When the frame was two
+//! run (one timestamp fewer) on another H100 gave 2.3x (5 rows) and 1.4x. When the frame was two
 //! submissions with the allocation on the CPU between them (stop 24, another H100) its frames
 //! took 3.2 to 6.2 ms and the medians were 1.7x and 1.2x; with its plan and up-sampling on the
 //! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
 //! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
-
+//!
 //! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, the frame one submission:
 //! `adaptive` median 11.8x, 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 6.2x, 6
 //! of 24 at 10x or more (the other readings lower: level-normalized 1.9x and 1.5x, the FFT
