@@ -199,6 +199,14 @@ fn the_adaptive_modes_report_their_work_and_their_quality() {
         let (samples, budget) = (json["samples"].as_u64().unwrap(), json["budget"].as_u64().unwrap());
         assert!(samples <= budget && 2 * samples > budget, "{json}");
         assert!(json["ms_per_frame"].as_f64().unwrap() > 0.0, "{json}");
+        // The default (area) allocation: the frame is one submission; on lavapipe, which has
+        // timestamp queries, its steps on the GPU's clock fit within its wall time.
+        let t = &json["timings_ms"];
+        assert_eq!(t["submissions"], 1, "{json}");
+        if t["gpu_clock"] == true {
+            let steps: f64 = ["prediction", "plan_and_samples", "shading"].iter().map(|k| t[k].as_f64().unwrap()).sum();
+            assert!(steps > 0.0 && steps <= json["ms_per_frame"].as_f64().unwrap(), "{json}");
+        }
         assert_eq!(json["aa"], 1);
         let psnr = json["psnr_db"].as_f64().unwrap();
         println!("{mode}: {psnr:.2} dB against the converged estimate, shaded fraction {fraction:.3}");

@@ -54,22 +54,24 @@
 //! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
 //! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
 //!
-//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, the frame one submission:
-//! `adaptive` median 11.8x, 15 of 24 rows at 4x or more; `adaptive-prefiltered` median 6.2x, 6
-//! of 24 at 10x or more (the other readings lower: level-normalized 1.9x and 1.5x, the FFT
-//! oracle 4.2x and 3.9x). In two submissions (stop 24) the medians were 11.9x and 7.4x, and with
-//! the plan and the up-sampling on the CPU (two runs, stop 23) 12.3x to 14.1x and 8.2x to 8.5x,
-//! with the same rows passing: on lavapipe the "GPU" is the same two cores, and a frame's time is
-//! its work, not its waits (by lavapipe's clock prediction, pyramids and plan 19 to 37 ms,
-//! samples and list 4 to 11 ms, shading, up-sampling and output 25 to 142 ms, of frames of 51 to
-//! 178 ms; the brute force's frame at 1 spp takes 41 to 54 ms). Chrome misses in all its 16 rows
-//! (0.6x to 1.6x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a mirror's
-//! reflection loses its detail, and the readings that keep it shade 34 to 98% of the pixels), a
-//! PSNR the brute force reaches at 4 to 32 spp in 82 to 152 ms. The others that miss:
-//! white-paint / quarry / torus (1.9x to 3.0x in three rows; its brute-force curve is on the
-//! sun's plateau, above), white-paint / quarry / sphere pre-filtered (3.9x, 8.4x), and
-//! pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to 8.8x), where the
-//! prediction (a third of a pre-filtered frame at 2 spp) costs about what the shading does.
+//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, the frame one submission, two
+//! runs (the second `--no-extras`): `adaptive` median 11.8x and 9.0x, 15 of 24 rows at 4x or more
+//! in both; `adaptive-prefiltered` median 6.2x and 5.1x, 6 of 24 at 10x or more in both (the
+//! other readings lower: level-normalized 1.9x and 1.5x, the FFT oracle 4.2x and 3.9x, first
+//! run). The runs differ mostly in the brute force's speed (its 1 spp frame 41 to 54 ms, then 37
+//! to 43). In two submissions (stop 24) the medians were 11.9x and 7.4x, and with the plan and
+//! the up-sampling on the CPU (two runs, stop 23) 12.3x to 14.1x and 8.2x to 8.5x, with the same
+//! rows passing: on lavapipe the "GPU" is the same two cores, and a frame's time is its work, not
+//! its waits (second run, by lavapipe's clock: prediction 9.5 to 29 ms, pyramids, plan and
+//! samples 12 to 39 ms, shading, up-sampling and output 24 to 128 ms, of frames of 48 to 163
+//! ms). Chrome misses in all its 16 rows (0.6x to 1.6x): its frames stop at their ceiling (34.9
+//! to 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it
+//! shade 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 32 spp in 82 to 152
+//! ms. The others that miss: white-paint / quarry / torus (1.9x to 3.0x in three rows; its
+//! brute-force curve is on the sun's plateau, above), white-paint / quarry / sphere pre-filtered
+//! (3.9x, 8.4x), and pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to
+//! 8.8x), where the prediction and the plan (together 40 to 60% of a pre-filtered frame at 2
+//! spp) cost about what the shading does.
 //! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
 //! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.5x (14 rows at 4x)
 //! and the pre-filtered one stays at 6.3x (7 at 10x); the default stays 2.
