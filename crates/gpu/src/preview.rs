@@ -1067,8 +1067,12 @@ impl Renderer {
 /// The workgroups of a list of `count` items (`shade_blocks`, `predict_blocks`): a power of two of
 /// workgroups, taken in bit-reversed order (`item_index` in the WGSL), as `(x, y)`.
 fn item_groups(count: u32) -> (u32, u32) {
-    let groups = count.div_ceil(64).next_power_of_two();
-    (groups.min(32768), groups.div_ceil(32768))
+    workgroups(count.div_ceil(64).next_power_of_two())
+}
+
+/// `n` workgroups as `(x, y)`, each within the dispatch limit of a dimension.
+fn workgroups(n: u32) -> (u32, u32) {
+    (n.min(32768), n.div_ceil(32768))
 }
 
 /// The RGB of RGBA `f32` values (little-endian bytes, as a buffer maps), over `divisor`.

@@ -105,7 +105,17 @@ const MIN_WEIGHT: f32 = 7.888609052210118e-31;
 
 // The item of this invocation in a dispatch of `(x, y)` workgroups of 64.
 fn adaptive_item(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
-    return (group.y * groups.x + group.x) * 64u + local;
+    return workgroup_index(group, groups) * 64u + local;
+}
+
+// The index of workgroup `group` in a dispatch of `(x, y)` workgroups.
+fn workgroup_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return group.y * groups.x + group.x;
+}
+
+// a / b rounded up.
+fn div_ceil(a: u32, b: u32) -> u32 {
+    return (a + b - 1u) / b;
 }
 
 struct Record {
@@ -426,18 +436,18 @@ fn set_control(i: u32, value: u32) {
 // Workgroups of 64 for `count` items as (x, y), at least one: `groups` of `preview/adaptive.rs`,
 // and with `power_of_two` the power of two of `item_groups` (`item_index`'s order).
 fn set_groups(at: u32, count: u32, power_of_two: bool) {
-    var n = max((count + 63u) / 64u, 1u);
+    var n = max(div_ceil(count, 64u), 1u);
     if (power_of_two && n > 1u) {
         n = 1u << (32u - countLeadingZeros(n - 1u));
     }
     set_control(at, min(n, 32768u));
-    set_control(at + 1u, (n + 32767u) / 32768u);
+    set_control(at + 1u, div_ceil(n, 32768u));
     set_control(at + 2u, 1u);
 }
 
 // The parts of a level's `count` blocks of `samples` samples, the first `doubled` of twice that.
 fn level_items(count: u32, doubled: u32, samples: u32, part: u32) -> u32 {
-    return doubled * ((2u * samples + part - 1u) / part) + (count - doubled) * ((samples + part - 1u) / part);
+    return doubled * div_ceil(2u * samples, part) + (count - doubled) * div_ceil(samples, part);
 }
 
 // `render::adaptive::area_allocation` of the shaded blocks per level (`adaptive_plan`'s counts),
@@ -595,19 +605,20 @@ fn shaded_candidate(c: u32) -> bool {
     return action == ACTION_SHADE || action == ACTION_RESCUED;
 }
 
-// The shaded candidates among invocation `local`'s RUN of chunk `chunk`'s CHUNK candidates.
-fn run_count(chunk: u32, local: u32) -> u32 {
+// Invocation `local`'s RUN of chunk `chunk`'s CHUNK candidates, as (first, end).
+fn run_range(chunk: u32, local: u32) -> vec2<u32> {
     let first = chunk * CHUNK + local * RUN;
-    let last = min(first + RUN, candidates_total());
+    return vec2<u32>(first, min(first + RUN, candidates_total()));
+}
+
+// The shaded candidates among invocation `local`'s run of chunk `chunk`.
+fn run_count(chunk: u32, local: u32) -> u32 {
+    let run = run_range(chunk, local);
     var sum = 0u;
-    for (var c = first; c < last; c++) {
+    for (var c = run.x; c < run.y; c++) {
         sum += u32(shaded_candidate(c));
     }
     return sum;
-}
-
-fn chunk_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
-    return group.y * groups.x + group.x;
 }
 
 // The list in the plan's order, step 1 of 3: the shaded candidates of each chunk of CHUNK, a
@@ -619,7 +630,7 @@ fn adaptive_chunks(
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let chunk = chunk_index(group, groups);
+    let chunk = workgroup_index(group, groups);
     let sum = workgroup_scan(local, run_count(chunk, local), 64u);
     if (local == 63u && chunk * CHUNK < candidates_total()) {
         set_control(CONTROL_CHUNKS + chunk, sum);
@@ -631,8 +642,8 @@ fn adaptive_chunks(
 // through its stretch again).
 @compute @workgroup_size(256)
 fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
-    let chunks = (candidates_total() + CHUNK - 1u) / CHUNK;
-    let per = (chunks + 255u) / 256u;
+    let chunks = div_ceil(candidates_total(), CHUNK);
+    let per = div_ceil(chunks, 256u);
     let first = min(local * per, chunks);
     let last = min(first + per, chunks);
     var sum = 0u;
@@ -656,16 +667,15 @@ fn adaptive_list(
     @builtin(local_invocation_index) local: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let chunk = chunk_index(group, groups);
+    let chunk = workgroup_index(group, groups);
     let mine = run_count(chunk, local);
     let inclusive = workgroup_scan(local, mine, 64u);
     if (mine == 0u || control_word(CONTROL_STATUS) != 0u) {
         return;
     }
     var rank = control_word(CONTROL_CHUNKS + chunk) + inclusive - mine;
-    let first = chunk * CHUNK + local * RUN;
-    let last = min(first + RUN, candidates_total());
-    for (var c = first; c < last; c++) {
+    let run = run_range(chunk, local);
+    for (var c = run.x; c < run.y; c++) {
         if (shaded_candidate(c)) {
             list_entry(tables[adapt.candidates + c], rank);
             rank += 1u;
@@ -688,15 +698,15 @@ fn list_entry(block: u32, rank: u32) {
     let doubled = control_word(at + 1u);
     let part = control_word(CONTROL_PART);
     let r = rank - control_word(at + 3u);
-    let parts_doubled = (2u * samples + part - 1u) / part;
+    let parts_doubled = div_ceil(2u * samples, part);
     var n = samples;
     var first = control_word(at + 2u) + r * parts_doubled;
     if (r >= doubled) {
-        first = control_word(at + 2u) + doubled * parts_doubled + (r - doubled) * ((samples + part - 1u) / part);
+        first = control_word(at + 2u) + doubled * parts_doubled + (r - doubled) * div_ceil(samples, part);
     } else {
         n = 2u * samples;
     }
-    let count = (n + part - 1u) / part;
+    let count = div_ceil(n, part);
     for (var m = 0u; m < count; m++) {
         let start = m * part;
         accumulation[first + m] = bitcast<vec4<f32>>(vec4<u32>(pixel, n, start, min(part, n - start)));

@@ -233,8 +233,7 @@ fn slot_stride(alignment: u64) -> u64 {
 
 /// Workgroups of 64 for `count` items, as `(x, y)` within the dispatch limits.
 fn groups(count: u32) -> (u32, u32) {
-    let groups = count.div_ceil(64).max(1);
-    (groups.min(32768), groups.div_ceil(32768))
+    super::workgroups(count.div_ceil(64).max(1))
 }
 
 impl Renderer {
@@ -613,9 +612,9 @@ impl Renderer {
                     cpass = self.begin_timed_pass(&mut encoder, stamp(2, None));
                     run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
                 }
-                run(&mut cpass, &pipelines.chunks, plan_slot, (chunks.min(32768), chunks.div_ceil(32768)));
+                run(&mut cpass, &pipelines.chunks, plan_slot, super::workgroups(chunks));
                 run(&mut cpass, &pipelines.offsets, plan_slot, (1, 1));
-                run(&mut cpass, &pipelines.list, plan_slot, (chunks.min(32768), chunks.div_ceil(32768)));
+                run(&mut cpass, &pipelines.list, plan_slot, super::workgroups(chunks));
             }
             if on_gpu {
                 let spp_at = std::mem::offset_of!(super::ShadeUniform, spp) as u64;
