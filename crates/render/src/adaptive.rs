@@ -932,7 +932,6 @@ fn allocate(levels: &[Level], actions: &mut [Vec<Action>], budget: u64, settings
 /// [`area_allocation`], so that its blocks get exactly the samples the CPU's plan gives them.
 pub fn allocation(blocks: &[(usize, f64)], budget: u64, settings: &Settings) -> Result<Vec<u32>, Error> {
     let max_spp = settings.max_spp;
-    check_budget(blocks.len() as u64, budget)?;
     if settings.allocation == Allocation::Area {
         let top = blocks.iter().map(|&(k, _)| k).max().unwrap_or(0);
         let mut counts = vec![0u64; top + 1];
@@ -940,16 +939,18 @@ pub fn allocation(blocks: &[(usize, f64)], budget: u64, settings: &Settings) -> 
             counts[k] += 1;
         }
         let per_level = area_allocation(&counts, budget, max_spp)?;
-        let first = |k: usize| blocks.partition_point(|&(j, _)| j < k) as u64;
+        // Each block's rank in its level, in the plan's order.
+        let mut rank = vec![0u64; top + 1];
         return Ok(blocks
             .iter()
-            .enumerate()
-            .map(|(i, &(k, _))| {
+            .map(|&(k, _)| {
                 let LevelSamples { samples, doubled } = per_level[k];
-                if (i as u64 - first(k)) < doubled { 2 * samples } else { samples }
+                rank[k] += 1;
+                if rank[k] <= doubled { 2 * samples } else { samples }
             })
             .collect());
     }
+    check_budget(blocks.len() as u64, budget)?;
     let weights: Vec<f64> = blocks
         .iter()
         .map(|&(k, variance)| match settings.allocation {
@@ -1011,10 +1012,10 @@ pub struct LevelSamples {
 /// `spare 2^k >= (max_spp - 1) W`; full levels take `max_spp` and leave the rest to the others
 /// until none is full; a level's samples are then the largest power of two `2^m <= max_spp`
 /// with `2^m W <= W + spare 2^k`, and the levels below their share double, furthest below
-/// first (the least level first among equals), while their samples fit what is left. `gpu::preview` computes the same in
-/// `preview_adaptive.wgsl`'s `adaptive_allocate`, with 64-bit sums of shifts for the products
-/// (every factor but the counts a power of two). `max_spp` is a power of two
-/// ([`check_settings`]).
+/// first (the least level first among equals), while their samples fit what is left.
+/// `gpu::preview` computes the same in `preview_adaptive.wgsl`'s `adaptive_allocate`, with
+/// 64-bit sums of shifts for the products (every factor but the counts a power of two).
+/// `max_spp` is a power of two ([`check_settings`]).
 pub fn area_allocation(counts: &[u64], budget: u64, max_spp: u32) -> Result<Vec<LevelSamples>, Error> {
     debug_assert!(max_spp.is_power_of_two());
     check_budget(counts.iter().sum(), budget)?;

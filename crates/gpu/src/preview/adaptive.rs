@@ -267,6 +267,13 @@ impl Renderer {
             blocks += w * h;
             (w, h) = (w.div_ceil(2), h.div_ceil(2));
         }
+        if levels.len() > MAX_LEVELS {
+            return Err(render::Error::Invalid(format!(
+                "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
+                levels.len()
+            ))
+            .into());
+        }
         // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
         // (`check_settings` holds the rows in range where the lobe weight is on).
         let sharpness: Vec<f32> = material
@@ -345,13 +352,6 @@ impl Renderer {
         // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
         let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
         let items: Vec<[u32; 4]> = at.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
-        if levels.len() > MAX_LEVELS {
-            return Err(render::Error::Invalid(format!(
-                "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
-                levels.len()
-            ))
-            .into());
-        }
         let state = capture_errors(&self.device, || {
             use wgpu::BufferUsages as U;
             use wgpu::util::DeviceExt;
