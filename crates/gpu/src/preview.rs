@@ -5,7 +5,9 @@
 //! vertices at the pixel centre the way the specification does (from the snapped coordinates,
 //! where a rasterizer's own interpolation may differ by a fraction of a sub-pixel), shades one
 //! frame per dispatch and adds it into an accumulation buffer (`preview_shade.wgsl`, compiled
-//! after [`MERL_LOOKUP_WGSL`], whose nearest lookup is the BRDF). [`Renderer::render_frames`]
+//! after [`MERL_LOOKUP_WGSL`], whose nearest lookup is the BRDF). The environment behind the
+//! mesh, the same in every frame of a camera, is drawn once with the G-buffer and read where no
+//! triangle covers a pixel (by the adaptive frames too). [`Renderer::render_frames`]
 //! reads back the average of the frames; [`Renderer::accumulate`] keeps adding frames across
 //! calls (an interactive view refines as it is shown), and a [`Presenter`] tone maps the running
 //! average into a texture, a window's included, exactly as `envmap::tonemap_rgb8` maps pictures.
@@ -271,6 +273,8 @@ pub struct Renderer {
     triangle_target: wgpu::Texture,
     depth_target: wgpu::Texture,
     shade_pipeline: wgpu::ComputePipeline,
+    /// `shade_backdrop`: the environment behind the mesh, drawn with the G-buffer.
+    backdrop_pipeline: wgpu::ComputePipeline,
     /// `shade_blocks`: the shaded blocks of an adaptive frame.
     blocks_pipeline: wgpu::ComputePipeline,
     /// `predict_blocks`: the bandwidth buffer of an adaptive frame, with group 3 from
@@ -441,6 +445,7 @@ impl Renderer {
                         count: None,
                     },
                     storage_entry(3, compute, false),
+                    storage_entry(4, compute, false),
                 ],
             });
             let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -468,6 +473,7 @@ impl Renderer {
                 })
             };
             let shade_pipeline = compute_pipeline(None, "shade_frame");
+            let backdrop_pipeline = compute_pipeline(None, "shade_backdrop");
             let blocks_pipeline = compute_pipeline(None, "shade_blocks");
             let predict_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview predict"),
@@ -535,6 +541,12 @@ impl Renderer {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
+            let backdrop = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("preview backdrop"),
+                size: 16 * pixels,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            });
             let view = |texture: &wgpu::Texture| texture.create_view(&Default::default());
             let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview render"),
@@ -554,6 +566,7 @@ impl Renderer {
                         resource: wgpu::BindingResource::TextureView(&view(&triangle_target)),
                     },
                     wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: backdrop.as_entire_binding() },
                 ],
             });
             Renderer {
@@ -571,6 +584,7 @@ impl Renderer {
                 triangle_target,
                 depth_target,
                 shade_pipeline,
+                backdrop_pipeline,
                 blocks_pipeline,
                 predict_pipeline,
                 predict_layout,
@@ -1018,6 +1032,20 @@ impl Renderer {
                 pass.set_bind_group(0, &self.raster_group, &[]);
                 // Not indexed: the vertex shader reads the indices, and vertex i / 3 is triangle i.
                 pass.draw(0..self.n_indices, 0..1);
+            }
+            // The environment behind the mesh, the same in every frame of this camera: the
+            // shading uniform's camera (the frames write theirs again).
+            let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+            let shade = self.shade_uniform(mode_index(Mode::Reference), &settings);
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            {
+                let mut pass = self.begin_pass(&mut encoder);
+                pass.set_pipeline(&self.backdrop_pipeline);
+                pass.dispatch_workgroups(
+                    self.width.div_ceil(SHADE_WORKGROUP),
+                    self.height.div_ceil(SHADE_WORKGROUP),
+                    1,
+                );
             }
             self.queue.submit([encoder.finish()]);
         })

@@ -762,8 +762,8 @@ fn adaptive_upsample(
 }
 
 // The output image into `accumulation`: each output pixel the mean of its ss x ss render
-// pixels (level 0's values, the environment where no triangle covers the pixel, black where one
-// covers it without a shading frame), w = 1 where a triangle covers any of them.
+// pixels (level 0's values, the environment (`backdrop`) where no triangle covers the pixel, black
+// where one covers it without a shading frame), w = 1 where a triangle covers any of them.
 @compute @workgroup_size(64)
 fn adaptive_output(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -784,7 +784,7 @@ fn adaptive_output(
         let p = y * adapt.width + x;
         let r = record(p);
         if (r.depth < 0.0) {
-            sum += env_bilinear(0u, env_uv(camera_ray(x, y)));
+            sum += backdrop[p].xyz;
         } else {
             covered = 1.0;
             if (r.prediction != NONE) {

@@ -93,6 +93,9 @@ struct Frame {
 @group(2) @binding(2) var gbuffer_triangle: texture_2d<u32>;
 // Per pixel: the sum of the frames' radiance, and in w whether a triangle covers it.
 @group(2) @binding(3) var<storage, read_write> accumulation: array<vec4<f32>>;
+// Per pixel: the environment seen along its camera ray, drawn where no triangle covers the pixel
+// (`shade_backdrop`, once per camera with the G-buffer).
+@group(2) @binding(4) var<storage, read_write> backdrop: array<vec4<f32>>;
 
 // `render::pcg_hash`: Jarzynski and Olano 2020. WGSL's u32 arithmetic wraps like Rust's
 // wrapping_*, so the words are the CPU's bit for bit.
@@ -515,6 +518,16 @@ fn camera_ray(x: u32, y: u32) -> vec3<f32> {
     return normalize(shade.ray_forward.xyz + x_ndc * shade.ray_right.xyz + y_ndc * shade.ray_up.xyz);
 }
 
+// The environment along every pixel's camera ray (`render::render`'s background), for the frames
+// of a camera: the same in each of them, so drawn once (`Renderer::rasterize`).
+@compute @workgroup_size(SHADE_WORKGROUP, SHADE_WORKGROUP)
+fn shade_backdrop(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= shade.width || gid.y >= shade.height) {
+        return;
+    }
+    backdrop[gid.y * shade.width + gid.x] = vec4<f32>(env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y))), 0.0);
+}
+
 @compute @workgroup_size(SHADE_WORKGROUP, SHADE_WORKGROUP)
 fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= shade.width || gid.y >= shade.height) {
@@ -549,7 +562,7 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     } else {
         // The environment behind the mesh in every mode, so that its orientation can be checked.
-        radiance = env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y)));
+        radiance = backdrop[pixel].xyz;
     }
     let sum = accumulation[pixel].xyz + radiance;
     accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));
