@@ -626,7 +626,7 @@ fn main() {
              times: the first (prediction, pyramids, plan, and the list read back) in the prediction's column, the \
              allocation of the samples on the CPU in the next, the second with the image's read-back in the last. The G-buffer is the \
              camera's, made once on the CPU before its frames and not in `frame`, as the brute force's raster pass \
-             is not in its time."
+             is not in its time; the environment behind the mesh is drawn once per camera too, for both."
         } else {
             "The G-buffer is made in every frame, as the brute force rasterizes in every frame."
         }
