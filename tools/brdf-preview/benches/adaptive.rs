@@ -72,11 +72,20 @@
 //! (3.9x, 8.4x), and pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to
 //! 8.8x), where the prediction and the plan (together 40 to 60% of a pre-filtered frame at 2
 //! spp) cost about what the shading does.
+//! Drawing the environment behind the mesh once per camera rather than in every frame (stop 26)
+//! shortened the adaptive frames of gold-paint / potsdamer / torus by 1 to 19 ms (the builds
+//! before and after, alternated twice on an idle machine: `adaptive` 4 spp 65 to 67 ms against
+//! 74 to 84, 16 spp 139 to 142 against 149 to 161, pre-filtered 2 spp 49 to 50 against 55 to 58,
+//! 8 spp 87 to 94 against 95 to 96) and the brute force's 1 spp frame by 1 to 5 ms (40 to 41
+//! against 42 to 45); a full run after it (`-- --gpu`): `adaptive` median 10.8x, 15 of 24 rows at 4x (the same rows), pre-filtered 6.2x, 6 at 10x (the same
+//! rows; four more within 15% of it: gold-paint / potsdamer / sphere at 2 spp 8.9x, white-paint
+//! / potsdamer / torus 9.3x and 8.6x, white-paint / quarry / sphere at 8 spp 8.8x), brute force
+//! 1 spp 38 to 46 ms, 16x anti-aliasing 2.8x to 6.7x the time of none.
 //! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
 //! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.5x (14 rows at 4x)
 //! and the pre-filtered one stays at 6.3x (7 at 10x); the default stays 2.
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
-//! minutes each on the CPU), a rerun about 15 (a minute a case; `--no-extras` 40 s). At this size
+//! minutes each on the CPU), a rerun 5 to 15 (20 s to a minute a case, with the extras). At this size
 //! 16x anti-aliasing costs 3.5x to 5.5x the time of none on lavapipe (4.3x to 6.7x in stop 24).
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
