@@ -839,9 +839,10 @@ impl Renderer {
     /// `render::adaptive::prediction_pixels`, row-major indices of the renderer's image) as
     /// `render::adaptive` does on the CPU, with `settings`' `n_b`, seed and estimator and the
     /// bandwidths of [`Renderer::set_bandwidths`]: each pixel's image bandwidth (cycles per pixel)
-    /// and variance. A pixel the GPU's raster finds not shadeable (the renderers may disagree at
-    /// a few silhouette pixels: crate docs) predicts the Nyquist rate, bandwidth 1/2 and variance
-    /// 0: level 0, shaded at full resolution, the safe side.
+    /// and variance. The curvature is the CPU's G-buffer's ([`Renderer::adaptive_geometry`], as
+    /// an adaptive frame's is). A pixel the GPU's raster finds not shadeable (the renderers may
+    /// disagree at a few silhouette pixels: crate docs) predicts the Nyquist rate, bandwidth 1/2
+    /// and variance 0: level 0, shaded at full resolution, the safe side.
     pub fn predict_blocks(
         &self,
         settings: &render::adaptive::Settings,
@@ -858,8 +859,9 @@ impl Renderer {
         if pixels.is_empty() {
             return Ok(Vec::new());
         }
+        let geometry = self.adaptive_geometry(1)?;
         capture_errors(&self.device, || self.write_predict_uniform(prediction, settings))?;
-        let items: Vec<[u32; 4]> = pixels.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        let items = prediction_items(pixels, geometry.pixels());
         let values = self.run_items(&self.predict_pipeline, &prediction.group, settings.mode, settings.seed, &items)?;
         Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
@@ -1094,6 +1096,13 @@ impl Renderer {
 
 /// The workgroups of a list of `count` items (`shade_blocks`, `predict_blocks`): a power of two of
 /// workgroups, taken in bit-reversed order (`item_index` in the WGSL), as `(x, y)`.
+/// `predict_blocks`' items: each prediction pixel with its G-buffer curvature in f32 (0 where the
+/// CPU's G-buffer finds the pixel not shadeable).
+fn prediction_items(at: &[u32], pixels: &[Option<render::adaptive::Pixel>]) -> Vec<[u32; 4]> {
+    let curvature = |p: u32| pixels[p as usize].as_ref().map_or(0.0, |px| px.curvature as f32);
+    at.iter().map(|&p| [p, curvature(p).to_bits(), 0, 0]).collect()
+}
+
 fn item_groups(count: u32) -> (u32, u32) {
     workgroups(count.div_ceil(64).next_power_of_two())
 }

@@ -689,39 +689,17 @@ fn bandwidth_at_eye(nu_env: f32, rho: f32, c: f32, depth: f32, cos_x: f32) -> f3
     return abs(nu.y);
 }
 
-// The curvature along one screen axis from the neighbours that are there (`render::adaptive`,
-// "The G-buffer"): |n(a) - n(b)| / |p(a) - p(b)|, the pixel itself standing in for a missing one.
-fn curvature_axis(a: Surface, b: Surface, me: Hit) -> f32 {
-    var pa = me;
-    var pb = me;
-    if (a.found) {
-        pa = a.hit;
-    }
-    if (b.found) {
-        pb = b.hit;
-    }
-    let dp = length(pa.position - pb.position);
-    if (dp > 0.0) {
-        return length(pa.normal - pb.normal) / dp;
-    }
-    return 0.0;
-}
-
-// `render::adaptive::predict_pixel` at the shadeable pixel (x, y): the image bandwidth (cycles per
-// pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the pre-convolved estimator) from the
-// first `n_b` samples of the pixel's vector; (-1, -1) where the pixel is not shadeable.
-fn predict_pixel(x: u32, y: u32) -> vec2<f32> {
-    let xi = i32(x);
-    let yi = i32(y);
-    let me = surface_at(xi, yi);
+// `render::adaptive::predict_pixel` at the shadeable pixel (x, y) of G-buffer curvature
+// `curvature` (the CPU's, a camera's: `render::adaptive::Geometry`): the image bandwidth (cycles
+// per pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the pre-convolved estimator) from
+// the first `n_b` samples of the pixel's vector; (-1, -1) where the pixel is not shadeable.
+fn predict_pixel(x: u32, y: u32, curvature: f32) -> vec2<f32> {
+    let me = surface_at(i32(x), i32(y));
     if (!me.found) {
         return vec2<f32>(-1.0);
     }
     let hit = me.hit;
     let frame = me.frame;
-    let horizontal = curvature_axis(surface_at(xi - 1, yi), surface_at(xi + 1, yi), hit);
-    let vertical = curvature_axis(surface_at(xi, yi - 1), surface_at(xi, yi + 1), hit);
-    let curvature = max(horizontal, vertical);
     let depth = length(shade.eye.xyz - hit.position);
     let pixel = y * shade.width + x;
     let n_b = min(predict.n_b, shade.n_samples);
@@ -761,7 +739,8 @@ fn predict_pixel(x: u32, y: u32) -> vec2<f32> {
 
 // The bandwidth buffer of an adaptive frame at its prediction pixels
 // (`render::adaptive::prediction_pixels`): item `i` of `shade.spp` items arrives in
-// `accumulation[i]` as the bits of (pixel, 0, 0, 0) and leaves as (bandwidth, variance, 0, 1).
+// `accumulation[i]` as the bits of (pixel, its G-buffer curvature as f32, 0, 0) and leaves as
+// (bandwidth, variance, 0, 1).
 @compute @workgroup_size(64)
 fn predict_blocks(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -772,7 +751,8 @@ fn predict_blocks(
     if (i >= shade.spp) {
         return;
     }
-    let pixel = bitcast<vec4<u32>>(accumulation[i]).x;
-    let prediction = predict_pixel(pixel % shade.width, pixel / shade.width);
+    let item = bitcast<vec4<u32>>(accumulation[i]);
+    let pixel = item.x;
+    let prediction = predict_pixel(pixel % shade.width, pixel / shade.width, bitcast<f32>(item.y));
     accumulation[i] = vec4<f32>(prediction, 0.0, 1.0);
 }

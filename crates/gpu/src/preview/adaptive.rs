@@ -351,7 +351,7 @@ impl Renderer {
         table.extend(sharpness.iter().map(|v| v.to_bits()));
         // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
         let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
-        let items: Vec<[u32; 4]> = at.iter().map(|&pixel| [pixel, 0, 0, 0]).collect();
+        let items = super::prediction_items(&at, pixels);
         let state = capture_errors(&self.device, || {
             use wgpu::BufferUsages as U;
             use wgpu::util::DeviceExt;
