@@ -987,7 +987,7 @@ impl Renderer {
         pass
     }
 
-    /// Draws the G-buffer with the current camera.
+    /// Draws the G-buffer with the current camera, and the environment behind the mesh.
     fn rasterize(&self) -> Result<(), GpuError> {
         // The CPU's projection and snapping, which the passes read rather than compute
         // (`preview_shade.wgsl`).
@@ -1094,8 +1094,6 @@ impl Renderer {
     }
 }
 
-/// The workgroups of a list of `count` items (`shade_blocks`, `predict_blocks`): a power of two of
-/// workgroups, taken in bit-reversed order (`item_index` in the WGSL), as `(x, y)`.
 /// `predict_blocks`' items: each prediction pixel with its G-buffer curvature in f32 (0 where the
 /// CPU's G-buffer finds the pixel not shadeable).
 fn prediction_items(at: &[u32], pixels: &[Option<render::adaptive::Pixel>]) -> Vec<[u32; 4]> {
@@ -1103,6 +1101,8 @@ fn prediction_items(at: &[u32], pixels: &[Option<render::adaptive::Pixel>]) -> V
     at.iter().map(|&p| [p, curvature(p).to_bits(), 0, 0]).collect()
 }
 
+/// The workgroups of a list of `count` items (`shade_blocks`, `predict_blocks`): a power of two of
+/// workgroups, taken in bit-reversed order (`item_index` in the WGSL), as `(x, y)`.
 fn item_groups(count: u32) -> (u32, u32) {
     workgroups(count.div_ceil(64).next_power_of_two())
 }
