@@ -128,7 +128,8 @@ struct ShadeUniform {
     n_samples: u32,
     n_levels: u32,
     n_view_rows: u32,
-    _pad: [u32; 2],
+    n_layers: u32,
+    layer_shift: u32,
 }
 
 /// `Predict` of the WGSL.
@@ -1084,7 +1085,8 @@ impl Renderer {
             n_samples: self.n_samples,
             n_levels: self.n_levels,
             n_view_rows: self.view_layers.len() as u32,
-            _pad: [0; 2],
+            n_layers: self.n_layers as u32,
+            layer_shift: 0,
         }
     }
 
@@ -1243,11 +1245,12 @@ mod tests {
 
     #[test]
     fn host_layouts_match_the_wgsl_structs() {
-        // WGSL `Shade`: four vec4<f32> (64 bytes), ten u32 (40), rounded up to its 16-byte
-        // alignment: 112.
+        // WGSL `Shade`: four vec4<f32> (64 bytes) and twelve u32 (48): 112, a multiple of its
+        // 16-byte alignment.
         assert_eq!(size_of::<ShadeUniform>(), 112);
         assert_eq!(std::mem::offset_of!(ShadeUniform, width), 64);
         assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 100);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, layer_shift), 108);
     }
 
     #[test]

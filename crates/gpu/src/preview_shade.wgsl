@@ -80,6 +80,10 @@ struct Shade {
     // Mip levels: the prefiltered layer `l` is map `n_levels + l`.
     n_levels: u32,
     n_view_rows: u32,
+    // Prefiltered layers; the prefiltered estimator reads the layer `layer_shift` layers sharper
+    // than the view's (an adaptive frame's shaded blocks: `render::adaptive::Settings`).
+    n_layers: u32,
+    layer_shift: u32,
 }
 
 // Its own uniform, at a dynamic offset: one command buffer holds many frames.
@@ -452,11 +456,11 @@ fn incident_radiance(map: u32, wi: vec3<f32>, pdf: f32) -> vec3<f32> {
 }
 
 // The prefiltered layer of the pixel: row r = min(floor((1 - cos_o) R), R - 1) of the view-layer
-// table (which must not be empty).
+// table (which must not be empty), `shade.layer_shift` layers sharper, the sharpest at most.
 fn view_layer(frame: ShadingFrame) -> u32 {
     let rows = shade.n_view_rows;
     let r = min(u32(max(floor((1.0 - frame.cos_o) * f32(rows)), 0.0)), rows - 1u);
-    return view_layers[r];
+    return min(view_layers[r] + min(shade.layer_shift, shade.n_layers), shade.n_layers - 1u);
 }
 
 // The map a bilinear mode reads at this pixel: level 0 (reference), or for the prefiltered mode

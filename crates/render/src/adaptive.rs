@@ -128,9 +128,26 @@
 //! take goes to the others), rounded down to a power of two (the baked vectors are read in
 //! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
 //! blocks furthest below their share, while it fits. The total never exceeds the budget; a
-//! budget below one sample per shaded block is an error. A shaded block is shaded by the chosen
-//! estimator with its count as `spp` and one frame, at its pixel (the random chunk of that
-//! pixel).
+//! budget below one sample per shaded block is an error.
+//!
+//! # Shading
+//!
+//! A shaded block is shaded by the chosen estimator with its count as `spp` and one frame, at
+//! its pixel (the random chunk of that pixel). The pre-convolved estimator (`001` section 2.5:
+//! samples of the illumination "pre-filtered ... at the level given by the maximum frequency of
+//! the BRDF") reads the Phong layer [`Settings::layer_shift`] layers sharper than the one the
+//! bake's selection picks for the view ([`Material::view_layers`]), the sharpest at most. That
+//! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
+//! `bake`, `stage::layers`), where a sharper layer's noise costs more than its blur: two layers
+//! sharper lose 1.4 to 1.8 dB there (`brdf-preview --mode prefiltered --spp 16 --converged 256`,
+//! 128 x 128 sphere: gold-paint and white-paint under potsdamer 40.43 and 37.84 dB against 38.58
+//! and 36.49; gold-paint under quarry 34.79 and 34.82). A shaded block takes tens of samples, the
+//! budget of the pixels it stands for, and there the blur dominates (the adaptive benchmark, 512
+//! x 512 sphere under potsdamer, 2 and 8 spp budgets, in dB, for 0 to 3 layers sharper):
+//! gold-paint 46.23 and 46.38, 50.53 and 51.00, 51.45 and 52.07, 51.53 and 52.15; white-paint
+//! 48.80 and 49.19, 49.61 and 50.09, 49.67 and 50.15, 49.63 and 50.10; white-paint under quarry,
+//! where the sun's rare samples dominate the error, 35.12 and 36.13 against 35.09 and 35.77 for
+//! any shift. The default is 2 ([`LAYER_SHIFT`]).
 //!
 //! # Anti-aliasing (`001` section 4.3)
 //!
@@ -241,7 +258,14 @@ pub struct Settings {
     /// adaptively" where the weights say the parents do not represent it. 0: only when they
     /// all vanish.
     pub rescue_below: f64,
+    /// [`Mode::Prefiltered`]: the shaded blocks read the Phong layer this many layers sharper
+    /// than the one [`Material::view_layers`] picks for their view (each layer a lobe half as
+    /// wide), the sharpest layer at most (module docs, "Shading"). Default [`LAYER_SHIFT`].
+    pub layer_shift: u32,
 }
+
+/// [`Settings::layer_shift`]'s default (module docs, "Shading").
+pub const LAYER_SHIFT: u32 = 2;
 
 /// How a frame's samples are shared among its shaded blocks (module docs, "Samples").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -293,6 +317,7 @@ impl Settings {
             allocation: Allocation::Variance,
             lobe_weight: false,
             rescue_below: 0.0,
+            layer_shift: LAYER_SHIFT,
         }
     }
 }
@@ -1427,7 +1452,7 @@ pub fn render_with(
             .map(|&(pixel, samples)| {
                 let local = shading_frame(gbuffer, frame.eye, pixel as usize);
                 let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
-                shade(&local, pixel, material, lighting, &shading).map(|v| v as f32)
+                shade(&local, pixel, material, lighting, &shading, settings.layer_shift).map(|v| v as f32)
             })
             .collect(),
     };

@@ -86,7 +86,8 @@
 //! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"): the Phong-lobe layer the material's
 //!   [`Material::view_layers`] picks for the pixel's view direction, bilinear. Row
 //!   `r = min(floor((1 - cos_o) * R), R - 1)` of the `R` entries (the rows of the bandwidth atlas,
-//!   equal steps of `cos theta`).
+//!   equal steps of `cos theta`). An adaptive frame's shaded blocks read a sharper layer
+//!   (`adaptive::Settings::layer_shift`, module `adaptive`, "Shading").
 //!
 //! A frame's estimate is averaged over `frames` frames (`f = 0 .. frames`): the image converges to
 //! the mode's expectation as frames grow. That expectation is over the choice of vector and chunk

@@ -37,7 +37,7 @@ pub fn render(scene: &Scene, material: &Material, lighting: &Lighting, settings:
         for (x, out) in row.chunks_exact_mut(3).enumerate() {
             let value = match gbuffer.hit(x, y) {
                 Some(hit) => match ShadingFrame::new(hit, eye) {
-                    Some(frame) => shade(&frame, (y * width + x) as u32, material, lighting, settings),
+                    Some(frame) => shade(&frame, (y * width + x) as u32, material, lighting, settings, 0),
                     None => [0.0; 3],
                 },
                 None => background(&rays, level0, x, y),
@@ -144,13 +144,16 @@ enum Source<'a> {
     Mips(&'a MipChain),
 }
 
-/// The estimate of one covered pixel, averaged over the frames.
+/// The estimate of one covered pixel, averaged over the frames; the prefiltered estimator reads
+/// the layer `layer_shift` layers sharper than the view's (the sharpest at most: an adaptive
+/// frame's shaded blocks, `adaptive::Settings::layer_shift`; 0 for [`render`]).
 pub(crate) fn shade(
     frame: &ShadingFrame,
     pixel: u32,
     material: &Material,
     lighting: &Lighting,
     settings: &Settings,
+    layer_shift: u32,
 ) -> [f64; 3] {
     let s: &SampleSet = &material.samples;
     let (n_vectors, n_samples, spp) = (s.n_vectors as u32, s.n_samples as u32, settings.spp);
@@ -161,7 +164,8 @@ pub(crate) fn shade(
         Mode::Prefiltered => {
             let rows = material.view_layers.len();
             let r = (((1.0 - frame.cos_o) * rows as f64).floor().max(0.0) as usize).min(rows - 1);
-            Source::Map(&lighting.layers[material.view_layers[r] as usize])
+            let layer = (material.view_layers[r] as usize).saturating_add(layer_shift as usize);
+            Source::Map(&lighting.layers[layer.min(lighting.layers.len() - 1)])
         }
     };
     let mut total = [0.0f64; 3];

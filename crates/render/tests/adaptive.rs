@@ -193,6 +193,52 @@ fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
 }
 
 #[test]
+fn pre_convolved_blocks_read_the_layer_layer_shift_sharper() {
+    // Three layers of the sky, each a different scale of it; every view picks layer 0. A plan
+    // that may not coarsen with a layer shift is the full-resolution renderer with the views'
+    // layers moved that far, the last layer at most.
+    let (material, sky, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let scaled = |k: f32| {
+        envmap::EnvMap::new(
+            sky.layers[0].width(),
+            sky.layers[0].height(),
+            sky.layers[0].rgb().iter().map(|v| v * k).collect(),
+        )
+        .unwrap()
+    };
+    let lighting =
+        render::Lighting { layers: vec![scaled(1.0), scaled(2.0), scaled(4.0)], exponents: vec![1, 4, 16], ..sky };
+    let scene = sphere_scene(40, 30);
+    let mut seen = Vec::new();
+    for shift in [0, 1, 2, 9] {
+        let settings = adaptive::Settings {
+            max_level: Some(0),
+            max_spp: 8,
+            seed: 3,
+            layer_shift: shift,
+            ..adaptive::Settings::new(Mode::Prefiltered, 8)
+        };
+        let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
+        let layer = shift.min(2);
+        let moved = render::Material { view_layers: vec![layer; material.view_layers.len()], ..material.clone() };
+        let full = render::render(
+            &scene,
+            &moved,
+            &lighting,
+            &Settings { mode: Mode::Prefiltered, spp: 8, frames: 1, seed: 3 },
+        )
+        .unwrap();
+        assert_eq!(frame.image.rgb, full.rgb, "shift {shift}");
+        // The mesh's light (the background is level 0 of the mips, the same in every frame).
+        let covered = frame.image.rgb.chunks_exact(3).zip(&frame.image.covered).filter(|&(_, &c)| c);
+        seen.push(covered.map(|(rgb, _)| rgb.iter().map(|&v| f64::from(v)).sum::<f64>()).sum::<f64>());
+    }
+    // The layers differ, so the shifts do: twice the light per layer.
+    assert!((seen[1] / seen[0] - 2.0).abs() < 1e-4 && (seen[2] / seen[0] - 4.0).abs() < 1e-4, "{seen:?}");
+    assert_eq!(seen[2], seen[3]);
+}
+
+#[test]
 fn the_exact_shader_gives_the_plans_ceiling() {
     // A reference image of scattered values (a pixel's index times a prime, modulo 1000),
     // which no interpolation reproduces: a plan that may not coarsen

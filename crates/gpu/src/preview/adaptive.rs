@@ -514,6 +514,15 @@ impl Renderer {
         let chunks = candidates.div_ceil(CHUNK).max(1);
         let out_pixels = (out_width * out_height) as u64;
         let pipelines = &self.adaptive_pipelines;
+        // The shading uniform of the frame's passes with `items` items (the prediction's, then
+        // `shade_blocks`' parts): the estimator, the seed, the pre-convolved estimator's layers.
+        let shade_uniform = |items: u32| super::ShadeUniform {
+            layer_shift: settings.layer_shift,
+            ..self.shade_uniform(
+                super::mode_index(settings.mode),
+                &render::Settings { mode: settings.mode, spp: items, frames: 1, seed: settings.seed },
+            )
+        };
         // The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling
         // and the output: `Some(count)` dispatches a known count, `None` the counts
         // `adaptive_allocate` left in the indirect buffer.
@@ -548,11 +557,7 @@ impl Renderer {
         let read = capture_errors(&self.device, || {
             self.progress.set(None);
             self.write_predict_uniform(prediction, settings);
-            let shade = self.shade_uniform(
-                super::mode_index(settings.mode),
-                &render::Settings { mode: settings.mode, spp: state.n_items, frames: 1, seed: settings.seed },
-            );
-            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade_uniform(state.n_items)));
             self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
             if let Some(oracle) = options.oracle {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
@@ -678,10 +683,7 @@ impl Renderer {
             let (items, targets) = parts(&list, &samples, &state.levels, width * height);
             let plan_ms = lap();
             let rgb = capture_errors(&self.device, || {
-                let shade = self.shade_uniform(
-                    super::mode_index(settings.mode),
-                    &render::Settings { mode: settings.mode, spp: items.len() as u32, frames: 1, seed: settings.seed },
-                );
+                let shade = shade_uniform(items.len() as u32);
                 self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
                 if !items.is_empty() {
                     self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
