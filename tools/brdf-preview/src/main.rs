@@ -130,7 +130,8 @@ struct Args {
     /// adaptive-prefiltered: the shaded blocks read the Phong layer N layers sharper than the one
     /// the bake picks for the view (each a lobe half as wide; the sharpest at most). The bake's
     /// pick suits 16 samples per pixel; a shaded block takes tens, and sharper layers blur less
-    /// (crate render, module adaptive, "Shading": 46.2 dB at 0 against 51.5 at 2 on gold-paint).
+    /// (crate render, module adaptive, "Shading": gold-paint under potsdamer 46.2 dB at 0, 50.5
+    /// at 1; under quarry's sun sharper layers cost noise).
     #[arg(long, value_name = "N", default_value_t = render::adaptive::LAYER_SHIFT)]
     layer_shift: u32,
 
