@@ -42,8 +42,10 @@
 //! made once before the frames (`Renderer::adaptive_geometry`), as the brute force's raster pass
 //! is; on the CPU both rasterize in every frame.
 //!
-//! On an NVIDIA H100 (`--gpu --no-extras`, all twelve cases) the adaptive frames take 2.7 to
-//! 3.9 ms, of which the GPU is busy 1.1 to 1.5 ms by its clock (prediction 0.3 ms; pyramids,
+//! On an NVIDIA H100 (stop 25, before the changes of stop 26 below; `--gpu --no-extras`, all
+//! twelve cases; the medians as those reports printed them, the upper of the two middle rows:
+//! recomputed, 2.2x and 1.05x, and 2.15x and 1.4x for the earlier run) the adaptive frames
+//! take 2.7 to 3.9 ms, of which the GPU is busy 1.1 to 1.5 ms by its clock (prediction 0.3 ms; pyramids,
 //! plan and samples 0.4 to 0.5 ms; shading, up-sampling and output 0.4 to 0.8 ms): the rest is
 //! the submission, the wait and the image's read-back, about what the brute force's frame
 //! costs whole at 1 spp (1.8 to 2.6 ms; 8.7 to 15 ms at 256 spp). Median speed-up 2.5x for
@@ -54,39 +56,48 @@
 //! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
 //! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
 //!
-//! Measured on lavapipe (`-- --gpu`, 2 cores), paper reading, the frame one submission, two
-//! runs (the second `--no-extras`): `adaptive` median 11.8x and 9.0x, 15 of 24 rows at 4x or more
-//! in both; `adaptive-prefiltered` median 6.2x and 5.1x, 6 of 24 at 10x or more in both (the
-//! other readings lower: level-normalized 1.9x and 1.5x, the FFT oracle 4.2x and 3.9x, first
-//! run). The runs differ mostly in the brute force's speed (its 1 spp frame 41 to 54 ms, then 37
-//! to 43). In two submissions (stop 24) the medians were 11.9x and 7.4x, and with the plan and
-//! the up-sampling on the CPU (two runs, stop 23) 12.3x to 14.1x and 8.2x to 8.5x, with the same
-//! rows passing: on lavapipe the "GPU" is the same two cores, and a frame's time is its work, not
-//! its waits (second run, by lavapipe's clock: prediction 9.5 to 29 ms, pyramids, plan and
-//! samples 12 to 39 ms, shading, up-sampling and output 24 to 128 ms, of frames of 48 to 163
-//! ms). Chrome misses in all its 16 rows (0.6x to 1.6x): its frames stop at their ceiling (34.9
-//! to 44 dB: up-sampling a mirror's reflection loses its detail, and the readings that keep it
-//! shade 34 to 98% of the pixels), a PSNR the brute force reaches at 4 to 32 spp in 82 to 152
-//! ms. The others that miss: white-paint / quarry / torus (1.9x to 3.0x in three rows; its
-//! brute-force curve is on the sun's plateau, above), white-paint / quarry / sphere pre-filtered
-//! (3.9x, 8.4x), and pre-filtered rows of gold-paint and white-paint under potsdamer (5.0x to
-//! 8.8x), where the prediction and the plan (together 40 to 60% of a pre-filtered frame at 2
-//! spp) cost about what the shading does.
-//! Drawing the environment behind the mesh once per camera rather than in every frame (stop 26)
+//! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 26 (the environment
+//! behind the mesh drawn once per camera, the prediction's curvature the CPU G-buffer's,
+//! `adaptive-prefiltered`'s blocks one layer sharper than the bake's pick: `render::adaptive`,
+//! "Shading"): `adaptive` median 11.0x, 15 of 24 rows at 4x or more; `adaptive-prefiltered`
+//! median 8.0x, 12 of 24 at 10x or more (the middle rows 5.6x and 10.4x; the other readings:
+//! level-normalized 1.6x and 1.4x, the FFT oracle 3.8x and 3.2x). The medians are of 24 rows,
+//! the mean of the middle two; the reports before stop 26 printed the upper of the two, and
+//! their runs' medians were, recomputed: stop 25 10.7x and 5.6x (printed 11.8x and 6.2x), then
+//! 8.6x and 5.0x (9.0x, 5.1x); stop 26 before the layer shift 10.1x and 5.6x. The layer shift
+//! moved gold-paint / potsdamer / sphere pre-filtered from 46.2 to 50.5 dB (8.9x to 16.3x at 2
+//! spp), the torus from 7.7x and 4.9x to 11.0x and 11.5x, white-paint / potsdamer / torus from
+//! 9.3x and 8.6x to 10.9x and 10.4x. The 12 rows below 10x are chrome's 8 (0.8x to 2.0x) and white-paint
+//! under quarry's 4 (2.7x to 5.6x), where the sun's rare samples keep the adaptive frame at 31
+//! to 36 dB, which the brute force reaches in 150 to 600 ms. The brute force's 1 spp frame took
+//! 38 to 46 ms; 16x anti-aliasing cost 2.8x to 4.9x the time of none. Adaptive frames 45 to 173
+//! ms: prediction 9.6 to 19 ms, pyramids, plan and samples 13 to 31, shading, up-sampling and
+//! output 20 to 147 (by lavapipe's clock).
+//! Earlier (stop 25, the frame one submission): `adaptive` 15 of 24 rows at 4x,
+//! `adaptive-prefiltered` 6 of 24 at 10x, in two runs that differed mostly in the brute force's
+//! speed (its 1 spp frame 41 to 54 ms, then 37 to 43). In two submissions (stop 24) and with the
+//! plan and the up-sampling on the CPU (stop 23) the same rows passed: on lavapipe the "GPU" is
+//! the same two cores, and a frame's time is its work, not its waits. Chrome misses in all its
+//! 16 rows (0.6x to 2.0x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a
+//! mirror's reflection loses its detail, and the readings that keep it shade 34 to 98% of the
+//! pixels), a PSNR the brute force reaches at 4 to 32 spp in 82 to 152 ms. The other that misses
+//! 4x: white-paint / quarry / torus at 16 spp (1.9x; in stop 25 two more of its rows, to 3.0x;
+//! its brute-force curve is on the sun's plateau, above).
+//! Drawing the environment behind the mesh once per camera rather than in every frame
 //! shortened the adaptive frames of gold-paint / potsdamer / torus by 1 to 19 ms (the builds
 //! before and after, alternated twice on an idle machine: `adaptive` 4 spp 65 to 67 ms against
 //! 74 to 84, 16 spp 139 to 142 against 149 to 161, pre-filtered 2 spp 49 to 50 against 55 to 58,
 //! 8 spp 87 to 94 against 95 to 96) and the brute force's 1 spp frame by 1 to 5 ms (40 to 41
-//! against 42 to 45); a full run after it (`-- --gpu`): `adaptive` median 10.8x, 15 of 24 rows at 4x (the same rows), pre-filtered 6.2x, 6 at 10x (the same
-//! rows; four more within 15% of it: gold-paint / potsdamer / sphere at 2 spp 8.9x, white-paint
-//! / potsdamer / torus 9.3x and 8.6x, white-paint / quarry / sphere at 8 spp 8.8x), brute force
-//! 1 spp 38 to 46 ms, 16x anti-aliasing 2.8x to 6.7x the time of none.
+//! against 42 to 45); taking the curvature from the CPU's G-buffer shortened the prediction of
+//! gold-paint / potsdamer / sphere from 19 to 23 ms to 17 to 20.
 //! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
-//! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.5x (14 rows at 4x)
-//! and the pre-filtered one stays at 6.3x (7 at 10x); the default stays 2.
+//! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.0x (14 rows at 4x;
+//! 10.7x at level 2 in the same stop) and the pre-filtered one stays at 5.9x (7 at 10x; 5.6x);
+//! the default stays 2.
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
-//! minutes each on the CPU), a rerun 5 to 15 (20 s to a minute a case, with the extras). At this size
-//! 16x anti-aliasing costs 3.5x to 5.5x the time of none on lavapipe (4.3x to 6.7x in stop 24).
+//! minutes each on the CPU), a rerun 5 to 15 (20 s to a minute a case, with the extras). At this
+//! size 16x anti-aliasing cost 3.5x to 5.5x the time of none on lavapipe in stop 25 (4.3x to 6.7x
+//! in stop 24).
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
@@ -597,10 +608,12 @@ fn main() {
             }
             let goal = if label == "adaptive" { 4.0 } else { 10.0 };
             let hit = v.iter().filter(|&&s| s >= goal).count();
+            // Of an even count, the mean of the two middle rows.
+            let middle = v.len() / 2;
+            let median = if v.len() % 2 == 1 { v[middle] } else { (v[middle - 1] + v[middle]) / 2.0 };
             out(format!(
-                "| {label} | {reading} | {:.1} | {:.1} | {:.1} | {hit} of {} (goal {goal}x) |",
+                "| {label} | {reading} | {:.1} | {median:.1} | {:.1} | {hit} of {} (goal {goal}x) |",
                 v[0],
-                v[v.len() / 2],
                 v[v.len() - 1],
                 v.len()
             ));
