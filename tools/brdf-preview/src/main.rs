@@ -511,8 +511,14 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let ms_per_frame = t.total_ms;
     let picture = metrics::tonemap(&frame.image, &preview);
     let aa = settings.supersample * settings.supersample;
+    // The pre-convolved estimator's layers, where they are not the bake's.
+    let layers = match (mode, settings.layer_shift) {
+        (Mode::Prefiltered, 0) => String::new(),
+        (Mode::Prefiltered, n) => format!(" ({n} layer{} sharper)", if n == 1 { "" } else { "s" }),
+        _ => String::new(),
+    };
     let caption = format!(
-        "{} | {} | {} spp budget, {} samples | shaded fraction {:.3} | AA {aa}x | {}x{} | exposure {:+.2} EV",
+        "{} | {}{layers} | {} spp budget, {} samples | shaded fraction {:.3} | AA {aa}x | {}x{} | exposure {:+.2} EV",
         names(&loaded.manifest),
         args.mode.name(),
         settings.spp,
