@@ -138,10 +138,11 @@
 //! the BRDF") reads the Phong layer [`Settings::layer_shift`] layers sharper than the one the
 //! bake's selection picks for the view ([`Material::view_layers`]), the sharpest at most. That
 //! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
-//! `bake`, `stage::layers`), where a sharper layer's noise costs more than its blur: two layers
-//! sharper lose 1.4 to 1.8 dB there (`brdf-preview --mode prefiltered --spp 16 --converged 256`,
-//! 128 x 128 sphere: gold-paint and white-paint under potsdamer 40.43 and 37.84 dB against 38.58
-//! and 36.49; gold-paint under quarry 34.79 and 34.82). A shaded block takes tens of samples, the
+//! `bake`, `stage::layers`), where a sharper layer's noise costs about what its blur saves: two
+//! layers sharper lose 1.4 to 1.8 dB there under potsdamer and gain nothing under quarry
+//! (`brdf-preview --mode prefiltered --spp 16 --converged 256`, 128 x 128 sphere: gold-paint and
+//! white-paint under potsdamer 40.43 and 37.84 dB against 38.58 and 36.49; gold-paint under
+//! quarry 34.79 against 34.82). A shaded block takes tens of samples, the
 //! budget of the pixels it stands for, and there the blur dominates (the adaptive benchmark, 512
 //! x 512 sphere under potsdamer, 2 and 8 spp budgets, in dB, for 0 to 3 layers sharper):
 //! gold-paint 46.23 and 46.38, 50.53 and 51.00, 51.45 and 52.07, 51.53 and 52.15; white-paint
@@ -326,7 +327,7 @@ impl Settings {
 }
 
 /// A shadeable pixel's G-buffer (module docs, "The G-buffer"), what the plan reads; its shading
-/// frame is made again where a pixel is shaded or predicted ([`shading_frame`]). Kept small: a
+/// frame is made again where a pixel is shaded or predicted (`shading_frame`). Kept small: a
 /// frame allocates one per render pixel, and fresh memory costs more than the arithmetic.
 #[derive(Clone, Copy, Debug)]
 pub struct Pixel {
