@@ -138,8 +138,11 @@ bake: build
 $(OUT)/%/manifest.json: $(IN)/%.binary $(ENV) $(BIN)/brdf-bake
 	@$(BIN)/brdf-bake $< $(if $(ENV),--env $(ENV)) --out-dir $(OUT)/$* --quiet || test $$? -eq 1
 
+## lint: clippy on everything, warnings as errors; rustdoc on the libraries, warnings as errors
+## (the tools' doc comments are their --help text, where rustdoc's markup does not apply).
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps --lib
 
 clean-demo:
 	rm -rf $(DEMO)

@@ -15,8 +15,8 @@
 //! with `t = l . r` (`l` makes the angle `2 theta_h` with `r = n`, so `cos^2 theta_h = (1 + t) /
 //! 2`), `D(c) = alpha^2 / (pi (c (alpha^2 - 1) + 1)^2)` and `N = 2 pi int_0^1 D((1 + t) / 2) t dt`
 //! making `K` integrate to 1. `K` depends on `l . r` alone: a zonal lobe around `r`, like the Phong
-//! lobe, so the same two methods compute it exactly ([`crate::sh`] with its Legendre coefficients,
-//! [`crate::window`] over its cap), and the same brute-force sum is its reference.
+//! lobe, so the same two methods compute it exactly (module `sh` with its Legendre coefficients,
+//! module `window` over its cap), and the same brute-force sum is its reference.
 //!
 //! # Legendre coefficients
 //!
