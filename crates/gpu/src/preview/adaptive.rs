@@ -128,9 +128,9 @@ pub(super) struct State {
     clock: Option<Clock>,
 }
 
-/// Five timestamps of a one-submission frame (the starts of its four passes: the prediction; the
-/// pyramids and the plan; the samples and the list; the shading, up-sampling and output; and the
-/// end of the last), and the buffer they resolve into.
+/// Four timestamps of a one-submission frame (the starts of its three passes: the prediction; the
+/// pyramids, the plan, the samples and the list; the shading, up-sampling and output; and the end
+/// of the last), and the buffer they resolve into.
 #[derive(Debug)]
 struct Clock {
     set: wgpu::QuerySet,
@@ -138,7 +138,7 @@ struct Clock {
 }
 
 /// Bytes of [`Clock`]'s timestamps.
-const CLOCK_BYTES: u64 = 5 * 8;
+const CLOCK_BYTES: u64 = 4 * 8;
 
 /// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
 #[derive(Debug)]
@@ -417,7 +417,7 @@ impl Renderer {
                 set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("adaptive stages"),
                     ty: wgpu::QueryType::Timestamp,
-                    count: 5,
+                    count: 4,
                 }),
                 resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("adaptive stages"),
@@ -613,8 +613,6 @@ impl Renderer {
                 }
                 run(&mut cpass, &pipelines.plan, plan_slot, groups(candidates));
                 if on_gpu {
-                    drop(cpass);
-                    cpass = self.begin_timed_pass(&mut encoder, stamp(2, None));
                     run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
                 }
                 run(&mut cpass, &pipelines.chunks, plan_slot, super::workgroups(chunks));
@@ -637,9 +635,9 @@ impl Renderer {
                     0,
                     24,
                 );
-                shading(&mut self.begin_timed_pass(&mut encoder, stamp(3, Some(4))), None, None);
+                shading(&mut self.begin_timed_pass(&mut encoder, stamp(2, Some(3))), None, None);
                 if let Some(clock) = state.clock.as_ref() {
-                    encoder.resolve_query_set(&clock.set, 0..5, &clock.resolved, 0);
+                    encoder.resolve_query_set(&clock.set, 0..4, &clock.resolved, 0);
                 }
             }
             encoder
@@ -716,7 +714,7 @@ impl Renderer {
                 let period_ms = f64::from(self.queue.get_timestamp_period()) * 1e-6;
                 let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period_ms;
                 let (predict_ms, plan_ms, stages_ms) =
-                    if ticks.len() == 5 { (ms(0, 1), ms(1, 3), ms(3, 4)) } else { (0.0, 0.0, shade_ms) };
+                    if ticks.len() == 4 { (ms(0, 1), ms(1, 2), ms(2, 3)) } else { (0.0, 0.0, shade_ms) };
                 Timings {
                     gbuffer_ms: geometry.millis(),
                     predict_ms,
@@ -724,7 +722,7 @@ impl Renderer {
                     shade_ms: stages_ms,
                     total_ms: shade_ms,
                     submissions: 1,
-                    gpu_clock: ticks.len() == 5,
+                    gpu_clock: ticks.len() == 4,
                 }
             } else {
                 Timings {
