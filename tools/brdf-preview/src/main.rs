@@ -513,8 +513,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let aa = settings.supersample * settings.supersample;
     // The pre-convolved estimator's layers, where they are not the bake's.
     let layers = match (mode, settings.layer_shift) {
-        (Mode::Prefiltered, 0) => String::new(),
-        (Mode::Prefiltered, n) => format!(" ({n} layer{} sharper)", if n == 1 { "" } else { "s" }),
+        (Mode::Prefiltered, n) if n > 0 => format!(" ({n} layer{} sharper)", if n == 1 { "" } else { "s" }),
         _ => String::new(),
     };
     let caption = format!(
