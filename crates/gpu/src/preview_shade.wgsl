@@ -590,11 +590,13 @@ fn item_index(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
 
 // The shaded blocks of an adaptive frame (`render::adaptive`), in parts: item `i` of `shade.spp`
 // items arrives in `accumulation[i]` as the bits of (pixel, samples, first, count) and leaves as
-// terms `first .. first + count` of the pixel's estimate in frame 0 with that many samples
+// terms `first .. first + count` of the pixel's estimate with that many samples
 // (`render::adaptive`'s shading, the same estimator as `shade_frame`) over `samples`, w = 1: the
-// parts of a block sum to its estimate. A block's samples in several parts run side by side
-// rather than one after another in one invocation. Each invocation reads and writes its own
-// item only.
+// parts of a block sum to its estimate. Up to a vector's `n_samples` the samples are frame 0's;
+// a block of more reads `samples / n_samples` frames of `n_samples` (term `j` is term
+// `j % n_samples` of frame `j / n_samples`), a part that spans frames taking each frame's terms
+// in turn. A block's samples in several parts run side by side rather than one after another in
+// one invocation. Each invocation reads and writes its own item only.
 @compute @workgroup_size(64)
 fn shade_blocks(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -610,7 +612,16 @@ fn shade_blocks(
     let surface = surface_at(i32(pixel % shade.width), i32(pixel / shade.width));
     var radiance = vec3<f32>(0.0);
     if (surface.found) {
-        radiance = estimate_sum(surface.frame, pixel, 0u, item.y, item.z, item.w) / f32(item.y);
+        let per_frame = min(item.y, shade.n_samples);
+        var j = item.z;
+        let end = item.z + item.w;
+        while (j < end) {
+            let first = j % per_frame;
+            let count = min(end - j, per_frame - first);
+            radiance += estimate_sum(surface.frame, pixel, j / per_frame, per_frame, first, count);
+            j += count;
+        }
+        radiance /= f32(item.y);
     }
     accumulation[i] = vec4<f32>(radiance, 1.0);
 }

@@ -599,25 +599,31 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
 /// modes' tolerances, with and without anti-aliasing, for both estimators, with the lobe weight
 /// and with the oracle's bandwidths in place of the prediction's; with the samples allocated on
 /// the GPU (the area allocation: one submission; at 64 samples per pixel levels reach the cap
-/// of 64) and on the host (the variance and the standard deviation). A budget below a sample
-/// per shaded block is the same error on either.
+/// of 64) and on the host (the variance and the standard deviation); with the default cap,
+/// blocks of more samples than the 64 of a vector (several vectors; at 256 spp parts of 128
+/// samples, each across two vectors). A budget below a sample per shaded block is the same
+/// error on either.
 #[test]
 fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
     use render::adaptive::Allocation::{Area, StdDev, Variance};
-    for (mode, supersample, spp, lobe_weight, oracle, allocation) in [
-        (Mode::Reference, 1, 8, false, false, Area),
-        (Mode::Prefiltered, 1, 4, false, false, Area),
-        (Mode::Reference, 2, 4, false, false, Area),
-        (Mode::Reference, 1, 8, true, false, Variance),
-        (Mode::Reference, 1, 8, false, true, Area),
-        (Mode::Reference, 1, 64, false, false, Area),
-        (Mode::Prefiltered, 1, 4, false, false, StdDev),
+    const ONE_VECTOR: u32 = 64;
+    const DEFAULT: u32 = render::adaptive::MAX_SPP;
+    for (mode, supersample, spp, lobe_weight, oracle, allocation, max_spp) in [
+        (Mode::Reference, 1, 8, false, false, Area, ONE_VECTOR),
+        (Mode::Prefiltered, 1, 4, false, false, Area, ONE_VECTOR),
+        (Mode::Reference, 2, 4, false, false, Area, ONE_VECTOR),
+        (Mode::Reference, 1, 8, true, false, Variance, ONE_VECTOR),
+        (Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
+        (Mode::Reference, 1, 64, false, false, Area, ONE_VECTOR),
+        (Mode::Prefiltered, 1, 4, false, false, StdDev, ONE_VECTOR),
+        (Mode::Reference, 1, 256, false, false, Area, DEFAULT),
+        (Mode::Prefiltered, 1, 32, false, false, StdDev, DEFAULT),
     ] {
         let settings = render::adaptive::Settings {
             supersample,
-            max_spp: 64,
+            max_spp,
             lobe_weight,
             allocation,
             ..render::adaptive::Settings::new(mode, spp)
@@ -655,9 +661,19 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         }
         let shaded: usize = cpu_frame.shaded_per_level.iter().sum();
         assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
+        let most = (cpu_frame.details().plan.actions.iter().flatten())
+            .filter_map(|a| match *a {
+                render::adaptive::Action::Shade { samples, .. } => Some(samples),
+                _ => None,
+            })
+            .max();
+        if max_spp > ONE_VECTOR {
+            assert!(most > Some(ONE_VECTOR), "the largest block has {most:?} samples");
+        }
         let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
         log(&format!(
-            "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples, \
+            "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples \
+             (at most {most:?} a block), \
              worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}, {} submissions, \
              stages {:.2} + {:.2} + {:.2} ms of {:.2} (GPU clock: {})",
             mode.name(),

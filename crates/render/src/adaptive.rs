@@ -124,16 +124,24 @@
 //!   samples follow from the shaded blocks per level alone: [`area_allocation`] computes them
 //!   in exact integers (as `gpu::preview` does on the GPU, without a sort);
 //!
-//! at most `max_spp` (what a capped block cannot
+//! at most the cap (what a capped block cannot
 //! take goes to the others), rounded down to a power of two (the baked vectors are read in
 //! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
 //! blocks furthest below their share, while it fits. The total never exceeds the budget; a
-//! budget below one sample per shaded block is an error.
+//! budget below one sample per shaded block is an error. The cap is [`Settings::max_spp`]
+//! within a slice's samples ([`Settings::block_cap`]): by default ([`MAX_SPP`]) a block may read
+//! every vector of its slice (see "Shading"), so that the budget is spent. (A cap of one vector
+//! left it unspent wherever the plan shades few blocks: on the benchmark's sphere at 512 x 512,
+//! whose plans shade 2% of the pixels, every block reached 256 samples, and a 16 spp budget
+//! spent 584704 of 2076672 samples.)
 //!
 //! # Shading
 //!
-//! A shaded block is shaded by the chosen estimator with its count as `spp` and one frame, at
-//! its pixel (the random chunk of that pixel). The pre-convolved estimator (`001` section 2.5:
+//! A shaded block is shaded by the chosen estimator at its pixel: up to the `N` samples of a
+//! baked vector, with its count as `spp` and one frame (the random chunk of that pixel); a block
+//! of more samples (a power of two, so a multiple of `N`) with `spp = N` and `count / N` frames,
+//! that is whole vectors, the first `count / N` of its pixel's walk through the slice's `V`
+//! vectors (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`. The pre-convolved estimator (`001` section 2.5:
 //! samples of the illumination "pre-filtered ... at the level given by the maximum frequency of
 //! the BRDF") reads the Phong layer [`Settings::layer_shift`] layers sharper than the one the
 //! bake's selection picks for the view ([`Material::view_layers`]), the sharpest at most. That
@@ -167,7 +175,7 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::raster::GBuffer;
 use crate::shade::{ShadingFrame, background, brdf, shade, slice_of, visibility_of};
-use crate::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, pcg_hash};
+use crate::{Camera, Image, Lighting, Material, Mesh, Mode, SampleSet, Scene, pcg_hash};
 
 /// The environment's local angular bandwidth, in cycles per radian, on the environment's
 /// lat-long grid (`envmap`'s orientation): the bake's `env-bandwidth.exr`.
@@ -236,8 +244,10 @@ pub struct Settings {
     pub mode: Mode,
     /// The budget: mean samples per covered pixel of the output image.
     pub spp: u32,
-    /// The most samples one shaded block gets: a power of two dividing the bake's samples per
-    /// vector.
+    /// The most samples one shaded block gets: a power of two. A block with more samples than
+    /// a baked vector holds reads several whole vectors (module docs, "Shading"); a frame reads
+    /// at most the samples of a slice, so the cap it applies is [`Settings::block_cap`].
+    /// Default [`MAX_SPP`].
     pub max_spp: u32,
     /// Incident directions per pixel for the prediction (`n_b`).
     pub n_b: usize,
@@ -270,6 +280,10 @@ pub struct Settings {
 
 /// [`Settings::layer_shift`]'s default (module docs, "Shading").
 pub const LAYER_SHIFT: u32 = 1;
+
+/// [`Settings::max_spp`]'s default: no cap below a slice's samples for any bake up to 2^16 of
+/// them, the most the GPU's allocation takes (`gpu::preview`).
+pub const MAX_SPP: u32 = 1 << 16;
 
 /// How a frame's samples are shared among its shaded blocks (module docs, "Samples").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -304,14 +318,23 @@ impl Settings {
         self.predict_level.saturating_add(self.supersample.trailing_zeros() as usize).min(top)
     }
 
+    /// The most samples a block gets with `samples`: [`Settings::max_spp`], at most the largest
+    /// power of two within a slice's `V N` samples (beyond them a block would read a vector
+    /// twice). A frame applies this cap ([`render_with`], `gpu::preview`).
+    pub fn block_cap(&self, samples: &SampleSet) -> u32 {
+        let slice = (samples.n_vectors as u64).saturating_mul(samples.n_samples as u64).max(1);
+        let slice = 1u64 << (63 - slice.leading_zeros());
+        u64::from(self.max_spp).min(slice) as u32
+    }
+
     /// The defaults for a mode and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
-    /// `max_spp` 256, depth sigma 0.02, seed 0, a prediction per pixel, samples in proportion
-    /// to the variance (the paper's choices where it makes one).
+    /// `max_spp` [`MAX_SPP`], depth sigma 0.02, seed 0, a prediction per pixel, samples in
+    /// proportion to the variance (the paper's choices where it makes one).
     pub fn new(mode: Mode, spp: u32) -> Self {
         Settings {
             mode,
             spp,
-            max_spp: 256,
+            max_spp: MAX_SPP,
             n_b: 16,
             seed: 0,
             supersample: 1,
@@ -1239,8 +1262,14 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
             settings.mode.name()
         )));
     }
-    let base = crate::Settings { mode: settings.mode, spp: settings.max_spp, frames: 1, seed: settings.seed };
-    crate::check_settings(&base, material.samples.n_samples, lighting.layers.len(), &material.view_layers)?;
+    if !settings.max_spp.is_power_of_two() {
+        return Err(Error::Invalid(format!("max_spp {} must be a power of two", settings.max_spp)));
+    }
+    // A block's samples are read a vector's worth (at most) at a time: the chunks' check.
+    let n_samples = material.samples.n_samples;
+    let per_frame = settings.max_spp.min(u32::try_from(n_samples).unwrap_or(u32::MAX));
+    let base = crate::Settings { mode: settings.mode, spp: per_frame, frames: 1, seed: settings.seed };
+    crate::check_settings(&base, n_samples, lighting.layers.len(), &material.view_layers)?;
     if settings.spp == 0 || settings.n_b == 0 || !matches!(settings.supersample, 1 | 2 | 4) {
         return Err(Error::Invalid(format!(
             "spp {} and n_b {} must be at least 1 and supersample ({}) 1, 2 or 4",
@@ -1377,6 +1406,7 @@ pub fn render_with(
     let Hooks { oracle, predictor, shader } = hooks;
     crate::check_inputs(material, lighting)?;
     check_settings(settings, material, lighting)?;
+    let settings = &Settings { max_spp: settings.block_cap(&material.samples), ..*settings };
     if settings.supersample != geometry.supersample {
         return Err(Error::Invalid(format!(
             "a frame supersampled {} times from a geometry made for {}",
@@ -1432,6 +1462,8 @@ pub fn render_with(
     let plan_ms = lap();
 
     // Shading does not depend on up-sampling: every shaded block at once, then coarse to fine.
+    // A block's samples come a vector's worth at most per frame (module docs, "Shading").
+    let n_samples = material.samples.n_samples as u32;
     let mut shaded: Vec<(u32, u32)> = Vec::new();
     let mut slot: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
     for (k, actions) in plan.actions.iter().enumerate() {
@@ -1455,7 +1487,8 @@ pub fn render_with(
             .par_iter()
             .map(|&(pixel, samples)| {
                 let local = shading_frame(gbuffer, frame.eye, pixel as usize);
-                let shading = crate::Settings { mode: settings.mode, spp: samples, frames: 1, seed: settings.seed };
+                let spp = samples.min(n_samples);
+                let shading = crate::Settings { mode: settings.mode, spp, frames: samples / spp, seed: settings.seed };
                 shade(&local, pixel, material, lighting, &shading, settings.layer_shift).map(|v| v as f32)
             })
             .collect(),

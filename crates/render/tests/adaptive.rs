@@ -193,6 +193,68 @@ fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
 }
 
 #[test]
+fn a_block_of_more_samples_than_a_vector_reads_whole_vectors() {
+    // Vectors of 8 samples (each of phong's slices cut into 1024 of them). A plan that may not
+    // coarsen, at 32 samples per pixel and the cap at the mean, shades every pixel with four
+    // whole vectors, the frames 0 to 3 of its walk: the full-resolution renderer's 4 frames of 8.
+    let (phong, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
+    let s = &phong.samples;
+    let samples = render::SampleSet { n_samples: 8, n_vectors: s.n_vectors * s.n_samples / 8, ..s.clone() };
+    let material = render::Material { samples, ..phong.clone() };
+    let scene = sphere_scene(40, 30);
+    for mode in [Mode::Reference, Mode::Prefiltered] {
+        let settings =
+            adaptive::Settings { max_level: Some(0), max_spp: 32, seed: 3, ..adaptive::Settings::new(mode, 32) };
+        let frame = adaptive::render(&scene, &material, &lighting, &bandwidths, &settings).unwrap();
+        let full =
+            render::render(&scene, &material, &lighting, &Settings { mode, spp: 8, frames: 4, seed: 3 }).unwrap();
+        assert_eq!(frame.image.rgb, full.rgb, "{}", mode.name());
+        // Not the first frame's vector four times over.
+        let first =
+            render::render(&scene, &material, &lighting, &Settings { mode, spp: 8, frames: 1, seed: 3 }).unwrap();
+        assert_ne!(frame.image.rgb, first.rgb);
+    }
+    // A coarse plan with the default cap spends its budget: its coarse blocks take many vectors
+    // (a cap of one vector, as before, left all but 8 samples a block of it unspent).
+    let settings =
+        adaptive::Settings { allocation: adaptive::Allocation::Area, ..adaptive::Settings::new(Mode::Reference, 64) };
+    let frame = adaptive::render(&scene, &material, &lighting, &bandwidths, &settings).unwrap();
+    let counts: Vec<u32> = frame
+        .details()
+        .plan
+        .actions
+        .iter()
+        .flatten()
+        .filter_map(|a| match *a {
+            Action::Shade { samples, .. } => Some(samples),
+            _ => None,
+        })
+        .collect();
+    let most = *counts.iter().max().unwrap();
+    assert!(most > 8 && most <= settings.block_cap(&material.samples), "{most} samples");
+    assert!(2 * frame.samples > frame.budget && frame.samples <= frame.budget, "{} of {}", frame.samples, frame.budget);
+    assert!(frame.samples > 8 * counts.len() as u64);
+}
+
+#[test]
+fn the_block_cap_is_max_spp_within_a_slice() {
+    let phong = phong(1);
+    let s = &phong.samples;
+    let three =
+        render::SampleSet { n_vectors: 3, n_samples: 8, texels: s.texels[..s.n_slices * 24].to_vec(), ..s.clone() };
+    let settings = adaptive::Settings::new(Mode::Reference, 4);
+    assert_eq!(settings.max_spp, adaptive::MAX_SPP);
+    // 3 vectors of 8: 24 samples a slice, 16 the largest power of two within them.
+    assert_eq!(settings.block_cap(&three), 16);
+    assert_eq!(adaptive::Settings { max_spp: 4, ..settings }.block_cap(&three), 4);
+    assert_eq!(settings.block_cap(s), (s.n_vectors * s.n_samples) as u32);
+    let (lighting, bandwidths) = (sky_lighting(), bandwidths());
+    let odd = adaptive::Settings { max_spp: 24, ..settings };
+    let error = adaptive::render(&sphere_scene(8, 8), phong, &lighting, &bandwidths, &odd).unwrap_err().to_string();
+    assert!(error.contains("max_spp 24 must be a power of two"), "{error}");
+}
+
+#[test]
 fn pre_convolved_blocks_read_the_layer_layer_shift_sharper() {
     // Three layers of the sky, each a different scale of it; every view picks layer 0. A plan
     // that may not coarsen with a layer shift is the full-resolution renderer with the views'

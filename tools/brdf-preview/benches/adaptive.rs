@@ -56,7 +56,27 @@
 //! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
 //! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
 //!
-//! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 26 (the environment
+//! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 27, after a shaded
+//! block may read several baked vectors (`render::adaptive`, "Samples": the cap was one vector
+//! of 256 samples, and the sphere's plans, which shade 2% of the pixels, left most of a large
+//! budget unspent): the builds before and after, run one after the other, then the new one
+//! again: `adaptive` median 10.3x before, 8.7x and 8.6x after, 15 of 24 rows at 4x or more in
+//! each; `adaptive-prefiltered` 7.1x before, 9.4x and 9.3x after (the middle rows 9.4x and
+//! 9.4x), 10 then 11 and 11 rows at 10x or more. At equal budget the frames are as good or
+//! better in 21 of the 24 rows of each mode (gold-paint / potsdamer / sphere at 16 spp 52.93 dB
+//! against 51.81, with 2075648 samples against 584704; white-paint / quarry / sphere
+//! pre-filtered at 8 spp 36.83 against 35.77, from 4.8x to more than 17x); where the extra
+//! samples buy little (near the ceiling) the frame takes longer for little gain (the same
+//! gold-paint row 203 ms against 96, 15.3x to 8.4x), and under quarry's sun three rows lose up
+//! to 0.4 dB (white-paint / quarry / sphere pre-filtered at 2 spp 34.67 against 35.09 dB: the
+//! coarse blocks take more of the budget than the cap left them). The torus's plans shade
+//! enough blocks that the cap rarely bound; its rows moved by the brute force's timing alone
+//! (its 1 spp frame 35 to 42 ms in these runs, 38 to 46 in stop 26). Other readings (the
+//! second run after): level-normalized 1.9x and 1.5x, the FFT oracle 3.6x and 3.0x, paper +
+//! lobe weight 8.3x and 9.1x. Adaptive frames 43 to 223 ms; 16x anti-aliasing 2.7x to 4.1x the
+//! time of none.
+//!
+//! Stop 26 (the environment
 //! behind the mesh drawn once per camera, the prediction's curvature the CPU G-buffer's,
 //! `adaptive-prefiltered`'s blocks one layer sharper than the bake's pick: `render::adaptive`,
 //! "Shading"): `adaptive` median 11.0x, 15 of 24 rows at 4x or more; `adaptive-prefiltered`

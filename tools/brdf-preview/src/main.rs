@@ -476,7 +476,6 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         )
     })?;
     let mode = args.mode.estimator();
-    let n_samples = loaded.material.samples.n_samples as u32;
     let settings = render::adaptive::Settings {
         supersample: args.aa,
         predict_level: args.predict_level,
@@ -487,7 +486,6 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         },
         lobe_weight: args.lobe_weight,
         layer_shift: args.layer_shift,
-        max_spp: n_samples.min(256),
         seed: args.seed,
         ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
     };
