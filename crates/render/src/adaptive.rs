@@ -141,17 +141,19 @@
 //! baked vector, with its count as `spp` and one frame (the random chunk of that pixel); a block
 //! of more samples (a power of two, so a multiple of `N`) with `spp = N` and `count / N` frames,
 //! that is whole vectors, the first `count / N` of its pixel's walk through the slice's `V`
-//! vectors (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`. The pre-convolved estimator (`001` section 2.5:
-//! samples of the illumination "pre-filtered ... at the level given by the maximum frequency of
-//! the BRDF") reads the Phong layer [`Settings::layer_shift`] layers sharper than the one the
-//! bake's selection picks for the view ([`Material::view_layers`]), the sharpest at most. That
-//! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
-//! `bake`, `stage::layers`), where a sharper layer's noise costs about what its blur saves: two
-//! layers sharper lose 1.4 to 1.8 dB there under potsdamer and gain nothing under quarry
-//! (`brdf-preview --mode prefiltered --spp 16 --converged 256`, 128 x 128 sphere: gold-paint and
-//! white-paint under potsdamer 40.43 and 37.84 dB against 38.58 and 36.49; gold-paint under
-//! quarry 34.79 against 34.82). A shaded block takes tens of samples, the
-//! budget of the pixels it stands for, and there the blur dominates (the adaptive benchmark, 512
+//! vectors (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
+//!
+//! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
+//! ... at the level given by the maximum frequency of the BRDF") reads the Phong layer
+//! [`Settings::layer_shift`] layers sharper than the one the bake's selection picks for the view
+//! ([`Material::view_layers`]), the sharpest at most. That selection was chosen for the
+//! full-resolution pre-filtered mode at 16 samples per pixel (crate `bake`, `stage::layers`),
+//! where a sharper layer's noise costs about what its blur saves: two layers sharper lose 1.4 to
+//! 1.8 dB there under potsdamer and gain nothing under quarry (`brdf-preview --mode prefiltered
+//! --spp 16 --converged 256`, 128 x 128 sphere: gold-paint and white-paint under potsdamer 40.43
+//! and 37.84 dB against 38.58 and 36.49; gold-paint under quarry 34.79 against 34.82). A shaded
+//! block takes tens to hundreds of samples, the budget of the pixels it stands for, and there
+//! the blur dominates (measured with blocks of at most 256 samples: the adaptive benchmark, 512
 //! x 512 sphere under potsdamer, 2 and 8 spp budgets, in dB, for 0 to 3 layers sharper):
 //! gold-paint 46.23 and 46.38, 50.53 and 51.00, 51.45 and 52.07, 51.53 and 52.15; white-paint
 //! 48.80 and 49.19, 49.61 and 50.09, 49.67 and 50.15, 49.63 and 50.10. Under quarry, whose sun a
