@@ -312,8 +312,12 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
     if (n.x == 0.0 && n.y == 0.0) {
         n = vec2<f32>(1.0, 0.0);
     }
-    var chosen = array<u32, 4>(0u, 0u, 0u, 0u);
-    var w = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    // The counted parents and their weights, slot `count` the next: vectors written and searched
+    // by masks (an array indexed by a variable would live in scratch memory, which costs about
+    // 1.5 ms a dispatch on llvmpipe).
+    let slots = vec4<u32>(0u, 1u, 2u, 3u);
+    var chosen = vec4<u32>(0u);
+    var w = vec4<f32>(0.0);
     var count = 0u;
     var total = 0.0;
     for (var j = 0u; j < 4u; j++) {
@@ -323,10 +327,7 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
         let px = min(first.x + dx, parent.x - 1u);
         let py = min(first.y + dy, parent.y - 1u);
         let b = py * parent.x + px;
-        var seen = false;
-        for (var m = 0u; m < count; m++) {
-            seen = seen || chosen[m] == b;
-        }
+        let seen = any((chosen == vec4<u32>(b)) & (slots < vec4<u32>(count)));
         if (alpha <= 0.0 || min_level(parent.z + b) < i32(k + 1u) || seen) {
             continue;
         }
@@ -347,8 +348,9 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
         }
         let weight = g_z * g_a * alpha * g_lobe;
         if (weight >= MIN_WEIGHT) {
-            chosen[count] = b;
-            w[count] = weight;
+            let slot = slots == vec4<u32>(count);
+            chosen = select(chosen, vec4<u32>(b), slot);
+            w = select(w, vec4<f32>(weight), slot);
             total += weight;
             count += 1u;
         }
@@ -356,8 +358,8 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
     if (count == 0u || !(total > adapt.rescue_below)) {
         return 0u;
     }
-    parents[block] = vec4<u32>(chosen[0], chosen[1], chosen[2], chosen[3]);
-    weights[block] = vec4<f32>(w[0], w[1], w[2], w[3]) / total;
+    parents[block] = chosen;
+    weights[block] = w / total;
     return count;
 }
 
@@ -450,21 +452,34 @@ fn level_items(count: u32, doubled: u32, samples: u32, part: u32) -> u32 {
     return doubled * div_ceil(2u * samples, part) + (count - doubled) * div_ceil(samples, part);
 }
 
+// `adaptive_allocate`'s per-level state, in workgroup memory (its one invocation's): arrays in
+// function memory indexed by a variable live in scratch memory on llvmpipe, which costs about
+// 1.5 ms a dispatch there however little the shader runs.
+var<workgroup> alloc_counts: array<u32, MAX_LEVELS>;
+var<workgroup> alloc_capped: array<bool, MAX_LEVELS>;
+var<workgroup> alloc_shift: array<u32, MAX_LEVELS>;
+var<workgroup> alloc_doubled: array<u32, MAX_LEVELS>;
+var<workgroup> alloc_full: array<bool, MAX_LEVELS>;
+var<workgroup> alloc_done: array<bool, MAX_LEVELS>;
+
 // `render::adaptive::area_allocation` of the shaded blocks per level (`adaptive_plan`'s counts),
 // step for step in integers, and `preview/adaptive.rs`'s `parts` of its samples: the samples per
 // part, each level's first item and first rank, the items in all and the workgroups of
 // `shade_blocks` and of the list's passes. One invocation: a few levels.
 @compute @workgroup_size(1)
 fn adaptive_allocate() {
-    var counts: array<u32, MAX_LEVELS>;
-    var capped: array<bool, MAX_LEVELS>;
-    var shift: array<u32, MAX_LEVELS>;
-    var doubled: array<u32, MAX_LEVELS>;
     let levels_n = adapt.top + 1u;
     var n = 0u;
-    for (var k = 0u; k < levels_n; k++) {
-        counts[k] = control_word(CONTROL_COUNTS + k);
-        n += counts[k];
+    for (var k = 0u; k < MAX_LEVELS; k++) {
+        alloc_counts[k] = 0u;
+        if (k < levels_n) {
+            alloc_counts[k] = control_word(CONTROL_COUNTS + k);
+        }
+        n += alloc_counts[k];
+        alloc_capped[k] = false;
+        alloc_shift[k] = 0u;
+        alloc_doubled[k] = 0u;
+        alloc_done[k] = false;
     }
     if (n > adapt.budget) {
         set_control(CONTROL_STATUS, 1u);
@@ -478,52 +493,50 @@ fn adaptive_allocate() {
     loop {
         total = 0u;
         for (var k = 0u; k < levels_n; k++) {
-            if (counts[k] > 0u && !capped[k]) {
-                total += counts[k] << k;
+            if (alloc_counts[k] > 0u && !alloc_capped[k]) {
+                total += alloc_counts[k] << k;
             }
         }
         if (spare == 0u || total == 0u) {
             break;
         }
         let bar = wide_sub(wide_shl(wide(total), cap_shift), wide(total));
-        var full = array<bool, MAX_LEVELS>();
         var some_full = false;
         for (var k = 0u; k < levels_n; k++) {
-            full[k] = counts[k] > 0u && !capped[k] && wide_le(bar, wide_shl(wide(spare), k));
-            some_full = some_full || full[k];
+            alloc_full[k] = alloc_counts[k] > 0u && !alloc_capped[k] && wide_le(bar, wide_shl(wide(spare), k));
+            some_full = some_full || alloc_full[k];
         }
         if (!some_full) {
             sharing = true;
             break;
         }
         for (var k = 0u; k < levels_n; k++) {
-            if (full[k]) {
-                spare -= counts[k] * (adapt.max_spp - 1u);
-                capped[k] = true;
+            if (alloc_full[k]) {
+                spare -= alloc_counts[k] * (adapt.max_spp - 1u);
+                alloc_capped[k] = true;
             }
         }
     }
     // Each level's power of two below its share (total + spare 2^k over total where shared).
     var left = adapt.budget;
     for (var k = 0u; k < levels_n; k++) {
-        if (capped[k]) {
-            shift[k] = cap_shift;
-        } else if (sharing && counts[k] > 0u) {
+        if (alloc_capped[k]) {
+            alloc_shift[k] = cap_shift;
+        } else if (sharing && alloc_counts[k] > 0u) {
             let share = wide_add(wide(total), wide_shl(wide(spare), k));
-            while (shift[k] < cap_shift && wide_le(wide_shl(wide(total), shift[k] + 1u), share)) {
-                shift[k] += 1u;
+            while (alloc_shift[k] < cap_shift && wide_le(wide_shl(wide(total), alloc_shift[k] + 1u), share)) {
+                alloc_shift[k] += 1u;
             }
         }
-        left -= counts[k] << shift[k];
+        left -= alloc_counts[k] << alloc_shift[k];
     }
     // Doubling, furthest below the share first (the lesser level among equals): only the shared
     // levels can (a capped level is at max_spp; without a shared round nothing is left).
     if (sharing) {
-        var done = array<bool, MAX_LEVELS>();
         loop {
             var best = MAX_LEVELS;
             for (var k = 0u; k < levels_n; k++) {
-                if (capped[k] || counts[k] == 0u || done[k]) {
+                if (alloc_capped[k] || alloc_counts[k] == 0u || alloc_done[k]) {
                     continue;
                 }
                 if (best == MAX_LEVELS) {
@@ -531,8 +544,8 @@ fn adaptive_allocate() {
                     continue;
                 }
                 // share_k / 2^shift_k > share_best / 2^shift_best
-                let mine = wide_shl(wide_add(wide(total), wide_shl(wide(spare), k)), shift[best]);
-                let theirs = wide_shl(wide_add(wide(total), wide_shl(wide(spare), best)), shift[k]);
+                let mine = wide_shl(wide_add(wide(total), wide_shl(wide(spare), k)), alloc_shift[best]);
+                let theirs = wide_shl(wide_add(wide(total), wide_shl(wide(spare), best)), alloc_shift[k]);
                 if (!wide_le(mine, theirs)) {
                     best = k;
                 }
@@ -540,10 +553,10 @@ fn adaptive_allocate() {
             if (best == MAX_LEVELS) {
                 break;
             }
-            done[best] = true;
-            if (shift[best] < cap_shift) {
-                doubled[best] = min(counts[best], left >> shift[best]);
-                left -= doubled[best] << shift[best];
+            alloc_done[best] = true;
+            if (alloc_shift[best] < cap_shift) {
+                alloc_doubled[best] = min(alloc_counts[best], left >> alloc_shift[best]);
+                left -= alloc_doubled[best] << alloc_shift[best];
             }
         }
     }
@@ -554,7 +567,7 @@ fn adaptive_allocate() {
     loop {
         items = 0u;
         for (var k = 0u; k < levels_n; k++) {
-            items += level_items(counts[k], doubled[k], 1u << shift[k], part);
+            items += level_items(alloc_counts[k], alloc_doubled[k], 1u << alloc_shift[k], part);
         }
         if (items <= adapt.capacity || part >= 0x7fffffffu) {
             break;
@@ -565,13 +578,13 @@ fn adaptive_allocate() {
     var first_rank = 0u;
     for (var k = 0u; k < levels_n; k++) {
         let at = CONTROL_LEVELS + 4u * k;
-        let samples = 1u << shift[k];
+        let samples = 1u << alloc_shift[k];
         set_control(at, samples);
-        set_control(at + 1u, doubled[k]);
+        set_control(at + 1u, alloc_doubled[k]);
         set_control(at + 2u, first_item);
         set_control(at + 3u, first_rank);
-        first_item += level_items(counts[k], doubled[k], samples, part);
-        first_rank += counts[k];
+        first_item += level_items(alloc_counts[k], alloc_doubled[k], samples, part);
+        first_rank += alloc_counts[k];
     }
     set_control(CONTROL_SAMPLES, adapt.budget - left);
     set_control(CONTROL_PARTS, items);

@@ -75,6 +75,16 @@
 //! second run after): level-normalized 1.9x and 1.5x, the FFT oracle 3.6x and 3.0x, paper +
 //! lobe weight 8.3x and 9.1x. Adaptive frames 43 to 223 ms; 16x anti-aliasing 2.7x to 4.1x the
 //! time of none.
+//! Then, in the same stop, the WGSL without function-local arrays indexed by a variable
+//! (llvmpipe keeps those in scratch memory, about 1.5 ms a dispatch: `adaptive_allocate` took
+//! 1.7 to 2.0 ms though it runs one invocation over a few levels, 0.1 ms after; ARCHITECTURE,
+//! `gpu`): the builds before and after alternated twice (`-- --gpu --no-extras`), the pyramids,
+//! plan and samples 16.2 and 15.9 ms on average before, 13.0 and 12.8 after; `adaptive` median
+//! 8.75x and 8.45x before, 8.95x and 8.5x after (15 of 24 rows each); `adaptive-prefiltered`
+//! 9.35x and 8.65x before (11 rows at 10x), 10.2x and 10.1x after (13 rows: white-paint /
+//! potsdamer / torus at 2 and 8 spp, 10.2x and 10.0x in the second run, cross the line: the
+//! median sits at the goal, within the brute force's timing noise, not above it). Adaptive
+//! frames 40 to 218 ms, the brute force's 1 spp frame 34 to 40 ms.
 //!
 //! Stop 26 (the environment
 //! behind the mesh drawn once per camera, the prediction's curvature the CPU G-buffer's,
