@@ -322,7 +322,7 @@ impl Settings {
 
     /// The most samples a block gets with `samples`: [`Settings::max_spp`], at most the largest
     /// power of two within a slice's `V N` samples (beyond them a block would read a vector
-    /// twice). A frame applies this cap ([`render_with`], `gpu::preview`).
+    /// twice). A frame applies this cap ([`check_settings`] gives its settings).
     pub fn block_cap(&self, samples: &SampleSet) -> u32 {
         let slice = (samples.n_vectors as u64).saturating_mul(samples.n_samples as u64).max(1);
         let slice = 1u64 << (63 - slice.leading_zeros());
@@ -1256,8 +1256,10 @@ impl Adaptive {
     }
 }
 
-/// The checks [`render`] makes on its settings.
-pub fn check_settings(settings: &Settings, material: &Material, lighting: &Lighting) -> Result<(), Error> {
+/// The checks [`render`] makes on its settings, and the settings a frame of `material` runs
+/// with: these with [`Settings::max_spp`] lowered to the block cap ([`Settings::block_cap`]).
+/// Both renderers take their frame's settings from here.
+pub fn check_settings(settings: &Settings, material: &Material, lighting: &Lighting) -> Result<Settings, Error> {
     if !matches!(settings.mode, Mode::Reference | Mode::Prefiltered) {
         return Err(Error::Invalid(format!(
             "adaptive shading uses the reference or the prefiltered estimator, not {}",
@@ -1289,7 +1291,7 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
     if !(settings.depth_sigma > 0.0 && settings.depth_sigma.is_finite()) {
         return Err(Error::Invalid(format!("depth sigma {} must be positive", settings.depth_sigma)));
     }
-    Ok(())
+    Ok(Settings { max_spp: settings.block_cap(&material.samples), ..*settings })
 }
 
 /// The pyramid's top level for a render of `width x height`: eq. 11's `floor(log2(min(w, h)))`,
@@ -1407,8 +1409,7 @@ pub fn render_with(
 ) -> Result<Adaptive, Error> {
     let Hooks { oracle, predictor, shader } = hooks;
     crate::check_inputs(material, lighting)?;
-    check_settings(settings, material, lighting)?;
-    let settings = &Settings { max_spp: settings.block_cap(&material.samples), ..*settings };
+    let settings = &check_settings(settings, material, lighting)?;
     if settings.supersample != geometry.supersample {
         return Err(Error::Invalid(format!(
             "a frame supersampled {} times from a geometry made for {}",

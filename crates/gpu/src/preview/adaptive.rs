@@ -472,8 +472,7 @@ impl Renderer {
         options: FrameOptions,
     ) -> Result<Adaptive, GpuError> {
         let prediction = self.prediction.as_ref().ok_or_else(no_bandwidths)?;
-        render::adaptive::check_settings(settings, material, lighting)?;
-        let settings = &render::adaptive::Settings { max_spp: settings.block_cap(&material.samples), ..*settings };
+        let settings = &render::adaptive::check_settings(settings, material, lighting)?;
         let geometry = self.adaptive_geometry(settings.supersample)?;
         let (width, height) = geometry.render_size();
         if let Some(oracle) = options.oracle
