@@ -601,25 +601,31 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
 /// the GPU (the area allocation: one submission; at 64 samples per pixel levels reach the cap
 /// of 64) and on the host (the variance and the standard deviation); with the default cap,
 /// blocks of more samples than the 64 of a vector (several vectors; at 256 spp parts of 128
-/// samples, each across two vectors). A budget below a sample per shaded block is the same
-/// error on either.
+/// samples, each across two vectors); and with the sphere filling the image, so that the blocks
+/// in its top-left corner, block 0 of their levels, are parents (the WGSL's search for a parent
+/// already counted must not take its unwritten slots for block 0). A budget below a sample per
+/// shaded block is the same error on either.
 #[test]
 fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
-    let scene = sphere_scene(SIZE);
+    let whole = sphere_scene(SIZE);
+    // From 1.5 radii away the sphere subtends 84 degrees; a 30 degree view sees only the sphere.
+    let camera = Camera::orbit(glam::Vec3::ZERO, 1.5, 0.3, 0.2, 30f32.to_radians()).unwrap();
+    let filled = Scene { camera, ..whole.clone() };
     use render::adaptive::Allocation::{Area, StdDev, Variance};
     const ONE_VECTOR: u32 = 64;
     const DEFAULT: u32 = render::adaptive::MAX_SPP;
-    for (mode, supersample, spp, lobe_weight, oracle, allocation, max_spp) in [
-        (Mode::Reference, 1, 8, false, false, Area, ONE_VECTOR),
-        (Mode::Prefiltered, 1, 4, false, false, Area, ONE_VECTOR),
-        (Mode::Reference, 2, 4, false, false, Area, ONE_VECTOR),
-        (Mode::Reference, 1, 8, true, false, Variance, ONE_VECTOR),
-        (Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
-        (Mode::Reference, 1, 64, false, false, Area, ONE_VECTOR),
-        (Mode::Prefiltered, 1, 4, false, false, StdDev, ONE_VECTOR),
-        (Mode::Reference, 1, 256, false, false, Area, DEFAULT),
-        (Mode::Prefiltered, 1, 32, false, false, StdDev, DEFAULT),
+    for (scene, mode, supersample, spp, lobe_weight, oracle, allocation, max_spp) in [
+        (&whole, Mode::Reference, 1, 8, false, false, Area, ONE_VECTOR),
+        (&whole, Mode::Prefiltered, 1, 4, false, false, Area, ONE_VECTOR),
+        (&whole, Mode::Reference, 2, 4, false, false, Area, ONE_VECTOR),
+        (&whole, Mode::Reference, 1, 8, true, false, Variance, ONE_VECTOR),
+        (&whole, Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
+        (&whole, Mode::Reference, 1, 64, false, false, Area, ONE_VECTOR),
+        (&whole, Mode::Prefiltered, 1, 4, false, false, StdDev, ONE_VECTOR),
+        (&whole, Mode::Reference, 1, 256, false, false, Area, DEFAULT),
+        (&whole, Mode::Prefiltered, 1, 32, false, false, StdDev, DEFAULT),
+        (&filled, Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
     ] {
         let settings = render::adaptive::Settings {
             supersample,
@@ -644,7 +650,10 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
             oracle: oracle.then_some(&ramp[..]),
             ..Default::default()
         };
-        let geometry = render::adaptive::Geometry::of_scene(&scene, settings.supersample).unwrap();
+        let geometry = render::adaptive::Geometry::of_scene(scene, settings.supersample).unwrap();
+        if std::ptr::eq(scene, &filled) {
+            assert!(geometry.pixels().iter().all(Option::is_some), "the sphere fills the image");
+        }
         let cpu_frame =
             render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &settings, hooks).unwrap();
         let worst = gpu_frame.details().plan.compare(&cpu_frame.details().plan, 1e-5).unwrap_or_else(|e| panic!("{e}"));
@@ -693,7 +702,7 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
     }
     // Every render pixel at level 0 (an oracle at the Nyquist rate) with 2 x 2 anti-aliasing
     // shades about 4 blocks per output pixel: 1 sample per output pixel cannot pay for them.
-    let render_scene = Scene { width: SIZE * 2, height: SIZE * 2, ..scene.clone() };
+    let render_scene = Scene { width: SIZE * 2, height: SIZE * 2, ..whole.clone() };
     let mut renderer_2 = renderer(&render_scene, material, lighting);
     renderer_2.set_bandwidths(&bandwidths).unwrap();
     let nyquist = vec![0.5; 4 * SIZE * SIZE];
@@ -709,7 +718,7 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         assert!(error.to_string().contains("less than one for each"), "{}: {error}", allocation.name());
     }
     // The prediction needs the bandwidths; without them the frame is an error that says so.
-    let renderer = renderer(&scene, material, lighting);
+    let renderer = renderer(&whole, material, lighting);
     let settings = render::adaptive::Settings::new(Mode::Reference, 4);
     let error = renderer.render_adaptive(material, lighting, &settings, details()).expect_err("no bandwidths");
     assert!(error.to_string().contains("set_bandwidths"), "{error}");
