@@ -75,13 +75,13 @@ struct AdaptivePass {
 @group(3) @binding(11) var<storage, read> tables: array<u32>;
 @group(3) @binding(12) var<storage, read_write> control: array<atomic<u32>>;
 
-// The control words, zero at the start of a frame (the host clears the first CONTROL_CHUNKS):
+// The control words, zero at the start of a frame (the host clears them all):
 // shaded blocks in all, the status (1: the budget is below a sample per shaded block), the
 // samples given, `shade_blocks`' items, their workgroups (x, y, 1) and the list's (x, y, 1), the
 // samples per part; from CONTROL_COUNTS the shaded blocks per level; from CONTROL_LEVELS per
 // level its samples, how many of its blocks get twice that, its first item and its first rank
 // in the list (`adaptive_allocate`); from CONTROL_CHUNKS the shaded candidates per chunk of
-// CHUNK, then the shaded candidates before each chunk (`adaptive_chunks`, `adaptive_offsets`).
+// CHUNK (`adaptive_plan`), then the shaded candidates before each chunk (`adaptive_offsets`).
 const CONTROL_SHADED: u32 = 0u;
 const CONTROL_STATUS: u32 = 1u;
 const CONTROL_SAMPLES: u32 = 2u;
@@ -395,6 +395,7 @@ fn adaptive_plan(
         if (action == ACTION_SHADE || action == ACTION_RESCUED) {
             atomicAdd(&control[CONTROL_SHADED], 1u);
             atomicAdd(&control[CONTROL_COUNTS + k], 1u);
+            atomicAdd(&control[CONTROL_CHUNKS + c / CHUNK], 1u);
         }
     }
     levels[block].z = action;
@@ -594,6 +595,8 @@ fn adaptive_allocate() {
 }
 
 var<workgroup> scan_words: array<u32, 256>;
+// `adaptive_list`: 1 where the workgroup's chunk has no shaded candidate (or the frame failed).
+var<workgroup> chunk_empty: u32;
 
 // The inclusive prefix sum of `value` over a workgroup of `size` (at most 256) invocations
 // (Hillis and Steele).
@@ -634,25 +637,9 @@ fn run_count(chunk: u32, local: u32) -> u32 {
     return sum;
 }
 
-// The list in the plan's order, step 1 of 3: the shaded candidates of each chunk of CHUNK, a
-// workgroup of 64 a chunk and RUN candidates an invocation (few barriers: lavapipe runs them
-// slowly; many invocations: a GPU hides its memory's latency with them).
-@compute @workgroup_size(64)
-fn adaptive_chunks(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-    @builtin(num_workgroups) groups: vec3<u32>,
-) {
-    let chunk = workgroup_index(group, groups);
-    let sum = workgroup_scan(local, run_count(chunk, local), 64u);
-    if (local == 63u && chunk * CHUNK < candidates_total()) {
-        set_control(CONTROL_CHUNKS + chunk, sum);
-    }
-}
-
-// Step 2, one workgroup of 256: the shaded candidates before each chunk, in place of its own
-// (each invocation sums a stretch of chunks, a prefix sum over the stretches, then each goes
-// through its stretch again).
+// The list in the plan's order, step 1 of 2, one workgroup of 256: the shaded candidates before
+// each chunk of CHUNK, in place of its own, which the plan counted (each invocation sums a
+// stretch of chunks, a prefix sum over the stretches, then each goes through its stretch again).
 @compute @workgroup_size(256)
 fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
     let chunks = div_ceil(candidates_total(), CHUNK);
@@ -671,9 +658,11 @@ fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
     }
 }
 
-// Step 3, as step 1: each shaded candidate's entry at its rank. Where the GPU allocates, also
-// its samples (the first of its level that `adaptive_allocate` doubled get twice its level's)
-// and its parts in `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
+// Step 2, a workgroup of 64 a chunk and RUN candidates an invocation (few barriers: lavapipe
+// runs them slowly; many invocations: a GPU hides its memory's latency with them): each shaded
+// candidate's entry at its rank. Where the GPU allocates, also its samples (the first of its
+// level that `adaptive_allocate` doubled get twice its level's) and its parts in
+// `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
 @compute @workgroup_size(64)
 fn adaptive_list(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -681,9 +670,26 @@ fn adaptive_list(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let chunk = workgroup_index(group, groups);
+    // A chunk without shaded candidates (most, where the plan shades little) has nothing to
+    // write: the whole workgroup leaves before the scan.
+    if (local == 0u) {
+        let total = candidates_total();
+        var empty = chunk * CHUNK >= total || control_word(CONTROL_STATUS) != 0u;
+        if (!empty) {
+            var after = control_word(CONTROL_SHADED);
+            if ((chunk + 1u) * CHUNK < total) {
+                after = control_word(CONTROL_CHUNKS + chunk + 1u);
+            }
+            empty = after == control_word(CONTROL_CHUNKS + chunk);
+        }
+        chunk_empty = u32(empty);
+    }
+    if (workgroupUniformLoad(&chunk_empty) != 0u) {
+        return;
+    }
     let mine = run_count(chunk, local);
     let inclusive = workgroup_scan(local, mine, 64u);
-    if (mine == 0u || control_word(CONTROL_STATUS) != 0u) {
+    if (mine == 0u) {
         return;
     }
     var rank = control_word(CONTROL_CHUNKS + chunk) + inclusive - mine;

@@ -4,11 +4,11 @@
 //!
 //! 1. the prediction at the prediction pixels (`predict_blocks`), the levels of the bandwidth
 //!    buffer, the min and max pyramids and the plan of every block (`preview_adaptive.wgsl`),
-//!    which counts the shaded blocks per level;
+//!    which counts the shaded blocks per level and per chunk of [`CHUNK`] candidates;
 //! 2. their samples (`adaptive_allocate`, one invocation: `render::adaptive::area_allocation`
 //!    from the counts per level, in integers, so the CPU's samples exactly), and the list of
-//!    shaded blocks in the plan's order, by a prefix sum over the candidates (`adaptive_chunks`,
-//!    `adaptive_offsets`, `adaptive_list`), each with its samples and its parts of at most
+//!    shaded blocks in the plan's order, by a prefix sum over the chunks and the candidates
+//!    (`adaptive_offsets`, `adaptive_list`), each with its samples and its parts of at most
 //!    [`PART`] samples in `shade_blocks`' items;
 //! 3. the parts (`shade_blocks`, dispatched with the counts the allocation left: an indirect
 //!    dispatch, and the count copied into the shading uniform), their sums put in place, the
@@ -71,7 +71,8 @@ const NONE: u32 = u32::MAX;
 
 /// The WGSL's control words (`preview_adaptive.wgsl`): shaded blocks in all, the status, the
 /// samples given, `shade_blocks`' items, the indirect dispatches' workgroups, shaded blocks
-/// per level; the first `CONTROL_CHUNKS` are cleared each frame and read back.
+/// per level, ..., then from `CONTROL_CHUNKS` one per chunk of [`CHUNK`] candidates; all are cleared
+/// each frame, the first `CONTROL_CHUNKS` read back.
 const CONTROL_SHADED: u32 = 0;
 const CONTROL_STATUS: u32 = 1;
 const CONTROL_SAMPLES: u32 = 2;
@@ -580,7 +581,9 @@ impl Renderer {
             }
             self.queue.write_buffer(&state.uniform, 0, &uniform);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            encoder.clear_buffer(&state.buffers.control, 0, Some(control_bytes));
+            // The chunks' words too: the plan adds to them.
+            let chunk_words = candidates.div_ceil(CHUNK);
+            encoder.clear_buffer(&state.buffers.control, 0, Some(control_bytes + 4 * u64::from(chunk_words)));
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
             // The one-submission frame's passes start with timestamps where the adapter has them.
             let stamp = |start: u32, end: Option<u32>| {
@@ -615,7 +618,6 @@ impl Renderer {
                 if on_gpu {
                     run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
                 }
-                run(&mut cpass, &pipelines.chunks, plan_slot, super::workgroups(chunks));
                 run(&mut cpass, &pipelines.offsets, plan_slot, (1, 1));
                 run(&mut cpass, &pipelines.list, plan_slot, super::workgroups(chunks));
             }
@@ -816,7 +818,6 @@ pub(super) struct Pipelines {
     pub upsample: wgpu::ComputePipeline,
     pub output: wgpu::ComputePipeline,
     pub allocate: wgpu::ComputePipeline,
-    pub chunks: wgpu::ComputePipeline,
     pub offsets: wgpu::ComputePipeline,
     pub list: wgpu::ComputePipeline,
 }
@@ -831,7 +832,6 @@ impl Pipelines {
             upsample: make("adaptive_upsample"),
             output: make("adaptive_output"),
             allocate: make("adaptive_allocate"),
-            chunks: make("adaptive_chunks"),
             offsets: make("adaptive_offsets"),
             list: make("adaptive_list"),
         }
