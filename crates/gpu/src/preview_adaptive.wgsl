@@ -46,9 +46,9 @@ struct AdaptivePass {
 
 // The state, per render pixel or per block of every level (blocks of level k start at the level
 // table's offset for k):
-// - records, per render pixel: its depth (-1 where no triangle covers it), cos theta_o and the
-//   screen-projected normal (x, y); and its mirror direction (x, y, z) with the index of its
-//   prediction (`NONE` where it is not shadeable);
+// - records, per render pixel: its depth (-1 where no triangle covers it, 0 where one covers it
+//   but it is not shadeable), cos theta_o and the screen-projected normal (x, y); and its mirror
+//   direction (x, y, z) with the index of its prediction (`NONE` where it is not shadeable);
 // - bandwidths, per render pixel: its image bandwidth (cycles per pixel);
 // - levels, per block: the min pyramid (i32), the max pyramid of the variance, the action
 //   (`ACTION_*`, with the parents' count in bits 8 and up), unused;
@@ -801,12 +801,13 @@ fn adaptive_output(
         let x = ox * adapt.ss + j % adapt.ss;
         let y = oy * adapt.ss + j / adapt.ss;
         let p = y * adapt.width + x;
-        let r = record(p);
-        if (r.depth < 0.0) {
+        // The depth alone tells the three apart: the rest of the record is not read.
+        let depth = records_surface[p].x;
+        if (depth < 0.0) {
             sum += backdrop[p].xyz;
         } else {
             covered = 1.0;
-            if (r.prediction != NONE) {
+            if (depth > 0.0) {
                 sum += values[p].xyz;
             }
         }

@@ -336,6 +336,8 @@ impl Renderer {
                     *l = [f(px.mirror.x), f(px.mirror.y), f(px.mirror.z), of_pixel[i]];
                 }
                 None => {
+                    // The WGSL's output tells covered pixels without a shading frame by a depth
+                    // of 0: a shaded pixel's is positive.
                     s[0] = if geometry.covers(i) { 0.0 } else { -1.0 };
                     l[3] = NONE;
                 }
