@@ -81,6 +81,17 @@
 //! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
 //! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
 //!
+//! Stop 28, after the plan counts each chunk's shaded blocks (the `adaptive_chunks` pass gone),
+//! the list skips chunks without one, and the output reads the depth alone: the builds before
+//! and after alternated twice (`-- --gpu --no-extras`, seed 0), pyramids, plan and samples 13.5
+//! and 13.4 ms on average before, 11.7 and 11.5 after; adaptive frames 99.8 and 96.8 ms on
+//! average before, 95.4 and 91.8 after. Medians over all rows: `adaptive` 7.9x and 8.2x before,
+//! 8.7x and 8.9x after; `adaptive-prefiltered` 9.6x and 9.6x, then 9.7x and 9.8x. Off the
+//! plateau: `adaptive` 4.0x and 4.0x, then 3.9x and 4.1x (8 of 16 rows at 4x in all four);
+//! `adaptive-prefiltered` 9.8x and 9.7x (10 of 21 at 10x), then 10.2x and 9.9x (11 and 10).
+//! The rows at the middle, white-paint / potsdamer / torus pre-filtered at 2 and 8 spp, gave
+//! 9.2x to 10.2x over the four runs: they sit on the goal's line.
+//!
 //! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 27, after a shaded
 //! block may read several baked vectors (`render::adaptive`, "Samples": the cap was one vector
 //! of 256 samples, and the sphere's plans, which shade 2% of the pixels, left most of a large
