@@ -159,7 +159,13 @@
 //! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
 //! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.0x (14 rows at 4x;
 //! 10.7x at level 2 in the same stop) and the pre-filtered one stays at 5.9x (7 at 10x; 5.6x);
-//! the default stays 2.
+//! the default stays 2. Again in stop 28 (seed 0, against the two runs at level 2 above): the
+//! frames 3 to 29 ms shorter, the ceilings 0.4 to 1.9 dB lower (gold-paint / potsdamer / sphere
+//! 52.09 dB against 53.01), so the low budgets gain (white-paint / potsdamer / torus
+//! pre-filtered at 2 spp 13.4x against 10.2x and 9.9x) and the budgets near the ceiling lose (at
+//! 8 spp 9.7x against 9.2x and 9.7x; white-paint / potsdamer / sphere 10.2x against 12.5x and
+//! 11.3x): medians off the plateau 3.7x (`adaptive`, 9 of 18 rows at 4x) and 10.2x (12 of 23
+//! at 10x), against 3.9x and 4.1x, 10.2x and 9.9x.
 //! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
 //! minutes each on the CPU), a rerun 5 to 15 (20 s to a minute a case, with the extras). At this
 //! size 16x anti-aliasing cost 3.5x to 5.5x the time of none on lavapipe in stop 25 (4.3x to 6.7x
