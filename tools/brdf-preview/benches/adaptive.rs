@@ -160,7 +160,7 @@
 //! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.0x (14 rows at 4x;
 //! 10.7x at level 2 in the same stop) and the pre-filtered one stays at 5.9x (7 at 10x; 5.6x);
 //! the default stays 2. Again in stop 28 (seed 0, against the two runs at level 2 above): the
-//! frames 3 to 29 ms shorter, the ceilings 0.4 to 1.9 dB lower (gold-paint / potsdamer / sphere
+//! frames 1 to 29 ms shorter, the ceilings 0.4 to 2.8 dB lower (gold-paint / potsdamer / sphere
 //! 52.09 dB against 53.01), so the low budgets gain (white-paint / potsdamer / torus
 //! pre-filtered at 2 spp 13.4x against 10.2x and 9.9x) and the budgets near the ceiling lose (at
 //! 8 spp 9.7x against 9.2x and 9.7x; white-paint / potsdamer / sphere 10.2x against 12.5x and
