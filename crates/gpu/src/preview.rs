@@ -310,6 +310,19 @@ pub struct Renderer {
     view_layers: Vec<u32>,
 }
 
+/// Dropping a renderer waits for the work it submitted. Its passes may still be running on the
+/// device's threads (lavapipe compiles a pipeline's shader there when it first runs it: a
+/// renderer made and dropped at once leaves its raster and backdrop passes in flight), and a
+/// process that exits meanwhile tears the compiler down under them: the GPU test binary crashed
+/// after every test had passed, in a lavapipe thread inside LLVM's JIT, about one run in 30 on
+/// a busy machine.
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // A drop has no one to report to; a lost device has no work left to wait for either.
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
 impl Renderer {
     /// Checks the inputs as `render::render` does, uploads the mesh, the MERL table, the samples,
     /// the mip chain, the prefiltered layers and the view-layer table, and draws the G-buffer

@@ -663,8 +663,15 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         // adapter has one) within the frame's wall time; two otherwise.
         let t = gpu_frame.timings;
         assert_eq!(t.submissions, if allocation == Area { 1 } else { 2 });
+        // In two submissions the stages are differences of the wall clock's readings, and their
+        // sum may pass the last reading by a rounding (seen: 62.97396800000001 against
+        // 62.973968000000006).
         let stages = t.predict_ms + t.plan_ms + t.shade_ms;
-        assert!(stages > 0.0 && stages <= t.total_ms, "stages {stages} ms of a frame of {} ms", t.total_ms);
+        assert!(
+            stages > 0.0 && stages <= t.total_ms * (1.0 + 1e-12),
+            "stages {stages} ms of a frame of {} ms",
+            t.total_ms
+        );
         if t.gpu_clock {
             assert!(t.predict_ms > 0.0 && t.plan_ms > 0.0 && t.shade_ms > 0.0, "{t:?}");
         }
