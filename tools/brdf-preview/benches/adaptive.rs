@@ -724,9 +724,9 @@ fn main() {
     out("|---|---|---|---:|---:|---:|---:|".into());
     for label in ["adaptive", "adaptive-prefiltered"] {
         for reading in ["paper", "level-normalized", "oracle (FFT)", "paper + lobe weight"] {
-            for (rows, keep) in [("all", false), ("off the plateau", true)] {
+            for (rows, off_plateau) in [("all", false), ("off the plateau", true)] {
                 let mut v: Vec<f64> = (speedups.iter())
-                    .filter(|s| s.1 == label && s.2 == reading && !(keep && matches!(s.4, Match::Plateau(_))))
+                    .filter(|s| s.1 == label && s.2 == reading && !(off_plateau && matches!(s.4, Match::Plateau(_))))
                     .map(|s| s.3)
                     .collect();
                 v.sort_by(f64::total_cmp);

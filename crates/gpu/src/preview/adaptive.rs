@@ -71,8 +71,9 @@ const NONE: u32 = u32::MAX;
 
 /// The WGSL's control words (`preview_adaptive.wgsl`): shaded blocks in all, the status, the
 /// samples given, `shade_blocks`' items, the indirect dispatches' workgroups, shaded blocks
-/// per level, ..., then from `CONTROL_CHUNKS` one per chunk of [`CHUNK`] candidates; all are cleared
-/// each frame, the first `CONTROL_CHUNKS` read back.
+/// per level, the allocation's per level, then from `CONTROL_CHUNKS` one per chunk of [`CHUNK`]
+/// candidates (the plan's counts); all are cleared each frame, the first `CONTROL_CHUNKS` read
+/// back.
 const CONTROL_SHADED: u32 = 0;
 const CONTROL_STATUS: u32 = 1;
 const CONTROL_SAMPLES: u32 = 2;
