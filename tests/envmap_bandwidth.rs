@@ -144,8 +144,9 @@ fn input_errors_name_the_file() {
     assert!(!out.exists());
 }
 
-/// Usage errors exit 2 (clap's status) and say what was wrong; values that only the estimator
-/// refuses exit 2 with one line.
+/// Usage errors exit 2 and say what was wrong in one line, as every other error does (clap's own
+/// message spans several lines, with the usage); values that only the estimator refuses exit 2
+/// with one line.
 #[test]
 fn bad_arguments() {
     let input = shared().join("data/env/quarry_01_1k.hdr");
@@ -167,6 +168,7 @@ fn bad_arguments() {
         cmd.arg(&input).args(args);
         let r = run(cmd, "").expect_code(2);
         assert!(r.stderr.contains(needle), "stderr should mention {needle}\n{r}");
+        assert!(r.stderr.starts_with("error: ") && r.stderr.lines().count() == 1, "one line\n{r}");
         assert!(r.stdout.is_empty(), "{r}");
     }
     // A value that only the estimator refuses: one line naming the file. (`--levels 0` is a

@@ -30,6 +30,33 @@ pub fn main(run: impl FnOnce() -> anyhow::Result<ExitCode>) -> ExitCode {
     }
 }
 
+/// Parses the command line into a tool's arguments. `--help` and `--version` print as clap does
+/// and exit 0; a usage error becomes an error of one line (clap's own message spans several, with
+/// the usage after it), which [`main`] prints with exit status 2, as for any other error.
+pub fn args<T: clap::Parser>() -> anyhow::Result<T> {
+    T::try_parse().map_err(|e| {
+        if !e.use_stderr() {
+            e.exit()
+        }
+        anyhow::anyhow!("{}", usage_error(&e, T::command().get_name()))
+    })
+}
+
+/// A clap error as one line: its message and tips, without the usage that clap prints after them,
+/// and where to read more.
+fn usage_error(e: &clap::Error, tool: &str) -> String {
+    let rendered = e.render().to_string();
+    let mut line = String::new();
+    for part in rendered.lines().take_while(|l| !l.starts_with("Usage:")).map(str::trim).filter(|l| !l.is_empty()) {
+        let part = part.strip_prefix("error: ").unwrap_or(part);
+        if !line.is_empty() {
+            line.push_str(if line.ends_with(':') { " " } else { "; " });
+        }
+        line.push_str(part);
+    }
+    format!("{line}; see {tool} --help")
+}
+
 /// Messages start in lower case, whoever wrote them (the operating system writes "No such file
 /// or directory"); a first word that is not plain capitalized ("NaN", "EXR") is left alone.
 fn lower_case_start(message: &str) -> String {
@@ -186,7 +213,37 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::{lower_case_start, parse_bytes, parse_count, parse_size};
+    use super::{lower_case_start, parse_bytes, parse_count, parse_size, usage_error};
+
+    /// clap's messages of several lines (a list of missing arguments, a tip) become one, without
+    /// the usage; what clap says stays.
+    #[test]
+    fn usage_errors_are_one_line() {
+        use clap::{Arg, ArgAction, Command};
+        let command = || {
+            Command::new("tool")
+                .arg(Arg::new("input").required(true))
+                .arg(Arg::new("out").long("out").required(true))
+                .arg(Arg::new("quiet").long("quiet").action(ArgAction::SetTrue))
+        };
+        let cases: [(&[&str], &str); 3] = [
+            (&["tool", "in"], "the following required arguments were not provided: --out <out>; see tool --help"),
+            (
+                &["tool", "in", "--out", "x", "--quiet=3"],
+                "unexpected value '3' for '--quiet' found; no more were expected",
+            ),
+            (
+                &["tool", "--bake", "x"],
+                "unexpected argument '--bake' found; tip: to pass '--bake' as a value, use '-- --bake'",
+            ),
+        ];
+        for (argv, expected) in cases {
+            let e = command().try_get_matches_from(argv).expect_err("a usage error");
+            let line = usage_error(&e, "tool");
+            assert!(line.starts_with(expected), "{argv:?}: {line}");
+            assert!(!line.contains('\n') && !line.contains("Usage") && line.ends_with("; see tool --help"), "{line}");
+        }
+    }
 
     #[test]
     fn sizes_parse() {

@@ -48,7 +48,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let args = Args::parse();
+    let args: Args = cli::args()?;
     let context = || format!("reading {}", args.file.display());
     let report = match asset::read_file_with_header(&args.file) {
         Ok((header, asset)) => Report { header, computed: header.checksum, asset: Some(asset) },

@@ -59,7 +59,7 @@ struct Args {
 const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

@@ -269,7 +269,7 @@ fn parse_camera(text: &str) -> Result<(f32, f32), String> {
 }
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

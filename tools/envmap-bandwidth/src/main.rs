@@ -96,7 +96,7 @@ fn parse_eps(text: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

@@ -110,7 +110,7 @@ impl From<MethodArg> for Method {
 const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

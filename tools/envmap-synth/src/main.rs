@@ -31,7 +31,7 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

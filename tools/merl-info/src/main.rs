@@ -82,7 +82,7 @@ const ALBEDO_LIMIT: f64 = 1.01;
 const NO_DATA_LIMIT: f64 = 0.01;
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {

@@ -102,7 +102,7 @@ fn positive(name: &str, v: f64) -> Result<f64> {
 }
 
 fn main() -> ExitCode {
-    cli::main(|| run(Args::parse()))
+    cli::main(|| run(cli::args()?))
 }
 
 fn run(args: Args) -> Result<ExitCode> {
