@@ -6,15 +6,19 @@
 //! it.
 
 use crate::colormap::linear_ticks;
-use crate::font::{GLYPH_H, text_height, text_width, wrap};
+use crate::font::{ADVANCE, GLYPH_H, text_height, text_width, wrap};
 use crate::{BACKGROUND, Canvas, INK, TEXT_SCALE, format_number};
 
 /// Space between a title and what it labels.
 pub const TITLE_GAP: usize = 6;
 
+/// Space after a panel title, beside the gap, before the next column: two characters.
+pub const TITLE_SPACE: usize = 2 * ADVANCE * TEXT_SCALE;
+
 /// Panels in rows of `columns`, left to right, top to bottom. A column is as wide as its widest
-/// panel or panel title, a row as high as its highest panel plus the title line (none when no
-/// panel of the row has a title).
+/// panel or panel title, a title followed by [`TITLE_SPACE`] where another column comes after it
+/// (two titles a gap apart read as one line); a row is as high as its highest panel plus the
+/// title line (none when no panel of the row has a title).
 #[derive(Clone, Debug)]
 pub struct Grid {
     columns: usize,
@@ -64,10 +68,12 @@ impl Grid {
 
     /// The width of each column.
     fn column_widths(&self) -> Vec<usize> {
-        let mut widths = vec![0; self.columns.min(self.panels.len())];
+        let columns = self.columns.min(self.panels.len());
+        let mut widths = vec![0; columns];
         for (i, (panel, title)) in self.panels.iter().enumerate() {
+            let followed = i % self.columns + 1 < columns && !title.is_empty();
             let w = &mut widths[i % self.columns];
-            *w = (*w).max(panel.width).max(text_width(title, TEXT_SCALE));
+            *w = (*w).max(panel.width).max(text_width(title, TEXT_SCALE) + if followed { TITLE_SPACE } else { 0 });
         }
         widths
     }

@@ -1,5 +1,5 @@
 use picture::font::{GLYPH_H, text_width};
-use picture::layout::{Axis, CAPTION_MARGIN, Grid, TITLE_GAP, caption, heat_map, stack};
+use picture::layout::{Axis, CAPTION_MARGIN, Grid, TITLE_GAP, TITLE_SPACE, caption, heat_map, stack};
 use picture::{BACKGROUND, Canvas, INK, TEXT_SCALE};
 
 use crate::bounding_box;
@@ -48,10 +48,18 @@ fn grid_sizes_and_positions() {
         }
     }
     assert_eq!(bounding_box(&canvas, [9, 9, 9]), Some((0, body, width + 7, body + 9)));
-    // A long panel title widens its column.
+    // A long panel title widens its column, and where another column follows it keeps
+    // TITLE_SPACE beside the gap, free of ink, so that two titles do not read as one line.
     let mut grid = Grid::new(3);
     grid.add(panel(10, 10, 0), "a long title");
     assert_eq!(grid.width(), 2 * 16 + text_width("a long title", TEXT_SCALE));
+    let title = text_width("a long title", TEXT_SCALE);
+    let mut grid = Grid::new(2);
+    grid.margin(0).gap(gap).add(panel(10, 10, 0), "a long title").add(panel(10, 10, 1), "next");
+    assert_eq!(grid.width(), title + TITLE_SPACE + gap + text_width("next", TEXT_SCALE));
+    let canvas = grid.render();
+    let ink = |x: usize| (0..title_line).any(|y| canvas.pixel(x, y) == Some(INK));
+    assert!(ink(title - 1) && (title..title + TITLE_SPACE + gap).all(|x| !ink(x)) && ink(title + TITLE_SPACE + gap));
     assert_eq!(Grid::new(0).render().width, 32);
 }
 
