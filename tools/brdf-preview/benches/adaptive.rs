@@ -92,6 +92,18 @@
 //! The rows at the middle, white-paint / potsdamer / torus pre-filtered at 2 and 8 spp, gave
 //! 9.2x to 10.2x over the four runs: they sit on the goal's line.
 //!
+//! Stop 29, the frame's code as in stop 28, seeds 0 (with the extras), 1 and 2: medians over all
+//! rows `adaptive` 8.2x, 5.4x and 5.4x, `adaptive-prefiltered` 10.7x, 7.2x and 10.2x; off the
+//! plateau 3.8x, 3.8x and 4.1x (8 of 16 rows at 4x in each), and 11.0x, 10.7x and 10.6x (12, 12 and
+//! 11 of 21 at 10x); white-paint / potsdamer / torus pre-filtered at 2 and 8 spp, stop 28's middle
+//! rows, 9.4x to 11.4x. Chrome's rows (0.4x to 2.3x) are out of the goal's reach on this adapter:
+//! under the paper's reading its plans shade 2 to 15% of the pixels and stop at or near their
+//! ceiling (34.9 to 44.1 dB), which the brute force reaches at 4 to 16 spp in 76 to 136 ms, so 4x
+//! asks for a frame of 19 to 34 ms, what the prediction and the plan take by themselves (19 to 33
+//! ms on the GPU's clock); the readings that keep the mirror's detail shade 34 to 98% of the
+//! pixels, and a frame that skips the rest gains at most one over that fraction over a brute force
+//! as fast per sample (they measured 0.5x to 2.3x).
+//!
 //! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 27, after a shaded
 //! block may read several baked vectors (`render::adaptive`, "Samples": the cap was one vector
 //! of 256 samples, and the sphere's plans, which shade 2% of the pixels, left most of a large
