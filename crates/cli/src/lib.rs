@@ -46,15 +46,24 @@ pub fn args<T: clap::Parser>() -> anyhow::Result<T> {
 /// and where to read more.
 fn usage_error(e: &clap::Error, tool: &str) -> String {
     let rendered = e.render().to_string();
-    let mut line = String::new();
-    for part in rendered.lines().take_while(|l| !l.starts_with("Usage:")).map(str::trim).filter(|l| !l.is_empty()) {
-        let part = part.strip_prefix("error: ").unwrap_or(part);
-        if !line.is_empty() {
-            line.push_str(if line.ends_with(':') { " " } else { "; " });
-        }
-        line.push_str(part);
+    let message = rendered.split("\nUsage:").next().unwrap_or_default();
+    // Paragraphs (a message, a tip) apart with "; ", the lines of a list after a colon with ", ";
+    // clap's pointer to `--help` replaced by the tool's.
+    let mut parts = Vec::new();
+    for paragraph in message.split("\n\n") {
+        let mut lines = paragraph.lines().map(str::trim).filter(|l| !l.is_empty());
+        let Some(first) = lines.next().filter(|l| !l.starts_with("For more information")) else { continue };
+        let first = first.strip_prefix("error: ").unwrap_or(first);
+        let rest: Vec<&str> = lines.collect();
+        parts.push(if rest.is_empty() {
+            first.to_string()
+        } else if first.ends_with(':') {
+            format!("{first} {}", rest.join(", "))
+        } else {
+            format!("{first}; {}", rest.join("; "))
+        });
     }
-    format!("{line}; see {tool} --help")
+    format!("{}; see {tool} --help", parts.join("; "))
 }
 
 /// Messages start in lower case, whoever wrote them (the operating system writes "No such file
@@ -225,8 +234,14 @@ mod tests {
                 .arg(Arg::new("input").required(true))
                 .arg(Arg::new("out").long("out").required(true))
                 .arg(Arg::new("quiet").long("quiet").action(ArgAction::SetTrue))
+                .arg(Arg::new("n").long("n").value_parser(clap::value_parser!(u32)))
         };
-        let cases: [(&[&str], &str); 3] = [
+        let cases: [(&[&str], &str); 5] = [
+            (
+                &["tool", "in", "--out", "x", "--n", "x"],
+                "invalid value 'x' for '--n <n>': invalid digit found in string; see tool --help",
+            ),
+            (&["tool"], "the following required arguments were not provided: --out <out>, <input>; see tool --help"),
             (&["tool", "in"], "the following required arguments were not provided: --out <out>; see tool --help"),
             (
                 &["tool", "in", "--out", "x", "--quiet=3"],
@@ -241,7 +256,8 @@ mod tests {
             let e = command().try_get_matches_from(argv).expect_err("a usage error");
             let line = usage_error(&e, "tool");
             assert!(line.starts_with(expected), "{argv:?}: {line}");
-            assert!(!line.contains('\n') && !line.contains("Usage") && line.ends_with("; see tool --help"), "{line}");
+            let one = !line.contains('\n') && !line.contains("Usage") && !line.contains("For more information");
+            assert!(one && line.ends_with("; see tool --help"), "{line}");
         }
     }
 
