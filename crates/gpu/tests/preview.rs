@@ -644,6 +644,10 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
         let gpu_frame = renderer
             .render_adaptive(material, lighting, &settings, options)
             .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
+        // The same frame again on the same renderer: nothing of the first (the plan's counts per
+        // level and per chunk, which it adds to) carries over.
+        let again = renderer.render_adaptive(material, lighting, &settings, options).unwrap();
+        assert!(again.image.rgb == gpu_frame.image.rgb && again.samples == gpu_frame.samples, "a second frame differs");
         let mut replay = render::adaptive::replay_predictor(&gpu_frame.details().predictions);
         let hooks = render::adaptive::Hooks {
             predictor: Some(&mut replay),
