@@ -584,9 +584,8 @@ impl Renderer {
             }
             self.queue.write_buffer(&state.uniform, 0, &uniform);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            // The chunks' words too: the plan adds to them.
-            let chunk_words = candidates.div_ceil(CHUNK);
-            encoder.clear_buffer(&state.buffers.control, 0, Some(control_bytes + 4 * u64::from(chunk_words)));
+            // Every word, the chunks' too: the plan adds to them.
+            encoder.clear_buffer(&state.buffers.control, 0, None);
             encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
             // The one-submission frame's passes start with timestamps where the adapter has them.
             let stamp = |start: u32, end: Option<u32>| {
