@@ -31,6 +31,16 @@ impl Distribution1D {
         Ok(Self { func: func.to_vec(), cdf, integral })
     }
 
+    /// The distribution whose CDF table is `cdf` as it is (`n + 1 >= 2` values, `cdf[0] = 0`,
+    /// `cdf[n] = 1`, finite and non-decreasing), bin `i` of value `(cdf[i + 1] - cdf[i]) n`: the
+    /// distribution a renderer samples when it reads a stored table, such as one rounded to
+    /// `f32` for a GPU, where rebuilding the CDF from the values could move a bin edge by a
+    /// rounding. Its integral is 1.
+    pub fn from_cdf(cdf: &[f64]) -> Result<Self, Error> {
+        let func = func_of_cdf(cdf)?;
+        Ok(Self { func, cdf: cdf.to_vec(), integral: 1.0 })
+    }
+
     /// Maps `u` in `[0, 1)` to `x` in `[0, 1)` distributed with density `pdf(x)`. Linear within
     /// a bin, so `x` is a continuous, non-decreasing function of `u`.
     pub fn sample(&self, u: f64) -> Sample1D {
@@ -86,6 +96,22 @@ pub(crate) fn check_values(func: &[f64]) -> Result<(), Error> {
         Some(index) => Err(Error::InvalidValue { index, value: func[index] }),
         None => Ok(()),
     }
+}
+
+/// The bin values `(cdf[i + 1] - cdf[i]) n` of a CDF table, after checking that it is one: at
+/// least two entries, the first 0, the last 1, finite and non-decreasing.
+pub(crate) fn func_of_cdf(cdf: &[f64]) -> Result<Vec<f64>, Error> {
+    let n = cdf.len().checked_sub(1).filter(|&n| n > 0).ok_or(Error::Empty)?;
+    if cdf[0] != 0.0 {
+        return Err(Error::InvalidCdf { index: 0, value: cdf[0] });
+    }
+    if cdf[n] != 1.0 {
+        return Err(Error::InvalidCdf { index: n, value: cdf[n] });
+    }
+    if let Some(i) = (0..n).find(|&i| !(cdf[i + 1] >= cdf[i] && cdf[i + 1].is_finite())) {
+        return Err(Error::InvalidCdf { index: i + 1, value: cdf[i + 1] });
+    }
+    Ok(cdf.windows(2).map(|w| (w[1] - w[0]) * n as f64).collect())
 }
 
 /// Fills `cdf` (`func.len() + 1` entries) and returns the integral, the mean of `func`. Values

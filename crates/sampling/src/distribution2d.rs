@@ -1,4 +1,4 @@
-use crate::distribution1d::{Piecewise, build_cdf, check_values, clamp_unit};
+use crate::distribution1d::{Piecewise, build_cdf, check_values, clamp_unit, func_of_cdf};
 use crate::{Distribution1D, Error};
 
 /// A piecewise-constant distribution over `[0, 1)^2` on an `nu` x `nv` grid, sampled as pbrt's
@@ -41,6 +41,40 @@ impl Distribution2D {
             .collect();
         let marginal = Distribution1D::new(&row_integrals)?;
         Ok(Self { nu, nv, func: func.to_vec(), conditional_cdf, marginal })
+    }
+
+    /// The distribution whose tables are `marginal_cdf` (`nv + 1` values over the rows) and
+    /// `conditional_cdf` (`nv` rows of `nu + 1`) as they are, each a CDF table as
+    /// [`Distribution1D::from_cdf`] takes it: what a renderer samples when it reads stored
+    /// tables. Cell `(iu, iv)` has the value `marginal bin iv x conditional bin iu` of those
+    /// tables' differences, so `pdf` is the product of the two tables' bin widths times `nu nv`.
+    pub fn from_cdfs(marginal_cdf: &[f64], conditional_cdf: &[f64], nu: usize, nv: usize) -> Result<Self, Error> {
+        if nu == 0 || nv == 0 {
+            return Err(Error::EmptyGrid { nu, nv });
+        }
+        if marginal_cdf.len() != nv + 1 || nv.checked_mul(nu + 1) != Some(conditional_cdf.len()) {
+            return Err(Error::WrongSize { len: conditional_cdf.len(), nu: nu + 1, nv });
+        }
+        let marginal = Distribution1D::from_cdf(marginal_cdf)?;
+        let mut func = Vec::with_capacity(nu * nv);
+        for (iv, cdf) in conditional_cdf.chunks_exact(nu + 1).enumerate() {
+            let row = func_of_cdf(cdf).map_err(|e| match e {
+                Error::InvalidCdf { index, value } => Error::InvalidCdf { index: iv * (nu + 1) + index, value },
+                other => other,
+            })?;
+            func.extend(row.iter().map(|c| c * marginal.func()[iv]));
+        }
+        Ok(Self { nu, nv, func, conditional_cdf: conditional_cdf.to_vec(), marginal })
+    }
+
+    /// The same distribution with its CDF tables rounded to `f32` ([`Distribution2D::from_cdfs`]
+    /// of the rounded tables): the one a GPU that reads them as `f32` samples. Rounding keeps
+    /// every table non-decreasing from 0 to 1; a bin narrower than the rounding may close
+    /// (never sampled, pdf 0) or open up to a rounding's width.
+    pub fn rounded_to_f32(&self) -> Distribution2D {
+        let round = |t: &[f64]| t.iter().map(|&c| f64::from(c as f32)).collect::<Vec<f64>>();
+        Distribution2D::from_cdfs(&round(self.marginal.cdf()), &round(&self.conditional_cdf), self.nu, self.nv)
+            .expect("rounding to f32 keeps a CDF table a CDF table")
     }
 
     /// Maps `u` in `[0, 1)^2` to `p` in `[0, 1)^2` distributed with density `pdf(p)`: `u[1]`

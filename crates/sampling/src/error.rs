@@ -15,4 +15,8 @@ pub enum Error {
     /// index `iv * nu + iu`.
     #[error("func[{index}] is {value}, expected a finite value >= 0")]
     InvalidValue { index: usize, value: f64 },
+    /// A CDF table entry out of place: not 0 first, not 1 last, not finite, or below the entry
+    /// before it.
+    #[error("cdf[{index}] is {value}, expected a finite table from 0 to 1 that never decreases")]
+    InvalidCdf { index: usize, value: f64 },
 }

@@ -28,16 +28,25 @@
 //!   `func / integral` itself must treat `integral == 0` as pdf 1. In 2D a zero row of a function
 //!   that is not all zero gets a uniform conditional and marginal probability 0, so it is never
 //!   sampled and its pdf is 0.
+//! - **Stored tables**: [`Distribution1D::from_cdf`] and [`Distribution2D::from_cdfs`] sample a
+//!   CDF table as it was stored (an asset's `f32` tables, or [`Distribution2D::rounded_to_f32`]
+//!   for a GPU's), the bin values following from the table, so that two renderers reading the same
+//!   tables choose the same bins for the same `u`.
+//!
+//! [`LatLong`] puts a 2D distribution on the sphere through the lat-long parameterization (an
+//! environment map's importance sampling), with densities per unit solid angle.
 
 pub mod chi2;
 mod distribution1d;
 mod distribution2d;
 mod error;
+mod latlong;
 mod sobol;
 
 pub use distribution1d::{Distribution1D, Sample1D};
 pub use distribution2d::{Distribution2D, Sample2D};
 pub use error::Error;
+pub use latlong::{LatLong, LatLongSample};
 pub use sobol::{OwenSobol2D, owen_sobol_vectors};
 
 /// The largest `f64` below 1: where a `u` in `[0, 1)` is clamped to, and the largest coordinate a

@@ -31,11 +31,20 @@ impl OwenSobol2D {
         Self::new(seed ^ mix64(vector.wrapping_add(0x9e37_79b9_7f4a_7c15)))
     }
 
+    /// The sequence scrambled by the words `seeds`, one per dimension, as they are: for callers
+    /// that derive them with 32-bit arithmetic a GPU repeats (the scrambling itself is 32-bit).
+    pub fn from_words(seeds: [u32; 2]) -> Self {
+        Self { seeds }
+    }
+
     /// Point `index` of the sequence, in `[0, 1)^2`.
     pub fn point(&self, index: u32) -> [f64; 2] {
-        let x = owen_scramble(index.reverse_bits(), self.seeds[0]);
-        let y = owen_scramble(sobol_dim1(index), self.seeds[1]);
-        [to_unit(x), to_unit(y)]
+        self.point_bits(index).map(to_unit)
+    }
+
+    /// Point `index` in 32-bit fixed point: [`OwenSobol2D::point`] is these times `2^-32`.
+    pub fn point_bits(&self, index: u32) -> [u32; 2] {
+        [owen_scramble(index.reverse_bits(), self.seeds[0]), owen_scramble(sobol_dim1(index), self.seeds[1])]
     }
 
     /// The first `n_samples` points. For `n_samples = 2^m` they form a (0,m,2)-net.

@@ -234,3 +234,69 @@ fn all_zero_function_is_uniform() {
     assert!((s.p[0] - 0.5).abs() < 1e-15 && (s.p[1] - 0.25).abs() < 1e-15, "{s:?}");
     assert_eq!(d.pdf([0.9, 0.9]), 1.0);
 }
+
+#[test]
+fn stored_tables_sample_as_the_distribution_they_came_from() {
+    let mut rng = StdRng::seed_from_u64(23);
+    for (name, f) in functions() {
+        let (_, nu, nv) = f;
+        let d = dist(&f);
+        let stored = Distribution2D::from_cdfs(d.marginal().cdf(), d.conditional_cdf(), nu, nv).unwrap();
+        assert_eq!((stored.marginal().cdf(), stored.conditional_cdf()), (d.marginal().cdf(), d.conditional_cdf()));
+        for _ in 0..20_000 {
+            let u: [f64; 2] = [rng.random(), rng.random()];
+            let (a, b) = (d.sample(u), stored.sample(u));
+            assert_eq!((a.p, a.index), (b.p, b.index), "{name}: {u:?}");
+            // The stored tables' bin values are CDF differences: the same pdf up to rounding.
+            assert!((a.pdf - b.pdf).abs() <= TOL * a.pdf, "{name}: {u:?}: pdf {} against {}", b.pdf, a.pdf);
+            assert_eq!(stored.pdf(b.p), b.pdf, "{name}: {u:?}");
+        }
+    }
+}
+
+/// The bin an `f32` CDF table gives `u`, found with `f32` comparisons as a GPU finds it.
+fn f32_bin(cdf: &[f64], u: f32) -> usize {
+    cdf.iter().map(|&c| c as f32).rposition(|c| c <= u).unwrap().min(cdf.len() - 2)
+}
+
+#[test]
+fn tables_rounded_to_f32_choose_the_bins_a_gpu_chooses() {
+    let mut rng = StdRng::seed_from_u64(24);
+    for (name, f) in functions() {
+        let (func, nu, nv) = &f;
+        let rounded = dist(&f).rounded_to_f32();
+        let tables = rounded.marginal().cdf().iter().chain(rounded.conditional_cdf());
+        assert!(tables.into_iter().all(|&c| f64::from(c as f32) == c), "{name}: a table entry is not an f32");
+        for _ in 0..20_000 {
+            // u on the 2^-24 grid, as a GPU makes it from 24 bits of a random word.
+            let u = [0, 1].map(|_| (rng.random::<u32>() >> 8) as f32 / 16_777_216.0);
+            let s = rounded.sample(u.map(f64::from));
+            let iv = f32_bin(rounded.marginal().cdf(), u[1]);
+            let iu = f32_bin(&rounded.conditional_cdf()[iv * (nu + 1)..(iv + 1) * (nu + 1)], u[0]);
+            // Zero-width bins share their edge with the next: the search takes the last bin whose
+            // edge is at most u, which is the one of positive width.
+            assert_eq!(s.index, [iu, iv], "{name}: {u:?}");
+            assert!(func[iv * nu + iu] > 0.0 || func.iter().all(|&v| v == 0.0), "{name}: {u:?} in a zero cell");
+        }
+        let chi2 = chi2_2d(|u| rounded.sample(u).p, |p| rounded.pdf(p), [f.1, f.2], [45, 37], 200_000, 25);
+        assert_accepts(chi2, name);
+    }
+}
+
+#[test]
+fn stored_tables_that_are_not_cdfs_are_refused() {
+    use sampling::Error;
+    let conditional = [0.0, 0.5, 1.0, 0.0, 1.0, 1.0];
+    let cases: [(&str, Vec<f64>, Vec<f64>, Error); 5] = [
+        ("marginal not from 0", vec![0.1, 0.5, 1.0], conditional.to_vec(), Error::InvalidCdf { index: 0, value: 0.1 }),
+        ("marginal not to 1", vec![0.0, 0.5, 0.9], conditional.to_vec(), Error::InvalidCdf { index: 2, value: 0.9 }),
+        ("decreasing", vec![0.0, 0.5, 1.0], vec![0.0, 0.6, 1.0, 0.0, 1.5, 1.0], Error::InvalidCdf { index: 5, value: 1.0 }),
+        ("NaN", vec![0.0, f64::NAN, 1.0], conditional.to_vec(), Error::InvalidCdf { index: 1, value: f64::NAN }),
+        ("wrong size", vec![0.0, 1.0], conditional.to_vec(), Error::WrongSize { len: 6, nu: 3, nv: 2 }),
+    ];
+    for (name, marginal, conditional, expected) in cases {
+        let error = Distribution2D::from_cdfs(&marginal, &conditional, 2, 2).unwrap_err();
+        // NaN != NaN: compare the messages.
+        assert_eq!(error.to_string(), expected.to_string(), "{name}");
+    }
+}

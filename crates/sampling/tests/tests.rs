@@ -4,4 +4,5 @@ mod chi2;
 mod distribution_1d;
 mod distribution_2d;
 mod errors;
+mod lat_long;
 mod point_sets;
