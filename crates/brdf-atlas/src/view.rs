@@ -82,11 +82,24 @@ impl ViewReduction {
 /// The energy of each detail level of a lobe image's wavelet decomposition: the periodic
 /// image's mirror tiling ([`mirror_tiling`]: four copies of the image, so the shares are the
 /// image's own), D4, [`analysis_levels`] levels;
-/// finest first, the three orientations of a level summed.
-pub fn band_energy(image: &[f64], n: usize) -> Vec<f64> {
+/// finest first, the three orientations of a level summed. A coefficient of level `j` counts only
+/// from `relative_noise_floor` times the image's largest magnitude times `2^j` (the noise floor
+/// of the per-texel analysis, [`Config::relative_noise_floor`]), so that a lobe without detail,
+/// a Lambertian's constant, has none, rather than its lookups' rounding noise, which would read
+/// as the finest frequencies (27 cycles per radian at the default size: the sharpest layer).
+pub fn band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
     let decomposition = wavelet::wavedec2(&mirror_tiling(image, n), wavelet::Wavelet::D4, analysis_levels(n))
         .expect("lobe images have a power-of-two size of at least 16");
-    decomposition.details.iter().map(|level| level.iter().map(wavelet::Image::energy).sum()).collect()
+    let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    decomposition
+        .details
+        .iter()
+        .enumerate()
+        .map(|(i, level)| {
+            let floor = relative_noise_floor * peak * (1u64 << (i + 1)) as f64;
+            level.iter().flat_map(wavelet::Image::data).filter(|c| c.abs() >= floor).map(|c| c * c).sum()
+        })
+        .collect()
 }
 
 /// The frequency, in cycles per pixel, below which a share `q` of the detail energy `energy`
@@ -117,7 +130,7 @@ pub fn band_quantile(energy: &[f64], q: f64, c: f64) -> f64 {
 pub fn layer_bandwidth(config: &Config, n: u32, reduction: ViewReduction) -> f64 {
     let analyser = Analyser::new(config);
     let image = lobe_image_from_fn(analyser.map(), |w| Some(w.z.max(0.0).powi(n as i32)));
-    let energy = band_energy(&image, config.analysis_size);
+    let energy = band_energy(&image, config.analysis_size, config.relative_noise_floor);
     let tile = analyser.analyse_image(image).tile(config.tile);
     reduction.reduce(&tile, &energy, config)
 }
@@ -134,6 +147,29 @@ pub fn nearest_layer(nu: f64, layers: &[f64]) -> usize {
     } else {
         by(&|b: f64| b)
     }
+}
+
+/// Where a view of bandwidth `nu` falls among layers of bandwidths `layers` (increasing), as a
+/// coordinate to blend two layers by: `k + t` reads layer `k` with weight `1 - t` and layer
+/// `k + 1` with weight `t`, `t = (ln nu - ln b_k) / (ln b_(k+1) - ln b_k)` between the two layers
+/// that bracket `nu` on a log scale, the measure [`nearest_layer`] uses, so the coordinate
+/// rounds to its layer. Below the broadest layer, and for a flat view (`nu = 0`), 0; above the
+/// sharpest, the last index. Layers whose bandwidths do not increase (a damaged selection) blend
+/// nothing: the coordinate is [`nearest_layer`]'s.
+pub fn layer_coordinate(nu: f64, layers: &[f64]) -> f64 {
+    let increasing = layers.windows(2).all(|w| w[1] > w[0]) && layers.first().is_some_and(|&b| b > 0.0);
+    if !increasing || !nu.is_finite() {
+        return nearest_layer(nu, layers) as f64;
+    }
+    let last = layers.len() - 1;
+    if nu <= layers[0] {
+        return 0.0;
+    }
+    if nu >= layers[last] {
+        return last as f64;
+    }
+    let k = layers.partition_point(|&b| b <= nu) - 1;
+    k as f64 + (nu.ln() - layers[k].ln()) / (layers[k + 1].ln() - layers[k].ln())
 }
 
 /// Which Phong layer serves each view elevation of a material.

@@ -5,6 +5,7 @@ mod atlas;
 mod flat;
 mod pca;
 mod phong;
+mod view;
 
 use merl::analytic::Analytic;
 use merl::{Dims, MerlTable};

@@ -1,0 +1,46 @@
+//! `view::layer_coordinate`: the blend between the two layers around a view's bandwidth agrees
+//! with the nearest layer and moves continuously with the bandwidth.
+
+use brdf_atlas::view::{layer_coordinate, nearest_layer};
+
+/// The default layers' bandwidths at an analysis size of 256 (`bake`'s layer test prints them).
+const LAYERS: [f64; 7] = [0.2909, 0.3176, 0.4484, 0.8741, 1.7171, 3.3612, 6.3283];
+
+#[test]
+fn the_coordinate_rounds_to_the_nearest_layer_and_never_jumps() {
+    let mut previous = 0.0;
+    for i in 0..=20_000 {
+        let nu = 0.1 * (100.0f64).powf(i as f64 / 20_000.0);
+        let x = layer_coordinate(nu, &LAYERS);
+        // Exactly halfway on a log scale the two rules may part by the rounding of the logarithms.
+        assert_eq!(x.round() as usize, nearest_layer(nu, &LAYERS), "nu {nu}: coordinate {x}");
+        assert!(x >= previous && x - previous < 0.01, "nu {nu}: {previous} then {x}");
+        previous = x;
+    }
+    assert_eq!(previous, 6.0);
+}
+
+#[test]
+fn the_coordinate_is_exact_at_the_layers_and_halfway_between_them_on_a_log_scale() {
+    for (k, &b) in LAYERS.iter().enumerate() {
+        assert!((layer_coordinate(b, &LAYERS) - k as f64).abs() < 1e-12, "layer {k}");
+    }
+    let between = (LAYERS[3] * LAYERS[4]).sqrt();
+    assert!((layer_coordinate(between, &LAYERS) - 3.5).abs() < 1e-12);
+}
+
+#[test]
+fn flat_broad_and_sharp_views_take_the_end_layers() {
+    assert_eq!(layer_coordinate(0.0, &LAYERS), 0.0, "a flat view takes the broadest layer");
+    assert_eq!(layer_coordinate(0.01, &LAYERS), 0.0);
+    assert_eq!(layer_coordinate(100.0, &LAYERS), 6.0);
+    assert_eq!(layer_coordinate(1.0, &[0.5]), 0.0, "one layer");
+}
+
+#[test]
+fn layers_that_do_not_increase_blend_nothing() {
+    let damaged = [0.3, 0.2, 0.9];
+    for nu in [0.0, 0.25, 0.5, 2.0, f64::NAN] {
+        assert_eq!(layer_coordinate(nu, &damaged), nearest_layer(nu, &damaged) as f64, "nu {nu}");
+    }
+}
