@@ -96,7 +96,7 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
                 ),
             ));
         }
-        view_layers = selection.view_layer;
+        view_layers = brdf_atlas::view::view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth);
         let bandwidth_path = file("environment-bandwidth")?;
         let image = envmap::read_image(&bandwidth_path, &envmap::Limits::default())
             .map_err(|e| Error::read(&bandwidth_path, e))?;
@@ -107,7 +107,7 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
         let brdf =
             crate::stage::atlas::from_payload(read_payload(&atlas_path)?).map_err(|e| Error::read(&atlas_path, e))?;
         bandwidths = Some(render::adaptive::Bandwidths { environment, brdf });
-        Some(render::Lighting { mips, layers, exponents: prefiltered.exponents })
+        Some(render::Lighting::new(mips, layers, prefiltered.exponents).map_err(|e| Error::read(&mips_path, e))?)
     } else {
         None
     };
@@ -168,11 +168,28 @@ fn sample_set(s: asset::ImportanceSamples) -> Result<render::SampleSet, String> 
     if !s.n_samples.is_power_of_two() {
         return Err(format!("{} samples per vector: the renderers need a power of two", s.n_samples));
     }
+    // The payload's check holds the tables' lengths to the slices, rows and sectors.
+    let rows = importance::HalfVectorRows::from_theta_edges(&s.theta_h_edges).map_err(|e| e.to_string())?;
+    let (n_rows, n_phi) = (rows.len(), s.n_phi_h as usize);
+    let f64s = |t: &[f32]| t.iter().map(|&v| f64::from(v)).collect::<Vec<f64>>();
+    let tables = s
+        .theta_o
+        .iter()
+        .enumerate()
+        .map(|(k, &theta_o)| {
+            let marginal = &s.marginal_cdf[k * (n_rows + 1)..(k + 1) * (n_rows + 1)];
+            let conditional = &s.conditional_cdf[k * n_rows * (n_phi + 1)..(k + 1) * n_rows * (n_phi + 1)];
+            let dist = sampling::Distribution2D::from_cdfs(&f64s(marginal), &f64s(conditional), n_phi, n_rows)
+                .map_err(|e| format!("slice {k}'s tables: {e}"))?;
+            importance::Slice::from_tables(theta_o, rows.clone(), dist).map_err(|e| format!("slice {k}: {e}"))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     Ok(render::SampleSet {
         n_slices,
         n_vectors: s.n_vectors as usize,
         n_samples: s.n_samples as usize,
         texels: s.samples,
+        tables,
     })
 }
 

@@ -172,6 +172,12 @@ pub fn layer_coordinate(nu: f64, layers: &[f64]) -> f64 {
     k as f64 + (nu.ln() - layers[k].ln()) / (layers[k + 1].ln() - layers[k].ln())
 }
 
+/// [`layer_coordinate`] of every view bandwidth, as the renderers read them
+/// (`render::Material::view_layers`).
+pub fn view_coordinates(view_bandwidth: &[f64], layer_bandwidth: &[f64]) -> Vec<f32> {
+    view_bandwidth.iter().map(|&nu| layer_coordinate(nu, layer_bandwidth) as f32).collect()
+}
+
 /// Which Phong layer serves each view elevation of a material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LayerSelection {

@@ -160,6 +160,32 @@ impl EnvMap {
     pub fn luminance(&self) -> Vec<f32> {
         self.texels().iter().map(|&rgb| crate::luminance(rgb.map(f64::from)) as f32).collect()
     }
+
+    /// Per texel, the luminance of the bilinear reconstruction ([`EnvMap::lookup_uv`]) averaged
+    /// over the texel: the luminances filtered by `[1, 6, 1] / 8` along each axis (the mean over
+    /// a texel of the linear interpolation between texel centres is 1/8 of each neighbour and 3/4
+    /// of itself), wrapping in `u`, the edge rows repeated in `v` (the lookup clamps to their
+    /// centres). Positive wherever the lookup is, half a texel around a bright texel included:
+    /// the weights of an importance sampler that must find every direction the lookup lights.
+    pub fn bilinear_luminance(&self) -> Vec<f64> {
+        let (w, h) = (self.width, self.height);
+        let luminance = self.luminance();
+        let mut along_u = vec![0.0f64; w * h];
+        for y in 0..h {
+            let at = |x: usize| f64::from(luminance[y * w + x]);
+            for x in 0..w {
+                along_u[y * w + x] = (at((x + w - 1) % w) + 6.0 * at(x) + at((x + 1) % w)) / 8.0;
+            }
+        }
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let (up, down) = (y.saturating_sub(1), (y + 1).min(h - 1));
+                // Luminance of non-negative radiance with positive weights: finite and >= 0.
+                ((along_u[up * w + x] + 6.0 * along_u[i] + along_u[down * w + x]) / 8.0).max(0.0)
+            })
+            .collect()
+    }
 }
 
 /// Rejects an empty map, then one that is not 2:1.

@@ -82,6 +82,18 @@ impl MipChain {
         (0.5 * (texels / (n_samples as f64 * pdf_uv)).log2()).max(0.0)
     }
 
+    /// The level of detail for one of `n_samples` samples drawn with density `pdf_omega` per unit
+    /// solid angle, by the footprint's extent along `v` rather than its area in the map: the level
+    /// [`MipChain::lod`] gives a footprint of that solid angle at the equator, wherever it lies,
+    /// `max(log4(width * height / (n_samples * pdf_omega * 2 pi^2)), 0)`. Towards the poles a
+    /// footprint of a given solid angle covers ever more of `u` and no more of `v`; a square
+    /// level matched to its area there would blur it along `v` by `1 / sqrt(sin theta)`, mixing
+    /// elevations the footprint does not reach (the zenith with the sky around a sun), where this
+    /// level blurs it too little along `u` only: noise rather than bias.
+    pub fn lod_solid_angle(&self, n_samples: usize, pdf_omega: f64) -> f64 {
+        self.lod(n_samples, pdf_omega * 2.0 * std::f64::consts::PI * std::f64::consts::PI)
+    }
+
     /// Trilinear lookup: bilinear ([`EnvMap::lookup_uv`]) in the two levels around `lod`, then
     /// linear between them. `lod` is clamped to `[0, n_levels() - 1]`; NaN reads level 0.
     pub fn lookup_uv(&self, u: f64, v: f64, lod: f64) -> [f32; 3] {

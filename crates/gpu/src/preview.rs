@@ -130,6 +130,39 @@ struct ShadeUniform {
     n_view_rows: u32,
     n_layers: u32,
     layer_shift: u32,
+    maps: MapLayout,
+    tables: TableLayout,
+}
+
+/// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,
+/// `peak_map` of the WGSL): map 0 is level 0 of the environment whole; the chain and the layers
+/// the filtered estimators read are the smooth part's where the environment has peaks
+/// (`render::Lighting::smooth_mips`), then come the peaks' level 0.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct MapLayout {
+    mips_first: u32,
+    layers_first: u32,
+    peak_map: u32,
+}
+
+/// `Shade::peak_map` where the environment has no peaks (`NO_MAP` of the WGSL).
+const NO_MAP: u32 = u32::MAX;
+
+/// Where the sampling tables start in the `tables` buffer (`Shade::brdf_rows` to
+/// `peak_conditional` of the WGSL; [`sampling_tables`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct TableLayout {
+    brdf_rows: u32,
+    brdf_sectors: u32,
+    t_edges: u32,
+    brdf_marginal: u32,
+    brdf_conditional: u32,
+    env_marginal: u32,
+    env_conditional: u32,
+    peak_marginal: u32,
+    peak_conditional: u32,
 }
 
 /// `Predict` of the WGSL.
@@ -307,7 +340,9 @@ pub struct Renderer {
     n_samples: u32,
     n_levels: u32,
     n_layers: usize,
-    view_layers: Vec<u32>,
+    view_layers: Vec<f32>,
+    maps: MapLayout,
+    tables: TableLayout,
 }
 
 /// Dropping a renderer waits for the work it submitted. Its passes may still be running on the
@@ -351,8 +386,10 @@ impl Renderer {
         }
         let samples = &material.samples;
         check_buffer_fits(&limits, info, 16 * samples.texels.len() as u64, "the importance samples")?;
-        let (env_maps, env_texels) = env_buffers(lighting);
+        let (env_maps, env_texels, maps) = env_buffers(lighting);
         check_buffer_fits(&limits, info, 4 * env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
+        let (tables, sampling_layout) = sampling_tables(material, lighting);
+        check_buffer_fits(&limits, info, 4 * tables.len() as u64, "the sampling tables")?;
         let pixels = u64::from(width) * u64::from(height);
         check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
         // Clip-space positions, positions and normals interleaved: one storage buffer for all
@@ -441,7 +478,7 @@ impl Renderer {
             });
             let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview bake"),
-                entries: &(0..6).map(|binding| storage_entry(binding, compute, true)).collect::<Vec<_>>(),
+                entries: &(0..7).map(|binding| storage_entry(binding, compute, true)).collect::<Vec<_>>(),
             });
             let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview render"),
@@ -532,8 +569,9 @@ impl Renderer {
             let texels_buffer = storage("preview env texels", bytemuck::cast_slice(&env_texels));
             // A binding cannot be empty; a table nobody reads (the mode check rejects the
             // prefiltered mode without one) holds one unused entry.
-            let view_layers = if material.view_layers.is_empty() { &[0][..] } else { &material.view_layers[..] };
+            let view_layers = if material.view_layers.is_empty() { &[0.0][..] } else { &material.view_layers[..] };
             let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(view_layers));
+            let tables_buffer = storage("preview sampling tables", bytemuck::cast_slice(&tables));
             let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview bake"),
                 layout: &bake_layout,
@@ -544,6 +582,7 @@ impl Renderer {
                     wgpu::BindGroupEntry { binding: 3, resource: view_layers_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: vertex_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 5, resource: index_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 6, resource: tables_buffer.as_entire_binding() },
                 ],
             });
 
@@ -621,6 +660,8 @@ impl Renderer {
                 n_levels: lighting.mips.n_levels() as u32,
                 n_layers: lighting.layers.len(),
                 view_layers: material.view_layers.clone(),
+                maps,
+                tables: sampling_layout,
             }
         })?;
         renderer.rasterize()?;
@@ -1100,6 +1141,8 @@ impl Renderer {
             n_view_rows: self.view_layers.len() as u32,
             n_layers: self.n_layers as u32,
             layer_shift: 0,
+            maps: self.maps,
+            tables: self.tables,
         }
     }
 
@@ -1153,15 +1196,63 @@ fn check_scene(scene: &Scene, material: &Material, lighting: &Lighting) -> Resul
 
 /// The maps' descriptors `(width, height, offset, 0)` (the mip levels, then the prefiltered
 /// layers) and their texels, concatenated.
-fn env_buffers(lighting: &Lighting) -> (Vec<[u32; 4]>, Vec<f32>) {
-    let maps = lighting.mips.levels().iter().chain(&lighting.layers);
+fn env_buffers(lighting: &Lighting) -> (Vec<[u32; 4]>, Vec<f32>, MapLayout) {
+    let level0 = lighting.mips.level(0);
+    let (smooth_mips, layers) = (lighting.smooth_mips().levels(), lighting.smooth_layers());
+    // Without peaks the smooth chain is the chain, and map 0 its level 0.
+    let (whole, peak) = match &lighting.peaks {
+        Some(peaks) => (std::slice::from_ref(level0), Some(&peaks.map)),
+        None => (&[][..], None),
+    };
+    let maps = MapLayout {
+        mips_first: whole.len() as u32,
+        layers_first: (whole.len() + smooth_mips.len()) as u32,
+        peak_map: peak.map_or(NO_MAP, |_| (whole.len() + smooth_mips.len() + layers.len()) as u32),
+    };
     let mut descriptors = Vec::new();
     let mut texels = Vec::new();
-    for map in maps {
+    for map in whole.iter().chain(smooth_mips).chain(layers).chain(peak) {
         descriptors.push([map.width() as u32, map.height() as u32, texels.len() as u32, 0]);
         texels.extend_from_slice(map.rgb());
     }
-    (descriptors, texels)
+    (descriptors, texels, maps)
+}
+
+/// The CDF tables the shading pass samples, in one buffer: the material's half-vector rows and
+/// every slice's tables, level 0's distribution and the peaks' (level 0's again where there are
+/// none: a binding cannot be empty, and no mode reads them then), all `f32` as the CPU's
+/// distributions hold them (`sampling::Distribution2D::from_cdfs`), so both pick the same bins.
+fn sampling_tables(material: &Material, lighting: &Lighting) -> (Vec<f32>, TableLayout) {
+    let mut data: Vec<f32> = Vec::new();
+    let mut put = |values: &mut dyn Iterator<Item = f64>| -> u32 {
+        let first = data.len() as u32;
+        data.extend(values.map(|v| v as f32));
+        first
+    };
+    let slices = &material.samples.tables;
+    let rows = slices.first().map_or(1, |s| s.distribution().nv());
+    let sectors = slices.first().map_or(1, |s| s.distribution().nu());
+    let t_edges = put(&mut slices.first().map_or(&[0.0, 1.0][..], |s| s.rows().t_edges()).iter().copied());
+    let brdf_marginal = put(&mut slices.iter().flat_map(|s| s.distribution().marginal().cdf().iter().copied()));
+    let brdf_conditional = put(&mut slices.iter().flat_map(|s| s.distribution().conditional_cdf().iter().copied()));
+    let environment = lighting.environment.distribution();
+    let env_marginal = put(&mut environment.marginal().cdf().iter().copied());
+    let env_conditional = put(&mut environment.conditional_cdf().iter().copied());
+    let peaks = lighting.peaks.as_ref().map_or(environment, |p| p.sampling.distribution());
+    let peak_marginal = put(&mut peaks.marginal().cdf().iter().copied());
+    let peak_conditional = put(&mut peaks.conditional_cdf().iter().copied());
+    let layout = TableLayout {
+        brdf_rows: rows as u32,
+        brdf_sectors: sectors as u32,
+        t_edges,
+        brdf_marginal,
+        brdf_conditional,
+        env_marginal,
+        env_conditional,
+        peak_marginal,
+        peak_conditional,
+    };
+    (data, layout)
 }
 
 fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
@@ -1258,12 +1349,45 @@ mod tests {
 
     #[test]
     fn host_layouts_match_the_wgsl_structs() {
-        // WGSL `Shade`: four vec4<f32> (64 bytes) and twelve u32 (48): 112, a multiple of its
-        // 16-byte alignment.
-        assert_eq!(size_of::<ShadeUniform>(), 112);
+        // WGSL `Shade`: four vec4<f32> (64 bytes) and 24 u32 (96, the last 12 the map and table
+        // layouts, flattened in the WGSL): 160, a multiple of its 16-byte alignment.
+        assert_eq!(size_of::<ShadeUniform>(), 160);
         assert_eq!(std::mem::offset_of!(ShadeUniform, width), 64);
         assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 100);
         assert_eq!(std::mem::offset_of!(ShadeUniform, layer_shift), 108);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, maps), 112);
+        assert_eq!(std::mem::offset_of!(ShadeUniform, tables), 124);
+        assert_eq!(size_of::<MapLayout>() + size_of::<TableLayout>(), 48);
+        // The WGSL's fields in the same order.
+        let fields = [
+            "layer_shift: u32",
+            "mips_first: u32",
+            "layers_first: u32",
+            "peak_map: u32",
+            "brdf_rows: u32",
+            "brdf_sectors: u32",
+            "t_edges: u32",
+            "brdf_marginal: u32",
+            "brdf_conditional: u32",
+            "env_marginal: u32",
+            "env_conditional: u32",
+            "peak_marginal: u32",
+            "peak_conditional: u32",
+        ];
+        let at: Vec<usize> = fields
+            .iter()
+            .map(|f| PREVIEW_SHADE_WGSL.find(f).unwrap_or_else(|| panic!("the WGSL has no `{f}`")))
+            .collect();
+        assert!(at.windows(2).all(|w| w[0] < w[1]), "the WGSL's `Shade` orders its fields otherwise");
+    }
+
+    #[test]
+    fn sampling_constants_match_the_cpu() {
+        let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
+        let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
+        for decl in [salt, no_map] {
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
     }
 
     #[test]

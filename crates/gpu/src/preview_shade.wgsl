@@ -48,8 +48,8 @@ const SUBPIXELS: f32 = 256.0;
 // than textures: float32 textures need not be filterable, and doing the bilinear weights by hand
 // makes them the CPU's arithmetic.
 @group(1) @binding(2) var<storage, read> env_texels: array<f32>;
-// `render::Material::view_layers`.
-@group(1) @binding(3) var<storage, read> view_layers: array<u32>;
+// `render::Material::view_layers`: each view row's Phong layer coordinate.
+@group(1) @binding(3) var<storage, read> view_layers: array<f32>;
 // The mesh, as `preview_raster.wgsl` reads it: twelve values per vertex, three indices per
 // triangle. Per vertex: the clip-space position with the current camera and the snapped viewport
 // x and y in 1/256 pixels (integers, exact in f32 within the guard band; 0 outside the clip
@@ -59,6 +59,9 @@ const SUBPIXELS: f32 = 256.0;
 // sub-pixel step, and a small triangle's interpolation with it.
 @group(1) @binding(4) var<storage, read> mesh_vertices: array<f32>;
 @group(1) @binding(5) var<storage, read> mesh_indices: array<u32>;
+// The CDF tables the estimators sample, f32 as the CPU samples them (`render::SampleSet::tables`,
+// `render::Lighting::environment` and the peaks' `sampling`), where `Shade` says they start.
+@group(1) @binding(6) var<storage, read> sampling_tables: array<f32>;
 
 // Group 2: the render.
 
@@ -77,14 +80,37 @@ struct Shade {
     n_slices: u32,
     n_vectors: u32,
     n_samples: u32,
-    // Mip levels: the prefiltered layer `l` is map `n_levels + l`.
+    // Mip levels (of `mips_first`'s chain).
     n_levels: u32,
     n_view_rows: u32,
-    // Prefiltered layers; the prefiltered estimator reads the layer `layer_shift` layers sharper
+    // Prefiltered layers; the prefiltered estimator reads the layers `layer_shift` layers sharper
     // than the view's (an adaptive frame's shaded blocks: `render::adaptive::Settings`).
     n_layers: u32,
     layer_shift: u32,
+    // Maps in `env_maps` (map 0 is level 0 of the environment, whole): the first level of the mip
+    // chain the fis estimator reads and the first Phong layer (`render::Lighting::smooth_mips` and
+    // `smooth_layers`), and the peaks' level 0 (`NO_MAP` where the environment has none).
+    mips_first: u32,
+    layers_first: u32,
+    peak_map: u32,
+    // In `sampling_tables`: the BRDF tables' rows (of half vectors) and sectors (of phi_h); where the row
+    // edges `t = 1 - cos theta_h` (R + 1), the slices' marginal CDFs (R + 1 each) and their
+    // conditional CDFs (R rows of C + 1 each) start.
+    brdf_rows: u32,
+    brdf_sectors: u32,
+    t_edges: u32,
+    brdf_marginal: u32,
+    brdf_conditional: u32,
+    // Level 0's distribution and the peaks': marginal (H + 1) and conditional (H rows of W + 1)
+    // CDFs over map 0's texels.
+    env_marginal: u32,
+    env_conditional: u32,
+    peak_marginal: u32,
+    peak_conditional: u32,
 }
+
+// `Shade::peak_map` where the environment has no peaks.
+const NO_MAP: u32 = 0xffffffffu;
 
 // Its own uniform, at a dynamic offset: one command buffer holds many frames.
 struct Frame {
@@ -117,6 +143,218 @@ fn sample_range(pixel: u32, f: u32, spp: u32) -> vec2<u32> {
     let h = pcg_hash(pixel ^ pcg_hash(shade.seed));
     let chunk = (h % chunks + f % chunks) % chunks;
     return vec2<u32>(chunk / per_vector, (chunk % per_vector) * spp);
+}
+
+// `render::pixel_sequences`' salt.
+const SEQUENCE_SALT: u32 = 0x6a09e667u;
+
+// `sampling::OwenSobol2D`'s nested uniform scrambling of the bits of `v` (pbrt-v4's
+// FastOwenScrambler): u32 arithmetic that wraps as the CPU's does.
+fn owen_scramble(value: u32, seed: u32) -> u32 {
+    var v = reverseBits(value);
+    v ^= v * 0x3d20adeau;
+    v += seed;
+    v *= (seed >> 16u) | 1u;
+    v ^= v * 0x05526c56u;
+    v ^= v * 0x53a22864u;
+    return reverseBits(v);
+}
+
+// `sampling::OwenSobol2D`'s second Sobol' dimension.
+fn sobol_dim1(i: u32) -> u32 {
+    var index = i;
+    var result = 0u;
+    var v = 0x80000000u;
+    while (index != 0u) {
+        if ((index & 1u) != 0u) {
+            result ^= v;
+        }
+        index >>= 1u;
+        v ^= v >> 1u;
+    }
+    return result;
+}
+
+// `render::pixel_sequences`: the scrambling words of the pixel's two sequences, the BRDF's in
+// xy, the light's in zw.
+fn pixel_words(pixel: u32) -> vec4<u32> {
+    let w0 = pcg_hash(pixel ^ pcg_hash(shade.seed ^ SEQUENCE_SALT));
+    let w1 = pcg_hash(w0);
+    let w2 = pcg_hash(w1);
+    return vec4<u32>(w0, w1, w2, pcg_hash(w2));
+}
+
+// `render::point`: point `index` of the sequence scrambled by `words`, the top 24 bits of each
+// coordinate (exact in f32).
+fn sequence_point(words: vec2<u32>, index: u32) -> vec2<f32> {
+    let x = owen_scramble(reverseBits(index), words.x);
+    let y = owen_scramble(sobol_dim1(index), words.y);
+    return vec2<f32>(f32(x >> 8u), f32(y >> 8u)) / 16777216.0;
+}
+
+// The largest f32 below 1 (`sampling::ONE_MINUS_EPSILON` in f32).
+const ONE_BELOW: f32 = 0.99999994;
+
+// The bin of the CDF table of `n` bins at `sampling_tables[first]` that `u` (in [0, 1)) falls in: the
+// last edge at most `u`, as `sampling::Distribution1D::sample` finds it, so a bin of zero width
+// is never taken.
+fn cdf_bin(first: u32, n: u32, u: f32) -> u32 {
+    var lo = 0u;
+    var hi = n;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (sampling_tables[first + mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// Where `u` lies within bin `i` of the CDF table at `sampling_tables[first]`, in [0, 1).
+fn cdf_fraction(first: u32, i: u32, u: f32) -> f32 {
+    let c0 = sampling_tables[first + i];
+    return min((u - c0) / (sampling_tables[first + i + 1u] - c0), ONE_BELOW);
+}
+
+// The width of bin `i` of the CDF table at `sampling_tables[first]`: its probability.
+fn cdf_width(first: u32, i: u32) -> f32 {
+    return sampling_tables[first + i + 1u] - sampling_tables[first + i];
+}
+
+// A direction and its density per unit solid angle.
+struct DirectionSample {
+    wi: vec3<f32>,
+    pdf: f32,
+}
+
+// The outgoing direction of slice `k` (`importance::Slice::wo`): theta_o = k / S pi / 2.
+fn slice_wo(k: u32) -> vec3<f32> {
+    let theta_o = f32(k) / f32(shade.n_slices) * HALF_PI;
+    return vec3<f32>(sin(theta_o), 0.0, cos(theta_o));
+}
+
+// `importance::Slice::h_density` of cell (iu, iv) of slice `k`'s tables: the cell's probability
+// over its solid angle of half vectors.
+fn h_density(k: u32, iv: u32, iu: u32) -> f32 {
+    let rows = shade.brdf_rows;
+    let sectors = shade.brdf_sectors;
+    let row_width = sampling_tables[shade.t_edges + iv + 1u] - sampling_tables[shade.t_edges + iv];
+    let p_row = cdf_width(shade.brdf_marginal + k * (rows + 1u), iv);
+    let p_cell = cdf_width(shade.brdf_conditional + (k * rows + iv) * (sectors + 1u), iu);
+    return p_row * p_cell / (row_width * 2.0 * PI / f32(sectors));
+}
+
+// `importance::Slice::sample` of slice `k` at `u`.
+fn brdf_sample(k: u32, u: vec2<f32>) -> DirectionSample {
+    let rows = shade.brdf_rows;
+    let sectors = shade.brdf_sectors;
+    let marginal = shade.brdf_marginal + k * (rows + 1u);
+    let iv = cdf_bin(marginal, rows, u.y);
+    let fv = cdf_fraction(marginal, iv, u.y);
+    let conditional = shade.brdf_conditional + (k * rows + iv) * (sectors + 1u);
+    let iu = cdf_bin(conditional, sectors, u.x);
+    let fu = cdf_fraction(conditional, iu, u.x);
+    let t0 = sampling_tables[shade.t_edges + iv];
+    let t = t0 + fv * (sampling_tables[shade.t_edges + iv + 1u] - t0);
+    let phi = 2.0 * PI * (f32(iu) + fu) / f32(sectors);
+    let h = vec3<f32>(sqrt(max(t * (2.0 - t), 0.0)) * vec2<f32>(cos(phi), sin(phi)), 1.0 - t);
+    let wo = slice_wo(k);
+    let wo_h = dot(wo, h);
+    if (!(wo_h > 0.0)) {
+        return DirectionSample(vec3<f32>(0.0), 0.0);
+    }
+    return DirectionSample(2.0 * wo_h * h - wo, h_density(k, iv, iu) / (4.0 * wo_h));
+}
+
+// `importance::Slice::pdf` of slice `k` at `wi` (tangent frame).
+fn brdf_pdf(k: u32, wi: vec3<f32>) -> f32 {
+    let wo = slice_wo(k);
+    let sum = wi + wo;
+    let len = length(sum);
+    if (!(len > 0.0)) {
+        return 0.0;
+    }
+    let h = sum / len;
+    let wo_h = dot(wo, h);
+    if (!(h.z > 0.0 && wo_h > 0.0)) {
+        return 0.0;
+    }
+    let t = (h.x * h.x + h.y * h.y) / (1.0 + h.z);
+    // `importance::HalfVectorRows::row_of`: the edges 1 ..= R at most t, counted, at most R - 1.
+    var lo = 0u;
+    var hi = shade.brdf_rows;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (sampling_tables[shade.t_edges + 1u + mid] <= t) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let iv = min(lo, shade.brdf_rows - 1u);
+    var phi = merl_atan2(h.y, h.x);
+    if (phi < 0.0) {
+        phi += 2.0 * PI;
+    }
+    let iu = min(u32(min(phi / (2.0 * PI), ONE_BELOW) * f32(shade.brdf_sectors)), shade.brdf_sectors - 1u);
+    return h_density(k, iv, iu) / (4.0 * wo_h);
+}
+
+// A lat-long distribution over map 0's texels in `sampling_tables` (`sampling::LatLong`).
+struct LatLong {
+    marginal: u32,
+    conditional: u32,
+}
+
+// A point of the map and its density per unit solid angle.
+struct LightSample {
+    uv: vec2<f32>,
+    pdf: f32,
+}
+
+// `pdf_uv / (2 pi^2 sin(pi v))`, 0 where sin(pi v) is not positive.
+fn solid_angle_density(pdf_uv: f32, v: f32) -> f32 {
+    let sin_theta = sin(PI * v);
+    if (!(sin_theta > 0.0 && pdf_uv > 0.0)) {
+        return 0.0;
+    }
+    return pdf_uv / (2.0 * PI * PI * sin_theta);
+}
+
+// The density over (u, v) of texel (x, y): its row's probability times its own within the row,
+// over the texel's area.
+fn latlong_texel_density(d: LatLong, x: u32, y: u32) -> f32 {
+    let size = env_maps[0];
+    let p_row = cdf_width(d.marginal, y);
+    let p_texel = cdf_width(d.conditional + y * (size.x + 1u), x);
+    return p_row * p_texel * f32(size.x) * f32(size.y);
+}
+
+// `sampling::LatLong::sample` at `u`.
+fn latlong_sample(d: LatLong, u: vec2<f32>) -> LightSample {
+    let size = env_maps[0];
+    let y = cdf_bin(d.marginal, size.y, u.y);
+    let fy = cdf_fraction(d.marginal, y, u.y);
+    let row = d.conditional + y * (size.x + 1u);
+    let x = cdf_bin(row, size.x, u.x);
+    let fx = cdf_fraction(row, x, u.x);
+    let uv = vec2<f32>((f32(x) + fx) / f32(size.x), (f32(y) + fy) / f32(size.y));
+    return LightSample(uv, solid_angle_density(latlong_texel_density(d, x, y), uv.y));
+}
+
+// `sampling::LatLong::pdf` at `uv` (in [0, 1]^2).
+fn latlong_pdf(d: LatLong, uv: vec2<f32>) -> f32 {
+    let size = env_maps[0];
+    let x = min(u32(max(uv.x * f32(size.x), 0.0)), size.x - 1u);
+    let y = min(u32(max(uv.y * f32(size.y), 0.0)), size.y - 1u);
+    return solid_angle_density(latlong_texel_density(d, x, y), uv.y);
+}
+
+// `render::shade::mis_weight`: the balance heuristic.
+fn mis_weight(p: f32, q: f32) -> f32 {
+    return p / (p + q);
 }
 
 // What covers a pixel (`render::raster::Hit`): the world position and the normalized normal
@@ -354,6 +592,17 @@ fn to_world(frame: ShadingFrame, local: vec3<f32>) -> vec3<f32> {
     return local.x * frame.t + local.y * frame.b + local.z * frame.n;
 }
 
+fn to_local(frame: ShadingFrame, world: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(world, frame.t), dot(world, frame.b), dot(world, frame.n));
+}
+
+// `envmap::direction`: the unit direction at map coordinates (u, v).
+fn env_direction(uv: vec2<f32>) -> vec3<f32> {
+    let phi = 2.0 * PI * uv.x;
+    let theta = PI * uv.y;
+    return vec3<f32>(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+}
+
 // `render::shade::slice_of`: the slice nearest theta_o = atan2(wo_local.x, wo_local.z).
 fn slice_of(frame: ShadingFrame) -> u32 {
     let theta_o = merl_atan2(frame.wo_local.x, frame.wo_local.z);
@@ -375,11 +624,6 @@ fn env_uv(w: vec3<f32>) -> vec2<f32> {
         }
     }
     return vec2<f32>(u, theta / PI);
-}
-
-// `envmap::geometry::uv_jacobian`: d omega / (du dv).
-fn uv_jacobian(v: f32) -> f32 {
-    return 2.0 * PI * PI * sin(PI * v);
 }
 
 fn env_texel(base: u32, index: u32) -> vec3<f32> {
@@ -412,22 +656,21 @@ fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
     return top * (1.0 - fy) + bottom * fy;
 }
 
-// `envmap::MipChain::lod` for one of `spp` samples of density `pdf_uv` over the unit square:
-// max(log4(width height / (spp pdf_uv)), 0). As a difference of logarithms, because the quotient
-// overflows f32 for the tiny densities near the poles, where the CPU's f64 does not. A density
-// that is not positive (sin(pi v) rounds to 0 or below at the poles in f32) stands for the
-// CPU's infinite level: the last.
-fn mip_lod(pdf_uv: f32) -> f32 {
-    if (!(pdf_uv > 0.0)) {
+// `envmap::MipChain::lod_solid_angle` for one of `spp` samples of density `pdf` per unit solid
+// angle: max(log4(width height / (spp pdf 2 pi^2)), 0), as a difference of logarithms (the
+// quotient overflows f32 for tiny densities, where the CPU's f64 does not). A density that is not
+// positive stands for the CPU's infinite level: the last.
+fn mip_lod(pdf: f32) -> f32 {
+    if (!(pdf > 0.0)) {
         return f32(shade.n_levels - 1u);
     }
-    let level0 = env_maps[0];
+    let level0 = env_maps[shade.mips_first];
     let texels = f32(level0.x) * f32(level0.y);
-    return max(0.5 * (log2(texels) - log2(f32(shade.spp)) - log2(pdf_uv)), 0.0);
+    return max(0.5 * (log2(texels) - log2(f32(shade.spp)) - log2(pdf * 2.0 * PI * PI)), 0.0);
 }
 
-// `envmap::MipChain::lookup_uv`: bilinear in the two levels around `lod` (clamped to the chain),
-// then linear between them.
+// `envmap::MipChain::lookup_uv` in the chain from `shade.mips_first`: bilinear in the two levels
+// around `lod` (clamped to the chain), then linear between them.
 fn mip_trilinear(uv: vec2<f32>, lod: f32) -> vec3<f32> {
     let last = f32(shade.n_levels - 1u);
     var l = 0.0;
@@ -436,43 +679,53 @@ fn mip_trilinear(uv: vec2<f32>, lod: f32) -> vec3<f32> {
     }
     let l0 = floor(l);
     let t = l - l0;
-    let a = env_bilinear(u32(l0), uv);
+    let a = env_bilinear(shade.mips_first + u32(l0), uv);
     if (t == 0.0) {
         return a;
     }
-    let b = env_bilinear(u32(l0) + 1u, uv);
+    let b = env_bilinear(shade.mips_first + u32(l0) + 1u, uv);
     return a * (1.0 - t) + b * t;
 }
 
-// `L(wi)` of each mode (crate documentation of `render`, "The estimators"). `map` is the map a
-// bilinear mode reads: level 0, or the pixel's prefiltered layer.
-fn incident_radiance(map: u32, wi: vec3<f32>, pdf: f32) -> vec3<f32> {
-    let uv = env_uv(wi);
-    if (shade.mode == MODE_FIS) {
-        let pdf_uv = pdf * uv_jacobian(uv.y);
-        return mip_trilinear(uv, mip_lod(pdf_uv));
-    }
-    return env_bilinear(map, uv);
-}
-
-// The prefiltered layer of the pixel: row r = min(floor((1 - cos_o) R), R - 1) of the view-layer
-// table (which must not be empty), `shade.layer_shift` layers sharper, the sharpest at most.
-fn view_layer(frame: ShadingFrame) -> u32 {
+// `render::view_layer`: the pixel's Phong layer coordinate, between the view rows' centres.
+fn view_layer_coordinate(frame: ShadingFrame) -> f32 {
     let rows = shade.n_view_rows;
-    let r = min(u32(max(floor((1.0 - frame.cos_o) * f32(rows)), 0.0)), rows - 1u);
-    return min(view_layers[r] + min(shade.layer_shift, shade.n_layers), shade.n_layers - 1u);
-}
-
-// The map a bilinear mode reads at this pixel: level 0 (reference), or for the prefiltered mode
-// the pixel's layer.
-fn source_map(frame: ShadingFrame) -> u32 {
-    if (shade.mode != MODE_PREFILTERED) {
-        return 0u;
+    let s = clamp((1.0 - frame.cos_o) * f32(rows) - 0.5, 0.0, f32(rows - 1u));
+    let r = min(u32(floor(s)), rows - 1u);
+    let t = s - f32(r);
+    let a = view_layers[r];
+    if (t > 0.0) {
+        return a + (view_layers[r + 1u] - a) * t;
     }
-    return shade.n_levels + view_layer(frame);
+    return a;
 }
 
-// What a debug mode shows at a pixel with a shading frame: (index, 1, 0).
+// The Phong layers the prefiltered estimator blends at this pixel: `shade.layer_shift` layers
+// sharper than the view's coordinate, the sharpest at most; (first layer, its weight's
+// complement t) as `render::shade` blends them: (1 - t) layer k + t layer k + 1.
+struct LayerBlend {
+    k: u32,
+    t: f32,
+}
+
+fn layer_blend(frame: ShadingFrame) -> LayerBlend {
+    let x = min(view_layer_coordinate(frame) + f32(shade.layer_shift), f32(shade.n_layers - 1u));
+    let k = u32(floor(x));
+    return LayerBlend(k, x - f32(k));
+}
+
+// The blended layers at `uv`.
+fn layers_bilinear(blend: LayerBlend, uv: vec2<f32>) -> vec3<f32> {
+    let a = env_bilinear(shade.layers_first + blend.k, uv);
+    if (blend.t > 0.0) {
+        let b = env_bilinear(shade.layers_first + min(blend.k + 1u, shade.n_layers - 1u), uv);
+        return a * (1.0 - blend.t) + b * blend.t;
+    }
+    return a;
+}
+
+// What a debug mode shows at a pixel with a shading frame: (index, 1, 0): the sample slice, or
+// the prefiltered layer coordinate (-1 without a table).
 fn debug_index(frame: ShadingFrame) -> vec3<f32> {
     if (shade.mode == MODE_DEBUG_SLICE) {
         return vec3<f32>(f32(slice_of(frame)), 1.0, 0.0);
@@ -480,36 +733,76 @@ fn debug_index(frame: ShadingFrame) -> vec3<f32> {
     if (shade.n_view_rows == 0u) {
         return vec3<f32>(-1.0, 1.0, 0.0);
     }
-    return vec3<f32>(f32(view_layer(frame)), 1.0, 0.0);
+    let blend = layer_blend(frame);
+    return vec3<f32>(f32(blend.k) + blend.t, 1.0, 0.0);
 }
 
-// One frame's estimate at a covered pixel: 1 / spp sum_j f(wi_j, wo) L(wi_j) cos(theta_j) / pdf_j
-// over the pixel's samples; a sample with pdf <= 0, wi below the horizon or no table data adds 0.
+// One frame's estimate at a covered pixel: 1 / spp of `estimate_sum` over its spp terms.
 fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
     return estimate_sum(frame, pixel, f, spp, 0u, spp) / f32(spp);
 }
 
-// The sum of `estimate`'s terms `first .. first + count` of the pixel's `spp` samples in frame `f`.
+// The light the two strategies of multiple importance sampling share in this mode
+// (`render::shade`): level 0 whole in the reference mode, the peaks in the filtered modes;
+// `valid` is false where a filtered mode's environment has no peaks.
+struct SampledLight {
+    valid: bool,
+    map: u32,
+    distribution: LatLong,
+}
+
+fn sampled_light() -> SampledLight {
+    if (shade.mode == MODE_REFERENCE) {
+        return SampledLight(true, 0u, LatLong(shade.env_marginal, shade.env_conditional));
+    }
+    return SampledLight(shade.peak_map != NO_MAP, shade.peak_map, LatLong(shade.peak_marginal, shade.peak_conditional));
+}
+
+// The sum of terms `first .. first + count` of the pixel's `spp` in frame `f`
+// (`render::shade::shade`): term `j` is the BRDF's sample at point `base + j` of the pixel's
+// BRDF sequence and, where the mode samples a light, the light's at the same point of its own.
 fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, count: u32) -> vec3<f32> {
     let k = slice_of(frame);
-    let map = source_map(frame);
     let range = sample_range(pixel, f, spp);
-    let start = (k * shade.n_vectors + range.x) * shade.n_samples + range.y;
+    let base = range.x * shade.n_samples + range.y;
+    let words = pixel_words(pixel);
+    let light = sampled_light();
+    var blend = LayerBlend(0u, 0.0);
+    if (shade.mode == MODE_PREFILTERED) {
+        blend = layer_blend(frame);
+    }
     var sum = vec3<f32>(0.0);
     for (var j = first; j < first + count; j++) {
-        let texel = samples[start + j];
-        let wi_local = texel.xyz;
-        let pdf = texel.w;
-        if (!(pdf > 0.0 && wi_local.z > 0.0)) {
+        let index = base + j;
+        let s = brdf_sample(k, sequence_point(words.xy, index));
+        if (s.pdf > 0.0 && s.wi.z > 0.0) {
+            let brdf = material_brdf(s.wi, frame.wo_local);
+            // No data counts as 0; the CPU skips zeros too.
+            if (any(brdf != vec3<f32>(0.0))) {
+                let uv = env_uv(to_world(frame, s.wi));
+                if (shade.mode == MODE_FIS) {
+                    sum += brdf * mip_trilinear(uv, mip_lod(s.pdf)) * (s.wi.z / s.pdf);
+                } else if (shade.mode == MODE_PREFILTERED) {
+                    sum += brdf * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
+                }
+                if (light.valid) {
+                    let weight = mis_weight(s.pdf, latlong_pdf(light.distribution, uv));
+                    sum += brdf * env_bilinear(light.map, uv) * (s.wi.z * weight / s.pdf);
+                }
+            }
+        }
+        if (!light.valid) {
             continue;
         }
-        let brdf = material_brdf(wi_local, frame.wo_local);
-        // No data counts as 0; the CPU skips zeros too.
-        if (all(brdf == vec3<f32>(0.0))) {
-            continue;
+        let drawn = latlong_sample(light.distribution, sequence_point(words.zw, index));
+        let wi = to_local(frame, env_direction(drawn.uv));
+        if (drawn.pdf > 0.0 && wi.z > 0.0) {
+            let brdf = material_brdf(wi, frame.wo_local);
+            if (any(brdf != vec3<f32>(0.0))) {
+                let weight = mis_weight(drawn.pdf, brdf_pdf(k, wi));
+                sum += brdf * env_bilinear(light.map, drawn.uv) * (wi.z * weight / drawn.pdf);
+            }
         }
-        let radiance = incident_radiance(map, to_world(frame, wi_local), pdf);
-        sum += brdf * radiance * (wi_local.z / pdf);
     }
     return sum;
 }

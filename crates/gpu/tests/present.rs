@@ -24,8 +24,8 @@ fn material() -> &'static Material {
         let table = Analytic::Ggx { alpha: 0.2, f0: [0.95, 0.64, 0.54] }.table(Dims::MERL);
         let config = importance::Config { n_theta_o: 16, n_vectors: 4, n_samples: 64, ..Default::default() };
         let tables = importance::build(&table, &config).expect("a valid config");
-        let samples = SampleSet { n_slices: 16, n_vectors: 4, n_samples: 64, texels: tables.sample_texels() };
-        Material { table, samples, view_layers: vec![0, 0, 1, 1, 2, 2], wavelet: None }
+        let samples = SampleSet::new(&tables);
+        Material { table, samples, view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0], wavelet: None }
     })
 }
 
@@ -50,7 +50,7 @@ fn lighting() -> &'static Lighting {
         let exponents = vec![1, 16, 256];
         let config = prefilter::Config { exponents: exponents.clone(), width: 32, height: 16, ..Default::default() };
         let layers = prefilter::prefilter(&map, &config).expect("a valid config").layers;
-        Lighting { mips: MipChain::new(&map), layers: layers.into_iter().map(|l| l.map).collect(), exponents }
+        Lighting::new(MipChain::new(&map), layers.into_iter().map(|l| l.map).collect(), exponents).expect("a valid map")
     })
 }
 
@@ -177,18 +177,18 @@ fn the_present_pass_centres_the_image() {
 
 /// The debug views hold what the specification says the estimators read, evaluated on the CPU
 /// in f64 from the G-buffer's interpolated position and normal: the normal itself (exactly: the
-/// same interpolation), the view-layer table's row `min(floor((1 - cos_o) R), R - 1)` and the
-/// slice `min(floor(theta_o / (pi / 2) S + 1/2), S - 1)`. A pixel whose `cos_o` or `theta_o`
-/// lies within f32 rounding of a row or slice boundary may fall either way: a few in an image
-/// of hundreds of boundary-free pixels (measured: none), where a wrong row or slice formula moves
-/// whole bands.
+/// same interpolation), the layer coordinate `render::view_layer` (to 1e-5: f32 arithmetic on
+/// coordinates below 3) and the slice `min(floor(theta_o / (pi / 2) S + 1/2), S - 1)`. A pixel
+/// whose `theta_o` lies within f32 rounding of a slice boundary may fall either way: a few in an
+/// image of hundreds of boundary-free pixels (measured: none), where a wrong slice formula moves
+/// whole bands, and a wrong interpolation of the rows whole rings.
 #[test]
 fn debug_views_show_what_the_estimators_read() {
     let mut renderer = renderer();
     let gbuffer = renderer.gbuffer().expect("the g-buffer");
     let eye = renderer.camera().eye().as_dvec3();
     let material = material();
-    let (rows, slices) = (material.view_layers.len(), material.samples.n_slices);
+    let slices = material.samples.n_slices;
 
     renderer.accumulate(&settings(1), View::Normal).expect("accumulating normals");
     let normals = renderer.accumulated_image().expect("reading back");
@@ -213,14 +213,14 @@ fn debug_views_show_what_the_estimators_read() {
             assert_eq!(value(&slice_view), [0.0; 3], "slice at pixel {i}, facing away");
             continue;
         }
-        let row = (((1.0 - cos_o) * rows as f64).floor().max(0.0) as usize).min(rows - 1);
-        let layer = material.view_layers[row] as f32;
+        let layer = render::view_layer(&material.view_layers, cos_o) as f32;
         let theta_o = (wo - cos_o * n).length().atan2(cos_o);
         let slice = ((theta_o / FRAC_PI_2 * slices as f64 + 0.5).floor() as usize).min(slices - 1) as f32;
-        if value(&layers) != [layer, 1.0, 0.0] || value(&slice_view) != [slice, 1.0, 0.0] {
+        let [shown, one, zero] = value(&layers);
+        if (shown - layer).abs() > 1e-5 || [one, zero] != [1.0, 0.0] || value(&slice_view) != [slice, 1.0, 0.0] {
             mismatches += 1;
         }
-        seen_layers.push(layer as u32);
+        seen_layers.push(layer.round() as u32);
         seen_slices.push(slice as u32);
     }
     seen_layers.sort_unstable();

@@ -82,6 +82,9 @@ impl Default for Config {
 pub enum Error {
     #[error("invalid setting: {0}")]
     Config(String),
+    /// Stored tables that do not make a distribution.
+    #[error("invalid table: {0}")]
+    Table(String),
 }
 
 impl Config {
@@ -150,6 +153,21 @@ impl HalfVectorRows {
         HalfVectorRows { t_edges }
     }
 
+    /// The rows of a stored table: its row edges in `theta_h` (asset kind 2's `theta_h_edges`),
+    /// at least two, from 0 to `pi / 2`, increasing.
+    pub fn from_theta_edges(theta_edges: &[f64]) -> Result<HalfVectorRows, Error> {
+        let increasing = theta_edges.windows(2).all(|w| w[1] > w[0]);
+        let (first, last) = (theta_edges.first().copied(), theta_edges.last().copied());
+        let ends = first == Some(0.0) && last.is_some_and(|l| (l - std::f64::consts::FRAC_PI_2).abs() <= 1e-9);
+        if theta_edges.len() < 2 || !increasing || !ends {
+            return Err(Error::Table(format!(
+                "{} theta_h edges from {first:?} to {last:?}: need at least two, increasing from 0 to pi/2",
+                theta_edges.len()
+            )));
+        }
+        Ok(HalfVectorRows { t_edges: theta_edges.iter().map(|&theta| t_of_theta(theta)).collect() })
+    }
+
     pub fn len(&self) -> usize {
         self.t_edges.len() - 1
     }
@@ -193,7 +211,7 @@ fn half_vector(t: f64, phi_h: f64) -> DVec3 {
 }
 
 /// The importance-sampling table of one outgoing direction.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Slice {
     theta_o: f64,
     wo: DVec3,
@@ -209,12 +227,37 @@ struct Located {
 }
 
 impl Slice {
+    /// The slice of a stored table (asset kind 2): outgoing elevation `theta_o`, the rows, and the
+    /// distribution over `[phi_h / 2 pi, row coordinate]` with `rows.len()` rows (for example
+    /// `sampling::Distribution2D::from_cdfs` of the stored CDFs, which samples them as they are).
+    pub fn from_tables(theta_o: f64, rows: HalfVectorRows, dist: Distribution2D) -> Result<Slice, Error> {
+        if dist.nv() != rows.len() {
+            return Err(Error::Table(format!("{} rows of half vectors, but the distribution has {}", rows.len(), dist.nv())));
+        }
+        if !(0.0..std::f64::consts::FRAC_PI_2).contains(&theta_o) {
+            return Err(Error::Table(format!("theta_o {theta_o} is outside [0, pi/2)")));
+        }
+        Ok(Slice { theta_o, wo: spherical_dir(theta_o, 0.0), rows, dist })
+    }
+
+    /// The slice as a renderer reads it back from the asset (kind 2): the CDF tables rounded to
+    /// `f32` (`sampling::Distribution2D::rounded_to_f32`), the rows through their `theta_h` edges.
+    pub fn as_stored(&self) -> Slice {
+        let rows = HalfVectorRows::from_theta_edges(&self.rows.theta_edges()).expect("the rows of a build are valid");
+        Slice { theta_o: self.theta_o, wo: self.wo, rows, dist: self.dist.rounded_to_f32() }
+    }
+
     pub fn theta_o(&self) -> f64 {
         self.theta_o
     }
 
     pub fn wo(&self) -> DVec3 {
         self.wo
+    }
+
+    /// The rows of half vectors the distribution's rows are.
+    pub fn rows(&self) -> &HalfVectorRows {
+        &self.rows
     }
 
     /// The piecewise-constant distribution over `[phi_h / 2 pi, row coordinate]`, row-major
@@ -461,7 +504,19 @@ pub mod quality {
     /// resolved.
     pub fn chi2_against_density(slice: &Slice, n: usize, seed: u64, q: Quadrature) -> sampling::chi2::Chi2 {
         use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        chi2_of_points(slice, (0..n).map(|_| [rng.random(), rng.random()]), q)
+    }
+
+    /// [`chi2_against_density`] of the directions `slice` draws from the given points, which must
+    /// be uniform on `[0, 1)^2` for the test to accept: a renderer's points, say.
+    pub fn chi2_of_points(
+        slice: &Slice,
+        points: impl ExactSizeIterator<Item = [f64; 2]>,
+        q: Quadrature,
+    ) -> sampling::chi2::Chi2 {
         const BINS: usize = 80;
+        let n = points.len();
         let bin = |wi: glam::DVec3| {
             (wi.z > 0.0).then(|| {
                 let band = ((wi.z * 8.0) as usize).min(7);
@@ -486,10 +541,9 @@ pub mod quality {
         let total: f64 = expected.iter().sum();
         expected.iter_mut().for_each(|e| *e *= n as f64 / total);
 
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
         let mut observed = vec![0u64; BINS + 1];
-        for _ in 0..n {
-            let s = slice.sample([rng.random(), rng.random()]);
+        for u in points {
+            let s = slice.sample(u);
             let b = if s.pdf > 0.0 { bin(s.wi) } else { None };
             observed[b.unwrap_or(BINS)] += 1;
         }

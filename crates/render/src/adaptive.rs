@@ -1282,7 +1282,7 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
     }
     if settings.lobe_weight
         && (material.view_layers.is_empty()
-            || material.view_layers.iter().any(|&l| l as usize >= lighting.exponents.len()))
+            || material.view_layers.iter().any(|&l| !(l >= 0.0 && (l as usize) < lighting.exponents.len())))
     {
         return Err(Error::Invalid(
             "the lobe weight reads the bake's layer selection, which is missing or out of range".into(),
@@ -1450,10 +1450,10 @@ pub fn render_with(
     let predict_ms = lap();
     let levels = pyramid(&predictions, width, height, top);
     let covered_output = geometry.covered.iter().filter(|&&c| c).count() as u64;
-    // The lobe weight's sharpness per view row: the exponent of the Phong layer the bake picks.
+    // The lobe weight's sharpness per view row: the exponent at the row's layer coordinate.
     let sharpness: Option<Vec<f64>> = settings
         .lobe_weight
-        .then(|| material.view_layers.iter().map(|&l| f64::from(lighting.exponents[l as usize])).collect());
+        .then(|| material.view_layers.iter().map(|&x| crate::layer_exponent(&lighting.exponents, x)).collect());
     let plan = plan(
         levels,
         pixels,

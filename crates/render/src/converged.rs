@@ -6,17 +6,12 @@
 //! `g(x_s) / (p_env + p_cos + p_h)(x_s)`, so the estimate is unbiased wherever one density is
 //! positive, and the cosine density is positive on the whole upper hemisphere.
 //!
-//! - **Environment** (`p_env`): a `sampling::Distribution2D` over level 0's texels, texel
-//!   `(x, y)` weighted by `Y(x, y) sin theta_y` (`theta_y` at the row centre) where `Y` is the
-//!   Rec. 709 luminance of the **bilinear reconstruction averaged over the texel**: the texels
-//!   filtered by `[1, 6, 1] / 8` along each axis (wrapping in `u`, the edge rows repeated in `v`,
-//!   as the bilinear lookup clamps there). Within a texel the direction is uniform in `(u, v)`,
-//!   so its density per solid angle is `func / integral / (2 pi^2 sin theta)`, `theta` the
-//!   direction's own. Weighting by the filtered luminance rather than the texel's own keeps the
-//!   density positive wherever the bilinear lookup is (half a texel around a bright texel, where
-//!   the texel's own value may be 0) and follows the integrand within a texel, so a sun does not
-//!   throw fireflies; any positive density would leave the estimate unbiased, as it is evaluated
-//!   exactly for every direction.
+//! - **Environment** (`p_env`): the lighting's own importance sampling of level 0
+//!   ([`crate::Lighting::environment`]: texels weighted by the luminance of the bilinear
+//!   reconstruction averaged over each texel, times `sin theta`; uniform in `(u, v)` within a
+//!   texel), the one the reference mode draws from too. Its density is evaluated exactly for
+//!   every direction and is positive wherever the bilinear lookup is, so reading `L` bilinearly
+//!   costs no bias, and a sun does not throw fireflies.
 //! - **Cosine** (`p_cos = cos theta_i / pi`): Malley's method, `wi = (sqrt(u0) cos 2 pi u1,
 //!   sqrt(u0) sin 2 pi u1, sqrt(1 - u0))`.
 //! - **MERL-grid half vector** (`p_h`): `x_h = u0`, `theta_h = (pi / 2) x_h^2` (MERL's
@@ -30,10 +25,9 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use envmap::EnvMap;
 use glam::DVec3;
 use rayon::prelude::*;
-use sampling::{Distribution2D, OwenSobol2D};
+use sampling::OwenSobol2D;
 
 use crate::error::Error;
 use crate::shade::{ShadingFrame, background, brdf, visibility};
@@ -55,7 +49,6 @@ pub fn converged(
     let gbuffer = visibility(scene)?;
     let level0 = lighting.mips.level(0);
     let rays = scene.camera.rays(scene.width, scene.height);
-    let env = EnvSampler::new(level0);
     let eye = scene.camera.eye().as_dvec3();
     let width = scene.width;
     let mut rgb = vec![0.0f32; 3 * width * scene.height];
@@ -65,7 +58,7 @@ pub fn converged(
                 Some(hit) => match ShadingFrame::new(hit, eye) {
                     Some(frame) => {
                         let pixel = (y * width + x) as u64;
-                        estimate(&frame, material, level0, &env, samples_per_strategy, seed, pixel)
+                        estimate(&frame, material, lighting, samples_per_strategy, seed, pixel)
                     }
                     None => [0.0; 3],
                 },
@@ -75,55 +68,6 @@ pub fn converged(
         }
     });
     Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
-}
-
-/// The environment strategy.
-struct EnvSampler {
-    dist: Distribution2D,
-}
-
-impl EnvSampler {
-    fn new(map: &EnvMap) -> EnvSampler {
-        let (w, h) = (map.width(), map.height());
-        let luminance = map.luminance();
-        // [1, 6, 1] / 8 is the mean over a texel of the linear interpolation between texel
-        // centres (1/8 of each neighbour, 3/4 of itself); along u it wraps, along v the lookup
-        // clamps to the edge rows' centres, which the repeated edge row reproduces.
-        let mut along_u = vec![0.0f64; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let at = |x: usize| f64::from(luminance[y * w + x]);
-                along_u[y * w + x] = (at((x + w - 1) % w) + 6.0 * at(x) + at((x + 1) % w)) / 8.0;
-            }
-        }
-        let mut func = vec![0.0f64; w * h];
-        for y in 0..h {
-            let sin_theta = (PI * (y as f64 + 0.5) / h as f64).sin();
-            let (up, down) = (y.saturating_sub(1), (y + 1).min(h - 1));
-            for x in 0..w {
-                let filtered = (along_u[up * w + x] + 6.0 * along_u[y * w + x] + along_u[down * w + x]) / 8.0;
-                // Luminance of non-negative radiance with positive weights: finite and >= 0.
-                func[y * w + x] = filtered.max(0.0) * sin_theta;
-            }
-        }
-        let dist = Distribution2D::new(&func, w, h).expect("a valid map gives finite, non-negative weights");
-        EnvSampler { dist }
-    }
-
-    /// A direction and its density per solid angle (0 on the poles, where it draws nothing).
-    fn sample(&self, u: [f64; 2]) -> (DVec3, f64) {
-        let s = self.dist.sample(u);
-        let [x, v] = s.p;
-        let sin_theta = (PI * v).sin();
-        let pdf = if sin_theta > 0.0 { s.pdf / (2.0 * PI * PI * sin_theta) } else { 0.0 };
-        (envmap::direction(x, v), pdf)
-    }
-
-    fn pdf(&self, wi: DVec3) -> f64 {
-        let (u, v) = envmap::uv(wi);
-        let sin_theta = wi.x.hypot(wi.y) / wi.length();
-        if sin_theta > 0.0 { self.dist.pdf([u, v]) / (2.0 * PI * PI * sin_theta) } else { 0.0 }
-    }
 }
 
 /// The cosine strategy, in the shading frame (density [`pdf_cosine`]).
@@ -166,16 +110,9 @@ fn pdf_half_vector(wi_local: DVec3, wo: DVec3) -> f64 {
 }
 
 /// One pixel's estimate.
-fn estimate(
-    frame: &ShadingFrame,
-    material: &Material,
-    level0: &EnvMap,
-    env: &EnvSampler,
-    rounds: u32,
-    seed: u64,
-    pixel: u64,
-) -> [f64; 3] {
+fn estimate(frame: &ShadingFrame, material: &Material, lighting: &Lighting, rounds: u32, seed: u64, pixel: u64) -> [f64; 3] {
     let wo = frame.wo_local;
+    let (level0, env) = (lighting.mips.level(0), &lighting.environment);
     let sequences = [0, 1, 2].map(|s| OwenSobol2D::for_vector(seed, 3 * pixel + s));
     // `g / (p_env + p_cos + p_h)` of one direction, given in both frames.
     let contribution = |wi_local: DVec3, wi: DVec3, sum: &mut [f64; 3], env_pdf: Option<f64>| {
@@ -186,7 +123,7 @@ fn estimate(
         if f == [0.0; 3] {
             return;
         }
-        let p = env_pdf.unwrap_or_else(|| env.pdf(wi)) + pdf_cosine(wi_local) + pdf_half_vector(wi_local, wo);
+        let p = env_pdf.unwrap_or_else(|| env.pdf(envmap::uv(wi).into())) + pdf_cosine(wi_local) + pdf_half_vector(wi_local, wo);
         if !(p > 0.0 && p.is_finite()) {
             return;
         }
@@ -197,9 +134,10 @@ fn estimate(
     };
     let mut sum = [0.0f64; 3];
     for round in 0..rounds {
-        let (wi, pdf) = env.sample(sequences[0].point(round));
-        if pdf > 0.0 {
-            contribution(frame.to_local(wi), wi, &mut sum, Some(pdf));
+        let light = env.sample(sequences[0].point(round));
+        if light.pdf > 0.0 {
+            let wi = envmap::direction(light.uv[0], light.uv[1]);
+            contribution(frame.to_local(wi), wi, &mut sum, Some(light.pdf));
         }
         let wi_local = sample_cosine(sequences[1].point(round));
         contribution(wi_local, frame.to_world(wi_local), &mut sum, None);

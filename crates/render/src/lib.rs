@@ -40,59 +40,132 @@
 //! `wo_local = (|wo - cos_o n|, 0, cos_o)` (normalized), the frame of the baked samples (`phi_o =
 //! 0`), and a local direction `(x, y, z)` is `x t + y b + z n` in world space.
 //!
-//! # Samples ([`SampleSet`], [`sample_range`])
+//! # Samples ([`SampleSet`], [`sample_range`], [`pixel_sequences`])
 //!
-//! The baked importance samples come in `S` slices (slice `k` for `theta_o = k / S * pi / 2`), `V`
-//! vectors per slice and `N` samples per vector, each `(wi_local, pdf)` with `pdf` per unit solid
-//! angle (`data-schema/README.md`, kind 2). A pixel uses the slice nearest its `theta_o =
-//! atan2(wo_local.x, wo_local.z)`: `k = min(floor(theta_o / (pi / 2) * S + 1/2), S - 1)`.
+//! The bake's importance tables come in `S` slices (slice `k` for `theta_o = k / S * pi / 2`):
+//! per slice a piecewise-constant distribution over the half vector, MERL's `theta_h` rows by
+//! sectors of `phi_h`, uniform in the solid angle of `h` within a cell (`importance`'s crate
+//! docs), held as the asset's `f32` CDF tables and sampled as stored
+//! (`sampling::Distribution2D::from_cdfs`, [`SampleSet::tables`]; `data-schema/README.md`, kind
+//! 2). A pixel uses the slice nearest its `theta_o = atan2(wo_local.x, wo_local.z)`:
+//! `k = min(floor(theta_o / (pi / 2) * S + 1/2), S - 1)`.
 //!
-//! With `spp` samples per pixel and frame (a power of two dividing `N`), a slice holds
-//! `C = V N / spp` chunks of `spp` consecutive samples: chunk `c` is vector `c / (N / spp)`,
-//! samples from `(c % (N / spp)) spp`. Pixel `i = y * width + x` draws one random word
-//! `h = pcg_hash(i ^ pcg_hash(seed))` ([`pcg_hash`]: Jarzynski and Olano 2020, wrapping `u32`
-//! arithmetic, so both renderers draw the same word; the seed is hashed so that neighbouring seeds
-//! give unrelated words) and in frame `f` takes chunk `c = (h % C + f % C) % C`: the frames walk
-//! through the slice's chunks from a random start, each chunk once per `C` frames. Each vector is
-//! an Owen-scrambled Sobol' sequence, so every aligned block of a power-of-two length is itself
-//! stratified (`001` section 3.3: "we read N_p samples randomly, from multiple pre-computed
-//! vectors"). After `C` frames a pixel has used every baked sample of its slice exactly once: the
-//! image is then the estimator's expectation over the sample choice, exactly, and more frames only
-//! repeat it (a render that wants less noise than the bake's `V N` samples allow needs a bake
-//! with more samples).
+//! Every pixel draws its own directions. Pixel `i = y * width + x` has two Owen-scrambled Sobol'
+//! (0,2)-sequences ([`pixel_sequences`]: `sampling::OwenSobol2D` scrambled by words of
+//! [`pcg_hash`], Jarzynski and Olano 2020, `w0 = pcg_hash(i ^ pcg_hash(seed ^ 0x6a09e667))`,
+//! each next word the hash of the one before; wrapping `u32` arithmetic, so both renderers draw
+//! the same points), one for the BRDF's directions and one for the light's. A point is read as the
+//! top 24 bits of each coordinate ([`point`]: exact in `f32`), and the slice's table maps it to a
+//! direction and its density (`importance::Slice::sample`: `u1` picks the row through the
+//! marginal CDF, `u0` the sector through that row's conditional, linear within both).
+//!
+//! Which points: with `spp` samples per pixel and frame (a power of two dividing the bake's `N`
+//! samples per vector), the first `V N` points of a sequence hold `C = V N / spp` chunks of `spp`
+//! consecutive points, chunk `c` starting at point `c spp` (as vector `c / (N / spp)`, sample
+//! `(c % (N / spp)) spp` of the bake's layout: [`sample_range`]). The pixel draws one more word
+//! `h = pcg_hash(i ^ pcg_hash(seed))` and in frame `f` takes chunk `c = (h % C + f % C) % C`: the
+//! frames walk through its points from a random start, each chunk once per `C` frames, and every
+//! aligned chunk of a power-of-two length is itself stratified (a (0, m, 2)-net).
+//!
+//! Why each pixel has its own points. The papers' renderer reads precomputed vectors of samples
+//! (`001` section 3.3), the same for every pixel of a slice: after `C` frames every pixel of the
+//! slice has averaged the same `V N` directions, so it shares their Monte Carlo error, which under
+//! a sun is whether those few directions happen to hit it. That error is constant along the
+//! circles of equal `theta_o`, and a sphere shows rings. Rotating a pixel's baked directions about
+//! the normal by a random azimuth does not help: a view's lobe depends on `phi_i - phi_o`, so
+//! rotating `wi` with `wo` fixed moves the samples out of the lobe, another distribution (the same
+//! one only for `wo = n`). What keeps the distribution: nested uniform scrambling makes every
+//! point of a scrambled sequence uniform on `[0, 1)^2` whatever the scramble (Owen 1995), so the
+//! table maps each pixel's points to directions of exactly the table's density, and the density
+//! the estimators divide by is that of the direction drawn: unbiased, pixel by pixel. Pixels
+//! with unrelated scrambles have unrelated errors, so the error carries no structure from pixel
+//! to pixel. The scrambles come from a hash rather than independent draws; the tests hold one
+//! point of many pixels to the table's density by chi-square and measure the correlation of
+//! neighbouring pixels' errors. The bake's own sample texels ([`SampleSet::texels`], the
+//! papers' vectors) stay in the asset: the adaptive prediction reads one vector's first samples
+//! (module [`adaptive`]), and `merl-importance` shows them. The price is a table lookup per
+//! sample in place of a texel read: two binary searches, over 91 row edges and 129 sector edges.
 //!
 //! # The estimators ([`Mode`])
 //!
-//! Every mode computes, per frame,
+//! Every mode sums, per frame, over the pixel's `spp` points: point `n` gives one direction from
+//! the BRDF's strategy (`wi_b` of density `p_b`, the slice's table) and, where the mode samples
+//! a light, one from the light's (`wi_l` of density `p_l`, a `sampling::LatLong` of a map):
 //!
 //! ```text
-//! L_o = 1 / spp * sum_j f(wi_j, wo) L(wi_j) cos(theta_j) / pdf_j
+//! L_o = 1 / spp * sum_n [ f(wi_b) cos_b (F(wi_b) / p_b + M(wi_b) / (p_b(wi_b) + p_l(wi_b)))
+//!                         + f(wi_l) cos_l M(wi_l) / (p_b(wi_l) + p_l(wi_l)) ]
 //! ```
 //!
-//! over the pixel's `spp` samples, where a sample with `pdf <= 0` or `wi_local.z <= 0`
-//! contributes 0, `f` is the BRDF at `(wi_local, wo_local)` and `cos(theta_j) = wi_local.z`. The
-//! BRDF is the table's nearest lookup (`merl::MerlTable::lookup` with `Interp::Nearest`, the
-//! lookup the WGSL ports), 0 where the table holds no data; or, when the material carries a
-//! [`Wavelet`], its reconstruction at the wavelet's level of detail
-//! (`haar_brdf::WaveletBrdf::eval`: bilinear over the 4 x 4 surrounding cell pairs of the sphere
-//! grid, Haar synthesis of each, in the log domain; the WGSL `brdf_wavelet.wgsl` ports it). The
-//! modes differ in `L`:
+//! `F` is the light a filtered mode reads, `M` the light multiple importance sampling takes,
+//! with the balance heuristic (each strategy's weight is its density over the sum of the two, one
+//! direction of each per point). A direction with a density of 0 or
+//! `wi_local.z <= 0` contributes 0, `f` is the BRDF at `(wi_local, wo_local)` and `cos =
+//! wi_local.z`. `p_b` of a light's direction is the slice's table density at it
+//! (`importance::Slice::pdf`, from the cell it falls in), `p_l` of a BRDF direction the light's
+//! at its map coordinates (`sampling::LatLong::pdf`): both exact for every direction, so the
+//! weights sum to 1 wherever either density is positive. The table's density is positive over
+//! the whole upper hemisphere (its defensive share), so `M` is integrated without bias. The BRDF
+//! is the table's nearest lookup (`merl::MerlTable::lookup` with `Interp::Nearest`, the lookup
+//! the WGSL ports), 0 where the table holds no data; or, when the material carries a [`Wavelet`],
+//! its reconstruction at the wavelet's level of detail (`haar_brdf::WaveletBrdf::eval`: bilinear
+//! over the 4 x 4 surrounding cell pairs of the sphere grid, Haar synthesis of each, in the log
+//! domain; the WGSL `brdf_wavelet.wgsl` ports it). The modes differ in `F` and `M`:
 //!
-//! - [`Mode::Reference`]: the environment's level 0, bilinear (`envmap::EnvMap::lookup`).
-//! - [`Mode::Fis`] (filtered importance sampling, `002`): the mip chain, trilinear
-//!   (`envmap::MipChain::lookup`) at `lod = max(log4(w h / (spp p_uv)), 0)`, `w x h` the level-0
-//!   size, `p_uv = pdf * envmap::geometry::uv_jacobian(v)` the sample's density over the map's
-//!   unit square (`envmap::MipChain::lod`), `v` the world direction's map coordinate. No bias.
-//! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"): the Phong-lobe layer the material's
-//!   [`Material::view_layers`] picks for the pixel's view direction, bilinear. Row
-//!   `r = min(floor((1 - cos_o) * R), R - 1)` of the `R` entries (the rows of the bandwidth atlas,
-//!   equal steps of `cos theta`). An adaptive frame's shaded blocks read a sharper layer
-//!   (`adaptive::Settings::layer_shift`, module `adaptive`, "Shading").
+//! - [`Mode::Reference`]: `F = 0`, `M` the environment's level 0, bilinear
+//!   (`envmap::EnvMap::lookup`), `p_l` its importance sampling ([`Lighting::environment`]: texels
+//!   by the luminance of their bilinear reconstruction times `sin theta`). Unbiased: it estimates
+//!   `int f L cos` with level 0 as the renderers read it, the converged estimate's integral.
+//! - [`Mode::Fis`] (filtered importance sampling, `002`): `F` the mip chain of the environment's
+//!   smooth part ([`Lighting::smooth_mips`]), trilinear at `lod = max(log4(w h / (spp p_b 2 pi^2)),
+//!   0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the level a footprint of
+//!   solid angle `1 / (spp p_b)` gets at the equator, wherever it lies; "Small bright sources"
+//!   says why); `M` the environment's peaks, `p_l` theirs ([`Peaks`]).
+//! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"): `F` the smooth part's Phong layers
+//!   ([`Lighting::smooth_layers`]) blended at the pixel's layer coordinate `x` =
+//!   [`view_layer`]`(cos_o)` (the material's [`Material::view_layers`], one per row of the
+//!   bandwidth atlas, interpolated between the rows' centres) `+ layer_shift`, at most the last
+//!   layer: `(1 - t)` of layer `k` and `t` of layer `k + 1`, `k + t = x`, each bilinear. Blending
+//!   by a coordinate that moves continuously with the view leaves no seam where the chosen layer
+//!   changes. An adaptive frame's shaded blocks read sharper layers
+//!   (`adaptive::Settings::layer_shift`, module `adaptive`, "Shading"). `M` and `p_l` as fis.
 //!
-//! A frame's estimate is averaged over `frames` frames (`f = 0 .. frames`): the image converges to
-//! the mode's expectation as frames grow. That expectation is over the choice of vector and chunk
-//! only: with the bake fixed it is the mean over the slice's `V N` samples, which is off the
-//! integral by the bake's own Monte Carlo error (it shrinks as `1 / sqrt(V N)`, not with frames).
+//! Where the environment has no peaks, the filtered modes take no light's directions (`M = 0`).
+//! A frame's estimate is averaged over `frames` frames (`f = 0 .. frames`): the image converges
+//! to the mode's expectation, the integral for the reference mode and the filtered
+//! approximation for the others, as the frames grow.
+//!
+//! # Small bright sources ([`Lighting::peaks`])
+//!
+//! The filtered modes read light that is already averaged, fis over a mip texel the size of the
+//! sample's footprint, prefiltered over a Phong lobe: the estimate is `int L (f cos * K)` for a
+//! kernel `K`, a bias wherever the BRDF times the cosine changes within the kernel. Under a small
+//! bright source it was large: the sun's light spread over a footprint reaches directions below a
+//! surface's horizon and beyond a lobe (mean luminance -7% to +31% against the converged estimate
+//! under quarry's sun, +64% in a band with the sun behind the sphere). So level 0 is split in two
+//! ([`Peaks`]): a texel whose luminance `Y` exceeds [`PEAK_CONTRAST`] (4) times the map's mean
+//! luminance (by solid angle) keeps `T / Y` of itself, `T` that threshold, and gives the rest to
+//! the peaks. The peaks' light is integrated without a filter, by multiple importance sampling of
+//! the BRDF's directions and the peaks' own importance sampling; the filters read the smooth rest,
+//! at most 4 times the mean. Filtering is linear, so the smooth part's chain and layers are the
+//! bake's minus the peaks' own (made with the code that made the bake's, `envmap::MipChain::new`
+//! and `prefilter::prefilter`, once per map when the lighting is made: 0.22 s for a 1024 x 512
+//! map). A lower contrast moves more light into the unbiased part, with more noise at few
+//! samples; a higher one more into the filter: at 16, fis ended 3.5% dark on white-paint under
+//! `studio_small_03` with the light behind the sphere, at 4 within 2% on every case of issue 31
+//! (white-paint, gold-paint and chrome under `quarry_01` and `studio_small_03`, the light before
+//! and behind the sphere; the peaks hold 54% of quarry's light, 83% of the studio's and 1% of
+//! `potsdamer_platz`'s).
+//!
+//! A second bias was fis's own on a lat-long chain: a footprint of a given solid angle covers ever
+//! more of `u` towards the poles and no more of `v`, and a square level matched to its area there
+//! blurs it along `v` by `1 / sqrt(sin theta)`. With the sun behind the sphere that mixed the
+//! zenith with the bright sky around the sun, 3% too bright on gold-paint; the level a footprint
+//! of that solid angle gets at the equator blurs too little along `u` instead (noise, not bias).
+//!
+//! What remains is the filters' bias on the smooth part: a gradient of soft light across a
+//! footprint or a lobe. `cargo bench -p brdf-preview --bench mitsuba` measures every mode against
+//! the converged estimate and Mitsuba 3.
 //!
 //! Pixels no triangle covers show the environment behind them: level 0, bilinear, in the
 //! direction of the ray through the pixel centre ([`Camera::ray`]: built from the camera's basis in
@@ -113,8 +186,9 @@
 //!
 //! An estimator that shares nothing baked with the two renderers: multiple importance sampling
 //! (balance heuristic, one sample from each strategy per round) of three strategies, none of which
-//! reads the importance tables: the environment's level 0 by its luminance times `sin theta`
-//! (a `sampling::Distribution2D` over the texels), the cosine over the hemisphere, and the half
+//! reads the importance tables: the environment's level 0 ([`Lighting::environment`], made from
+//! the map rather than baked; the reference mode samples it too), the cosine over the hemisphere,
+//! and the half
 //! vector drawn uniformly over the cells of the MERL grid (uniform in `sqrt(theta_h / (pi / 2))`
 //! and `phi_h`: dense near the normal, where mirror-like tables keep their energy, whatever the
 //! material). Same BRDF lookup, same visibility and frame, and the same `L` as
@@ -132,16 +206,18 @@ pub mod raster;
 
 mod camera;
 mod error;
+mod lighting;
 mod mesh;
 mod shade;
 
 pub use camera::{Camera, Rays};
 pub use error::Error;
+pub use lighting::{Lighting, PEAK_CONTRAST, Peaks};
 pub use mesh::Mesh;
 pub use shade::{Image, check_inputs, check_settings, render};
 
-use envmap::{EnvMap, MipChain};
 use merl::MerlTable;
+use sampling::OwenSobol2D;
 
 /// What the previewer looks at: one mesh, a camera and an image size.
 #[derive(Clone, Debug)]
@@ -163,6 +239,25 @@ pub struct SampleSet {
     pub n_samples: usize,
     /// `S * V * N` texels `(wi.x, wi.y, wi.z, pdf)`, slice-major, then vector, then sample.
     pub texels: Vec<[f32; 4]>,
+    /// The tables the samples were drawn from, one per slice (the asset's `f32` CDFs as they are
+    /// stored): the estimators draw each pixel's own directions from them (crate documentation,
+    /// "Samples").
+    pub tables: Vec<importance::Slice>,
+}
+
+impl SampleSet {
+    /// The sample set of importance tables built in memory, as the renderers read it from their
+    /// asset (`importance::Slice::as_stored`): what `bake::load` makes of the asset of `tables`.
+    pub fn new(tables: &importance::ImportanceTables) -> SampleSet {
+        let c = tables.config();
+        SampleSet {
+            n_slices: c.n_theta_o,
+            n_vectors: c.n_vectors,
+            n_samples: c.n_samples,
+            texels: tables.sample_texels(),
+            tables: tables.slices().iter().map(importance::Slice::as_stored).collect(),
+        }
+    }
 }
 
 /// A measured material with what a bake made of it.
@@ -170,10 +265,12 @@ pub struct SampleSet {
 pub struct Material {
     pub table: MerlTable,
     pub samples: SampleSet,
-    /// For [`Mode::Prefiltered`]: the Phong layer (an index into [`Lighting::layers`]) for each
-    /// of `R` view elevations in equal steps of `cos theta_o` (row `r` covers
-    /// `1 - cos theta_o` in `[r / R, (r + 1) / R)`).
-    pub view_layers: Vec<u32>,
+    /// For [`Mode::Prefiltered`]: where each of `R` view elevations, in equal steps of
+    /// `cos theta_o`, falls among the Phong layers of [`Lighting::layers`], as a layer coordinate
+    /// (`brdf_atlas::view::layer_coordinate`: `k + t` blends layer `k` and `k + 1` by `t`). Row
+    /// `r` is for `1 - cos theta_o = (r + 1/2) / R`; a pixel interpolates the rows around it
+    /// ([`view_layer`]).
+    pub view_layers: Vec<f32>,
     /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
     /// the table (`brdf-preview --brdf wavelet`): see "The BRDF" in the crate docs.
     pub wavelet: Option<Wavelet>,
@@ -186,17 +283,6 @@ pub struct Wavelet {
     pub brdf: haar_brdf::WaveletBrdf,
     /// In `[0, log2 n]`: 0 is full resolution (`haar_brdf::WaveletBrdf::eval`).
     pub lod: f64,
-}
-
-/// A distant environment with what a bake made of it.
-#[derive(Clone, Debug)]
-pub struct Lighting {
-    /// The environment's mip chain; level 0 is the map itself.
-    pub mips: MipChain,
-    /// The map convolved with normalized Phong lobes, one layer per exponent, all the same size.
-    pub layers: Vec<EnvMap>,
-    /// The exponent of each layer.
-    pub exponents: Vec<u32>,
 }
 
 /// Which estimator shades the covered pixels (see the crate documentation).
@@ -249,6 +335,49 @@ pub fn sample_range(pixel: u32, frame: u32, seed: u32, n_vectors: u32, n_samples
     let h = pcg_hash(pixel ^ pcg_hash(seed));
     let chunk = (h % chunks + frame % chunks) % chunks;
     (chunk / per_vector, (chunk % per_vector) * spp)
+}
+
+/// The Phong layer coordinate of a view with `cos theta_o = cos_o` among rows of layer coordinates
+/// `view_layers` (see [`Material::view_layers`]): linear in `1 - cos theta_o` between the two
+/// rows' centres around it, the first or last row's own beyond their centres. Continuous in the
+/// view, so the layer blend leaves no seam where rows meet. `view_layers` must not be empty.
+pub fn view_layer(view_layers: &[f32], cos_o: f64) -> f64 {
+    let rows = view_layers.len();
+    let s = ((1.0 - cos_o) * rows as f64 - 0.5).clamp(0.0, (rows - 1) as f64);
+    let r = (s.floor() as usize).min(rows - 1);
+    let t = s - r as f64;
+    let a = f64::from(view_layers[r]);
+    if t > 0.0 { a + (f64::from(view_layers[r + 1]) - a) * t } else { a }
+}
+
+/// The Phong exponent at layer coordinate `x` among layers of `exponents`: geometric between the
+/// two layers it blends (`n_k^(1 - t) n_(k+1)^t`), as the lobes' widths are.
+pub fn layer_exponent(exponents: &[u32], x: f32) -> f64 {
+    let last = exponents.len() - 1;
+    let x = f64::from(x).clamp(0.0, last as f64);
+    let k = (x.floor() as usize).min(last);
+    let (a, b) = (f64::from(exponents[k]), f64::from(exponents[(k + 1).min(last)]));
+    a.powf(1.0 - (x - k as f64)) * b.powf(x - k as f64)
+}
+
+/// The point sequences of pixel `pixel`: `[brdf, environment]`, Owen-scrambled Sobol' sequences
+/// scrambled by words of [`pcg_hash`] (crate documentation, "Samples"), so both renderers draw
+/// the same points and neighbouring pixels unrelated ones.
+pub fn pixel_sequences(pixel: u32, seed: u32) -> [OwenSobol2D; 2] {
+    let w0 = pcg_hash(pixel ^ pcg_hash(seed ^ SEQUENCE_SALT));
+    let w1 = pcg_hash(w0);
+    let w2 = pcg_hash(w1);
+    let w3 = pcg_hash(w2);
+    [OwenSobol2D::from_words([w0, w1]), OwenSobol2D::from_words([w2, w3])]
+}
+
+/// Mixed into the seed of [`pixel_sequences`], so that its words are not [`sample_range`]'s.
+pub const SEQUENCE_SALT: u32 = 0x6a09_e667;
+
+/// Point `index` of `sequence` as the renderers read it: the top 24 bits of each coordinate,
+/// exact in `f32`, in `[0, 1 - 2^-24]`.
+pub fn point(sequence: &OwenSobol2D, index: u32) -> [f64; 2] {
+    sequence.point_bits(index).map(|bits| f64::from(bits >> 8) / 16_777_216.0)
 }
 
 /// The frames after which a pixel has used every sample of its slice once ([`sample_range`]):

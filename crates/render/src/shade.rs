@@ -10,7 +10,9 @@ use rayon::prelude::*;
 
 use crate::error::Error;
 use crate::raster::{self, GBuffer, Hit};
-use crate::{Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, sample_range};
+use crate::{
+    Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, pixel_sequences, point, sample_range, view_layer,
+};
 
 /// A rendered image: linear RGB radiance, interleaved, row-major with row 0 at the top, and
 /// which pixels a triangle covers (the others show the environment).
@@ -138,8 +140,8 @@ pub(crate) fn brdf(material: &Material, wi_local: DVec3, wo_local: DVec3) -> [f6
 /// Where a mode reads `L`.
 #[derive(Clone, Copy)]
 enum Source<'a> {
-    /// Bilinear in one map: level 0 (reference) or a prefiltered layer.
-    Map(&'a EnvMap),
+    /// Bilinear in two Phong layers, blended: `(1 - t)` of the first and `t` of the second.
+    Layers(&'a EnvMap, &'a EnvMap, f64),
     /// Trilinear in the mip chain at the sample's level of detail (filtered importance sampling).
     Mips(&'a MipChain),
 }
@@ -157,51 +159,90 @@ pub(crate) fn shade(
 ) -> [f64; 3] {
     let s: &SampleSet = &material.samples;
     let (n_vectors, n_samples, spp) = (s.n_vectors as u32, s.n_samples as u32, settings.spp);
-    let k = slice_of(frame.theta_o(), s.n_slices);
-    let source = match settings.mode {
-        Mode::Reference => Source::Map(lighting.mips.level(0)),
-        Mode::Fis => Source::Mips(&lighting.mips),
+    let table = &s.tables[slice_of(frame.theta_o(), s.n_slices)];
+    let [brdf_points, env_points] = pixel_sequences(pixel, settings.seed);
+    // The light a filtered estimator reads (`Some` in fis and prefiltered) and the light that
+    // multiple importance sampling of the BRDF's and a light's strategy takes: level 0 whole in
+    // the reference mode, the peaks in the filtered modes (crate documentation).
+    let filtered = match settings.mode {
+        Mode::Reference => None,
+        Mode::Fis => Some(Source::Mips(lighting.smooth_mips())),
         Mode::Prefiltered => {
-            let rows = material.view_layers.len();
-            let r = (((1.0 - frame.cos_o) * rows as f64).floor().max(0.0) as usize).min(rows - 1);
-            let layer = (material.view_layers[r] as usize).saturating_add(layer_shift as usize);
-            Source::Map(&lighting.layers[layer.min(lighting.layers.len() - 1)])
+            let layers = lighting.smooth_layers();
+            let last = (layers.len() - 1) as f64;
+            let x = (view_layer(&material.view_layers, frame.cos_o) + f64::from(layer_shift)).min(last);
+            let k = x.floor() as usize;
+            Some(Source::Layers(&layers[k], &layers[(k + 1).min(layers.len() - 1)], x - k as f64))
         }
     };
+    let sampled = match (settings.mode, &lighting.peaks) {
+        (Mode::Reference, _) => Some((&lighting.environment, lighting.mips.level(0))),
+        (_, Some(peaks)) => Some((&peaks.sampling, &peaks.map)),
+        (_, None) => None,
+    };
     let mut total = [0.0f64; 3];
+    let mut add = |f: [f64; 3], radiance: [f32; 3], weight: f64| {
+        for c in 0..3 {
+            total[c] += f[c] * f64::from(radiance[c]) * weight;
+        }
+    };
     for f in 0..settings.frames {
         let (v, first) = sample_range(pixel, f, settings.seed, n_vectors, n_samples, spp);
-        let start = (k * s.n_vectors + v as usize) * s.n_samples + first as usize;
-        let mut sum = [0.0f64; 3];
-        for texel in &s.texels[start..start + spp as usize] {
-            let wi_local = DVec3::new(texel[0].into(), texel[1].into(), texel[2].into());
-            let pdf = f64::from(texel[3]);
-            if !(pdf > 0.0 && wi_local.z > 0.0) {
-                continue;
-            }
-            let f = brdf(material, wi_local, frame.wo_local);
-            if f == [0.0; 3] {
-                continue;
-            }
-            let wi = frame.to_world(wi_local);
-            let radiance = match source {
-                Source::Map(map) => map.lookup(wi),
-                Source::Mips(mips) => {
+        let base = v * n_samples + first;
+        for index in base..base + spp {
+            // The BRDF's strategy: the slice's table at the pixel's own point.
+            let sample = table.sample(point(&brdf_points, index));
+            let wi_local = sample.wi;
+            if sample.pdf > 0.0 && wi_local.z > 0.0 {
+                let f = brdf(material, wi_local, frame.wo_local);
+                if f != [0.0; 3] {
+                    let wi = frame.to_world(wi_local);
                     let (u, v) = envmap::uv(wi);
-                    let pdf_uv = pdf * envmap::geometry::uv_jacobian(v);
-                    mips.lookup_uv(u, v, mips.lod(spp as usize, pdf_uv))
+                    match filtered {
+                        Some(Source::Layers(a, b, t)) => {
+                            let radiance = if t > 0.0 { blend(a.lookup_uv(u, v), b.lookup_uv(u, v), t) } else { a.lookup_uv(u, v) };
+                            add(f, radiance, wi_local.z / sample.pdf);
+                        }
+                        Some(Source::Mips(mips)) => {
+                            let lod = mips.lod_solid_angle(spp as usize, sample.pdf);
+                            add(f, mips.lookup_uv(u, v, lod), wi_local.z / sample.pdf);
+                        }
+                        None => {}
+                    }
+                    if let Some((light, map)) = sampled {
+                        let weight = mis_weight(sample.pdf, light.pdf([u, v]));
+                        add(f, map.lookup_uv(u, v), wi_local.z * weight / sample.pdf);
+                    }
                 }
-            };
-            let weight = wi_local.z / pdf;
-            for c in 0..3 {
-                sum[c] += f[c] * f64::from(radiance[c]) * weight;
             }
-        }
-        for c in 0..3 {
-            total[c] += sum[c] / f64::from(spp);
+            // The light's strategy: its distribution at the pixel's other point.
+            let Some((light, map)) = sampled else { continue };
+            let drawn = light.sample(point(&env_points, index));
+            let [u, v] = drawn.uv;
+            let wi_local = frame.to_local(envmap::direction(u, v));
+            if drawn.pdf > 0.0 && wi_local.z > 0.0 {
+                let f = brdf(material, wi_local, frame.wo_local);
+                if f != [0.0; 3] {
+                    let weight = mis_weight(drawn.pdf, table.pdf(wi_local));
+                    add(f, map.lookup_uv(u, v), wi_local.z * weight / drawn.pdf);
+                }
+            }
         }
     }
-    total.map(|t| t / f64::from(settings.frames))
+    let samples = f64::from(spp) * f64::from(settings.frames);
+    total.map(|t| t / samples)
+}
+
+/// `(1 - t) a + t b`.
+fn blend(a: [f32; 3], b: [f32; 3], t: f64) -> [f32; 3] {
+    std::array::from_fn(|c| (f64::from(a[c]) * (1.0 - t) + f64::from(b[c]) * t) as f32)
+}
+
+/// The weight of a sample drawn with density `p` by one of two strategies that each draw one
+/// direction per sample, `q` the other's density at it: the balance heuristic `p / (p + q)`
+/// (crate documentation, "The estimators").
+pub(crate) fn mis_weight(p: f64, q: f64) -> f64 {
+    p / (p + q)
 }
 
 /// The checks [`render`] makes on its inputs before it reads them: the sample set is whole and
@@ -254,7 +295,7 @@ pub fn check_settings(
     settings: &Settings,
     n_samples: usize,
     n_layers: usize,
-    view_layers: &[u32],
+    view_layers: &[f32],
 ) -> Result<(), Error> {
     let spp = settings.spp as usize;
     if !settings.spp.is_power_of_two() || !n_samples.is_multiple_of(spp) {
@@ -273,8 +314,11 @@ pub fn check_settings(
         if view_layers.is_empty() {
             return Err(Error::Invalid("prefiltered mode needs at least one view-layer entry".into()));
         }
-        if let Some(&bad) = view_layers.iter().find(|&&l| l as usize >= n_layers) {
-            return Err(Error::Invalid(format!("view layer {bad} is out of range for {n_layers} prefiltered layers")));
+        if let Some(&bad) = view_layers.iter().find(|&&l| !(l >= 0.0 && l as f64 <= (n_layers - 1) as f64)) {
+            return Err(Error::Invalid(format!(
+                "view layer coordinate {bad} is outside 0 to {} (the last of {n_layers} prefiltered layers)",
+                n_layers - 1
+            )));
         }
     }
     Ok(())

@@ -5,26 +5,20 @@ use std::sync::OnceLock;
 
 use envmap::{EnvMap, MipChain};
 use glam::DVec3;
-use importance::{Config, ImportanceTables};
+use importance::Config;
 use merl::albedo::{Quadrature, directional_albedo};
 use merl::analytic::Analytic;
 use merl::{Dims, Interp, MerlTable};
 use render::raster::GBuffer;
 use render::{Camera, Lighting, Material, Mesh, SampleSet, Scene};
 
-/// The samples of a bake as the renderers read them (the layout of `merl-importance`'s asset).
-pub fn sample_set(tables: &ImportanceTables) -> SampleSet {
-    let c = tables.config();
-    SampleSet { n_slices: c.n_theta_o, n_vectors: c.n_vectors, n_samples: c.n_samples, texels: tables.sample_texels() }
-}
-
-/// The bakes: 16 vectors of 512 samples per slice (8192 per slice: the renderer's expectation is
-/// the mean over them, off the integral by their own Monte Carlo error), from `bake_seed`.
+/// The bakes: 16 vectors of 512 samples per slice, from `bake_seed` (the frames of a render walk
+/// through the first 8192 points of each pixel's own sequence).
 fn material(brdf: Analytic, bake_seed: u64) -> Material {
     let table = brdf.table(Dims::MERL);
     let config = Config { n_vectors: 16, n_samples: 512, seed: bake_seed, ..Config::default() };
     let tables = importance::build(&table, &config).expect("a valid config");
-    Material { samples: sample_set(&tables), table, view_layers: vec![0; 8], wavelet: None }
+    Material { samples: SampleSet::new(&tables), table, view_layers: vec![0.0; 8], wavelet: None }
 }
 
 /// Lambertian, albedo 0.5, baked with seed 0 or 1.
@@ -46,7 +40,7 @@ pub const L: [f32; 3] = [0.8, 1.0, 1.25];
 /// A constant environment: every mip level and the one prefiltered layer are the constant too.
 pub fn constant_lighting() -> Lighting {
     let map = EnvMap::constant(64, 32, L).expect("a 2:1 map");
-    Lighting { mips: MipChain::new(&map), layers: vec![map], exponents: vec![1] }
+    Lighting::new(MipChain::new(&map), vec![map], vec![1]).expect("a valid map")
 }
 
 /// A sky: a gradient from a bright zenith to a dim ground, and a sun disk (10 degrees across,
@@ -66,7 +60,7 @@ pub fn sky_lighting() -> Lighting {
         }
     }
     let map = EnvMap::new(w, h, rgb).expect("finite, non-negative, 2:1");
-    Lighting { mips: MipChain::new(&map), layers: vec![map], exponents: vec![1] }
+    Lighting::new(MipChain::new(&map), vec![map], vec![1]).expect("a valid map")
 }
 
 /// A unit sphere in front of the default camera.

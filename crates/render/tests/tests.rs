@@ -7,6 +7,7 @@ mod support;
 mod adaptive;
 mod converged;
 mod determinism;
+mod estimators;
 mod known_answer;
 mod mesh;
 mod metrics;

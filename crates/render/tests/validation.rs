@@ -66,8 +66,8 @@ fn prefiltered_mode_needs_layers() {
     expect_invalid(render::render(&scene, material, &mismatch, &prefiltered), "1 prefiltered layers but 2 exponents");
     let no_rows = Material { view_layers: Vec::new(), ..material.clone() };
     expect_invalid(render::render(&scene, &no_rows, &lighting, &prefiltered), "at least one view-layer entry");
-    let out_of_range = Material { view_layers: vec![0, 1], ..material.clone() };
-    expect_invalid(render::render(&scene, &out_of_range, &lighting, &prefiltered), "view layer 1 is out of range");
+    let out_of_range = Material { view_layers: vec![0.0, 1.0], ..material.clone() };
+    expect_invalid(render::render(&scene, &out_of_range, &lighting, &prefiltered), "view layer coordinate 1 is outside 0 to 0");
 }
 
 #[test]

@@ -263,7 +263,7 @@ fn f32_bin(cdf: &[f64], u: f32) -> usize {
 fn tables_rounded_to_f32_choose_the_bins_a_gpu_chooses() {
     let mut rng = StdRng::seed_from_u64(24);
     for (name, f) in functions() {
-        let (func, nu, nv) = &f;
+        let (func, nu, _) = &f;
         let rounded = dist(&f).rounded_to_f32();
         let tables = rounded.marginal().cdf().iter().chain(rounded.conditional_cdf());
         assert!(tables.into_iter().all(|&c| f64::from(c as f32) == c), "{name}: a table entry is not an f32");

@@ -20,7 +20,7 @@ mod common;
 use common::shared;
 use std::time::Instant;
 
-use brdf_atlas::view::{ViewReduction, select_layers_of_table};
+use brdf_atlas::view::{ViewReduction, select_layers_of_table, view_coordinates};
 use render::{Camera, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
@@ -62,18 +62,18 @@ fn main() {
         let layers =
             prefilter::prefilter(&map, &config).expect("prefiltering").layers.into_iter().map(|l| l.map).collect();
         let preview = metrics::auto_preview(&map);
-        let lighting = Lighting { mips: envmap::MipChain::new(&map), layers, exponents: exponents.clone() };
+        let lighting = Lighting::new(envmap::MipChain::new(&map), layers, exponents.clone()).expect("a valid map");
         environments.push((env.trim_end_matches(".hdr").to_string(), lighting, preview));
     }
     let mut cases = Vec::new();
     for name in MATERIALS {
         let table = material(name);
         let tables = importance::build(&table, &importance::Config::default()).expect("importance tables");
-        let samples = bake::stage::importance::sample_set(&tables);
+        let samples = render::SampleSet::new(&tables);
         for (env, lighting, preview) in &environments {
             let start = Instant::now();
             let material =
-                Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
+                Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0.0], wavelet: None };
             let converged =
                 render::converged::converged(&scene, &material, lighting, converged_samples, 1).expect("converged");
             let converged_picture = metrics::tonemap(&converged, preview);
@@ -121,14 +121,15 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
     for &size in sizes {
         let config = brdf_atlas::Config { analysis_size: size, ..brdf_atlas::Config::default() };
         // One atlas per material and size, shared by its two environments and every reduction.
-        let mut selections: Vec<Vec<Vec<u32>>> = Vec::new();
+        let mut selections: Vec<Vec<Vec<f32>>> = Vec::new();
         for pair in cases.chunks(ENVIRONMENTS.len()) {
             let build = brdf_atlas::build_atlas(&pair[0].table, &config, &|_| {}).expect("atlas");
             selections.push(
                 reductions
                     .iter()
                     .map(|&r| {
-                        brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection").view_layer
+                        let selection = brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection");
+                        view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth)
                     })
                     .collect(),
             );
@@ -148,7 +149,7 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
 }
 
 /// PSNR of one CPU render against the case's converged estimate.
-fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<u32>, mode: Mode, spp: u32, frames: u32) -> f64 {
+fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<f32>, mode: Mode, spp: u32, frames: u32) -> f64 {
     let material = Material { table: case.table.clone(), samples: case.samples.clone(), view_layers, wavelet: None };
     let image =
         render::render(scene, &material, &case.lighting, &Settings { mode, spp, frames, seed: 0 }).expect("render");
@@ -171,7 +172,7 @@ fn modes(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene, exponents: &[u32]) {
             let material = Material {
                 table: case.table.clone(),
                 samples: case.samples.clone(),
-                view_layers: selection.view_layer.clone(),
+                view_layers: view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth),
                 wavelet: None,
             };
             let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
@@ -219,10 +220,10 @@ fn expectation(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene) {
     println!("{:<32} {:>7} {:>12} {:>9} {:>10}", "case", "frames", "mean lum.", "PSNR dB", "ms/frame");
     for pair in cases.chunks(ENVIRONMENTS.len()) {
         let tables = importance::build(&pair[0].table, &config).expect("importance tables");
-        let samples = bake::stage::importance::sample_set(&tables);
+        let samples = render::SampleSet::new(&tables);
         for case in pair {
             let material =
-                Material { table: case.table.clone(), samples: samples.clone(), view_layers: vec![0], wavelet: None };
+                Material { table: case.table.clone(), samples: samples.clone(), view_layers: vec![0.0], wavelet: None };
             let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let spp = 256;
             let frames = render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp);

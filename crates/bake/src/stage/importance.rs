@@ -182,17 +182,6 @@ fn provenance_parameters(config: &Config) -> [(&'static str, String); 8] {
     ]
 }
 
-/// The tables' samples as the renderers read them (what `crate::load` makes of the asset).
-pub fn sample_set(tables: &ImportanceTables) -> render::SampleSet {
-    let config = tables.config();
-    render::SampleSet {
-        n_slices: config.n_theta_o,
-        n_vectors: config.n_vectors,
-        n_samples: config.n_samples,
-        texels: tables.sample_texels(),
-    }
-}
-
 /// The asset's payload, converted by hand from the crate's tables (f32 for textures).
 fn payload(config: &Config, tables: &ImportanceTables) -> asset::ImportanceSamples {
     let f32s = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();

@@ -278,11 +278,10 @@ impl Renderer {
         }
         // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
         // (`check_settings` holds the rows in range where the lobe weight is on).
-        let sharpness: Vec<f32> = material
-            .view_layers
-            .iter()
-            .map(|&l| lighting.exponents.get(l as usize).map_or(0.0, |&n| n as f32))
-            .collect();
+        let sharpness: Vec<f32> = match lighting.exponents.is_empty() {
+            true => vec![0.0; material.view_layers.len()],
+            false => material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect(),
+        };
         let p = (width * height) as u32;
         // The candidates: blocks that hold a shadeable pixel, level by level.
         let mut any_shadeable: Vec<bool> = shadeable.clone();
