@@ -22,7 +22,12 @@
 //! luminance to Mitsuba's and the same per channel. Mitsuba's floor: its seed 1 against its seed
 //! 0, the same figures. An image without error scores about 3 dB above the floor (it differs from
 //! seed 0 by seed 0's noise alone, where two seeds differ by twice its variance); an image exactly
-//! as noisy as Mitsuba's scores the floor.
+//! as noisy as Mitsuba's scores the floor. The floor's luminance ratio says how far Mitsuba's mean
+//! can be trusted: where a light is reflected in chrome, a few pixels hundreds of times brighter
+//! than the rest carry the sphere's mean luminance, and their noise moves it.
+//!
+//! Left out of every figure (and counted in the report): the pixels only one renderer covers, and
+//! those seen at grazing angles ([`GRAZING_COS`]), where rounding decides whether a pixel is black.
 //!
 //! # The conventions matched, and how
 //!
@@ -41,11 +46,13 @@
 //!   convention into `envmap`'s (the script's `ENV_TO_WORLD` says how). Checked on the
 //!   background: Mitsuba's image of the map alone (no mesh, 1 spp: the background has no noise)
 //!   against our renderer's background (level 0, bilinear, through `Camera::rays`), per map and
-//!   camera, in the report's first table;
+//!   camera, in the report's first table (the map's orientation, its rows and the camera: a
+//!   wrong one shows as an image of another part of the map);
 //! - the BRDF: a Python BSDF (`MerlNearest`) with the table's nearest lookup as BRDFRead.cpp and
 //!   `merl::Dims::nearest_cell` index it, the same channel scales, 0 where a cell holds no data or
 //!   below either horizon; its own sampling (a mixture of the cosine and a half-vector density
-//!   made from the table), so nothing sampled is shared with ours.
+//!   made from the table), so nothing sampled is shared with ours. Held to crate merl's lookup on
+//!   every run ([`lookup_pairs`], `render.py --check-lookup`), in the report's second table.
 //!
 //! Mitsuba's renders are kept beside the scene they were made from (a rerun reuses them when
 //! the scene file, its inputs' SHA-256 and the script are the same, and the spp and seed; `--fresh`
@@ -297,6 +304,82 @@ struct Mitsuba {
     cached: bool,
 }
 
+/// `render.py SCENE` run by the chosen Python.
+fn script_command(scene: &Path, options: &Options) -> Command {
+    let mut command = Command::new(&options.python);
+    command.arg(script()).arg(scene);
+    command
+}
+
+/// Runs `render.py` and returns the JSON line it prints last; a failure prints the command, its
+/// stdout and its stderr.
+fn run_script(mut command: Command) -> Value {
+    let output = command.output().unwrap_or_else(|e| panic!("running {command:?}: {e}"));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    if !output.status.success() {
+        panic!(
+            "{command:?} failed ({}; make setup-mitsuba installs Mitsuba)\nstdout:\n{stdout}\nstderr:\n{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    stdout
+        .lines()
+        .last()
+        .and_then(|l| serde_json::from_str(l).ok())
+        .unwrap_or_else(|| panic!("{command:?}: expected a JSON line on stdout, got {stdout:?}"))
+}
+
+/// Pairs of directions where the Python BSDF is held to crate merl's nearest lookup
+/// (`render.py --check-lookup`): nine little-endian `f64` per pair, `wi`, `wo` and
+/// `merl::MerlTable::lookup` (0 where the table holds no data). `wo` uniform over the upper
+/// hemisphere; `wi` uniform too for half of the pairs, within about a degree of `wo`'s mirror
+/// direction for the other half (where MERL's finest `theta_h` cells are). The directions are
+/// rounded to `f32` before the lookup, as Mitsuba's llvm variant reads them, so that only the
+/// arithmetic inside the two lookups differs. The numbers are `render::pcg_hash`'s.
+fn lookup_pairs(table: &merl::MerlTable, n: usize) -> Vec<u8> {
+    let mut counter = 0u32;
+    let mut next = || {
+        counter += 1;
+        f64::from(render::pcg_hash(counter)) / 4_294_967_296.0
+    };
+    let mut bytes = Vec::with_capacity(72 * n);
+    let mut pairs = 0;
+    while pairs < n {
+        let mut upper = || merl::spherical_dir(next().acos(), 2.0 * std::f64::consts::PI * next());
+        let wo = upper();
+        let wi = if pairs % 2 == 0 {
+            upper()
+        } else {
+            let spread = 0.02 * next() * next();
+            let jitter = glam::DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            (glam::DVec3::new(-wo.x, -wo.y, wo.z) + spread * jitter).normalize()
+        };
+        let (wi, wo) = (wi.as_vec3().as_dvec3(), wo.as_vec3().as_dvec3());
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            continue;
+        }
+        let f = table.lookup(wi, wo, merl::Interp::Nearest).unwrap_or([0.0; 3]);
+        for v in [wi.x, wi.y, wi.z, wo.x, wo.y, wo.z, f[0], f[1], f[2]] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        pairs += 1;
+    }
+    bytes
+}
+
+/// The Python BSDF against crate merl's lookup on [`lookup_pairs`]: `(pairs, how many differ)`.
+fn check_lookup(scene: &Path, table: &merl::MerlTable, options: &Options) -> (u64, u64) {
+    let pairs = scene.with_file_name("lookup-pairs.bin");
+    write(&pairs, &lookup_pairs(table, 100_000));
+    let mut command = script_command(scene, options);
+    command.arg("--check-lookup").arg(&pairs);
+    let info = run_script(command);
+    let count =
+        |key: &str| info[key].as_u64().unwrap_or_else(|| panic!("render.py --check-lookup: no {key} in {info}"));
+    (count("pairs"), count("differ"))
+}
+
 /// Mitsuba's image of `scene` (a scene.json) at `spp` and `seed` (`no_mesh`: the map alone), made
 /// by `render.py` or reused when the same scene, inputs and script made it before.
 fn mitsuba(scene: &Path, size: usize, spp: u32, seed: u32, no_mesh: bool, options: &Options) -> Mitsuba {
@@ -311,26 +394,13 @@ fn mitsuba(scene: &Path, size: usize, spp: u32, seed: u32, no_mesh: bool, option
     let (info, cached) = if reusable {
         (previous.expect("checked")["info"].clone(), true)
     } else {
-        let mut command = Command::new(&options.python);
-        command.arg(script()).arg(scene).arg("--out").arg(&out).arg("--coverage").arg(&coverage);
+        let mut command = script_command(scene, options);
+        command.arg("--out").arg(&out).arg("--coverage").arg(&coverage);
         command.args(["--spp", &spp.to_string(), "--seed", &seed.to_string()]);
         if no_mesh {
             command.arg("--no-mesh");
         }
-        let output = command.output().unwrap_or_else(|e| panic!("running {}: {e}", options.python));
-        let stdout = String::from_utf8_lossy(&output.stdout);
-        if !output.status.success() {
-            panic!(
-                "{command:?} failed ({}; make setup-mitsuba installs Mitsuba)\nstdout:\n{stdout}\nstderr:\n{}",
-                output.status,
-                String::from_utf8_lossy(&output.stderr)
-            );
-        }
-        let info: Value = stdout
-            .lines()
-            .last()
-            .and_then(|l| serde_json::from_str(l).ok())
-            .unwrap_or_else(|| panic!("{command:?}: expected a JSON line on stdout, got {stdout:?}"));
+        let info = run_script(command);
         let record = json!({ "scene": scene_text, "info": info });
         write(&sidecar, serde_json::to_string_pretty(&record).expect("json").as_bytes());
         (info, false)
@@ -463,6 +533,8 @@ fn main() {
     let mut table = String::new();
     let mut background_table = String::new();
     let mut variant = String::new();
+    // (material, pairs, pairs whose values differ) of the BSDF's check against crate merl.
+    let mut checked: Vec<(&str, u64, u64)> = Vec::new();
     for map_name in MAPS {
         for material_name in MATERIALS {
             if !VIEWS.iter().any(|v| wanted(&format!("{material_name} / {map_name} / {v}"))) {
@@ -483,6 +555,10 @@ fn main() {
                 let scene = scene(azimuth, elevation, size);
                 let dir = work().join(format!("{material_name}-{map_name}-{view}-{size}"));
                 let scene_file = export(&dir, &scene, level0, &material_path(material_name));
+                if !checked.iter().any(|(m, _, _)| *m == material_name) {
+                    let (pairs, differ) = check_lookup(&scene_file, &loaded.material.table, &options);
+                    checked.push((material_name, pairs, differ));
+                }
 
                 // The map's orientation and the camera: the background alone.
                 let back = mitsuba(&scene_file, size, 1, 0, true, &options);
@@ -533,10 +609,16 @@ fn main() {
 
                 writeln!(
                     background_table,
-                    "| {name} | {:.1}, {:.1} | {coverage_differs} | {grazing} | {} | {back_relative:.2e} |",
+                    "| {name} | {:.1}, {:.1} | {coverage_differs} | {grazing} | {} | {back_relative:.2e} | {} | {ours_s:.0} |",
                     azimuth.to_degrees(),
                     elevation.to_degrees(),
                     if back_psnr.is_finite() { format!("{back_psnr:.2}") } else { "identical".into() },
+                    // The script's own time (the renders, not the start-up), or where they were reused.
+                    match seeds.iter().map(|s| s.info["seconds"].as_f64()).sum::<Option<f64>>() {
+                        Some(t) if !seeds.iter().any(|s| s.cached) => format!("{t:.0}"),
+                        Some(t) => format!("{t:.0} (reused)"),
+                        None => "?".into(),
+                    },
                 )
                 .unwrap();
                 checks.push(json!({
@@ -573,7 +655,7 @@ fn main() {
                     );
                     writeln!(
                         table,
-                        "| {name} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} | {:.2} | {seconds:.1} |",
+                        "| {name} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} | {:.2} | {:.4} | {seconds:.1} |",
                         f.psnr_db,
                         f.psnr_sphere_db,
                         f.luminance_ratio,
@@ -582,6 +664,7 @@ fn main() {
                         f.channel_ratio[2],
                         floor.psnr_db,
                         floor.psnr_sphere_db,
+                        floor.luminance_ratio,
                     )
                     .unwrap();
                     figures.push(json!({ "mode": mode, "seconds": seconds, "against_mitsuba": f.json() }));
@@ -623,23 +706,41 @@ fn main() {
     out(format!(
         "Mitsuba's image of the map alone (1 spp through the pixel centres) against our renderer's background; pixels whose \
          coverage differs between our rasterizer and Mitsuba's ray casts; pixels of the sphere seen at grazing angles (cos \
-         theta_o < {GRAZING_COS}). Both kinds are left out of the figures."
+         theta_o < {GRAZING_COS}). Both kinds are left out of the figures. The wall times of Mitsuba's two renders (as \
+         its script measured them) and of our four images."
     ));
     out(String::new());
-    out("| case | camera az, el (deg) | coverage differs | grazing pixels left out | background PSNR dB | background rel. error |".into());
-    out("|---|---|---:|---:|---:|---:|".into());
+    out("| case | camera az, el (deg) | coverage differs | grazing pixels left out | background PSNR dB | background rel. error \
+         | Mitsuba s (2 seeds) | ours s (4 images) |"
+        .into());
+    out("|---|---|---:|---:|---:|---:|---:|---:|".into());
     out(background_table.trim_end().to_string());
+    out(String::new());
+    out("## The Python BSDF against crate merl's nearest lookup".into());
+    out(String::new());
+    out("Direction pairs (half of them within a degree of the mirror configuration, all rounded to f32) where the BSDF's \
+         value differs from crate merl's by more than 1e-3 in a channel: a different cell, which only rounding at a cell's edge \
+         should cause."
+        .into());
+    out(String::new());
+    out("| material | pairs | differing |".into());
+    out("|---|---:|---:|".into());
+    for (material, pairs, differ) in &checked {
+        out(format!("| {material} | {pairs} | {differ} |"));
+    }
     out(String::new());
     out("## Against Mitsuba's seed 0".into());
     out(String::new());
     out("PSNR on the 8-bit pictures (the whole picture, and the sphere alone, less the pixels left out); mean luminance and \
-         per-channel means of the sphere's, ours over Mitsuba's; the floor is Mitsuba's seed 1 against its seed 0 (an image without error scores about 3 dB \
-         above it)."
+         per-channel means of the sphere's, ours over Mitsuba's; the floor is Mitsuba's seed 1 against its seed 0, the same \
+         figures (an image without error scores about 3 dB above its PSNR; its luminance ratio is how far Mitsuba's own mean \
+         can be trusted: a light reflected in chrome is a few pixels hundreds of times brighter than the rest, and carries the \
+         mean)."
         .into());
     out(String::new());
-    out("| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | floor dB | floor sphere dB | ours s |"
+    out("| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | floor dB | floor sphere dB | floor luminance | ours s |"
         .into());
-    out("|---|---|---:|---:|---:|---|---:|---:|---:|".into());
+    out("|---|---|---:|---:|---:|---|---:|---:|---:|---:|".into());
     out(table.trim_end().to_string());
     std::fs::write(work().join("report.md"), &report).expect("writing report.md");
     let value = json!({
@@ -650,6 +751,7 @@ fn main() {
         "converged_samples_per_strategy": options.converged,
         "wall_seconds": wall_s,
         "checks": checks,
+        "lookup": checked.iter().map(|(m, p, d)| json!({ "material": m, "pairs": p, "differ": d })).collect::<Vec<_>>(),
         "cases": rows,
     });
     std::fs::write(work().join("report.json"), serde_json::to_string_pretty(&value).expect("json"))

@@ -23,8 +23,11 @@ Conventions matched, and how:
   growing towards +y: direction (sin v pi cos 2 pi u, sin v pi sin 2 pi u, cos v pi). Mitsuba's
   envmap looks a local direction l up at u = atan2(l.x, -l.z) / 2 pi, v = acos(l.y) / pi. With
   l = (w.y, w.z, -w.x) for a world direction w both give the same (u, v); the emitter's to_world
-  is the inverse of that rotation, ENV_TO_WORLD. The benchmark checks it on the background (an
-  image of the map alone against the renderer's background).
+  is the inverse of that rotation, ENV_TO_WORLD. Both put column x's centre at u = (x + 1/2) / W,
+  but Mitsuba's rows sit at v = k / (H - 1) (the first and last on the poles) where ours sit at
+  (y + 1/2) / H: the emitter is given `mitsuba_rows` of the map, with which its bilinear lookup
+  is ours. The benchmark checks all of it on the background (an image of the map alone against
+  the renderer's background).
 - The BSDF: the table's nearest lookup exactly as BRDFRead.cpp (and crate `merl`) does it, in the
   local shading frame of the interpolated normal: half vector and difference angles
   (Rusinkiewicz), theta_h index sqrt(theta_h / (pi / 2)) * 90, theta_d index theta_d / (pi / 2) *
@@ -36,12 +39,14 @@ Conventions matched, and how:
   phi_h), evaluated exactly for every direction, so the integrator's MIS with the emitter's
   sampling is unbiased.
 
-Variants: llvm_ad_rgb (vectorized; needs libLLVM, found by Dr.Jit or named by
-DRJIT_LIBLLVM_PATH) and scalar_rgb (always available, one Python call per sample: slow).
+Variants: llvm_ad_rgb (vectorized; needs libLLVM MIN_LLVM or newer, found here or named by
+DRJIT_LIBLLVM_PATH) and scalar_rgb (always available, one Python call per sample: slow). The
+BSDF's lookup is checked against crate merl's by the benchmark (--check-lookup).
 
 Usage: render.py SCENE.json --out OUT.exr [--coverage COVER.exr] [--spp N] [--seed S]
        [--variant auto|llvm_ad_rgb|scalar_rgb] [--no-mesh]
-Prints one JSON line: the variant, the samples and the wall time.
+       render.py SCENE.json --check-lookup PAIRS (the BSDF against crate merl's lookup)
+Prints one JSON line: the variant, the samples and the wall time (or the pairs that differ).
 """
 
 import argparse
@@ -289,13 +294,18 @@ def define_bsdf(mi, dr, dims, values, weights, edges):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", help="the scene file (JSON) the benchmark wrote")
-    parser.add_argument("--out", required=True, help="radiance, linear RGB (EXR)")
+    parser.add_argument("--out", help="radiance, linear RGB (EXR)")
     parser.add_argument("--coverage", help="which pixels the mesh covers (EXR, channel Y)")
     parser.add_argument("--spp", type=int, default=4096)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--variant", default="auto", choices=["auto", "llvm_ad_rgb", "scalar_rgb"])
     parser.add_argument("--no-mesh", action="store_true", help="the environment alone (the map's check)")
+    parser.add_argument("--check-lookup", metavar="PAIRS",
+                        help="instead of rendering, evaluate the BSDF at the direction pairs of PAIRS (nine "
+                             "little-endian f64 each: wi, wo and crate merl's f) and count where it differs")
     args = parser.parse_args()
+    if args.out is None and args.check_lookup is None:
+        fail("--out OUT.exr (or --check-lookup PAIRS) is required")
     if args.spp < 1:
         fail(f"--spp {args.spp}: at least 1")
     try:
@@ -311,6 +321,9 @@ def main():
     dims, values = read_merl(path("material"))
     weights, edges = half_vector_weights(dims, values)
     define_bsdf(mi, dr, dims, values, weights, edges)
+    if args.check_lookup:
+        check_lookup(mi, dr, args.check_lookup, variant)
+        return
 
     camera = scene_file["camera"]
     width, height = scene_file["width"], scene_file["height"]
@@ -358,6 +371,34 @@ def main():
         mi.Bitmap(covered.astype(np.float32)[:, :, None], pixel_format=mi.Bitmap.PixelFormat.Y).write(args.coverage)
     print(json.dumps({"variant": variant, "spp": args.spp, "seed": args.seed, "seconds": round(seconds, 2),
                       "mitsuba": mi.__version__}))
+
+
+def check_lookup(mi, dr, pairs_path, variant):
+    """Prints how many of the pairs' BSDF values (`eval` over the light's cosine) differ from crate
+    merl's by more than 1e-3 relative in a channel: a different cell differs by far more, and
+    with the directions given in f32 (as the benchmark writes them) only rounding at a cell's
+    edge separates the two lookups."""
+    try:
+        pairs = np.fromfile(pairs_path, dtype="<f8").reshape(-1, 9)
+    except (OSError, ValueError) as e:
+        fail(f"reading {pairs_path}: {e}")
+    bsdf = mi.load_dict({"type": "merl_nearest"})
+    wi, wo, expected = pairs[:, 0:3], pairs[:, 3:6], pairs[:, 6:9]
+    if dr.is_jit_v(mi.Float):
+        si = dr.zeros(mi.SurfaceInteraction3f, len(pairs))
+        si.wi = mi.Vector3f(*(mi.Float(wo[:, k].astype(np.float32)) for k in range(3)))
+        light = mi.Vector3f(*(mi.Float(wi[:, k].astype(np.float32)) for k in range(3)))
+        value = bsdf.eval(mi.BSDFContext(), si, light)
+        got = np.stack([np.array(value[k], dtype=np.float64) for k in range(3)], axis=1)
+    else:
+        got = np.zeros_like(expected)
+        for i in range(len(pairs)):
+            si = mi.SurfaceInteraction3f()
+            si.wi = mi.Vector3f(*wo[i])
+            got[i] = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(*wi[i])))
+    got /= wi[:, 2:3].astype(np.float32)
+    differ = np.any(np.abs(got - expected) > 1e-3 * np.abs(expected), axis=1)
+    print(json.dumps({"variant": variant, "pairs": len(pairs), "differ": int(differ.sum())}))
 
 
 def pixel_centres(mi, dr, width, height, repeat):
