@@ -118,8 +118,8 @@ target/merl/%.binary: | setup-python
 ## (lavapipe without one) at 512 x 512: about 50 minutes the first time on 2 cores (its bakes and
 ## converged images are kept under target/bench-adaptive/), 12 after. Last, issue 31's outside
 ## referee: the CPU renderer against Mitsuba 3 (setup-mitsuba) on twelve cases at 128 x 128, about
-## 26 minutes the first time on 2 cores (its bakes and Mitsuba's renders are kept under
-## target/bench-mitsuba/), 5 after.
+## 30 minutes the first time on 2 cores (its bakes and Mitsuba's renders are kept under
+## target/bench-mitsuba/), 6 after.
 bench: setup-gpu setup-mitsuba
 	$(CARGO) bench -p importance --bench build
 	$(CARGO) bench -p envmap --bench load
