@@ -9,7 +9,7 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python setup-node setup-ktx build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
+.PHONY: setup setup-gpu setup-python setup-node setup-ktx setup-mitsuba build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
 ## setup: everything the tests need (setup-gpu, setup-python, setup-node, setup-ktx). Idempotent.
 setup: setup-gpu setup-python setup-node setup-ktx
@@ -27,6 +27,20 @@ setup-gpu:
 ## setup-python: numpy, for ../shared/tools/nbrdf2merl.py (the real-derived test materials).
 setup-python:
 	@python3 -c 'import numpy' 2>/dev/null || { echo "installing numpy (for ../shared/tools/nbrdf2merl.py)"; python3 -m pip install --quiet numpy; }
+
+## setup-mitsuba: Mitsuba 3 (PyPI), the outside referee of make bench (the mitsuba benchmark of
+## brdf-preview), and libLLVM 19 from Debian for its vectorized llvm_ad_rgb variant (Dr.Jit finds
+## no usable backend in Debian 12's default libLLVM 14, and LLVM 15 and 16 abort on the referee's
+## kernels; without it the referee falls back to scalar_rgb, about 20 times slower). Installed only
+## when missing; quiet.
+setup-mitsuba: setup-python
+	@python3 -c 'import mitsuba' 2>/dev/null || { echo "installing mitsuba (the outside referee of make bench)"; python3 -m pip install --quiet mitsuba; }
+	@if ! ls /usr/lib/*/libLLVM.so.19* /usr/lib/*/libLLVM-19.so* >/dev/null 2>&1; then \
+	  echo "installing libllvm19 (for Mitsuba's llvm_ad_rgb variant)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libllvm19 >/dev/null; \
+	fi
 
 ## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
 ## tests run on the KTX2 files with node. Installs node and npm from Debian when missing.
@@ -99,11 +113,14 @@ target/merl/%.binary: | setup-python
 	@echo "making $@ (nbrdf2merl.py)"
 	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
 
-## bench: timings against baselines measured in the same run (benchmarks, not tests). The last
-## one is issue 11's equal-quality benchmark of the adaptive modes against the brute force, on the
-## GPU (lavapipe without one) at 512 x 512: about 50 minutes the first time on 2 cores (its
-## bakes and converged images are kept under target/bench-adaptive/), 12 after.
-bench: setup-gpu
+## bench: timings against baselines measured in the same run (benchmarks, not tests). Then issue
+## 11's equal-quality benchmark of the adaptive modes against the brute force, on the GPU
+## (lavapipe without one) at 512 x 512: about 50 minutes the first time on 2 cores (its bakes and
+## converged images are kept under target/bench-adaptive/), 12 after. Last, issue 31's outside
+## referee: the CPU renderer against Mitsuba 3 (setup-mitsuba) on twelve cases at 128 x 128, about
+## 30 minutes the first time on 2 cores (its bakes and Mitsuba's renders are kept under
+## target/bench-mitsuba/), 6 after.
+bench: setup-gpu setup-mitsuba
 	$(CARGO) bench -p importance --bench build
 	$(CARGO) bench -p envmap --bench load
 	$(CARGO) bench -p bandwidth --bench bandwidth
@@ -111,6 +128,7 @@ bench: setup-gpu
 	$(CARGO) bench -p brdf-atlas --bench atlas
 	$(CARGO) bench -p haar-brdf --bench table1
 	$(CARGO) bench -p brdf-preview --bench adaptive -- --gpu
+	$(CARGO) bench -p brdf-preview --bench mitsuba
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
 ## procedural calibration sky), then render previews (pre-convolved; reference, validated against
