@@ -137,7 +137,7 @@ demo: setup-gpu build
 	@mkdir -p $(DEMO)
 	$(BIN)/merl-synth ggx --alpha 0.2 --f0 0.95,0.64,0.54 --out $(DEMO)/ggx-copper.binary
 	$(BIN)/envmap-synth --out $(DEMO)/calibration-sky.exr
-	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --vectors 32 --out-dir $(DEMO)/bake
+	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --out-dir $(DEMO)/bake
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --mode prefiltered --size 384x384 --camera 200,15 --sheet $(DEMO)/sheet.png
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview-reference.png --size 384x384 --camera 200,15 --validate
 	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png, sheet.png"

@@ -125,23 +125,23 @@
 //!   in exact integers (as `gpu::preview` does on the GPU, without a sort);
 //!
 //! at most the cap (what a capped block cannot
-//! take goes to the others), rounded down to a power of two (the baked vectors are read in
+//! take goes to the others), rounded down to a power of two (a pixel's points are read in
 //! aligned chunks: crate docs, "Samples"); what rounding leaves is handed out by doubling the
 //! blocks furthest below their share, while it fits. The total never exceeds the budget; a
 //! budget below one sample per shaded block is an error. The cap is [`Settings::max_spp`]
-//! within a slice's samples ([`Settings::block_cap`]): by default ([`MAX_SPP`]) a block may read
-//! every vector of its slice (see "Shading"), so that the budget is spent. (A cap of one vector
+//! within a slice's `V N` points ([`Settings::block_cap`]): by default ([`MAX_SPP`]) a block may
+//! read all of them (see "Shading"), so that the budget is spent. (A cap of one vector
 //! left it unspent wherever the plan shades few blocks: on the benchmark's sphere at 512 x 512,
 //! whose plans shade 2% of the pixels, every block reached 256 samples, and a 16 spp budget
 //! spent 584704 of 2076672 samples.)
 //!
 //! # Shading
 //!
-//! A shaded block is shaded by the chosen estimator at its pixel: up to the `N` samples of a
-//! baked vector, with its count as `spp` and one frame (the random chunk of that pixel); a block
-//! of more samples (a power of two, so a multiple of `N`) with `spp = N` and `count / N` frames,
-//! that is whole vectors, the first `count / N` of its pixel's walk through the slice's `V`
-//! vectors (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
+//! A shaded block is shaded by the chosen estimator at its pixel: up to `N` samples (a baked
+//! vector's worth) with its count as `spp` and one frame (the random chunk of that pixel's
+//! points); a block of more samples (a power of two, so a multiple of `N`) with `spp = N` and
+//! `count / N` frames, the first `count / N` vectors' worth of its pixel's walk through its
+//! `V N` points (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
 //!
 //! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
 //! ... at the level given by the maximum frequency of the BRDF") reads the Phong layer
@@ -247,8 +247,8 @@ pub struct Settings {
     /// The budget: mean samples per covered pixel of the output image.
     pub spp: u32,
     /// The most samples one shaded block gets: a power of two. A block with more samples than
-    /// a baked vector holds reads several whole vectors (module docs, "Shading"); a frame reads
-    /// at most the samples of a slice, so the cap it applies is [`Settings::block_cap`].
+    /// a baked vector holds reads several vectors' worth of points (module docs, "Shading"); a
+    /// frame reads at most a slice's `V N`, so the cap it applies is [`Settings::block_cap`].
     /// Default [`MAX_SPP`].
     pub max_spp: u32,
     /// Incident directions per pixel for the prediction (`n_b`).
@@ -321,8 +321,8 @@ impl Settings {
     }
 
     /// The most samples a block gets with `samples`: [`Settings::max_spp`], at most the largest
-    /// power of two within a slice's `V N` samples (beyond them a block would read a vector
-    /// twice). A frame applies this cap ([`check_settings`] gives its settings).
+    /// power of two within a slice's `V N` (beyond them a block would read a point twice). A
+    /// frame applies this cap ([`check_settings`] gives its settings).
     pub fn block_cap(&self, samples: &SampleSet) -> u32 {
         let slice = (samples.n_vectors as u64).saturating_mul(samples.n_samples as u64).max(1);
         let slice = 1u64 << (63 - slice.leading_zeros());

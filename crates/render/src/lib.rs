@@ -318,6 +318,22 @@ pub struct Settings {
     pub seed: u32,
 }
 
+impl Settings {
+    /// The previewer's settings for `mode` where a user sets nothing: `spp` samples per pixel
+    /// and frame (default 64 for the reference mode, 16 for the filtered ones) and `frames` frames
+    /// (default: for the reference mode enough to use every point of a pixel's `V N` once,
+    /// [`frames_to_exhaust`]; for the filtered modes 8, which average their noise, not their
+    /// bias). `spp` must not be 0 where `frames` is left to the default of the reference mode.
+    pub fn previewer(mode: Mode, samples: &SampleSet, spp: Option<u32>, frames: Option<u32>, seed: u32) -> Settings {
+        let spp = spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
+        let frames = frames.unwrap_or_else(|| match mode {
+            Mode::Reference => frames_to_exhaust(samples.n_vectors, samples.n_samples, spp),
+            Mode::Fis | Mode::Prefiltered => 8,
+        });
+        Settings { mode, spp, frames, seed }
+    }
+}
+
 /// The random word of the sample choice: Jarzynski and Olano's PCG hash ("Hash functions for GPU
 /// rendering", JCGT 2020), wrapping `u32` arithmetic. The WGSL copy must match it bit for bit.
 pub fn pcg_hash(v: u32) -> u32 {

@@ -12,9 +12,8 @@
 //! default), the bake made with default settings (kept under target/bench-mitsuba/).
 //!
 //! Our images, as `brdf-preview` makes them by default: the converged estimate
-//! (`render::converged`, 1024 samples per strategy), `reference` (64 spp, every baked sample of
-//! a pixel's slice once: `render::frames_to_exhaust` frames), `fis` and `prefiltered` (16 spp, one
-//! frame). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
+//! (`render::converged`, 1024 samples per strategy), then `reference`, `fis` and `prefiltered` at
+//! the previewer's defaults (`render::Settings::previewer`). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
 //! renderer computes; a convex sphere has no interreflection), 4096 spp, two seeds. Per case and
 //! mode: the PSNR against Mitsuba's seed 0 on the 8-bit pictures (`render::metrics`, one exposure
 //! for all: `metrics::auto_preview` of the map), over the whole picture (the background included,
@@ -189,14 +188,9 @@ fn ours(scene: &Scene, material: &Material, lighting: &Lighting, converged: u32)
     let image = render::converged::converged(scene, material, lighting, converged, 0).expect("the converged estimate");
     let mut images = vec![("converged", image, start.elapsed().as_secs_f64())];
     for mode in Mode::ALL {
-        let spp = if mode == Mode::Reference { 64 } else { 16 };
-        let frames = if mode == Mode::Reference {
-            render::frames_to_exhaust(material.samples.n_vectors, material.samples.n_samples, spp)
-        } else {
-            1
-        };
+        let settings = Settings::previewer(mode, &material.samples, None, None, 0);
         let start = Instant::now();
-        let image = render::render(scene, material, lighting, &Settings { mode, spp, frames, seed: 0 })
+        let image = render::render(scene, material, lighting, &settings)
             .unwrap_or_else(|e| panic!("rendering {}: {e}", mode.name()));
         images.push((mode.name(), image, start.elapsed().as_secs_f64()));
     }
@@ -510,6 +504,8 @@ fn git(args: &[&str]) -> String {
 fn main() {
     let options = options();
     let started = Instant::now();
+    // What the cases' settings were, for the report's header (the same for every case's bake).
+    let mut defaults_described = String::new();
     let size = options.size;
     std::fs::create_dir_all(work()).expect("creating target/bench-mitsuba");
     let names: Vec<String> = MATERIALS
@@ -583,6 +579,14 @@ fn main() {
 
                 let start = Instant::now();
                 let images = ours(&scene, &loaded.material, lighting, options.converged);
+                defaults_described = Mode::ALL
+                    .iter()
+                    .map(|&mode| {
+                        let settings = Settings::previewer(mode, &loaded.material.samples, None, None, 0);
+                        format!("{} {} spp x {} frames", mode.name(), settings.spp, settings.frames)
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ");
                 let ours_s = start.elapsed().as_secs_f64();
                 for (mode, image, _) in &images {
                     let planes: [Vec<f32>; 3] =
@@ -697,8 +701,8 @@ fn main() {
     out(String::new());
     out(format!(
         "Commit {commit}, {host} ({cores} cores); Mitsuba {variant}, path integrator (max_depth 2), {} spp; ours: converged {} per \
-         strategy, reference 64 spp x every baked sample, fis and prefiltered 16 spp; {size} x {size}. Wall time {wall_s:.0} s.",
-        options.spp, options.converged
+         strategy, each mode at brdf-preview's defaults (render::Settings::previewer: {}); {size} x {size}. Wall time {wall_s:.0} s.",
+        options.spp, options.converged, defaults_described
     ));
     out(String::new());
     out("## The map's orientation and the camera".into());
