@@ -4,6 +4,7 @@
 mod support;
 
 mod asset_info;
+mod bake_folders;
 mod brdf_bake;
 mod brdf_bandwidth;
 mod brdf_wavelet;

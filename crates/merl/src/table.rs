@@ -51,12 +51,12 @@ impl Dims {
     }
 
     /// Cells per channel.
-    pub fn cells(&self) -> usize {
+    pub const fn cells(&self) -> usize {
         self.n_theta_h * self.n_theta_d * self.n_phi_d
     }
 
     /// Size of a file of these dimensions.
-    pub fn file_bytes(&self) -> u64 {
+    pub const fn file_bytes(&self) -> u64 {
         HEADER_BYTES as u64 + 3 * 8 * self.cells() as u64
     }
 

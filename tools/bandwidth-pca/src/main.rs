@@ -53,7 +53,10 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    let bytes = std::fs::read(&args.atlas).with_context(|| format!("reading {}", args.atlas.display()))?;
+    // A regular file only, within the largest asset a reader accepts, read once: the bytes hashed
+    // for the provenance are the bytes decoded.
+    let bytes = fsguard::read_regular(&args.atlas, asset::OUTPUT_LIMIT)
+        .with_context(|| format!("reading {}", args.atlas.display()))?;
     let atlas = read_atlas(&bytes).with_context(|| format!("reading {}", args.atlas.display()))?;
     let components = match (args.components, args.max_error) {
         (Some(k), _) => Components::Count(k),

@@ -37,7 +37,9 @@ struct Args {
     #[arg(long, value_name = "ENV")]
     env: Option<PathBuf>,
 
-    /// The folder to bake into (created if missing).
+    /// The folder to bake into (created if missing: the folder itself, its parent must exist). One
+    /// bake at a time holds a folder: a second brdf-bake (or a single-stage tool) started on it
+    /// meanwhile exits 2 at once, naming it.
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 

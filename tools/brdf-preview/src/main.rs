@@ -73,8 +73,9 @@ struct Args {
     #[arg(long, value_enum, default_value_t = BrdfArg::Table)]
     brdf: BrdfArg,
 
-    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default:
-    /// BAKE/wavelet-brdf.asset (brdf-wavelet MATERIAL --out-dir BAKE writes it there).
+    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default: the
+    /// bake's own (its manifest's wavelet-brdf output, which brdf-wavelet MATERIAL --out-dir BAKE
+    /// and brdf-bake --wavelet-ratio R add).
     #[arg(long, value_name = "FILE")]
     wavelet: Option<PathBuf>,
 
@@ -273,10 +274,16 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
+    // Where the outputs go must exist before anything is rendered.
+    for path in args.out.iter().chain(&args.sheet) {
+        check_output_folder(path)?;
+    }
     let mut loaded = bake::load(&args.bake, args.material.as_deref())?;
     if args.brdf == BrdfArg::Wavelet {
-        let path = args.wavelet.clone().unwrap_or_else(|| args.bake.join(bake::stage::wavelet::ASSET));
-        let brdf = bake::load_wavelet(&path, &loaded)?;
+        let (path, brdf) = match &args.wavelet {
+            Some(path) => (path.clone(), bake::load_wavelet(path, &loaded)?),
+            None => bake::bake_wavelet(&loaded)?,
+        };
         let levels = brdf.grid().levels() as f64;
         if !(0.0..=levels).contains(&args.wavelet_lod) {
             bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", args.wavelet_lod, path.display());
@@ -678,6 +685,16 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     Ok(Step { files, report, problems, value })
 }
 
+/// An output's folder must exist: found before the render rather than after it (nothing is
+/// created; `asset::write_atomic`).
+fn check_output_folder(path: &Path) -> Result<()> {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        bail!("writing {}: the folder {} does not exist (create it first)", path.display(), folder.display());
+    }
+    Ok(())
+}
+
 /// How pictures are tone mapped: --exposure, or the environment's automatic exposure.
 fn preview(args: &Args, lighting: &render::Lighting) -> envmap::Preview {
     match args.exposure {
@@ -702,7 +719,11 @@ fn scene(args: &Args) -> Result<Scene> {
         "sphere" => Mesh::sphere(1.0, 128, 64),
         "torus" => Mesh::torus(0.7, 0.3, 128, 48),
         path => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("reading {path}"))?;
+            // A regular file only (a FIFO or a device is refused without blocking), its size
+            // checked against the mesh limit before it is read.
+            let bytes = fsguard::read_regular(Path::new(path), Mesh::MAX_OBJ_BYTES as u64)
+                .with_context(|| format!("reading {path}"))?;
+            let text = String::from_utf8(bytes).map_err(|_| anyhow!("reading {path}: not utf-8 text (an obj file)"))?;
             Mesh::from_obj(&text).with_context(|| format!("reading {path}"))?
         }
     };

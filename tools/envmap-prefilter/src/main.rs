@@ -127,7 +127,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);
     progress.step("loading".to_string());
-    let limits = bake::stage::prefilter::limits(&config, args.max_memory);
+    let limits = bake::stage::prefilter::limits(&config, args.max_memory)?;
     let map =
         envmap::load_with_limits(&args.env, &limits).with_context(|| format!("reading {}", args.env.display()))?;
     let source = Source::hash(&args.env)?;
