@@ -15,3 +15,4 @@ mod invalid_inputs;
 mod json_output;
 mod merl_info;
 mod preview;
+mod ranges_and_messages;

@@ -41,15 +41,15 @@ struct Args {
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Keep 1/R of the coefficients (a power of two; 4, 16 and 32 are the paper's Table 1). The
-    /// default unless --threshold is given: 4.
+    /// Keep 1/R of the coefficients (a power of two up to the grid's N x N positions; 4, 16 and 32
+    /// are the paper's Table 1). The default unless --threshold is given: 4.
     #[arg(long, value_name = "R", conflicts_with = "threshold", value_parser = cli::parse_count)]
     ratio: Option<usize>,
 
     /// Instead of a ratio, keep the coefficient positions whose RMS coefficient (over all
-    /// outgoing slices and channels, log units) is at least T; 0 keeps everything (lossless up to
-    /// 32-bit floats).
-    #[arg(long, value_name = "T")]
+    /// outgoing slices and channels, log units) is at least T, a finite number from 0; 0 keeps
+    /// everything (lossless up to 32-bit floats).
+    #[arg(long, value_name = "T", value_parser = parse_threshold)]
     threshold: Option<f64>,
 
     /// Quantize the kept coefficients to this many bits (only 8 is supported: the paper's
@@ -62,7 +62,7 @@ struct Args {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SIDE, value_parser = cli::parse_count)]
     side: usize,
 
-    /// Bias of the log encoding log((f + eps mu) / mu), mu the channel mean.
+    /// Bias of the log encoding log((f + eps mu) / mu), mu the channel mean: from 1e-12 to 1.
     #[arg(long, value_name = "EPS", default_value_t = DEFAULT_EPSILON)]
     epsilon: f64,
 
@@ -70,6 +70,10 @@ struct Args {
     /// stderr.
     #[arg(long)]
     json: bool,
+}
+
+fn parse_threshold(text: &str) -> Result<f64, String> {
+    cli::parse_finite(text, 0.0, f64::MAX).map_err(|_| "expected a finite number from 0".to_string())
 }
 
 const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
