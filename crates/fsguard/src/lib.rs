@@ -184,22 +184,6 @@ impl Folder {
         Ok(())
     }
 
-    /// The names of the regular files the folder holds directly (links and everything else are
-    /// left out), unsorted.
-    pub fn file_names(&self) -> io::Result<Vec<String>> {
-        let mut names = Vec::new();
-        for entry in std::fs::read_dir(&self.path)? {
-            let entry = entry?;
-            // `file_type` does not follow a link.
-            if entry.file_type()?.is_file()
-                && let Some(name) = entry.file_name().to_str()
-            {
-                names.push(name.to_string());
-            }
-        }
-        Ok(names)
-    }
-
     /// Takes the folder's exclusive advisory lock (`flock(2)` on the folder itself) without
     /// waiting: `true` when taken, `false` when another process holds it. It is released when the
     /// `Folder` is dropped (or the process ends).
@@ -378,9 +362,6 @@ mod tests {
         assert!(!tmp.path().join("ours").exists());
         assert!(tmp.path().join("link").is_symlink() && tmp.path().join("sub").is_dir());
         assert_eq!(std::fs::read(&victim).unwrap(), b"not yours");
-        let mut names = folder.file_names().unwrap();
-        names.sort();
-        assert!(names.is_empty(), "{names:?}");
     }
 
     #[test]
