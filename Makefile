@@ -172,7 +172,7 @@ clean-demo:
 ## (copy each into fuzz/regressions/<target>/). Prints each target's executions; exit 1 if any
 ## target found a crash. E.g. make fuzz FUZZ_SECONDS=600 FUZZ_TARGETS=asset
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= merl asset envmap_exr envmap_hdr
+FUZZ_TARGETS ?= merl asset envmap_exr envmap_hdr manifest obj
 # Seeds every target reads besides its own: the committed fixtures and the shared hostile inputs
 # (crates/fuzzing/tests/regressions.rs replays the same folders).
 FUZZ_SHARED_SEEDS := fixtures ../shared/data/hostile

@@ -20,7 +20,7 @@ use crate::support::{
     ReferenceBake, bake_command, bake_env, copy_dir, ggx_copper, png_decode, reference_bake, root, run, temp_dir, tool,
 };
 
-const MANIFEST: &str = "manifest.json";
+pub(crate) const MANIFEST: &str = "manifest.json";
 
 /// The files `brdf-bake --help` says a bake with an environment writes, besides the Phong layers'
 /// EXRs (one per exponent) and the manifest.
@@ -38,7 +38,7 @@ const DOCUMENTED: [&str; 11] = [
     "layers.png",
 ];
 
-fn sha256_hex(bytes: &[u8]) -> String {
+pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     format!("{:x}", Sha256::digest(bytes))
 }
 
@@ -62,7 +62,7 @@ fn snapshot(dir: &Path) -> BTreeMap<String, (Vec<u8>, SystemTime)> {
 }
 
 /// Just the bytes of [`snapshot`].
-fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+pub(crate) fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     snapshot(dir).into_iter().map(|(name, (bytes, _))| (name, bytes)).collect()
 }
 
@@ -97,7 +97,7 @@ fn checked_manifest(dir: &Path) -> Value {
     manifest
 }
 
-fn outputs(manifest: &Value) -> impl Iterator<Item = &Value> {
+pub(crate) fn outputs(manifest: &Value) -> impl Iterator<Item = &Value> {
     manifest["stages"].as_array().expect("stages").iter().flat_map(|s| s["outputs"].as_array().expect("outputs"))
 }
 
@@ -117,7 +117,7 @@ fn check_decodable(dir: &Path, name: &str) {
 
 /// A finished bake: its manifest is valid and lists every file of the folder (the manifest
 /// aside), and nothing else is there: no temporary file, no file of an earlier bake.
-fn check_complete(dir: &Path) -> Value {
+pub(crate) fn check_complete(dir: &Path) -> Value {
     let manifest = checked_manifest(dir);
     let listed = output_paths(&manifest);
     let present: BTreeSet<String> = contents(dir).into_keys().filter(|n| n != MANIFEST).collect();

@@ -74,7 +74,10 @@ fn every_tool_prints_one_json_object_listing_the_files_it_wrote() {
     let dir = |name: &str| tmp.path().join(name);
     let os = |p: &Path| p.as_os_str().to_owned();
 
-    // merl-synth: the table.
+    // merl-synth: the table (outputs go into folders that exist).
+    for folder in ["synth", "info"] {
+        std::fs::create_dir(dir(folder)).unwrap();
+    }
     let table = dir("synth").join("lambert.binary");
     let r = tool_run("merl-synth", &["lambertian".as_ref(), "--json".as_ref(), "--out".as_ref(), table.as_os_str()]);
     let json = check(&r, &files_under(&dir("synth")));

@@ -36,6 +36,8 @@ fn bake(material: &str, environment: &str) -> PathBuf {
     if done.lock().unwrap().contains(&dir) {
         return dir;
     }
+    // brdf-bake creates its folder, not the folders above it.
+    std::fs::create_dir_all(dir.parent().expect("a parent")).expect("creating target/test-tmp/preview-bakes");
     let mut cmd = tool("brdf-bake");
     cmd.arg(&table)
         .arg("--env")

@@ -4,6 +4,7 @@
 mod support;
 
 mod asset_info;
+mod bake_folders;
 mod brdf_bake;
 mod brdf_bandwidth;
 mod brdf_wavelet;
@@ -14,3 +15,4 @@ mod invalid_inputs;
 mod json_output;
 mod merl_info;
 mod preview;
+mod ranges_and_messages;

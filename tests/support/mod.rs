@@ -94,6 +94,17 @@ impl Run {
         first
     }
 
+    /// Exit 2, stderr exactly one line `error: ...` containing `needle`, nothing on stdout, and no
+    /// panic: how every tool refuses what it cannot do.
+    pub fn expect_one_error_line(self, needle: &str) -> Run {
+        let line = self.stderr.strip_suffix('\n').unwrap_or(&self.stderr);
+        let one = self.code == Some(2) && line.starts_with("error: ") && !line.contains('\n');
+        assert!(one && self.stdout.is_empty(), "expected exit 2 and one line `error: ...`\n{self}");
+        assert!(line.contains(needle), "expected the error to say {needle:?}\n{self}");
+        assert!(!line.contains("panicked") && !line.ends_with('.'), "{self}");
+        self
+    }
+
     /// stderr is exactly one line `error: reading FILE: problem`, the problem in lower case,
     /// without a trailing period, and containing `needle`; and nothing panicked.
     pub fn expect_error(self, file: &Path, needle: &str) -> Run {
@@ -139,6 +150,50 @@ pub fn run(mut cmd: Command, stdin: &str) -> Run {
         stdout: String::from_utf8_lossy(&stdout).into_owned(),
         stderr: String::from_utf8_lossy(&stderr).into_owned(),
     }
+}
+
+/// Runs a command (stdin empty) like [`run`], but fails the test, with what the command printed so
+/// far, when it has not ended within `limit` (it is killed): for commands that must not block.
+/// Returns how long it ran.
+pub fn run_within(mut cmd: Command, limit: std::time::Duration) -> (Run, std::time::Duration) {
+    use std::io::Read;
+    let command = format!("{cmd:?}");
+    let start = std::time::Instant::now();
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("spawning {command}: {e}"));
+    let reader = |mut pipe: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            String::from_utf8_lossy(&bytes).into_owned()
+        })
+    };
+    let stdout = reader(Box::new(child.stdout.take().expect("stdout")));
+    let stderr = reader(Box::new(child.stderr.take().expect("stderr")));
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("polling the tool") {
+            break Some(status);
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    };
+    let elapsed = start.elapsed();
+    let r = Run {
+        command,
+        code: status.and_then(|s| s.code()),
+        stdout: stdout.join().expect("stdout reader"),
+        stderr: stderr.join().expect("stderr reader"),
+    };
+    assert!(status.is_some(), "still running after {limit:?}, killed\n{r}");
+    (r, elapsed)
 }
 
 /// `../shared` beside the checkout, which holds the real test data; fails with a clear message

@@ -240,15 +240,17 @@ pub fn encode_checked(asset: &Asset) -> Result<Vec<u8>, Error> {
     Ok(bytes)
 }
 
-/// Reads and checks an asset file. The header is read and checked against the file's size
-/// before anything sized by it is allocated.
+/// Reads and checks an asset file, which must be a regular file (a FIFO or a device is refused
+/// without blocking or reading). The header is read and checked against the file's size before
+/// anything sized by it is allocated.
 pub fn read_file(path: &Path) -> Result<Asset, Error> {
     read_file_with_header(path).map(|(_, asset)| asset)
 }
 
 /// [`read_file`], also returning the header as stored (for tools that show it).
 pub fn read_file_with_header(path: &Path) -> Result<(Header, Asset), Error> {
-    let mut file = std::fs::File::open(path)?;
+    // A regular file only, opened without blocking: a FIFO or a device is refused unread.
+    let mut file = fsguard::open_regular(path)?;
     let file_len = file.metadata()?.len();
     let mut bytes = Vec::with_capacity(HEADER_BYTES);
     file.by_ref().take(HEADER_BYTES as u64).read_to_end(&mut bytes)?;

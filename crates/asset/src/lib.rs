@@ -59,14 +59,15 @@ pub use container::{
 };
 pub use error::Error;
 pub use files::{
-    LinkedStatus, hex, linked_file_status, remove_temporaries, sha256, sha256_file, sha256_from_hex, temporary_target,
-    write_atomic, write_set,
+    LinkedStatus, Staging, create_folder, hex, linked_file_status, remove_temporaries, sha256, sha256_file,
+    sha256_from_hex, temporary_target, write_atomic, write_set,
 };
 pub use manifest::{
-    BakeManifest, FileFormat, MANIFEST_VERSION, READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool,
+    BakeManifest, FileFormat, MANIFEST_FILE, MANIFEST_LIMIT, MANIFEST_VERSION, OUTPUT_LIMIT,
+    READABLE_MANIFEST_VERSIONS, SourceFile, Stage, StageOutput, Tool,
 };
 pub use types::{
     Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples,
-    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MAX_WAVELET_SIDE, MaterialInfo, Payload, PrefilteredEnvmap,
-    Provenance, WaveletBrdf, WaveletCoefficients,
+    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MAX_WAVELET_CHANNEL_MEAN, MAX_WAVELET_SIDE, MaterialInfo, Payload,
+    PrefilteredEnvmap, Provenance, WAVELET_EPSILON_RANGE, WAVELET_LOG_BOUND, WaveletBrdf, WaveletCoefficients,
 };

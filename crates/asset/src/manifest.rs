@@ -5,13 +5,11 @@
 //! `data-schema/bake-manifest.schema.json` (version 2; version 1's is kept beside it); the two
 //! must agree (a test checks).
 
-use std::path::Path;
-
 use serde::{Deserialize, Serialize};
 
-use crate::container::FORMAT_VERSION;
+use crate::container::{FORMAT_VERSION, HEADER_BYTES, PAYLOAD_LIMIT, PROVENANCE_LIMIT};
 use crate::error::Error;
-use crate::files::{hex, sha256_file};
+use crate::files::{hex, sha256_open};
 
 use crate::types::AssetKind;
 
@@ -19,6 +17,13 @@ use crate::types::AssetKind;
 pub const MANIFEST_VERSION: u32 = 2;
 /// Every manifest version this build reads.
 pub const READABLE_MANIFEST_VERSIONS: &[u32] = &[1, 2];
+/// The manifest's file name in a bake's folder.
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// The largest manifest a reader accepts, in bytes: a bake's is a few tens of kilobytes.
+pub const MANIFEST_LIMIT: u64 = 16 << 20;
+/// The largest file a manifest may list, in bytes: the largest asset a reader accepts (its
+/// header, provenance and payload limits); no other file a bake writes comes near it.
+pub const OUTPUT_LIMIT: u64 = HEADER_BYTES as u64 + PROVENANCE_LIMIT + PAYLOAD_LIMIT;
 
 /// What a bake read and wrote.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -143,29 +148,57 @@ impl StageOutput {
         })
     }
 
-    /// Whether the file at `manifest_dir/path` is still the one described: same size and hash.
-    pub fn matches_file(&self, manifest_dir: &Path) -> std::io::Result<bool> {
-        let full = manifest_dir.join(&self.path);
-        match std::fs::metadata(&full) {
-            Ok(meta) if meta.len() == self.size_bytes => Ok(hex(&sha256_file(&full)?) == self.sha256),
-            Ok(_) => Ok(false),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
-            Err(e) => Err(e),
+    /// Whether the file at `path` in the manifest's folder is still the one described: a regular
+    /// file (reached without following a link, [`fsguard::Folder::open_file`]) of the same size,
+    /// from its metadata, and hash, reading exactly that size. A missing file, a link, a FIFO or a
+    /// device is `false`, never read; other failures to read are errors.
+    pub fn matches_file(&self, folder: &fsguard::Folder) -> std::io::Result<bool> {
+        let file = match folder.open_file(&self.path) {
+            Ok(file) => file,
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::InvalidInput) => {
+                return Ok(false);
+            }
+            Err(e) => return Err(e),
+        };
+        if file.metadata()?.len() != self.size_bytes {
+            return Ok(false);
         }
+        Ok(hex(&sha256_open(file)?) == self.sha256)
+    }
+
+    /// The bytes of the file at `path` in the manifest's folder, when it is the one described:
+    /// resolved and opened as [`StageOutput::matches_file`] does, its size checked against
+    /// `size_bytes` (and [`OUTPUT_LIMIT`]) from its metadata before anything is read, its SHA-256
+    /// against `sha256` after. The error says which check failed.
+    pub fn read(&self, folder: &fsguard::Folder) -> std::io::Result<Vec<u8>> {
+        let not_described = |why: String| {
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not the file the manifest describes ({why}): bake again"),
+            )
+        };
+        let file = folder.open_file(&self.path)?;
+        let len = file.metadata()?.len();
+        if len != self.size_bytes {
+            return Err(not_described(format!("{len} bytes, the manifest says {}", self.size_bytes)));
+        }
+        let bytes = fsguard::read_to_end(file, self.size_bytes.min(OUTPUT_LIMIT))?;
+        if hex(&crate::files::sha256(&bytes)) != self.sha256 {
+            return Err(not_described("its sha256 differs".into()));
+        }
+        Ok(bytes)
     }
 
     /// Checks the invariants the types cannot express: `kind` and `format_version` come with
-    /// assets and only with them; the path is relative and stays inside the manifest's folder.
+    /// assets and only with them; the path names a file inside the manifest's folder
+    /// ([`fsguard::check_relative`]: relative, `/`-separated, no empty, `.` or `..` component, no
+    /// `\` or NUL).
     fn check(&self) -> Result<(), String> {
         let is_asset = self.format == FileFormat::Asset;
         if is_asset != self.kind.is_some() || is_asset != self.format_version.is_some() {
             return Err(format!("output {:?}: kind and format_version belong to assets and only to them", self.path));
         }
-        let escapes = self.path.split('/').any(|part| part == "..");
-        if self.path.is_empty() || self.path.starts_with(['/', '\\']) || escapes {
-            return Err(format!("output path {:?} must be relative and inside the bake's folder", self.path));
-        }
-        Ok(())
+        fsguard::check_relative(&self.path).map_err(|e| format!("output {e}"))
     }
 }
 
@@ -199,14 +232,30 @@ impl BakeManifest {
             }
             None => return Err(Error::Invalid("invalid bake manifest: no integer manifest_version".into())),
         };
-        // Version 1 allowed any relative path (its example points outside its folder); its
-        // outputs are all assets, so there is nothing else to check.
-        if manifest.manifest_version >= 2 {
-            for output in manifest.outputs() {
-                output.check().map_err(|e| Error::Invalid(format!("invalid bake manifest: {e}")))?;
-            }
+        // Every version: paths name files inside the folder (version 1's schema allowed any
+        // relative path; its readers apply the same rule as version 2's).
+        for output in manifest.outputs() {
+            output.check().map_err(|e| Error::Invalid(format!("invalid bake manifest: {e}")))?;
         }
         Ok(manifest)
+    }
+
+    /// [`BakeManifest::from_json`] of a file's bytes, which must be UTF-8 and at most
+    /// [`MANIFEST_LIMIT`] long.
+    pub fn from_bytes(bytes: &[u8]) -> Result<BakeManifest, Error> {
+        if bytes.len() as u64 > MANIFEST_LIMIT {
+            return Err(Error::LimitExceeded { what: "manifest", found: bytes.len() as u64, limit: MANIFEST_LIMIT });
+        }
+        let text = std::str::from_utf8(bytes)
+            .map_err(|e| Error::Invalid(format!("invalid bake manifest: not utf-8 text ({e})")))?;
+        BakeManifest::from_json(text)
+    }
+
+    /// The manifest of the bake held open as `folder` ([`MANIFEST_FILE`]): a regular file in it
+    /// (not a link, a FIFO or a device), at most [`MANIFEST_LIMIT`] bytes by its metadata before
+    /// it is read. A missing manifest is [`Error::Io`] of kind `NotFound`.
+    pub fn read(folder: &fsguard::Folder) -> Result<BakeManifest, Error> {
+        BakeManifest::from_bytes(&folder.read(MANIFEST_FILE, MANIFEST_LIMIT)?)
     }
 
     /// Pretty JSON with a trailing newline, ready for [`crate::write_atomic`].

@@ -541,6 +541,22 @@ impl LayerSelection {
 /// compression-map indices (section 5.2).
 pub const MAX_WAVELET_SIDE: u32 = 256;
 
+/// The range of a [`WaveletBrdf`]'s log-encoding bias `epsilon`: the encoding's floor `eps mu` is
+/// from `1e-12` of the channel mean (log values down to `ln 1e-12 = -27.6`) to the mean itself
+/// (the paper's is `0.01`). A larger bias flattens the BRDF to nothing: `1e308` renders black.
+pub const WAVELET_EPSILON_RANGE: std::ops::RangeInclusive<f64> = 1e-12..=1.0;
+
+/// The largest channel mean `mu` of a [`WaveletBrdf`], in 1/sr: a material reflecting as much as
+/// that on average is no BRDF (a Lambertian white is `1 / pi`).
+pub const MAX_WAVELET_CHANNEL_MEAN: f64 = 1e6;
+
+/// The largest log-encoded value `|log((f + eps mu) / mu)|` a [`WaveletBrdf`] stands for: `f` from
+/// the floor up to `e^64` (6e27) times the channel mean. The transform is orthonormal, so an
+/// `n x n` slice of such values has no coefficient beyond `64 n` in magnitude (each coefficient
+/// is at most the slice's L2 norm): a stored coefficient (or a quantized slice's range) beyond
+/// that is refused.
+pub const WAVELET_LOG_BOUND: f64 = 64.0;
+
 /// A BRDF encoded in Haar wavelets (payload of [`AssetKind::WaveletBrdf`], written by
 /// `brdf-wavelet`; Claustres, Barthe and Paulin 2007, sections 4-5). Crate `haar-brdf`
 /// documents the parameterization, the transform and the reconstruction;
@@ -590,11 +606,19 @@ impl WaveletBrdf {
         if !n.is_power_of_two() || !(2..=MAX_WAVELET_SIDE).contains(&n) {
             return Err(format!("wavelet brdf side {n} is not a power of two in 2..={MAX_WAVELET_SIDE}"));
         }
-        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
-            return Err(format!("wavelet brdf epsilon {} is not a positive number", self.epsilon));
+        if !WAVELET_EPSILON_RANGE.contains(&self.epsilon) {
+            return Err(format!(
+                "wavelet brdf epsilon {} is outside {:e} to {}",
+                self.epsilon,
+                WAVELET_EPSILON_RANGE.start(),
+                WAVELET_EPSILON_RANGE.end()
+            ));
         }
-        if !self.channel_mean.iter().all(|m| m.is_finite() && *m > 0.0) {
-            return Err("wavelet brdf channel means must be positive numbers".into());
+        if !self.channel_mean.iter().all(|m| *m > 0.0 && *m <= MAX_WAVELET_CHANNEL_MEAN) {
+            return Err(format!(
+                "wavelet brdf channel means {:?} must be positive and at most {MAX_WAVELET_CHANNEL_MEAN:e} 1/sr",
+                self.channel_mean
+            ));
         }
         let cells = u64::from(n) * u64::from(n);
         if self.map.len() as u64 != cells {
@@ -611,15 +635,22 @@ impl WaveletBrdf {
         }
         let k = u64::from(next - 1);
         let values = product(&[k, cells, 3]).expect("k and cells are at most 2^16 each");
-        let (what, found, finite) = match &self.coefficients {
-            WaveletCoefficients::Float(v) => ("values", v.len(), v.iter().all(|x| x.is_finite())),
+        // Every stored coefficient within WAVELET_LOG_BOUND n (NaN and infinities fail too).
+        let bound = WAVELET_LOG_BOUND * f64::from(n);
+        let within = |x: f64| x.abs() <= bound;
+        let (what, found, in_range) = match &self.coefficients {
+            WaveletCoefficients::Float(v) => ("values", v.len(), v.iter().all(|&x| within(f64::from(x)))),
             WaveletCoefficients::Quantized { offset, step, codes } => {
                 for (what, found) in [("offsets", offset.len()), ("steps", step.len())] {
                     if found as u64 != 3 * k {
                         return Err(format!("wavelet brdf has {found} quantization {what}, expected {}", 3 * k));
                     }
                 }
-                let ranges = offset.iter().all(|x| x.is_finite()) && step.iter().all(|x| x.is_finite() && *x >= 0.0);
+                // Codes 0 to 255: the slice's range is offset .. offset + 255 step.
+                let ranges = offset.iter().zip(step).all(|(&o, &s)| {
+                    let (o, s) = (f64::from(o), f64::from(s));
+                    s >= 0.0 && within(o) && within(o + 255.0 * s)
+                });
                 ("codes", codes.len(), ranges)
             }
         };
@@ -628,8 +659,11 @@ impl WaveletBrdf {
                 "wavelet brdf holds {found} {what}, expected {values} ({k} slices of {cells} cells x 3)"
             ));
         }
-        if !finite {
-            return Err("wavelet brdf coefficients must be finite (and quantization steps not negative)".into());
+        if !in_range {
+            return Err(format!(
+                "wavelet brdf coefficients must be finite and within {bound} in magnitude ({WAVELET_LOG_BOUND} times the \
+                 side: log-encoded values within {WAVELET_LOG_BOUND}), and quantization steps not negative"
+            ));
         }
         Ok(())
     }

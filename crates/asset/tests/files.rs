@@ -84,13 +84,87 @@ fn a_failed_write_leaves_the_target_and_no_temporary_file() {
     assert_eq!(std::fs::read(dir.path().join("plain")).unwrap(), b"plain");
 }
 
+/// An output's folder must exist: a missing one is an error naming it, and nothing is created
+/// (`--out /nonexistent/dir/x.png` must not make folders from the root). A set's folder is created
+/// itself, its parent never.
 #[test]
-fn missing_parent_folders_are_created() {
+fn missing_parent_folders_are_not_created() {
     let dir = tempfile::tempdir().unwrap();
     let nested = dir.path().join("a/b/out.bin");
-    write_atomic(&nested, b"new").unwrap();
-    assert_eq!(std::fs::read(&nested).unwrap(), b"new");
-    assert_eq!(entries(&dir.path().join("a/b")), ["out.bin"]);
+    let e = write_atomic(&nested, b"new").unwrap_err();
+    assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
+    assert!(e.to_string().contains(&format!("the folder {} does not exist", dir.path().join("a/b").display())), "{e}");
+    assert!(entries(dir.path()).is_empty());
+
+    let (path, e) = asset::write_set(&dir.path().join("a/b"), &[("x", b"x")]).unwrap_err();
+    assert_eq!(path, dir.path().join("a/b"));
+    assert!(e.to_string().contains("parent folder"), "{e}");
+    assert!(entries(dir.path()).is_empty());
+    asset::write_set(&dir.path().join("a"), &[("x", b"x")]).unwrap();
+    assert_eq!(entries(&dir.path().join("a")), ["x"]);
+}
+
+/// A set staged and then dropped (an error before the switch: a full disk, a refused input)
+/// leaves the folder as it was; committed, it replaces the old files, the index last.
+#[test]
+fn a_staged_set_lands_on_commit_only() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("data"), b"old data").unwrap();
+    std::fs::write(dir.path().join("index"), b"old index").unwrap();
+    let mut staging = asset::Staging::new(dir.path());
+    staging.add("data", b"new data").unwrap();
+    staging.add("index", b"new index").unwrap();
+    assert_eq!(entries(dir.path()).len(), 4, "two temporaries beside the old files");
+    drop(staging);
+    assert_eq!(entries(dir.path()), ["data", "index"]);
+    assert_eq!(std::fs::read(dir.path().join("data")).unwrap(), b"old data");
+
+    let mut staging = asset::Staging::new(dir.path());
+    staging.add("data", b"new data").unwrap();
+    staging.add("index", b"new index").unwrap();
+    let seen = std::cell::RefCell::new(Vec::new());
+    staging
+        .commit(|| {
+            // Between the renames and the index: the data is new, the index not there.
+            seen.borrow_mut().push(std::fs::read(dir.path().join("data")).unwrap());
+            seen.borrow_mut().push(vec![u8::from(dir.path().join("index").exists())]);
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(seen.into_inner(), [b"new data".to_vec(), vec![0]]);
+    assert_eq!(entries(dir.path()), ["data", "index"]);
+    assert_eq!(std::fs::read(dir.path().join("index")).unwrap(), b"new index");
+}
+
+/// A FIFO or a device is refused without blocking or reading; a link is followed for a path
+/// given as it is, never for a name an asset links (`linked_file_status`).
+#[cfg(unix)]
+#[test]
+fn hashing_reads_regular_files_only() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let e = sha256_file(&fifo).unwrap_err();
+    assert!(e.to_string().contains("fifo"), "{e}");
+    let e = sha256_file(std::path::Path::new("/dev/zero")).unwrap_err();
+    assert!(e.to_string().contains("character device"), "{e}");
+
+    let outside = tempfile::tempdir().unwrap();
+    std::fs::write(outside.path().join("abc"), b"abc").unwrap();
+    std::os::unix::fs::symlink(outside.path().join("abc"), dir.path().join("link")).unwrap();
+    assert_eq!(hex(&sha256_file(&dir.path().join("link")).unwrap()), ABC_SHA256);
+    let status = asset::linked_file_status(dir.path(), "link", &sha256(b"abc"));
+    assert!(matches!(&status, asset::LinkedStatus::Unreadable(e) if e.contains("symbolic link")), "{status:?}");
+    let status = asset::linked_file_status(dir.path(), "fifo", &sha256(b"abc"));
+    assert!(matches!(&status, asset::LinkedStatus::Unreadable(e) if e.contains("fifo")), "{status:?}");
+    std::fs::write(dir.path().join("abc"), b"abc").unwrap();
+    assert_eq!(asset::linked_file_status(dir.path(), "abc", &sha256(b"abc")), asset::LinkedStatus::Matches);
+
+    // An output path that is a FIFO (or a device) is not renamed away.
+    let e = write_atomic(&fifo, b"x").unwrap_err();
+    assert!(e.to_string().contains("refusing to replace"), "{e}");
+    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
 }
 
 /// The temporary files of `write_atomic` and `write_set` are recognised by their whole name, so

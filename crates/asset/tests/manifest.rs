@@ -95,7 +95,9 @@ fn the_examples_describe_real_files() {
         assert!(!manifest.stages[0].outputs.is_empty(), "{name}");
         for output in manifest.outputs() {
             let dir = schema_dir().join("examples");
-            assert!(output.matches_file(&dir).unwrap(), "{name}: {} is not the file described", output.path);
+            let folder = fsguard::Folder::open(&dir).unwrap();
+            assert!(output.matches_file(&folder).unwrap(), "{name}: {} is not the file described", output.path);
+            assert_eq!(output.read(&folder).unwrap(), std::fs::read(dir.join(&output.path)).unwrap(), "{name}");
             let bytes = std::fs::read(dir.join(&output.path)).unwrap();
             let described = StageOutput::of_bytes(&output.path, output.format, &output.role, &bytes).unwrap();
             assert_eq!(&described, output, "{name}");
@@ -237,6 +239,21 @@ const BROKEN: &[Broken] = &[
         edit: |m| m["stages"][0]["parameters"] = json!([1, 2]),
         type_refuses: true,
     },
+    Broken {
+        what: "output path with an empty component",
+        edit: |m| m["stages"][0]["outputs"][0]["path"] = json!("a//x.asset"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "output path with a backslash",
+        edit: |m| m["stages"][0]["outputs"][0]["path"] = json!("a\\..\\x.asset"),
+        type_refuses: true,
+    },
+    Broken {
+        what: "output path of a dot component",
+        edit: |m| m["stages"][0]["outputs"][0]["path"] = json!("./x.asset"),
+        type_refuses: true,
+    },
     Broken { what: "environment null", edit: |m| m["environment"] = Value::Null, type_refuses: false },
 ];
 
@@ -253,6 +270,63 @@ fn broken_manifests_are_rejected() {
             assert!(parsed.is_err(), "{}: BakeManifest accepts it", broken.what);
         }
     }
+}
+
+/// Version 1 gets version 2's path rules: a file outside the folder, by an absolute path or by
+/// `..`, is refused, whichever version the manifest says it is (`brdf-bake` once deleted such
+/// files and `brdf-preview` read them).
+#[test]
+fn version_1_paths_stay_inside_the_folder() {
+    for path in ["/etc/passwd", "../outside/victim.txt", "a/../../x", "a//b", "\\server\\x"] {
+        let mut v1 = example_v1();
+        v1["stages"][0]["outputs"][0]["path"] = json!(path);
+        assert!(!validator_of("bake-manifest-v1.schema.json").is_valid(&v1), "{path}: the v1 schema accepts it");
+        let e = BakeManifest::from_json(&v1.to_string()).unwrap_err().to_string();
+        assert!(e.contains("expected a relative path inside the folder"), "{path}: {e}");
+    }
+}
+
+/// Reading an output checks, in order, that it is a regular file reached without a link, its size
+/// from its metadata, then its hash; `matches_file` says `false` for each instead.
+#[cfg(unix)]
+#[test]
+fn outputs_are_read_only_when_they_are_the_files_described() {
+    let dir = tempfile::tempdir().unwrap();
+    let outside = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.png"), b"picture").unwrap();
+    std::fs::write(outside.path().join("a.png"), b"picture").unwrap();
+    let output = StageOutput::of_bytes("a.png", FileFormat::Png, "picture", b"picture").unwrap();
+    let folder = fsguard::Folder::open(dir.path()).unwrap();
+    assert_eq!(output.read(&folder).unwrap(), b"picture");
+    assert!(output.matches_file(&folder).unwrap());
+
+    let other = StageOutput::of_bytes("a.png", FileFormat::Png, "picture", b"pictures").unwrap();
+    let e = other.read(&folder).unwrap_err().to_string();
+    assert_eq!(e, "not the file the manifest describes (7 bytes, the manifest says 8): bake again");
+    assert!(!other.matches_file(&folder).unwrap());
+    let other = StageOutput::of_bytes("a.png", FileFormat::Png, "picture", b"Picture").unwrap();
+    let e = other.read(&folder).unwrap_err().to_string();
+    assert_eq!(e, "not the file the manifest describes (its sha256 differs): bake again");
+
+    std::fs::remove_file(dir.path().join("a.png")).unwrap();
+    std::os::unix::fs::symlink(outside.path().join("a.png"), dir.path().join("a.png")).unwrap();
+    assert!(output.read(&folder).unwrap_err().to_string().contains("symbolic link"));
+    assert!(!output.matches_file(&folder).unwrap(), "a link is not the file, even to the same bytes");
+    std::fs::remove_file(dir.path().join("a.png")).unwrap();
+    assert!(std::process::Command::new("mkfifo").arg(dir.path().join("a.png")).status().unwrap().success());
+    assert!(output.read(&folder).unwrap_err().to_string().contains("fifo"));
+    assert!(!output.matches_file(&folder).unwrap());
+    std::fs::remove_file(dir.path().join("a.png")).unwrap();
+    assert_eq!(output.read(&folder).unwrap_err().kind(), std::io::ErrorKind::NotFound);
+    assert!(!output.matches_file(&folder).unwrap());
+}
+
+#[test]
+fn manifests_over_the_limit_or_not_utf8_are_refused_before_parsing() {
+    let e = BakeManifest::from_bytes(&vec![b' '; asset::MANIFEST_LIMIT as usize + 1]).unwrap_err().to_string();
+    assert!(e.contains("exceeds the limit"), "{e}");
+    let e = BakeManifest::from_bytes(b"{\xff}").unwrap_err().to_string();
+    assert!(e.contains("not utf-8"), "{e}");
 }
 
 #[test]

@@ -40,6 +40,13 @@ pub enum Error {
         #[source]
         source: Cause,
     },
+    /// Another bake holds the folder's lock: one bake at a time per folder.
+    #[error(
+        "{}: another bake is writing this folder (it holds the folder's lock): wait for it to finish, or bake into \
+         another folder",
+        .0.display()
+    )]
+    Busy(PathBuf),
     /// A bug: a value the code made does not pass its own checks.
     #[error("internal error: {0}")]
     Internal(String),

@@ -20,7 +20,16 @@
 //!
 //! Architecture Invariant: a bake's manifest is written last, after every file it names, and the
 //! previous manifest is removed before the first file is replaced, so that a manifest never
-//! names a missing or stale file, even after an interrupted bake.
+//! names a missing or stale file, even after an interrupted bake. The new files are written in full
+//! beside the old ones before anything is replaced, so a bake that fails (a refused input, a full
+//! disk, a read-only folder) leaves the previous bake intact and listed; one bake at a time holds a
+//! folder (its advisory lock).
+//!
+//! Architecture Invariant: a bake touches nothing outside its folder, and nothing in it that it did
+//! not write: paths a manifest names are resolved inside the folder without following links
+//! (`fsguard`), only regular files are read, each with a size bound, and a rebake removes a
+//! previous file only under a name some stage writes and only while it is the file the previous
+//! manifest describes.
 
 mod error;
 mod load;
@@ -31,8 +40,8 @@ pub mod stage;
 use std::path::{Path, PathBuf};
 
 pub use error::Error;
-pub use load::{Loaded, load, wavelet as load_wavelet};
-pub use run::{BakeConfig, BakeOutcome, MANIFEST, Progress, run_bake};
+pub use load::{Loaded, bake_wavelet, load, wavelet as load_wavelet};
+pub use run::{BakeConfig, BakeOutcome, MANIFEST, Progress, run_bake, write_stage};
 
 use asset::{FileFormat, StageOutput};
 
@@ -51,7 +60,8 @@ pub struct Source {
 }
 
 impl Source {
-    /// Hashes the file at `path` (in a stream).
+    /// Hashes the file at `path` (in a stream; a regular file only, never a FIFO or a device:
+    /// [`asset::sha256_file`]).
     pub fn hash(path: &Path) -> Result<Source, Error> {
         let sha256 = asset::sha256_file(path).map_err(|e| Error::read(path, e))?;
         Ok(Source { path: path.to_path_buf(), sha256 })
@@ -111,15 +121,52 @@ pub struct Staged {
 }
 
 impl Staged {
-    /// Writes the stage's files into `dir` (created if missing) as one set ([`asset::write_set`]):
-    /// all of them or none, the asset, which may name the others, landing last. Returns the
-    /// stage's manifest entry with the files' paths relative to `dir`.
+    /// Writes the stage's files into `dir` (created if missing: the folder itself, its parent must
+    /// exist) as one set ([`asset::write_set`]): all of them or none, the asset, which may name
+    /// the others, landing last. Returns the stage's manifest entry with the files' paths relative
+    /// to `dir`.
+    ///
+    /// A bake folder (one with a manifest) is refused, with what to do instead: the files would
+    /// replace some of the bake's and its manifest would then lie; [`write_stage`] writes a stage
+    /// into a bake through the bake's protocol. The folder's lock is held while writing, so a bake
+    /// running in it is [`Error::Busy`] too.
     pub fn write(&self, dir: &Path) -> Result<asset::Stage, Error> {
-        let mut files: Vec<&OutFile> = self.files.iter().collect();
-        files.sort_by_key(|f| f.format == asset::FileFormat::Asset);
-        let set: Vec<(&str, &[u8])> = files.iter().map(|f| (f.name.as_str(), &f.bytes[..])).collect();
+        let folder = fsguard::Folder::create(dir).map_err(|e| Error::write(dir, e))?;
+        if !folder.try_lock().map_err(|e| Error::write(dir, e))? {
+            return Err(Error::Busy(dir.to_path_buf()));
+        }
+        if std::fs::symlink_metadata(dir.join(MANIFEST)).is_ok() {
+            return Err(Error::Invalid(format!(
+                "{} is a bake folder (it has a {MANIFEST}): writing the {} stage's files into it would make its \
+                 manifest lie; bake it again with brdf-bake, or write into another folder",
+                dir.display(),
+                self.name
+            )));
+        }
+        self.write_set(dir)
+    }
+
+    /// [`Staged::write`] without the checks: the caller holds the folder.
+    fn write_set(&self, dir: &Path) -> Result<asset::Stage, Error> {
+        let set: Vec<(&str, &[u8])> = self.ordered().iter().map(|f| (f.name.as_str(), &f.bytes[..])).collect();
         asset::write_set(dir, &set).map_err(|(path, e)| Error::write(&path, e))?;
         self.manifest_stage()
+    }
+
+    /// Adds the stage's files to `staging` (the new files of a bake, switched in together) and
+    /// returns the stage's manifest entry.
+    fn stage(&self, staging: &mut asset::Staging) -> Result<asset::Stage, Error> {
+        for f in self.ordered() {
+            staging.add(&f.name, &f.bytes).map_err(|(path, e)| Error::write(&path, e))?;
+        }
+        self.manifest_stage()
+    }
+
+    /// The files with the asset, which may name the others, last.
+    fn ordered(&self) -> Vec<&OutFile> {
+        let mut files: Vec<&OutFile> = self.files.iter().collect();
+        files.sort_by_key(|f| f.format == asset::FileFormat::Asset);
+        files
     }
 
     /// The stage's manifest entry (paths are the file names).

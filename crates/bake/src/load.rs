@@ -27,36 +27,56 @@ pub struct Loaded {
 /// Reads the bake in `dir`. The MERL table is `material` when given, else the manifest's
 /// `source_path` (as given to the bake: absolute, or relative to the working folder or, failing
 /// that, to the bake's parent folder); either way its SHA-256 must be the manifest's.
+///
+/// Every file is read once, as the bytes that are checked and decoded: the manifest and the
+/// files it lists inside the folder without following a link, regular files only, each size
+/// checked from the file's metadata before it is read (the manifest's against
+/// [`asset::MANIFEST_LIMIT`], each output's against its `size_bytes`, then its SHA-256); the table
+/// (which may lie anywhere) as a regular file of at most [`merl::MAX_FILE_BYTES`], its SHA-256
+/// compared before anything in it is parsed or quoted.
 pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
+    let folder = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
     let manifest_path = dir.join(MANIFEST);
-    let text = std::fs::read_to_string(&manifest_path).map_err(|e| Error::read(&manifest_path, e))?;
-    let manifest = BakeManifest::from_json(&text).map_err(|e| Error::read(&manifest_path, e))?;
-    let file = |role: &str| -> Result<PathBuf, Error> {
+    let manifest = match BakeManifest::read(&folder) {
+        Ok(manifest) => manifest,
+        Err(asset::Error::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(Error::read(
+                dir,
+                format!(
+                    "not a bake folder (it has no {MANIFEST}): make one with brdf-bake MATERIAL.binary --env ENV.hdr \
+                     --out-dir {}",
+                    dir.display()
+                ),
+            ));
+        }
+        Err(e) => return Err(Error::read(&manifest_path, e)),
+    };
+    let file = |role: &str| -> Result<(PathBuf, Vec<u8>), Error> {
         let output = manifest.output(role).ok_or_else(|| {
             Error::read(&manifest_path, format!("the bake has no {role} output: bake it again with this version"))
         })?;
         let path = dir.join(&output.path);
-        if !output.matches_file(dir).map_err(|e| Error::read(&path, e))? {
-            return Err(Error::read(&path, "not the file the manifest describes (size or sha256 differ): bake again"));
-        }
-        Ok(path)
+        let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
+        Ok((path, bytes))
     };
 
     let table_path = match material {
         Some(path) => path.to_path_buf(),
         None => locate(&manifest.material.source_path, dir),
     };
-    let sha256 = asset::sha256_file(&table_path).map_err(|e| Error::read(&table_path, e))?;
-    if asset::hex(&sha256) != manifest.material.source_sha256 {
+    let table_bytes =
+        fsguard::read_regular(&table_path, merl::MAX_FILE_BYTES).map_err(|e| Error::read(&table_path, e))?;
+    if asset::hex(&asset::sha256(&table_bytes)) != manifest.material.source_sha256 {
         return Err(Error::read(
             &table_path,
             format!("not the material of the bake in {} (its sha256 differs)", dir.display()),
         ));
     }
-    let table = merl::read_file(&table_path).map_err(|e| Error::read(&table_path, e))?;
+    let table = merl::MerlTable::parse(&table_bytes).map_err(|e| Error::read(&table_path, e))?;
+    drop(table_bytes);
 
-    let samples_path = file("importance-samples")?;
-    let samples = match read_payload(&samples_path)? {
+    let (samples_path, samples_bytes) = file("importance-samples")?;
+    let samples = match read_payload(&samples_path, &samples_bytes)? {
         Payload::ImportanceSamples(s) => sample_set(s).map_err(|e| Error::read(&samples_path, e))?,
         other => {
             return Err(Error::read(&samples_path, format!("expected importance samples, found {}", other.kind())));
@@ -66,16 +86,16 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     let mut view_layers = Vec::new();
     let mut bandwidths = None;
     let lighting = if manifest.environment.is_some() {
-        let asset_path = file("prefiltered-envmap")?;
-        let Payload::PrefilteredEnvmap(prefiltered) = read_payload(&asset_path)? else {
+        let (asset_path, asset_bytes) = file("prefiltered-envmap")?;
+        let Payload::PrefilteredEnvmap(prefiltered) = read_payload(&asset_path, &asset_bytes)? else {
             return Err(Error::read(&asset_path, "expected a prefiltered-envmap asset"));
         };
-        let mips_path = file("environment-mips")?;
-        let mips = read_ktx2(&mips_path, prefiltered.mips_radiance_scale as f32)?;
+        let (mips_path, mips_bytes) = file("environment-mips")?;
+        let mips = read_ktx2(&mips_path, &mips_bytes, prefiltered.mips_radiance_scale as f32)?;
         let levels: Vec<EnvMap> = mips.into_iter().map(|mut layers| layers.remove(0)).collect();
         let mips = MipChain::from_levels(levels).map_err(|e| Error::read(&mips_path, e))?;
-        let layers_path = file("phong-layers")?;
-        let mut layers = read_ktx2(&layers_path, prefiltered.layers_radiance_scale as f32)?;
+        let (layers_path, layers_bytes) = file("phong-layers")?;
+        let mut layers = read_ktx2(&layers_path, &layers_bytes, prefiltered.layers_radiance_scale as f32)?;
         let layers = layers.remove(0);
         if layers.len() != prefiltered.exponents.len() {
             return Err(Error::read(
@@ -83,8 +103,8 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
                 format!("{} layers for {} exponents", layers.len(), prefiltered.exponents.len()),
             ));
         }
-        let selection_path = file("layer-selection")?;
-        let Payload::LayerSelection(selection) = read_payload(&selection_path)? else {
+        let (selection_path, selection_bytes) = file("layer-selection")?;
+        let Payload::LayerSelection(selection) = read_payload(&selection_path, &selection_bytes)? else {
             return Err(Error::read(&selection_path, "expected a layer-selection asset"));
         };
         if selection.exponents != prefiltered.exponents {
@@ -97,15 +117,15 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
             ));
         }
         view_layers = brdf_atlas::view::view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth);
-        let bandwidth_path = file("environment-bandwidth")?;
-        let image = envmap::read_image(&bandwidth_path, &envmap::Limits::default())
+        let (bandwidth_path, bandwidth_bytes) = file("environment-bandwidth")?;
+        let image = envmap::read_image_from_memory(&bandwidth_bytes, &envmap::Limits::default())
             .map_err(|e| Error::read(&bandwidth_path, e))?;
         let grey = image.rgb.chunks_exact(3).map(|t| t[0]).collect();
         let environment = render::adaptive::EnvBandwidth::new(image.width, image.height, grey)
             .map_err(|e| Error::read(&bandwidth_path, e))?;
-        let atlas_path = file("bandwidth-atlas")?;
-        let brdf =
-            crate::stage::atlas::from_payload(read_payload(&atlas_path)?).map_err(|e| Error::read(&atlas_path, e))?;
+        let (atlas_path, atlas_bytes) = file("bandwidth-atlas")?;
+        let brdf = crate::stage::atlas::from_payload(read_payload(&atlas_path, &atlas_bytes)?)
+            .map_err(|e| Error::read(&atlas_path, e))?;
         bandwidths = Some(render::adaptive::Bandwidths { environment, brdf });
         Some(render::Lighting::new(mips, layers, prefiltered.exponents).map_err(|e| Error::read(&mips_path, e))?)
     } else {
@@ -121,9 +141,36 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
 }
 
 /// Reads a `wavelet-brdf` asset (`brdf-wavelet`) for the material of a loaded bake: it must have
-/// been made from the same MERL table (same SHA-256).
+/// been made from the same MERL table (same SHA-256). `path` is the caller's (a regular file only,
+/// [`asset::read_file`]).
 pub fn wavelet(path: &Path, loaded: &Loaded) -> Result<haar_brdf::WaveletBrdf, Error> {
     let asset = asset::read_file(path).map_err(|e| Error::read(path, e))?;
+    wavelet_of_asset(path, &asset, loaded)
+}
+
+/// The bake's own `wavelet-brdf` output (`brdf-wavelet MATERIAL --out-dir BAKE` and `brdf-bake
+/// --wavelet-ratio R` list it in the manifest), read as [`load`] reads every output, with the path
+/// it was read from.
+pub fn bake_wavelet(loaded: &Loaded) -> Result<(PathBuf, haar_brdf::WaveletBrdf), Error> {
+    let Some(output) = loaded.manifest.output("wavelet-brdf") else {
+        return Err(Error::read(
+            &loaded.dir.join(MANIFEST),
+            format!(
+                "the bake has no wavelet-brdf output: add one with brdf-wavelet MATERIAL.binary --out-dir {} (or \
+                 brdf-bake --wavelet-ratio R), or name an asset with --wavelet FILE",
+                loaded.dir.display()
+            ),
+        ));
+    };
+    let path = loaded.dir.join(&output.path);
+    let folder = fsguard::Folder::open(&loaded.dir).map_err(|e| Error::read(&loaded.dir, e))?;
+    let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
+    let asset = asset::decode(&bytes).map_err(|e| Error::read(&path, e))?;
+    let brdf = wavelet_of_asset(&path, &asset, loaded)?;
+    Ok((path, brdf))
+}
+
+fn wavelet_of_asset(path: &Path, asset: &asset::Asset, loaded: &Loaded) -> Result<haar_brdf::WaveletBrdf, Error> {
     let Payload::WaveletBrdf(payload) = &asset.payload else {
         return Err(Error::read(path, format!("expected a wavelet-brdf asset, found {}", asset.kind())));
     };
@@ -151,8 +198,9 @@ fn locate(source_path: &str, dir: &Path) -> PathBuf {
     dir.parent().map(|parent| parent.join(&given)).filter(|p| p.exists()).unwrap_or(given)
 }
 
-fn read_payload(path: &Path) -> Result<Payload, Error> {
-    asset::read_file(path).map(|a| a.payload).map_err(|e| Error::read(path, e))
+/// The payload of an asset file's bytes (`path` names it in errors).
+fn read_payload(path: &Path, bytes: &[u8]) -> Result<Payload, Error> {
+    asset::decode(bytes).map(|a| a.payload).map_err(|e| Error::read(path, e))
 }
 
 /// The samples as the renderers read them; the slices must be the uniform ones
@@ -196,9 +244,8 @@ fn sample_set(s: asset::ImportanceSamples) -> Result<render::SampleSet, String> 
 /// The texels of a KTX2 file of ours (`prefilter::ktx`: RGBA16F or RGBA32F) as maps:
 /// `[level][layer]` (a plain 2D texture has one layer), radiance divided by `scale` (1 since the
 /// files hold radiance as it is; older bakes stored some at a power of two below 1).
-fn read_ktx2(path: &Path, scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
-    let decoded = ::prefilter::ktx::decode(&bytes).map_err(|e| Error::read(path, e))?;
+fn read_ktx2(path: &Path, bytes: &[u8], scale: f32) -> Result<Vec<Vec<EnvMap>>, Error> {
+    let decoded = ::prefilter::ktx::decode(bytes).map_err(|e| Error::read(path, e))?;
     if decoded.shape.faces != 1 {
         return Err(Error::read(path, "expected a lat-long 2d texture, found a cube map"));
     }

@@ -10,7 +10,7 @@ use crate::stage::{atlas, env_bandwidth, importance, layers, pca, prefilter, wav
 use crate::{Error, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
-pub const MANIFEST: &str = "manifest.json";
+pub const MANIFEST: &str = asset::MANIFEST_FILE;
 
 /// What to bake and how.
 #[derive(Clone, Debug)]
@@ -19,7 +19,7 @@ pub struct BakeConfig {
     pub material: PathBuf,
     /// The environment map, for the environment stages.
     pub environment: Option<PathBuf>,
-    /// The folder the bake writes (created if missing).
+    /// The folder the bake writes (created if missing: the folder itself, its parent must exist).
     pub out_dir: PathBuf,
     pub importance: ::importance::Config,
     pub atlas: brdf_atlas::Config,
@@ -145,19 +145,40 @@ pub struct BakeOutcome {
     pub problems: Vec<String>,
 }
 
-/// Runs the bake described by `config`. When the folder's manifest was written by this program
-/// and version from inputs with the same hashes and the same parameters, and every file it names
-/// is still the one it describes, nothing is written and the outcome says so. Otherwise the old
-/// manifest is removed first, every stage writes its files (each atomically), files of the old
-/// manifest that this bake does not write are removed, and the new manifest is written last.
+/// Runs the bake described by `config`, as `data-schema/README.md` ("Bake folders") specifies:
+///
+/// 1. The inputs are read (regular files only, with their size bounds) and hashed before the
+///    folder is touched; the folder is created if missing (itself only, not its parents) and its
+///    advisory lock taken for the whole run (a second bake of the same folder is
+///    [`Error::Busy`], at once, without waiting).
+/// 2. When the folder's manifest was written by this program and version from inputs with the
+///    same hashes and the same parameters, and every file it names is still the one it describes,
+///    nothing is written (only temporary files a killed bake left are removed) and the outcome
+///    says so.
+/// 3. Otherwise every stage runs and its files are written beside the old ones as synced
+///    temporary files, the new manifest last. Any failure up to here (a refused input, a full
+///    disk, a read-only folder) removes them and leaves the previous bake as it was, listed by
+///    its manifest.
+/// 4. The switch, by renames alone: the old manifest is removed, every new file renamed into
+///    place, the previous bake's files that this one does not write removed (only under a name
+///    some stage writes, as a regular file that is still the one the old manifest describes), and
+///    the new manifest renamed into place last.
 pub fn run_bake(
     config: &BakeConfig,
     program: &Program,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<BakeOutcome, Error> {
     config.check()?;
+    // The map is held through both environment stages: the larger of their needs per texel,
+    // under the budget less the layers (a budget the layers alone exceed is refused here).
+    let limits = envmap::Limits {
+        bytes_per_texel: env_bandwidth::BYTES_PER_TEXEL.max(prefilter::BYTES_PER_TEXEL),
+        ..prefilter::limits(&config.prefilter, config.env_bandwidth.max_memory)?
+    };
     let out = &config.out_dir;
-    let material_source = Source::hash(&config.material)?;
+    // The table's bytes are read once: what is hashed is what is parsed.
+    let material_bytes = merl::read_bytes(&config.material).map_err(|e| Error::read(&config.material, e))?;
+    let material_source = Source::of_bytes(&config.material, &material_bytes);
     let environment_source = config.environment.as_deref().map(Source::hash).transpose()?;
     let mut manifest = BakeManifest::new(
         source_file(&material_source),
@@ -165,41 +186,32 @@ pub fn run_bake(
         Tool { name: program.name.to_string(), version: program.version.to_string() },
         config.parameters(),
     );
-    let manifest_path = out.join(MANIFEST);
-    let previous = read_previous(&manifest_path);
+    let folder = BakeFolder::lock(out)?;
+    let previous = folder.manifest();
     if !config.force
         && let Some(previous) = &previous
         && is_same_bake(previous, &manifest)
-        && all_files_match(previous, out)?
+        && folder.all_files_match(previous)?
     {
+        // Only the temporary files a killed run of ours left (none the manifest names) go.
+        folder.remove_temporaries()?;
         let problems = recorded_problems(previous);
         return Ok(BakeOutcome { manifest: previous.clone(), up_to_date: true, reports: Vec::new(), problems });
     }
 
-    // Both inputs are read before the folder is touched: a bake that cannot run leaves the
+    // Both inputs are decoded before anything is written: a bake that cannot run leaves the
     // previous one as it was.
-    let table = merl::read_file(&config.material).map_err(|e| Error::read(&config.material, e))?;
-    // The map is held through both environment stages: the larger of their needs per texel,
-    // under the budget less the layers.
-    let limits = envmap::Limits {
-        bytes_per_texel: env_bandwidth::BYTES_PER_TEXEL.max(prefilter::BYTES_PER_TEXEL),
-        ..prefilter::limits(&config.prefilter, config.env_bandwidth.max_memory)
-    };
+    let table = merl::MerlTable::parse(&material_bytes).map_err(|e| Error::read(&config.material, e))?;
+    drop(material_bytes);
     let map = config
         .environment
         .as_deref()
         .map(|path| envmap::load_with_limits(path, &limits).map_err(|e| Error::read(path, e)))
         .transpose()?;
 
-    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
-    // From here on the folder's files change: first make sure no manifest can name them.
-    match std::fs::remove_file(&manifest_path) {
-        Ok(()) => sync_dir(out)?,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => return Err(Error::write(&manifest_path, e)),
-    }
-    // Temporary files an interrupted bake left, for any file: the folder is the bake's.
-    asset::remove_temporaries(out, |_| true).map_err(|e| Error::write(out, e))?;
+    // Temporary files an interrupted bake left: the folder is locked, so none is being written.
+    folder.remove_temporaries()?;
+    let mut staging = asset::Staging::new(out);
 
     let stages = stage_names(config);
     let mut reports = Vec::new();
@@ -210,7 +222,7 @@ pub fn run_bake(
         next += 1;
     };
     let mut record = |staged: Staged, manifest: &mut BakeManifest| -> Result<(), Error> {
-        let mut stage = staged.write(out)?;
+        let mut stage = staged.stage(&mut staging)?;
         // The manifest keeps what validation found, so that a rerun that finds the bake up to
         // date reports (and exits with) the same.
         if !staged.problems.is_empty() {
@@ -260,21 +272,150 @@ pub fn run_bake(
         record(staged, &mut manifest)?;
     }
 
-    // Files the previous bake wrote and this one did not (e.g. a PCA no longer asked for).
-    if let Some(previous) = &previous {
-        for old in previous.outputs() {
-            if manifest.output_by_path(&old.path).is_none() {
-                let path = out.join(&old.path);
-                match std::fs::remove_file(&path) {
-                    Ok(()) => {}
-                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                    Err(e) => return Err(Error::write(&path, e)),
-                }
+    folder.switch(staging, previous.as_ref(), &manifest)?;
+    Ok(BakeOutcome { manifest, up_to_date: false, reports, problems })
+}
+
+/// Writes one stage's files (`staged`, made by `program` from `material`) into `dir` for a
+/// single-stage tool: into a plain folder as one set ([`Staged::write`]); into a bake folder (one
+/// with a manifest) as `brdf-bake` would have written that stage, through the bake's protocol
+/// ([`run_bake`]): the folder locked, the files and the updated manifest (the stage added or
+/// replaced in `brdf-bake`'s order of stages, the bake's parameter `parameter` set) written beside
+/// the old ones and switched in, the replaced stage's files that the new one does not write
+/// removed. The material must be the bake's (same SHA-256). Returns whether `dir` was a bake.
+pub fn write_stage(
+    dir: &Path,
+    staged: &Staged,
+    material: &Source,
+    parameter: (&str, serde_json::Value),
+) -> Result<bool, Error> {
+    let folder = BakeFolder::lock(dir)?;
+    let manifest_path = dir.join(MANIFEST);
+    let previous = match BakeManifest::read(&folder.folder) {
+        Ok(previous) => previous,
+        Err(asset::Error::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
+            staged.write_set(dir)?;
+            return Ok(false);
+        }
+        Err(e) => {
+            return Err(Error::read(
+                &manifest_path,
+                format!("{e}: a bake folder whose manifest this build cannot read: bake it again with brdf-bake"),
+            ));
+        }
+    };
+    if previous.material.source_sha256 != asset::hex(&material.sha256) {
+        return Err(Error::Invalid(format!(
+            "{} is a bake of {} (sha256 {}), not of {}: write into another folder, or bake this material with \
+             brdf-bake",
+            dir.display(),
+            previous.material.name,
+            previous.material.source_sha256,
+            material.path.display()
+        )));
+    }
+    let mut manifest = previous.clone();
+    manifest.manifest_version = asset::MANIFEST_VERSION;
+    manifest.parameters.insert(parameter.0.to_string(), parameter.1);
+    folder.remove_temporaries()?;
+    let mut staging = asset::Staging::new(dir);
+    let mut stage = staged.stage(&mut staging)?;
+    if !staged.problems.is_empty() {
+        stage.figures.insert("problems".into(), json!(staged.problems));
+    }
+    let order = |name: &str| STAGE_ORDER.iter().position(|n| *n == name).unwrap_or(STAGE_ORDER.len());
+    manifest.stages.retain(|s| s.name != stage.name);
+    let at = manifest.stages.iter().position(|s| order(&s.name) > order(&stage.name)).unwrap_or(manifest.stages.len());
+    manifest.stages.insert(at, stage);
+    folder.switch(staging, Some(&previous), &manifest)?;
+    Ok(true)
+}
+
+/// The stages' names (`Staged::name`) in the order `run_bake` runs them.
+const STAGE_ORDER: [&str; 7] = [
+    "importance",
+    "bandwidth-atlas",
+    "bandwidth-pca",
+    "wavelet-brdf",
+    "environment-bandwidth",
+    "prefilter",
+    "layer-selection",
+];
+
+/// A bake's folder held by one writer: created if it was missing (the folder itself, never a
+/// chain of parents) and locked (`flock(2)` on the folder) for as long as this value lives.
+struct BakeFolder {
+    folder: fsguard::Folder,
+}
+
+impl BakeFolder {
+    fn lock(dir: &Path) -> Result<BakeFolder, Error> {
+        let folder = fsguard::Folder::create(dir).map_err(|e| Error::write(dir, e))?;
+        if !folder.try_lock().map_err(|e| Error::write(dir, e))? {
+            return Err(Error::Busy(dir.to_path_buf()));
+        }
+        Ok(BakeFolder { folder })
+    }
+
+    /// The folder's manifest, if there is one this build can read; anything else (none, a link, a
+    /// FIFO, a damaged or hostile manifest) is treated as no manifest: the bake then runs and
+    /// replaces it, and removes none of the files it named.
+    fn manifest(&self) -> Option<BakeManifest> {
+        BakeManifest::read(&self.folder).ok()
+    }
+
+    /// Whether every file `manifest` names is the one it describes (a link, a FIFO or a device is
+    /// not; none is followed or read).
+    fn all_files_match(&self, manifest: &BakeManifest) -> Result<bool, Error> {
+        for output in manifest.outputs() {
+            let path = self.folder.join(&output.path);
+            if !output.matches_file(&self.folder).map_err(|e| Error::read(&path, e))? {
+                return Ok(false);
             }
         }
+        Ok(true)
     }
-    asset::write_atomic(&manifest_path, manifest.to_json().as_bytes()).map_err(|e| Error::write(&manifest_path, e))?;
-    Ok(BakeOutcome { manifest, up_to_date: false, reports, problems })
+
+    /// Removes the temporary files an interrupted bake or tool left for the files a bake writes
+    /// and for the manifest (`.NAME.XXXXXX.tmp`, regular files only).
+    fn remove_temporaries(&self) -> Result<(), Error> {
+        let ours = |target: &str| target == MANIFEST || crate::stage::is_output_name(target);
+        asset::remove_temporaries(self.folder.path(), ours).map_err(|e| Error::write(self.folder.path(), e))?;
+        Ok(())
+    }
+
+    /// The switch (step 4 of [`run_bake`]): `staging` holds the new files; the manifest is added
+    /// as the set's index and everything is renamed into place, the previous bake's files that
+    /// the new manifest does not list removed just before the manifest lands.
+    fn switch(
+        &self,
+        mut staging: asset::Staging,
+        previous: Option<&BakeManifest>,
+        manifest: &BakeManifest,
+    ) -> Result<(), Error> {
+        let dir = self.folder.path();
+        // Decided before the switch: only files some stage writes, still as described.
+        let obsolete: Vec<&str> = previous
+            .into_iter()
+            .flat_map(BakeManifest::outputs)
+            .filter(|old| manifest.output_by_path(&old.path).is_none() && crate::stage::is_output_name(&old.path))
+            .filter(|old| old.matches_file(&self.folder).unwrap_or(false))
+            .map(|old| old.path.as_str())
+            .collect();
+        staging.add(MANIFEST, manifest.to_json().as_bytes()).map_err(|(path, e)| Error::write(&path, e))?;
+        staging
+            .commit(|| {
+                for name in &obsolete {
+                    match self.folder.remove_file(name) {
+                        Ok(()) => {}
+                        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                        Err(e) => return Err((dir.join(name), e)),
+                    }
+                }
+                Ok(())
+            })
+            .map_err(|(path, e)| Error::write(&path, e))
+    }
 }
 
 /// The problems the stages of a manifest recorded (`figures.problems`), as `run_bake` reports
@@ -313,13 +454,6 @@ fn source_file(source: &Source) -> SourceFile {
     }
 }
 
-/// The folder's manifest, if there is one this build can read; anything else is treated as no
-/// manifest (the bake then runs and replaces it).
-fn read_previous(path: &Path) -> Option<BakeManifest> {
-    let text = std::fs::read_to_string(path).ok()?;
-    BakeManifest::from_json(&text).ok()
-}
-
 /// Same tool and version, same inputs (by hash), same parameters.
 fn is_same_bake(previous: &BakeManifest, next: &BakeManifest) -> bool {
     let hashes =
@@ -328,20 +462,4 @@ fn is_same_bake(previous: &BakeManifest, next: &BakeManifest) -> bool {
         && previous.tool == next.tool
         && hashes(previous) == hashes(next)
         && previous.parameters == next.parameters
-}
-
-fn all_files_match(manifest: &BakeManifest, dir: &Path) -> Result<bool, Error> {
-    for output in manifest.outputs() {
-        if !output.matches_file(dir).map_err(|e| Error::read(&dir.join(&output.path), e))? {
-            return Ok(false);
-        }
-    }
-    Ok(true)
-}
-
-/// Makes a removal durable before files are replaced (Unix; a no-op elsewhere).
-fn sync_dir(dir: &Path) -> Result<(), Error> {
-    #[cfg(unix)]
-    std::fs::File::open(dir).and_then(|f| f.sync_all()).map_err(|e| Error::write(dir, e))?;
-    Ok(())
 }

@@ -26,9 +26,12 @@ pub const PANEL_WIDTH: usize = 1024;
 /// Pictures per row.
 pub const COLUMNS: usize = 2;
 
-/// The sheet of the bake whose manifest is `manifest`, its files in `dir`. Errors name the file
-/// that could not be read or decoded.
+/// The sheet of the bake whose manifest is `manifest`, its files in `dir`. Each picture is read
+/// inside the folder without following a link and only when it is the file the manifest
+/// describes (size and SHA-256: `asset::StageOutput::read`). Errors name the file that could not
+/// be read or decoded.
 pub fn contact_sheet(dir: &Path, manifest: &BakeManifest) -> Result<Canvas, Error> {
+    let folder = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
     let mut grid = Grid::new(COLUMNS);
     let title = match &manifest.environment {
         Some(environment) => format!("bake of {} under {}", manifest.material.name, environment.name),
@@ -39,17 +42,17 @@ pub fn contact_sheet(dir: &Path, manifest: &BakeManifest) -> Result<Canvas, Erro
         let outputs = manifest.stages.iter().flat_map(|s| &s.outputs);
         for output in outputs.filter(|o| o.format == FileFormat::Png && o.role == role) {
             let path = dir.join(&output.path);
-            let picture = read_png(&path)?;
+            let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
+            let picture = read_png(&path, &bytes)?;
             grid.add(fit(&picture, PANEL_WIDTH), format!("{what} ({})", output.path));
         }
     }
     Ok(grid.render())
 }
 
-/// A PNG file as an RGB canvas (grey and alpha converted).
-fn read_png(path: &Path) -> Result<Canvas, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
-    let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+/// A PNG file's bytes as an RGB canvas (grey and alpha converted); `path` names it in errors.
+fn read_png(path: &Path, bytes: &[u8]) -> Result<Canvas, Error> {
+    let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
         .map_err(|e| Error::read(path, e))?
         .to_rgb8();
     let (width, height) = (image.width() as usize, image.height() as usize);

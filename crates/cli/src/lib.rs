@@ -104,6 +104,46 @@ macro_rules! outln {
     ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
 }
 
+/// Runs `f` with the process's standard error sent to a temporary file, then prints what was
+/// written there except the lines `spurious` accepts, in order: for libraries that print a
+/// message of their own on a path that succeeds. (Mesa's Vulkan device-selection layer asks for a
+/// Wayland display while adapters are enumerated, and libwayland prints `error: XDG_RUNTIME_DIR is
+/// invalid or not set in the environment.` when there is none: a headless render needs none, and
+/// a script that looks for `error:` would take it for a failure.) Standard error is restored even
+/// if `f` panics; where it cannot be redirected, `f` runs as it is.
+pub fn without_stderr_lines<T>(spurious: impl Fn(&str) -> bool, f: impl FnOnce() -> T) -> T {
+    use std::io::{Read, Seek};
+    /// Puts the original standard error back when dropped.
+    struct Restore(std::os::fd::OwnedFd);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let _ = std::io::stderr().flush();
+            let _ = rustix::stdio::dup2_stderr(&self.0);
+        }
+    }
+    let redirected = tempfile::tempfile().and_then(|capture| {
+        let saved = rustix::io::dup(std::io::stderr())?;
+        let _ = std::io::stderr().flush();
+        rustix::stdio::dup2_stderr(&capture)?;
+        Ok((capture, Restore(saved)))
+    });
+    let Ok((mut capture, restore)) = redirected else { return f() };
+    let result = f();
+    drop(restore);
+    let mut text = String::new();
+    if capture.rewind().and_then(|()| capture.read_to_string(&mut text)).is_ok() {
+        for line in text.lines().filter(|line| !spurious(line)) {
+            eprintln!("{line}");
+        }
+    }
+    result
+}
+
+/// libwayland's complaint that there is no Wayland session (see [`without_stderr_lines`]).
+pub fn is_wayland_session_warning(line: &str) -> bool {
+    line.starts_with("error: XDG_RUNTIME_DIR") && line.contains("not set in the environment")
+}
+
 /// Parses a `WIDTHxHEIGHT` argument (`x` or `X`), as clap's `value_parser` wants it. Sizes are
 /// checked by whoever uses them; this only reads the two numbers.
 pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
@@ -116,9 +156,31 @@ pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
 /// whole number from 1 up. Tools set `allow_negative_numbers` on their commands, so `-1`
 /// reaches this parser and the message says what the option accepts.
 pub fn parse_count(text: &str) -> Result<usize, String> {
+    parse_whole(text, 1)
+}
+
+/// Parses a whole number from `min` up (as [`parse_count`] does from 1).
+pub fn parse_whole(text: &str, min: usize) -> Result<usize, String> {
     match text.trim().parse::<usize>() {
+        Ok(n) if n >= min => Ok(n),
+        _ => Err(format!("expected a whole number from {min} up")),
+    }
+}
+
+/// [`parse_count`] for options held in a `u32`: a whole number from 1 to 4294967295.
+pub fn parse_count_u32(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
         Ok(n) if n >= 1 => Ok(n),
-        _ => Err("expected a whole number from 1 up".to_string()),
+        _ => Err("expected a whole number from 1 to 4294967295".to_string()),
+    }
+}
+
+/// Parses a finite number within `min..=max` (an option where NaN or an infinity makes no sense);
+/// the error gives the range.
+pub fn parse_finite(text: &str, min: f64, max: f64) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && (min..=max).contains(&v) => Ok(v),
+        _ => Err(format!("expected a number from {min} to {max}")),
     }
 }
 
@@ -222,7 +284,15 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::{lower_case_start, parse_bytes, parse_count, parse_size, usage_error};
+    use super::{is_wayland_session_warning, lower_case_start, parse_bytes, parse_count, parse_size, usage_error};
+
+    #[test]
+    fn only_the_wayland_session_warning_is_spurious() {
+        assert!(is_wayland_session_warning("error: XDG_RUNTIME_DIR is invalid or not set in the environment."));
+        assert!(is_wayland_session_warning("error: XDG_RUNTIME_DIR not set in the environment."));
+        assert!(!is_wayland_session_warning("error: reading x: no such file or directory"));
+        assert!(!is_wayland_session_warning("warning: XDG_RUNTIME_DIR is invalid or not set in the environment."));
+    }
 
     /// clap's messages of several lines (a list of missing arguments, a tip) become one, without
     /// the usage; what clap says stays.
@@ -273,6 +343,14 @@ mod tests {
 
     #[test]
     fn counts_and_memory_sizes_parse() {
+        assert_eq!(super::parse_count_u32("4294967295"), Ok(u32::MAX));
+        for bad in ["0", "-1", "4294967296", "nan"] {
+            assert!(super::parse_count_u32(bad).is_err(), "{bad}");
+        }
+        assert_eq!(super::parse_finite("-2.5", -64.0, 64.0), Ok(-2.5));
+        for bad in ["nan", "NaN", "inf", "-inf", "65", "x", "1e400"] {
+            assert_eq!(super::parse_finite(bad, -64.0, 64.0), Err("expected a number from -64 to 64".to_string()));
+        }
         assert_eq!(parse_count("3"), Ok(3));
         for bad in ["0", "-1", "2.5", "x", ""] {
             assert!(parse_count(bad).is_err(), "{bad}");

@@ -122,16 +122,17 @@ pub fn load(path: &Path) -> Result<EnvMap, Error> {
 
 /// Loads a lat-long environment map from an OpenEXR or Radiance HDR file (the first bytes decide)
 /// and checks that it is one: non-empty, within `limits`, `width == 2 * height` (all three from
-/// the header, before decoding), and every value finite and non-negative.
+/// the header, before decoding), and every value finite and non-negative. Only a regular file is
+/// read: a FIFO or a device is refused without blocking ([`fsguard::open_regular`]).
 pub fn load_with_limits(path: &Path, limits: &Limits) -> Result<EnvMap, Error> {
-    let image = decode(BufReader::new(std::fs::File::open(path)?), limits, check_latlong_shape)?;
+    let image = decode(BufReader::new(fsguard::open_regular(path)?), limits, check_latlong_shape)?;
     Ok(EnvMap::from_checked(image.width, image.height, image.rgb))
 }
 
 /// Reads an OpenEXR or Radiance HDR image of any shape: the checks of [`load_with_limits`] except
 /// the 2:1 shape.
 pub fn read_image(path: &Path, limits: &Limits) -> Result<HdrImage, Error> {
-    decode(BufReader::new(std::fs::File::open(path)?), limits, check_not_empty)
+    decode(BufReader::new(fsguard::open_regular(path)?), limits, check_not_empty)
 }
 
 /// [`load_with_limits`] from bytes in memory.

@@ -13,6 +13,12 @@
 //! - [`envmap_exr`] and [`envmap_hdr`] run [`envmap::read_image_from_memory`] and
 //!   [`envmap::load_from_memory`] with [`env_limits`] (1024 x 512), on inputs that start with the
 //!   format's magic (`76 2f 31 01`, `#?`): two targets, so that each format gets its own inputs.
+//! - [`manifest()`] runs [`asset::BakeManifest::from_bytes`] (the size limit, UTF-8, JSON, both
+//!   versions and the path rules), and on a manifest it accepts what the readers do next: every
+//!   output's role and path looked up again, and a version-2 manifest written back and read to the
+//!   same value.
+//! - [`obj`] runs [`render::Mesh::from_obj`] on inputs that are UTF-8 text (what `brdf-preview
+//!   --mesh` reads after its size check), and checks what it accepts ([`render::Mesh::validate`]).
 //!
 //! # The memory bound
 //!
@@ -106,8 +112,14 @@ pub type Harness = fn(&[u8]);
 /// The harnesses by target name, in the order of `fuzz/Cargo.toml`: the replay runs the files
 /// of `fuzz/regressions/<name>/` and `fuzz/corpus/<name>/`, and those every target shares
 /// (`fixtures/`, `../shared/data/hostile/`), through the function named here.
-pub const HARNESSES: [(&str, Harness); 4] =
-    [("merl", merl), ("asset", asset), ("envmap_exr", envmap_exr), ("envmap_hdr", envmap_hdr)];
+pub const HARNESSES: [(&str, Harness); 6] = [
+    ("merl", merl),
+    ("asset", asset),
+    ("envmap_exr", envmap_exr),
+    ("envmap_hdr", envmap_hdr),
+    ("manifest", manifest),
+    ("obj", obj),
+];
 
 /// A MERL table from memory.
 pub fn merl(bytes: &[u8]) {
@@ -212,4 +224,28 @@ fn read_env(bytes: &[u8]) {
     let limits = env_limits();
     let _ = envmap::read_image_from_memory(bytes, &limits);
     let _ = envmap::load_from_memory(bytes, &limits);
+}
+
+/// A bake manifest from memory, as the bake and the previewer read one (see the crate docs). A
+/// manifest that reads but does not survive being written and read again, or whose paths the
+/// folder reader would not take, is a finding (a panic).
+pub fn manifest(bytes: &[u8]) {
+    let Ok(manifest) = asset::BakeManifest::from_bytes(bytes) else { return };
+    for output in manifest.outputs() {
+        assert!(fsguard::check_relative(&output.path).is_ok(), "a manifest read with path {:?}", output.path);
+        assert!(manifest.output(&output.role).is_some() && manifest.output_by_path(&output.path).is_some());
+    }
+    if manifest.manifest_version == asset::MANIFEST_VERSION {
+        let again = asset::BakeManifest::from_json(&manifest.to_json()).expect("a manifest written back reads");
+        assert_eq!(again, manifest, "a manifest written back reads as itself");
+    }
+}
+
+/// A Wavefront OBJ file from memory (UTF-8 text only, as `brdf-preview --mesh` reads it): what the
+/// reader accepts must be a consistent mesh.
+pub fn obj(bytes: &[u8]) {
+    let Ok(text) = std::str::from_utf8(bytes) else { return };
+    if let Ok(mesh) = render::Mesh::from_obj(text) {
+        mesh.validate().expect("a mesh the reader accepts is consistent");
+    }
 }

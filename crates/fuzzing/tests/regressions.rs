@@ -135,6 +135,16 @@ fn envmap_hdr() {
     replay("envmap_hdr");
 }
 
+#[test]
+fn manifest() {
+    replay("manifest");
+}
+
+#[test]
+fn obj() {
+    replay("obj");
+}
+
 /// The largest inputs a reader accepts keep the bound too: the real maps (at the harnesses'
 /// limits, the size they are) and a MERL table of full size (no fuzzer input is that large).
 #[test]

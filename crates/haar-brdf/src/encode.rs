@@ -120,10 +120,15 @@ pub enum Keep {
     Threshold(f64),
 }
 
-/// Refuses a log-encoding bias that is not a positive number.
+/// Refuses a log-encoding bias outside [`asset::WAVELET_EPSILON_RANGE`] (what an asset may hold).
 pub(crate) fn check_epsilon(epsilon: f64) -> Result<(), Error> {
-    if !(epsilon.is_finite() && epsilon > 0.0) {
-        return Err(Error::Invalid(format!("the log encoding's epsilon must be a positive number, found {epsilon}")));
+    let range = asset::WAVELET_EPSILON_RANGE;
+    if !range.contains(&epsilon) {
+        return Err(Error::Invalid(format!(
+            "the log encoding's epsilon must be a number from {:e} to {}, found {epsilon:?}",
+            range.start(),
+            range.end()
+        )));
     }
     Ok(())
 }

@@ -279,6 +279,23 @@ fn a_lambertian_material_evaluates_exactly_between_cells() {
     }
 }
 
+/// Stored coefficients are held to what log-encoded values of at most 64 in magnitude can give
+/// (`asset::WAVELET_LOG_BOUND` times the side): 1e30 decoded to "relative error inf".
+#[test]
+fn absurd_coefficients_are_refused() {
+    let table = resampled(4, LEWIS);
+    let good = encode(&table, Config { keep: Keep::Ratio(4), ..Config::default() }).unwrap().payload;
+    assert!(WaveletBrdf::from_payload(&good).is_ok());
+    let bound = (asset::WAVELET_LOG_BOUND * f64::from(good.side)) as f32;
+    for (value, accepted) in [(bound, true), (-bound, true), (1.001 * bound, false), (1e30, false), (f32::NAN, false)] {
+        let mut payload = good.clone();
+        let asset::WaveletCoefficients::Float(values) = &mut payload.coefficients else { panic!("not floats") };
+        values[0] = value;
+        let result = WaveletBrdf::from_payload(&payload);
+        assert_eq!(result.is_ok(), accepted, "{value}: {:?}", result.err().map(|e| e.to_string()));
+    }
+}
+
 #[test]
 fn damaged_payloads_are_refused_with_their_problem() {
     let table = resampled(4, LEWIS);
@@ -288,7 +305,27 @@ fn damaged_payloads_are_refused_with_their_problem() {
     let cases: Vec<(&str, Damage)> = vec![
         ("side", Box::new(|p| p.side = 6)),
         ("epsilon", Box::new(|p| p.epsilon = f64::NAN)),
+        // Values that decode but are no BRDF (they rendered black, or "relative error inf").
+        ("epsilon", Box::new(|p| p.epsilon = 1e308)),
+        ("epsilon", Box::new(|p| p.epsilon = 2.0)),
         ("channel means", Box::new(|p| p.channel_mean[1] = 0.0)),
+        ("channel means", Box::new(|p| p.channel_mean[1] = 1e30)),
+        (
+            "within",
+            Box::new(|p| {
+                if let asset::WaveletCoefficients::Quantized { step, .. } = &mut p.coefficients {
+                    step[0] = 3e38;
+                }
+            }),
+        ),
+        (
+            "within",
+            Box::new(|p| {
+                if let asset::WaveletCoefficients::Quantized { offset, .. } = &mut p.coefficients {
+                    offset[1] = -1e30;
+                }
+            }),
+        ),
         ("map has", Box::new(|p| p.map.truncate(3))),
         (
             "expected 0 or",

@@ -18,7 +18,7 @@ pub mod table;
 
 pub use coords::{HalfDiff, half_diff, spherical_dir};
 pub use error::Error;
-pub use io::read_file;
+pub use io::{MAX_FILE_BYTES, read_bytes, read_file};
 pub use table::{Cell, Dims, Interp, MerlTable, NO_DATA_RAW, SCALE};
 
 /// Rec. 709 luminance of a linear RGB triple, the one used wherever a scalar is needed.

@@ -51,12 +51,12 @@ impl Dims {
     }
 
     /// Cells per channel.
-    pub fn cells(&self) -> usize {
+    pub const fn cells(&self) -> usize {
         self.n_theta_h * self.n_theta_d * self.n_phi_d
     }
 
     /// Size of a file of these dimensions.
-    pub fn file_bytes(&self) -> u64 {
+    pub const fn file_bytes(&self) -> u64 {
         HEADER_BYTES as u64 + 3 * 8 * self.cells() as u64
     }
 
@@ -302,11 +302,40 @@ impl MerlTable {
 
 /// Reads the three header integers; fails on a short header.
 pub fn parse_header(bytes: &[u8]) -> Result<[i32; 3], Error> {
+    if let Some(format) = other_format(bytes) {
+        return Err(Error::Invalid(format!(
+            "not a MERL table: this is {format} (a MERL .binary table starts with its dimensions, 90 90 180, as \
+             32-bit integers)"
+        )));
+    }
     if bytes.len() < HEADER_BYTES {
         return Err(Error::Invalid(format!("truncated header: expected {HEADER_BYTES} bytes, found {}", bytes.len())));
     }
     let int = |i: usize| i32::from_le_bytes(bytes[4 * i..4 * i + 4].try_into().expect("4 bytes"));
     Ok([int(0), int(1), int(2)])
+}
+
+/// The kind of file `bytes` start like, among those a person may give for a table by mistake
+/// (the toolchain's own formats and common pictures); `None` for anything else. No MERL header
+/// starts like any of them.
+pub fn other_format(bytes: &[u8]) -> Option<&'static str> {
+    const MAGICS: [(&[u8], &str); 9] = [
+        (b"\x89PNG\r\n\x1a\n", "a PNG image"),
+        (&[0x76, 0x2f, 0x31, 0x01], "an OpenEXR image"),
+        (b"#?", "a Radiance HDR image"),
+        (b"BRDFASET", "an asset of this toolchain (asset-info shows what it holds)"),
+        (b"\xabKTX 20\xbb\r\n\x1a\n", "a KTX2 texture"),
+        (&[0xff, 0xd8, 0xff], "a JPEG image"),
+        (b"GIF8", "a GIF image"),
+        (&[0x1f, 0x8b], "a gzip archive (decompress it first)"),
+        (b"PK\x03\x04", "a zip archive (extract it first)"),
+    ];
+    let text = bytes.iter().find(|b| !b.is_ascii_whitespace()).is_some_and(|&b| b == b'{' || b == b'[');
+    MAGICS
+        .iter()
+        .find(|(magic, _)| bytes.starts_with(magic))
+        .map(|(_, name)| *name)
+        .or(text.then_some("JSON text (a bake's manifest.json names its table in material.source_path)"))
 }
 
 /// Checks that the size of a file agrees with its header.
@@ -343,6 +372,25 @@ mod tests {
             assert!(m.starts_with(&format!("not a MERL table: {detail}")), "{m}");
         }
         assert_eq!(Dims::from_header([90, 90, 360]).unwrap(), Dims::MERL_FULL_PHI);
+    }
+
+    /// A file of another known kind says what it is instead of quoting a header no table has.
+    #[test]
+    fn other_formats_are_named() {
+        let png = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
+        let message = parse_header(png).unwrap_err().to_string();
+        assert!(message.starts_with("not a MERL table: this is a PNG image"), "{message}");
+        for (bytes, name) in [
+            (&b"BRDFASET\x01\0\0\0"[..], "an asset"),
+            (b"#?RADIANCE\n", "a Radiance HDR image"),
+            (&[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 0, 0, 0, 0], "an OpenEXR image"),
+            (b"  {\"manifest_version\": 2}", "JSON text"),
+        ] {
+            let message = MerlTable::parse(bytes).unwrap_err().to_string();
+            assert!(message.contains(name), "{message}");
+        }
+        let table = MerlTable::from_raw(Dims::MERL, vec![0.5; 3 * Dims::MERL.cells()]).unwrap().to_bytes();
+        assert_eq!(other_format(&table), None);
     }
 
     #[test]

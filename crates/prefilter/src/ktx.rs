@@ -295,11 +295,16 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         Some(ktx2::Format::R32G32B32A32_SFLOAT) => TexelFormat::Rgba32f,
         other => return Err(format!("expected an rgba16f or rgba32f texture, found {other:?}")),
     };
-    if header.pixel_depth > 1 || !(header.face_count == 1 || header.face_count == 6) {
+    // pixelDepth 0 is a 2D texture; 1 and more a 3D one, whose levels hold depth slices.
+    if header.pixel_depth != 0 || !(header.face_count == 1 || header.face_count == 6) {
         return Err(format!(
             "expected a 2d texture or cube map, found depth {} and {} faces",
             header.pixel_depth, header.face_count
         ));
+    }
+    // Supercompressed levels (BasisLZ, Zstandard, ZLIB) are not texels: refused, never read raw.
+    if let Some(scheme) = header.supercompression_scheme {
+        return Err(format!("expected no supercompression, found scheme {}", scheme.value()));
     }
     let shape = Shape {
         width: header.pixel_width as usize,

@@ -224,3 +224,23 @@ fn a_header_whose_size_wraps_is_refused() {
     let error = ktx::decode(&bytes).unwrap_err();
     assert!(error.contains("larger than any file") || error.contains("not a ktx2 file"), "{error}");
 }
+
+/// A file of our format but with a depth (a 3D texture, even of depth 1) or supercompressed levels
+/// is refused: its levels are not the raw 2D texels the reader would take them for.
+#[test]
+fn depth_and_supercompression_are_refused() {
+    let rgb = [0.5f32; 3 * 4 * 2];
+    let shape = Shape { width: 4, height: 2, layers: 0, faces: 1 };
+    let bytes = ktx::encode(shape, &[vec![&rgb[..]]], Storage::Auto, "test").unwrap().bytes;
+    // Header: pixelDepth at 28, supercompressionScheme at 44 (KTX2 specification).
+    for (at, value, expected) in [
+        (28, 1u32, "found depth 1"),
+        (44, 2, "expected no supercompression, found scheme 2"),
+        (44, 1, "found scheme 1"),
+    ] {
+        let mut damaged = bytes.clone();
+        damaged[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        let error = ktx::decode(&damaged).unwrap_err();
+        assert!(error.contains(expected), "{at} = {value}: {error}");
+    }
+}

@@ -28,15 +28,16 @@ struct Args {
     /// bandwidth-atlas).
     atlas: PathBuf,
 
-    /// The folder to write into (created if missing).
+    /// The folder to write into (created if missing: the folder itself, its parent must exist).
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Keep exactly K components.
+    /// Keep exactly K components, 1 to the texels of a tile (256 for 16 x 16 tiles).
     #[arg(long, value_name = "K", value_parser = cli::parse_count)]
     components: Option<usize>,
 
-    /// Keep the fewest components whose relative RMSE is at most E (e.g. 0.02).
+    /// Keep the fewest components whose relative RMSE is at most E, a finite number from 0 (e.g.
+    /// 0.02).
     #[arg(long = "max-error", value_name = "E")]
     max_error: Option<f64>,
 
@@ -53,7 +54,10 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    let bytes = std::fs::read(&args.atlas).with_context(|| format!("reading {}", args.atlas.display()))?;
+    // A regular file only, within the largest asset a reader accepts, read once: the bytes hashed
+    // for the provenance are the bytes decoded.
+    let bytes = fsguard::read_regular(&args.atlas, asset::OUTPUT_LIMIT)
+        .with_context(|| format!("reading {}", args.atlas.display()))?;
     let atlas = read_atlas(&bytes).with_context(|| format!("reading {}", args.atlas.display()))?;
     let components = match (args.components, args.max_error) {
         (Some(k), _) => Components::Count(k),

@@ -37,17 +37,20 @@ struct Args {
     #[arg(long, value_name = "ENV")]
     env: Option<PathBuf>,
 
-    /// The folder to bake into (created if missing).
+    /// The folder to bake into (created if missing: the folder itself, its parent must exist). One
+    /// bake at a time holds a folder: a second brdf-bake (or a single-stage tool) started on it
+    /// meanwhile exits 2 at once, naming it.
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
     /// Also compress the bandwidth atlas by PCA, with the fewest components whose relative RMSE
-    /// is at most E (e.g. 0.02).
+    /// is at most E, in (0, 1) (e.g. 0.02).
     #[arg(long, value_name = "E")]
     pca_max_error: Option<f64>,
 
     /// Also encode the material in Haar wavelets (as brdf-wavelet does, on its default (32 x 32)^2
-    /// grid), keeping 1/R of the coefficients (4, 16 and 32 are the paper's Table 1).
+    /// grid), keeping 1/R of the coefficients: a power of two up to 1024 (4, 16 and 32 are the
+    /// paper's Table 1).
     #[arg(long, value_name = "R", value_parser = cli::parse_count)]
     wavelet_ratio: Option<usize>,
 
@@ -57,11 +60,11 @@ struct Args {
 
     /// Vectors of importance samples per view elevation (each of --samples samples): the
     /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
-    /// needs tens of vectors for percent-level agreement).
+    /// needs tens of vectors for percent-level agreement). From 1 to 1024.
     #[arg(long, value_name = "V", default_value_t = importance::Config::default().n_vectors, value_parser = cli::parse_count)]
     vectors: usize,
 
-    /// Importance samples per vector (a power of two).
+    /// Importance samples per vector (a power of two from 1 to 1048576).
     #[arg(long, value_name = "N", default_value_t = importance::Config::default().n_samples, value_parser = cli::parse_count)]
     samples: usize,
 
@@ -82,9 +85,9 @@ struct Args {
     #[arg(long, requires = "env")]
     chain: bool,
 
-    /// Also write the environment's GGX chain of M levels and the split-sum DFG table (ggx.ktx2,
-    /// dfg.ktx2, dfg.png; see envmap-prefilter --help).
-    #[arg(long, value_name = "M", requires = "env")]
+    /// Also write the environment's GGX chain of M levels, from 2 to 7, and the split-sum DFG table
+    /// (ggx.ktx2, dfg.ktx2, dfg.png; see envmap-prefilter --help).
+    #[arg(long, value_name = "M", value_parser = |s: &str| cli::parse_whole(s, 2), requires = "env")]
     ggx_levels: Option<usize>,
 
     /// How the environment's bandwidth compares wavelet levels (see envmap-bandwidth --help):
@@ -101,8 +104,9 @@ struct Args {
     #[arg(long)]
     force: bool,
 
-    /// Memory budget of the environment stages (4G, 512M, ...): a map whose estimated need (80
-    /// bytes per texel, plus the layers) is larger is refused from its header, before decoding.
+    /// Memory budget of the environment stages (4G, 512M, ...; from 1 byte to 16 EiB, more than the
+    /// layers alone need): a map whose estimated need (80 bytes per texel, plus the layers) is
+    /// larger is refused from its header, before decoding.
     #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
     max_memory: u64,
 
@@ -126,7 +130,7 @@ fn run(args: Args) -> Result<ExitCode> {
     if let Some(e) = args.pca_max_error
         && !(e > 0.0 && e < 1.0)
     {
-        anyhow::bail!("--pca-max-error {e} is not in (0, 1)");
+        anyhow::bail!("--pca-max-error {e:?} is not in (0, 1)");
     }
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;

@@ -29,20 +29,20 @@ struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
 
-    /// The folder to write into (created if missing).
+    /// The folder to write into (created if missing: the folder itself, its parent must exist).
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Incident directions per side of the grid.
+    /// Incident directions per side of the grid, 1 to 4096.
     #[arg(long, value_name = "N", default_value_t = Config::default().lobes, value_parser = cli::parse_count)]
     lobes: usize,
 
-    /// Texels per side of each lobe's tile (a power of two).
+    /// Texels per side of each lobe's tile (a power of two, at most --analysis-size).
     #[arg(long, value_name = "T", default_value_t = Config::default().tile, value_parser = cli::parse_count)]
     tile: usize,
 
-    /// Pixels per side of the image each lobe is analysed on (a power of two from 16, >= the
-    /// tile); the highest bandwidth it resolves grows with it.
+    /// Pixels per side of the image each lobe is analysed on (a power of two from 16 to 4096,
+    /// >= the tile); the highest bandwidth it resolves grows with it.
     #[arg(long = "analysis-size", value_name = "N", default_value_t = Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 

@@ -83,14 +83,15 @@ struct Args {
     #[arg(long, value_enum, default_value_t = BrdfArg::Table)]
     brdf: BrdfArg,
 
-    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default:
-    /// BAKE/wavelet-brdf.asset (brdf-wavelet MATERIAL --out-dir BAKE writes it there).
+    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default: the
+    /// bake's own (its manifest's wavelet-brdf output, which brdf-wavelet MATERIAL --out-dir BAKE
+    /// and brdf-bake --wavelet-ratio R add).
     #[arg(long, value_name = "FILE")]
     wavelet: Option<PathBuf>,
 
     /// Level of detail of the wavelet reconstruction, from 0 (full resolution) to log2 of the
-    /// grid side (the hemisphere's mean); fractions blend two levels.
-    #[arg(long, value_name = "L", default_value_t = 0.0)]
+    /// grid side (the hemisphere's mean, at most 8); fractions blend two levels.
+    #[arg(long, value_name = "L", default_value_t = 0.0, value_parser = parse_lod)]
     wavelet_lod: f64,
 
     /// The mesh: sphere, torus, or a Wavefront OBJ file (scaled to the unit sphere).
@@ -101,20 +102,21 @@ struct Args {
     #[arg(long, value_enum, default_value_t = ModeArg::Reference)]
     mode: ModeArg,
 
-    /// Samples per pixel and frame: a power of two up to the bake's samples per vector (256 by
-    /// default); in reference, fis and prefiltered each sample is a direction drawn from the
+    /// Samples per pixel and frame: a power of two from 1 up to the bake's samples per vector (256
+    /// by default); in reference, fis and prefiltered each sample is a direction drawn from the
     /// material's tables and, where the mode samples a light, one drawn from the light. Default:
     /// 64 for reference, 16 for fis and prefiltered. For the adaptive modes, the frame's budget in
     /// mean samples per covered pixel (any number from 1; default 8 for adaptive, 4 for
-    /// adaptive-prefiltered).
-    #[arg(long, value_name = "N")]
+    /// adaptive-prefiltered). Within --max-samples.
+    #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     spp: Option<u32>,
 
-    /// Frames averaged; each pixel's frames walk through its own sequence of points (render crate
-    /// docs, "Samples"). Default: for reference, as many as the bake's vectors hold samples at
-    /// this spp (32 at 64 spp with the default bake: 2048 directions of each strategy); 8 for fis
-    /// and prefiltered (more frames average their noise away, not their bias).
-    #[arg(long, value_name = "N")]
+    /// Frames averaged, from 1; each pixel's frames walk through its own sequence of points (render
+    /// crate docs, "Samples"). Default: for reference, as many as the bake's vectors hold samples
+    /// at this spp (32 at 64 spp with the default bake: 2048 directions of each strategy); 8 for
+    /// fis and prefiltered (more frames average their noise away, not their bias). Within
+    /// --max-samples.
+    #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     frames: Option<u32>,
 
     /// Adaptive modes: anti-aliasing by extra pyramid levels, 1, 4 or 16 render pixels per output
@@ -122,8 +124,9 @@ struct Args {
     #[arg(long, value_name = "1|4|16", default_value_t = 1, value_parser = parse_aa)]
     aa: usize,
 
-    /// Adaptive modes: one prediction per block of 2^L x 2^L pixels (0: every pixel, as the
-    /// paper; 2, the default, costs a sixteenth: cargo bench -p brdf-preview --bench adaptive).
+    /// Adaptive modes: one prediction per block of 2^L x 2^L pixels, L from 0 (every pixel, as the
+    /// paper; 2, the default, costs a sixteenth: cargo bench -p brdf-preview --bench adaptive); a
+    /// level above the pyramid's top predicts at the top.
     #[arg(long, value_name = "L", default_value_t = 2)]
     predict_level: usize,
 
@@ -141,7 +144,7 @@ struct Args {
     lobe_weight: bool,
 
     /// adaptive-prefiltered: the shaded blocks read the Phong layer N layers sharper than the one
-    /// the bake picks for the view (each a lobe half as wide; the sharpest at most). The bake's
+    /// the bake picks for the view (each a lobe half as wide; the sharpest at most), N from 0. The bake's
     /// pick suits 16 samples per pixel; a shaded block takes tens, and sharper layers blur less
     /// (crate render, module adaptive, "Shading": gold-paint under potsdamer 46.2 dB at 0, 50.5
     /// at 1; under quarry's sun sharper layers cost noise).
@@ -153,20 +156,21 @@ struct Args {
     #[arg(long)]
     debug_views: bool,
 
-    /// Image size, WIDTHxHEIGHT.
+    /// Image size, WIDTHxHEIGHT, each side from 1 to 8192. Within --max-samples.
     #[arg(long, value_name = "WxH", default_value = "256x256", value_parser = parse_size)]
     size: (usize, usize),
 
-    /// Exposure in stops; default: the environment's log-average luminance maps to 0.18.
-    #[arg(long, value_name = "EV", allow_negative_numbers = true)]
+    /// Exposure in stops, from -64 to 64; default: the environment's log-average luminance maps to
+    /// 0.18.
+    #[arg(long, value_name = "EV", allow_negative_numbers = true, value_parser = parse_exposure)]
     exposure: Option<f32>,
 
-    /// Camera azimuth and elevation in degrees (it orbits the mesh, looking at its centre; 0,0
-    /// looks from +x towards -x, horizontally).
+    /// Camera azimuth and elevation in degrees, finite numbers (it orbits the mesh, looking at its
+    /// centre; 0,0 looks from +x towards -x, horizontally).
     #[arg(long, value_name = "AZ,EL", default_value = "0,0", value_parser = parse_camera, allow_hyphen_values = true)]
     camera: (f32, f32),
 
-    /// Mixed into every pixel's sample choice.
+    /// Mixed into every pixel's sample choice: any whole number from 0 to 4294967295.
     #[arg(long, default_value_t = 0)]
     seed: u32,
 
@@ -182,15 +186,24 @@ struct Args {
     #[arg(long)]
     validate: bool,
 
-    /// Also render the independent converged estimate with N samples per strategy; report PSNR and
-    /// mean luminance against it and write OUT-converged.png.
-    #[arg(long, value_name = "N")]
+    /// Also render the independent converged estimate with N samples per strategy (from 1; three
+    /// strategies); report PSNR and mean luminance against it and write OUT-converged.png. Within
+    /// --max-samples.
+    #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     converged: Option<u32>,
 
     /// Exit 1 when a reported PSNR (against the CPU, and against the converged estimate when
-    /// asked for) is below this, in dB.
-    #[arg(long, value_name = "DB")]
+    /// asked for) is below this, in dB (a finite number).
+    #[arg(long, value_name = "DB", allow_negative_numbers = true, value_parser = parse_psnr)]
     min_psnr: Option<f64>,
+
+    /// The most samples this run may take, a ceiling against runaway work (a mistyped --frames or
+    /// --converged): pixels x spp x frames on the GPU (twice with --brdf wavelet), the same again
+    /// on the CPU with --validate, and pixels x 3 x N for the converged estimate (--converged N;
+    /// --validate in the adaptive modes takes 256). From 1; the default, 2^32, is about a minute
+    /// of a GPU or an hour of CPU: raise it for a deliberate long run.
+    #[arg(long, value_name = "N", default_value_t = 1 << 32, value_parser = parse_samples)]
+    max_samples: u64,
 
     /// Write a contact sheet of every picture the bake holds (PNG).
     #[arg(long, value_name = "FILE.png")]
@@ -275,8 +288,31 @@ fn parse_size(text: &str) -> Result<(usize, usize), String> {
     Ok((w, h))
 }
 
+fn parse_lod(text: &str) -> Result<f64, String> {
+    cli::parse_finite(text, 0.0, f64::from(asset::MAX_WAVELET_SIDE.ilog2()))
+}
+
+fn parse_exposure(text: &str) -> Result<f32, String> {
+    cli::parse_finite(text, -64.0, 64.0).map(|ev| ev as f32)
+}
+
+fn parse_psnr(text: &str) -> Result<f64, String> {
+    cli::parse_finite(text, f64::MIN, f64::MAX).map_err(|_| "expected a finite number of dB".to_string())
+}
+
+fn parse_samples(text: &str) -> Result<u64, String> {
+    match text.trim().parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("expected a whole number of samples from 1".to_string()),
+    }
+}
+
 fn parse_camera(text: &str) -> Result<(f32, f32), String> {
-    let parse = |s: &str| s.trim().parse::<f32>().map_err(|e| format!("{s:?}: {e}"));
+    let parse = |s: &str| match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("{s:?}: {v} degrees is not a finite angle")),
+        Err(e) => Err(format!("{s:?}: {e}")),
+    };
     let (a, e) = text.split_once(',').ok_or_else(|| format!("expected AZ,EL in degrees, got {text:?}"))?;
     Ok((parse(a)?, parse(e)?))
 }
@@ -286,10 +322,16 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
+    // Where the outputs go must exist before anything is rendered.
+    for path in args.out.iter().chain(&args.sheet) {
+        check_output_folder(path)?;
+    }
     let mut loaded = bake::load(&args.bake, args.material.as_deref())?;
     if args.brdf == BrdfArg::Wavelet {
-        let path = args.wavelet.clone().unwrap_or_else(|| args.bake.join(bake::stage::wavelet::ASSET));
-        let brdf = bake::load_wavelet(&path, &loaded)?;
+        let (path, brdf) = match &args.wavelet {
+            Some(path) => (path.clone(), bake::load_wavelet(path, &loaded)?),
+            None => bake::bake_wavelet(&loaded)?,
+        };
         let levels = brdf.grid().levels() as f64;
         if !(0.0..=levels).contains(&args.wavelet_lod) {
             bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", args.wavelet_lod, path.display());
@@ -328,15 +370,27 @@ fn run(args: Args) -> Result<ExitCode> {
             let mode = args.mode.estimator();
             let settings = Settings::previewer(mode, &loaded.material.samples, args.spp, args.frames, args.seed);
             let scene = scene(&args)?;
+            let pixels = (scene.width * scene.height) as u128;
+            let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
+            let renders = if loaded.material.wavelet.is_some() { 2 } else { 1 };
+            check_work(
+                &args,
+                &[
+                    ("on the GPU", renders * gpu_samples),
+                    ("for --validate on the CPU", if args.validate { gpu_samples } else { 0 }),
+                    ("for --converged on the CPU", pixels * 3 * u128::from(args.converged.unwrap_or(0))),
+                ],
+            )?;
             let preview = preview(&args, lighting);
             if args.window {
                 return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
             }
-            let gpu = gpu::Gpu::new()?;
+            let gpu = open_gpu()?;
             let out = args.out.as_ref().expect("clap requires --out without --window");
             let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
             let start = Instant::now();
             let image = renderer.render_frames(&settings)?;
+            check_finite(&args, &image.rgb, "the GPU render")?;
             let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
             let picture = metrics::tonemap(&image, &preview);
             let names = names(&loaded.manifest);
@@ -383,6 +437,7 @@ fn run(args: Args) -> Result<ExitCode> {
                 let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
                 let table =
                     gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
+                check_finite(&args, &table.rgb, "the GPU render from the table")?;
                 let table_picture = metrics::tonemap(&table, &preview);
                 let psnr = metrics::psnr_db(&picture, &table_picture);
                 let relative = metrics::relative_error(&image.rgb, &table.rgb);
@@ -395,6 +450,7 @@ fn run(args: Args) -> Result<ExitCode> {
             }
             if args.validate {
                 let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
+                check_finite(&args, &cpu.rgb, "the CPU render")?;
                 let cpu_picture = metrics::tonemap(&cpu, &preview);
                 let psnr = metrics::psnr_db(&picture, &cpu_picture);
                 let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
@@ -414,6 +470,7 @@ fn run(args: Args) -> Result<ExitCode> {
             if let Some(n) = args.converged {
                 let converged =
                     render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+                check_finite(&args, &converged.rgb, "the converged estimate")?;
                 let converged_picture = metrics::tonemap(&converged, &preview);
                 let psnr = metrics::psnr_db(&picture, &converged_picture);
                 let relative = metrics::relative_error(&image.rgb, &converged.rgb);
@@ -492,9 +549,25 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
     };
     let scene = scene(args)?;
-    let preview = preview(args, lighting);
-    let gpu = gpu::Gpu::new()?;
     let ss = settings.supersample;
+    let pixels = (scene.width * ss * scene.height * ss) as u128;
+    let frame_samples = pixels * u128::from(settings.spp);
+    let converged_samples = if args.validate || args.converged.is_some() {
+        (scene.width * scene.height) as u128 * 3 * u128::from(args.converged.unwrap_or(256))
+    } else {
+        0
+    };
+    check_work(
+        args,
+        &[
+            // A first frame compiles the pipelines, then the frame that is timed.
+            ("on the GPU", 2 * frame_samples),
+            ("for --validate on the CPU", if args.validate { frame_samples } else { 0 }),
+            ("for the converged estimate on the CPU", converged_samples),
+        ],
+    )?;
+    let preview = preview(args, lighting);
+    let gpu = open_gpu()?;
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
     let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
     renderer.set_bandwidths(bandwidths)?;
@@ -507,6 +580,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let details = args.debug_views || args.validate || args.converged.is_some();
     let options = gpu::preview::FrameOptions { details, ..Default::default() };
     let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
+    check_finite(args, &frame.image.rgb, "the GPU's adaptive frame")?;
     let t = frame.timings;
     let ms_per_frame = t.total_ms;
     let picture = metrics::tonemap(&frame.image, &preview);
@@ -643,6 +717,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     if args.validate || args.converged.is_some() {
         let n = args.converged.unwrap_or(256);
         let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+        check_finite(args, &converged.rgb, "the converged estimate")?;
         let converged_picture = metrics::tonemap(&converged, &preview);
         let psnr = metrics::psnr_db(&picture, &converged_picture);
         let relative = metrics::relative_error(&frame.image.rgb, &converged.rgb);
@@ -680,6 +755,56 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     Ok(Step { files, report, problems, value })
 }
 
+/// The GPU, without the spurious line a headless run prints where there is no Wayland session
+/// (`cli::without_stderr_lines`).
+fn open_gpu() -> Result<gpu::Gpu> {
+    Ok(cli::without_stderr_lines(cli::is_wayland_session_warning, gpu::Gpu::new)?)
+}
+
+/// An output's folder must exist: found before the render rather than after it (nothing is
+/// created; `asset::write_atomic`).
+fn check_output_folder(path: &Path) -> Result<()> {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        bail!("writing {}: the folder {} does not exist (create it first)", path.display(), folder.display());
+    }
+    Ok(())
+}
+
+/// The work the arguments ask for, `(what, samples)` by part, within --max-samples; otherwise an
+/// error that gives the parts and how to lift the ceiling.
+fn check_work(args: &Args, parts: &[(&str, u128)]) -> Result<()> {
+    let total: u128 = parts.iter().map(|(_, n)| n).sum();
+    if total <= u128::from(args.max_samples) {
+        return Ok(());
+    }
+    let listed: Vec<String> = parts.iter().filter(|(_, n)| *n > 0).map(|(what, n)| format!("{n} {what}")).collect();
+    bail!(
+        "this run would take {total} samples ({}; --size, --spp, --frames and --converged set them), above the \
+         ceiling of {} (--max-samples): ask for less, or raise --max-samples for a deliberate long run",
+        listed.join(", "),
+        args.max_samples
+    )
+}
+
+/// A render with a pixel that is not a finite number is an error naming what it was rendered
+/// from (a damaged or absurd asset can make a BRDF overflow), never a picture with exit 0.
+fn check_finite(args: &Args, rgb: &[f32], what: &str) -> Result<()> {
+    let bad = rgb.chunks_exact(3).filter(|p| p.iter().any(|v| !v.is_finite())).count();
+    if bad == 0 {
+        return Ok(());
+    }
+    let source = match (args.brdf, &args.wavelet) {
+        (BrdfArg::Wavelet, Some(path)) => path.display().to_string(),
+        (BrdfArg::Wavelet, None) => format!("the wavelet-brdf asset of {}", args.bake.display()),
+        (BrdfArg::Table, _) => format!("the bake in {}", args.bake.display()),
+    };
+    bail!(
+        "rendering {source}: {what} has {bad} of {} pixels that are not finite numbers (an asset's values overflow)",
+        rgb.len() / 3
+    )
+}
+
 /// How pictures are tone mapped: --exposure, or the environment's automatic exposure.
 fn preview(args: &Args, lighting: &render::Lighting) -> envmap::Preview {
     match args.exposure {
@@ -704,7 +829,11 @@ fn scene(args: &Args) -> Result<Scene> {
         "sphere" => Mesh::sphere(1.0, 128, 64),
         "torus" => Mesh::torus(0.7, 0.3, 128, 48),
         path => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("reading {path}"))?;
+            // A regular file only (a FIFO or a device is refused without blocking), its size
+            // checked against the mesh limit before it is read.
+            let bytes = fsguard::read_regular(Path::new(path), Mesh::MAX_OBJ_BYTES as u64)
+                .with_context(|| format!("reading {path}"))?;
+            let text = String::from_utf8(bytes).map_err(|_| anyhow!("reading {path}: not utf-8 text (an obj file)"))?;
             Mesh::from_obj(&text).with_context(|| format!("reading {path}"))?
         }
     };

@@ -20,6 +20,12 @@ use haar_brdf::{Config, DEFAULT_EPSILON, DEFAULT_SIDE, Keep};
 /// error). Reports the paper's Table 1 figures: RMS error and mean relative error against the
 /// resampled table. brdf-preview --brdf wavelet renders from the asset.
 ///
+/// Into a bake folder (one with a manifest.json, made by brdf-bake from the same table), the
+/// files are added to the bake as brdf-bake --wavelet-ratio would add them: the manifest lists
+/// them and records these settings, through the bake's own protocol (the folder locked, the new
+/// files and manifest switched in together). A later brdf-bake without --wavelet-ratio rebakes the
+/// folder without them.
+///
 /// Example: brdf-wavelet lewis.binary --out-dir lewis --ratio 16 --quantize 8
 ///
 /// Exit status: 0 ok, 1 the table holds no data at some resampled directions (encoded as 0),
@@ -30,19 +36,20 @@ struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
 
-    /// The folder to write into (created if missing).
+    /// The folder to write into (created if missing: the folder itself, its parent must exist); a
+    /// bake's folder gets the encoding added to its manifest.
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Keep 1/R of the coefficients (a power of two; 4, 16 and 32 are the paper's Table 1). The
-    /// default unless --threshold is given: 4.
+    /// Keep 1/R of the coefficients (a power of two up to the grid's N x N positions; 4, 16 and 32
+    /// are the paper's Table 1). The default unless --threshold is given: 4.
     #[arg(long, value_name = "R", conflicts_with = "threshold", value_parser = cli::parse_count)]
     ratio: Option<usize>,
 
     /// Instead of a ratio, keep the coefficient positions whose RMS coefficient (over all
-    /// outgoing slices and channels, log units) is at least T; 0 keeps everything (lossless up to
-    /// 32-bit floats).
-    #[arg(long, value_name = "T")]
+    /// outgoing slices and channels, log units) is at least T, a finite number from 0; 0 keeps
+    /// everything (lossless up to 32-bit floats).
+    #[arg(long, value_name = "T", value_parser = parse_threshold)]
     threshold: Option<f64>,
 
     /// Quantize the kept coefficients to this many bits (only 8 is supported: the paper's
@@ -55,7 +62,7 @@ struct Args {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SIDE, value_parser = cli::parse_count)]
     side: usize,
 
-    /// Bias of the log encoding log((f + eps mu) / mu), mu the channel mean.
+    /// Bias of the log encoding log((f + eps mu) / mu), mu the channel mean: from 1e-12 to 1.
     #[arg(long, value_name = "EPS", default_value_t = DEFAULT_EPSILON)]
     epsilon: f64,
 
@@ -63,6 +70,10 @@ struct Args {
     /// stderr.
     #[arg(long)]
     json: bool,
+}
+
+fn parse_threshold(text: &str) -> Result<f64, String> {
+    cli::parse_finite(text, 0.0, f64::MAX).map_err(|_| "expected a finite number from 0".to_string())
 }
 
 const PROGRAM: Program = Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
@@ -85,10 +96,21 @@ fn run(args: Args) -> Result<ExitCode> {
     let settings = Settings { side: args.side, config: Config { epsilon: args.epsilon, keep, quantize } };
     // Before the table is read: a refused setting costs nothing.
     settings.check()?;
-    let table = merl::read_file(&args.material).with_context(|| format!("reading {}", args.material.display()))?;
-    let source = Source::hash(&args.material)?;
+    // The bytes hashed are the bytes parsed.
+    let bytes = merl::read_bytes(&args.material).with_context(|| format!("reading {}", args.material.display()))?;
+    let source = Source::of_bytes(&args.material, &bytes);
+    let table = merl::MerlTable::parse(&bytes).with_context(|| format!("reading {}", args.material.display()))?;
+    drop(bytes);
     let staged = bake::stage::wavelet::run(&table, &source, &PROGRAM, settings)?;
     let dir = &args.out_dir;
-    staged.write(dir)?;
-    Ok(cli::finish(args.json, &staged.json(dir)?, &staged.report, &staged.problems, &staged.written(dir)))
+    let mut report = staged.report.clone();
+    let parameters = serde_json::Value::Object(settings.parameters());
+    if bake::write_stage(dir, &staged, &source, ("wavelet", parameters))? {
+        report.push(format!(
+            "added to the bake in {}: its {} lists the files and these settings",
+            dir.display(),
+            bake::MANIFEST
+        ));
+    }
+    Ok(cli::finish(args.json, &staged.json(dir)?, &report, &staged.problems, &staged.written(dir)))
 }

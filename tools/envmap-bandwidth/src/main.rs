@@ -69,7 +69,8 @@ struct Args {
     #[arg(long, default_value_t = Config::default().eps, value_parser = parse_eps)]
     eps: f64,
 
-    /// Number of wavelet levels; by default as many as the size allows.
+    /// Number of wavelet levels, 1 to 30 (and no more than the size allows); by default as many as
+    /// the size allows.
     #[arg(long, value_parser = cli::parse_count)]
     levels: Option<usize>,
 
@@ -80,8 +81,8 @@ struct Args {
     #[arg(long, value_name = "paper|level-normalized", default_value = "paper")]
     reading: bandwidth::Reading,
 
-    /// Memory budget (4G, 512M, ...): a map whose estimated need (80 bytes per texel) is larger
-    /// is refused from its header, before decoding.
+    /// Memory budget (4G, 512M, ...; from 1 byte to 16 EiB): a map whose estimated need (80 bytes
+    /// per texel) is larger is refused from its header, before decoding.
     #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
     max_memory: u64,
 }

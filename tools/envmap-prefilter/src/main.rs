@@ -33,16 +33,17 @@ struct Args {
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Phong exponents, one layer each, strictly increasing.
+    /// Phong exponents, one layer each, strictly increasing, each from 1 to 16777216.
     #[arg(long, value_name = "N,N,...", value_delimiter = ',', default_value = "1,4,16,64,256,1024,4096")]
     exponents: Vec<u32>,
 
-    /// Size of every layer, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT.
+    /// Size of every layer, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT, HEIGHT from 1 to 8192.
     #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = cli::parse_size)]
     size: (usize, usize),
 
-    /// Memory budget (4G, 512M, ...): a map whose estimated need (60 bytes per texel, plus the
-    /// layers) is larger is refused from its header, before decoding.
+    /// Memory budget (4G, 512M, ...; from 1 byte to 16 EiB, more than the layers alone need): a map
+    /// whose estimated need (60 bytes per texel, plus the layers) is larger is refused from its
+    /// header, before decoding.
     #[arg(long, value_name = "SIZE", default_value = "4G", value_parser = cli::parse_bytes)]
     max_memory: u64,
 
@@ -66,8 +67,8 @@ struct Args {
     /// Also write the GGX chain engines read (split sum, n = v = r): ggx.ktx2, M mip levels from
     /// the --size grid down, level m at perceptual roughness m / (M - 1) (alpha = roughness^2;
     /// level 0 the mirror), ggx-cube.ktx2 with --cube, and the split-sum DFG table (dfg.ktx2: A
-    /// in red, B in green of F0 A + B; dfg.png). At most log2(WIDTH) - 1 levels (7 for 256x128).
-    #[arg(long, value_name = "M")]
+    /// in red, B in green of F0 A + B; dfg.png). From 2 to log2(WIDTH) - 1 levels (7 for 256x128).
+    #[arg(long, value_name = "M", value_parser = |s: &str| cli::parse_whole(s, 2))]
     ggx_levels: Option<usize>,
 
     /// Store the KTX2 files as half floats even when some texels exceed 65504, clamping those
@@ -127,7 +128,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.check().context("invalid arguments")?;
     let progress = cli::Progress::new(args.quiet);
     progress.step("loading".to_string());
-    let limits = bake::stage::prefilter::limits(&config, args.max_memory);
+    let limits = bake::stage::prefilter::limits(&config, args.max_memory)?;
     let map =
         envmap::load_with_limits(&args.env, &limits).with_context(|| format!("reading {}", args.env.display()))?;
     let source = Source::hash(&args.env)?;

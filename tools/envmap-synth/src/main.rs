@@ -21,7 +21,7 @@ struct Args {
     #[arg(long, short, value_name = "FILE.exr")]
     out: PathBuf,
 
-    /// Width and height, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT.
+    /// Width and height, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT, from 8x4 to 16384x8192.
     #[arg(long, value_name = "WxH", default_value = "1024x512", value_parser = cli::parse_size)]
     size: (usize, usize),
 

@@ -23,27 +23,28 @@ struct Args {
     /// The MERL table (.binary).
     material: PathBuf,
 
-    /// The folder to write into (created if missing).
+    /// The folder to write into (created if missing: the folder itself, its parent must exist).
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
-    /// Outgoing elevations: theta_o = k / N * 90 degrees, k = 0 .. N-1.
+    /// Outgoing elevations, 1 to 1024: theta_o = k / N * 90 degrees, k = 0 .. N-1.
     #[arg(long = "theta-o", value_name = "N", default_value_t = Config::default().n_theta_o, value_parser = cli::parse_count)]
     n_theta_o: usize,
 
-    /// Vectors of samples per elevation.
+    /// Vectors of samples per elevation, 1 to 1024.
     #[arg(long, value_name = "V", default_value_t = Config::default().n_vectors, value_parser = cli::parse_count)]
     vectors: usize,
 
-    /// Samples per vector (a power of two keeps each vector stratified).
+    /// Samples per vector, 1 to 1048576 (a power of two keeps each vector stratified).
     #[arg(long, value_name = "S", default_value_t = Config::default().n_samples, value_parser = cli::parse_count)]
     samples: usize,
 
-    /// Sectors of phi_h.
+    /// Sectors of phi_h, 1 to 4096.
     #[arg(long, value_name = "N", default_value_t = Config::default().n_phi_h, value_parser = cli::parse_count)]
     phi_h: usize,
 
-    /// Seed of the scrambled Sobol' points the samples come from.
+    /// Seed of the scrambled Sobol' points the samples come from: any whole number from 0 to
+    /// 18446744073709551615.
     #[arg(long, default_value_t = 0)]
     seed: u64,
 

@@ -40,6 +40,7 @@ struct Args {
 #[derive(Debug, Subcommand)]
 enum Brdf {
     /// f = albedo / pi.
+    #[command(allow_negative_numbers = true)]
     Lambertian {
         /// Albedo: one value, or three (r,g,b), each in [0, 1].
         #[arg(long, default_value = "0.5", value_delimiter = ',', value_name = "A")]
@@ -50,8 +51,9 @@ enum Brdf {
     ///
     /// Example (the Lewis-like material of Claustres et al. 2007, Table 1):
     /// merl-synth phong -n 10 --ks 0.2 --kd 0.8 --out lewis.binary
+    #[command(allow_negative_numbers = true)]
     Phong {
-        /// Phong exponent n (> 0): larger is sharper.
+        /// Phong exponent n, in (0, 1e6]: larger is sharper.
         #[arg(long, short, value_name = "N")]
         n: f64,
         /// Specular reflectance: one value, or three (r,g,b), each in [0, 1].
@@ -63,8 +65,9 @@ enum Brdf {
         kd: Vec<f64>,
     },
     /// Blinn-Phong, f = ks (n+8)/(8 pi) cos^n theta_h.
+    #[command(allow_negative_numbers = true)]
     BlinnPhong {
-        /// Blinn-Phong exponent n (> 0) of cos theta_h: larger is sharper.
+        /// Blinn-Phong exponent n of cos theta_h, in (0, 1e6]: larger is sharper.
         #[arg(long, short, value_name = "N")]
         n: f64,
         /// Specular reflectance: one value, or three (r,g,b), each in [0, 1].
@@ -72,8 +75,9 @@ enum Brdf {
         ks: Vec<f64>,
     },
     /// GGX microfacets with height-correlated Smith masking and Schlick Fresnel.
+    #[command(allow_negative_numbers = true)]
     Ggx {
-        /// Roughness alpha (> 0, the GGX width).
+        /// Roughness alpha, the GGX width, in (0, 100].
         #[arg(long, value_name = "ALPHA")]
         alpha: f64,
         /// Reflectance at normal incidence: one value, or three (r,g,b), each in [0, 1].
@@ -94,12 +98,20 @@ fn rgb(name: &str, v: &[f64], max: f64) -> Result<[f64; 3]> {
     Ok(rgb)
 }
 
-fn positive(name: &str, v: f64) -> Result<f64> {
-    if !v.is_finite() || v <= 0.0 {
-        bail!("--{name} must be a positive number, found {v}");
+/// `v` in `(0, max]`: an exponent or width beyond `max` gives a table of values that overflow (or
+/// a lobe far narrower than a MERL cell).
+fn positive(name: &str, v: f64, max: f64) -> Result<f64> {
+    if !(v > 0.0 && v <= max) {
+        bail!("--{name} must be a number in (0, {max:e}], found {v:?}");
     }
     Ok(v)
 }
+
+/// The largest Phong and Blinn-Phong exponent: a lobe about 1e-3 radians wide, finer than MERL's
+/// finest cells resolve.
+const MAX_EXPONENT: f64 = 1e6;
+/// The largest GGX width: far past the roughest material (1 is already very rough).
+const MAX_ALPHA: f64 = 100.0;
 
 fn main() -> ExitCode {
     cli::main(|| run(cli::args()?))
@@ -119,15 +131,15 @@ fn run(args: Args) -> Result<ExitCode> {
             (Analytic::Lambertian { albedo }, "lambertian", json!({ "albedo": albedo }))
         }
         Brdf::Phong { n, ks, kd } => {
-            let (n, ks, kd) = (positive("n", *n)?, rgb("ks", ks, 1.0)?, rgb("kd", kd, 1.0)?);
+            let (n, ks, kd) = (positive("n", *n, MAX_EXPONENT)?, rgb("ks", ks, 1.0)?, rgb("kd", kd, 1.0)?);
             (Analytic::Phong { n, ks, kd }, "phong", json!({ "n": n, "ks": ks, "kd": kd }))
         }
         Brdf::BlinnPhong { n, ks } => {
-            let (n, ks) = (positive("n", *n)?, rgb("ks", ks, 1.0)?);
+            let (n, ks) = (positive("n", *n, MAX_EXPONENT)?, rgb("ks", ks, 1.0)?);
             (Analytic::BlinnPhong { n, ks }, "blinn-phong", json!({ "n": n, "ks": ks }))
         }
         Brdf::Ggx { alpha, f0 } => {
-            let (alpha, f0) = (positive("alpha", *alpha)?, rgb("f0", f0, 1.0)?);
+            let (alpha, f0) = (positive("alpha", *alpha, MAX_ALPHA)?, rgb("f0", f0, 1.0)?);
             (Analytic::Ggx { alpha, f0 }, "ggx", json!({ "alpha": alpha, "f0": f0 }))
         }
     };

@@ -8,3 +8,40 @@ pub mod layers;
 pub mod pca;
 pub mod prefilter;
 pub mod wavelet;
+
+/// Whether `name` is the name of a file some stage writes (`importance.asset`, `layer-n16.exr`,
+/// ...; `data-schema/README.md` lists them by role): a rebake removes a file of the previous
+/// manifest only under such a name, so that no manifest can make it remove anything else.
+pub fn is_output_name(name: &str) -> bool {
+    const NAMES: [&str; 24] = [
+        importance::ASSET,
+        importance::PICTURE,
+        atlas::ASSET,
+        atlas::EXR,
+        atlas::PICTURE,
+        pca::ASSET,
+        pca::PICTURE,
+        wavelet::ASSET,
+        wavelet::PICTURE,
+        env_bandwidth::EXR,
+        env_bandwidth::PICTURE,
+        prefilter::ASSET,
+        prefilter::LAYERS_KTX2,
+        prefilter::MIPS_KTX2,
+        prefilter::CONTACT_SHEET,
+        prefilter::LAYERS_CUBE_KTX2,
+        prefilter::MIPS_CUBE_KTX2,
+        prefilter::engine::PHONG_CHAIN_KTX2,
+        prefilter::engine::PHONG_CHAIN_CUBE_KTX2,
+        prefilter::engine::GGX_KTX2,
+        prefilter::engine::GGX_CUBE_KTX2,
+        prefilter::engine::DFG_KTX2,
+        prefilter::engine::DFG_PNG,
+        layers::ASSET,
+    ];
+    let layer_exr = name
+        .strip_prefix("layer-n")
+        .and_then(|rest| rest.strip_suffix(".exr"))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+    layer_exr || NAMES.contains(&name)
+}

@@ -36,15 +36,24 @@ pub const BYTES_PER_TEXEL: u64 = 60;
 /// The reading limits of this stage under a memory budget of `max_memory` bytes: the layers
 /// (one `f32` RGB map of the configured size per exponent, twice over while they are encoded)
 /// are set aside, the rest is the map's at [`BYTES_PER_TEXEL`], plus [`CUBE_BYTES_PER_TEXEL`] with
-/// cube maps.
-pub fn limits(config: &::prefilter::Config, max_memory: u64) -> envmap::Limits {
+/// cube maps. A budget the layers alone exceed is an error that says so (`--max-memory`).
+pub fn limits(config: &::prefilter::Config, max_memory: u64) -> Result<envmap::Limits, Error> {
     // A chain (GGX or Phong) holds 4/3 of a layer in its levels, encoded once more: counted as 2
     // layers each.
     let ggx = 2 * (u64::from(config.ggx_levels > 0) + u64::from(config.chain));
     let layers =
         (config.width as u64 * config.height as u64).saturating_mul(24 * (config.exponents.len() as u64 + ggx));
+    if layers >= max_memory {
+        return Err(Error::Invalid(format!(
+            "a memory budget of {} (--max-memory) leaves nothing for the map: the {}x{} layers alone need {}",
+            envmap::format_bytes(max_memory),
+            config.width,
+            config.height,
+            envmap::format_bytes(layers)
+        )));
+    }
     let per_texel = BYTES_PER_TEXEL + if config.cube { CUBE_BYTES_PER_TEXEL } else { 0 };
-    envmap::Limits::for_job(per_texel, max_memory.saturating_sub(layers))
+    Ok(envmap::Limits::for_job(per_texel, max_memory - layers))
 }
 
 /// What the cube mip chain adds per texel of the map: its faces hold 3/4 of the map's texels (six
@@ -356,7 +365,7 @@ fn compare_ktx2(
     expected: &[Vec<&[f32]>],
     problems: &mut Vec<String>,
 ) -> Result<f32, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
+    let bytes = fsguard::read_regular(path, asset::OUTPUT_LIMIT).map_err(|e| Error::read(path, e))?;
     let decoded = prefilter::ktx::decode(&bytes).map_err(|e| Error::read(path, e))?;
     let wanted = prefilter::ktx::Shape { width, height, layers: layer_count, faces: 1 };
     if decoded.shape != wanted || decoded.levels.len() != expected.len() {

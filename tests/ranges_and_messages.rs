@@ -1,0 +1,204 @@
+//! Numeric options with ranges, work with a ceiling, decoded values held to sane ranges, and the
+//! messages a newcomer meets (issue 32, points 4, 5, 7 and 8): every refusal is one line with
+//! exit 2 and comes at once, never a panic, a hang or a result that is not a number.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
+
+use crate::support::{ggx_copper, reference_bake, run, run_within, temp_dir, tool};
+
+/// Any of these runs ends in well under this; a refusal that computes first would not.
+const QUICK: Duration = Duration::from_secs(30);
+
+fn command(name: &str, args: &[&str]) -> Command {
+    let mut cmd = tool(name);
+    cmd.args(args);
+    cmd
+}
+
+fn preview(args: &[&str]) -> Command {
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(&reference_bake().dir).args(args);
+    cmd
+}
+
+/// Each value no option should take is refused at once with one line that names the option and
+/// says what it accepts; the work options name the ceiling and how to lift it.
+#[test]
+fn numeric_options_are_refused_outside_their_range() {
+    let tmp = temp_dir();
+    let png = tmp.path().join("p.png");
+    let png = png.to_str().unwrap();
+    let env = crate::support::bake_env();
+    let env = env.to_str().unwrap();
+    let material = ggx_copper().to_str().unwrap();
+    let out = tmp.path().join("out");
+    let out = out.to_str().unwrap();
+    let cases: Vec<(Command, &str)> = vec![
+        // A panic ("attempt to divide by zero"), with and without --frames.
+        (preview(&["--out", png, "--spp", "0"]), "'--spp <N>': expected a whole number from 1 to 4294967295"),
+        (preview(&["--out", png, "--spp", "0", "--frames", "1"]), "--spp <N>"),
+        // Work without a bound.
+        (preview(&["--out", png, "--frames", "4294967295"]), "above the ceiling of 4294967296 (--max-samples)"),
+        (preview(&["--out", png, "--converged", "4294967295"]), "raise --max-samples for a deliberate long run"),
+        (preview(&["--out", png, "--mode", "adaptive", "--spp", "4294967295"]), "(--max-samples)"),
+        (preview(&["--out", png, "--size", "8192x8192"]), "(--max-samples)"),
+        // NaN and infinities where they make no sense (a NaN gate always passed).
+        (preview(&["--out", png, "--exposure", "nan"]), "'--exposure <EV>': expected a number from -64 to 64"),
+        (preview(&["--out", png, "--exposure", "inf"]), "--exposure"),
+        (preview(&["--out", png, "--min-psnr", "nan"]), "'--min-psnr <DB>': expected a finite number of dB"),
+        (preview(&["--out", png, "--camera", "nan,0"]), "not a finite angle"),
+        (preview(&["--out", png, "--wavelet-lod", "nan"]), "--wavelet-lod"),
+        (preview(&["--out", png, "--max-samples", "0"]), "--max-samples"),
+        // A budget the layers alone exceed said "a budget of 0 bytes".
+        (
+            command("brdf-bake", &[material, "--env", env, "--out-dir", out, "--max-memory", "1"]),
+            "a memory budget of 1 bytes (--max-memory) leaves nothing for the map",
+        ),
+        // 0 turned the GGX chain off where 1 and 8 are refused.
+        (
+            command("brdf-bake", &[material, "--env", env, "--out-dir", out, "--ggx-levels", "0"]),
+            "'--ggx-levels <M>': expected a whole number from 2 up",
+        ),
+        (
+            command("envmap-prefilter", &[env, "--out-dir", out, "--ggx-levels", "0"]),
+            "expected a whole number from 2 up",
+        ),
+        // An epsilon that renders black, a threshold that is not a number.
+        (
+            command("brdf-wavelet", &[material, "--out-dir", out, "--epsilon", "1e308"]),
+            "epsilon must be a number from 1e-12 to 1, found 1e308",
+        ),
+        (
+            command("brdf-wavelet", &[material, "--out-dir", out, "--threshold", "nan"]),
+            "'--threshold <T>': expected a finite number from 0",
+        ),
+        // Exponents and widths whose tables overflow panicked.
+        (
+            command("merl-synth", &["phong", "-n", "1e308", "--out", out]),
+            "--n must be a number in (0, 1e6], found 1e308",
+        ),
+        (command("merl-synth", &["ggx", "--alpha", "1e308", "--out", out]), "--alpha must be a number in (0, 1e2]"),
+        (
+            command("merl-synth", &["blinn-phong", "-n", "-1", "--out", out]),
+            "--n must be a number in (0, 1e6], found -1",
+        ),
+    ];
+    for (cmd, needle) in cases {
+        let (r, took) = run_within(cmd, QUICK);
+        r.expect_one_error_line(needle);
+        assert!(took < QUICK, "{took:?}");
+    }
+    assert!(!Path::new(out).exists(), "a refused run wrote its folder");
+}
+
+/// Wavelet assets with values no BRDF has (coefficients of 1e30, a quantization step of 3e38,
+/// epsilon 1e308) are refused by `asset-info` and the previewer; an asset within the ranges whose
+/// reconstruction still overflows (every coefficient at the bound) renders non-finite pixels,
+/// which is an error naming the asset, never exit 0 with "relative error inf".
+#[test]
+fn absurd_wavelet_assets_are_refused_and_a_render_that_overflows_is_an_error() {
+    let tmp = temp_dir();
+    let dir = tmp.path().join("w");
+    let mut cmd = tool("brdf-wavelet");
+    cmd.arg(ggx_copper()).arg("--out-dir").arg(&dir).args(["--side", "8", "--ratio", "4"]);
+    run(cmd, "").expect_code(0);
+    let good = asset::read_file(&dir.join("wavelet-brdf.asset")).unwrap();
+    let asset::Payload::WaveletBrdf(payload) = &good.payload else { panic!("not a wavelet asset") };
+    let write = |name: &str, edit: &dyn Fn(&mut asset::WaveletBrdf)| {
+        let mut payload = payload.clone();
+        edit(&mut payload);
+        let asset = asset::Asset { provenance: good.provenance.clone(), payload: payload.into() };
+        let path = tmp.path().join(name);
+        // Written as a file would be damaged: the checks are the reader's.
+        std::fs::write(&path, asset::encode(&asset)).unwrap();
+        path
+    };
+    let float = |edit: fn(&mut Vec<f32>)| {
+        move |p: &mut asset::WaveletBrdf| match &mut p.coefficients {
+            asset::WaveletCoefficients::Float(v) => edit(v),
+            _ => panic!("float coefficients"),
+        }
+    };
+    let absurd = [
+        write("coefficient-1e30.asset", &float(|v| v[0] = 1e30)),
+        write("epsilon-1e308.asset", &|p| p.epsilon = 1e308),
+        write("step-3e38.asset", &|p| {
+            let k = 3 * p.stored_slices();
+            let codes = vec![0u8; k * (p.side as usize).pow(2)];
+            p.coefficients = asset::WaveletCoefficients::Quantized { offset: vec![0.0; k], step: vec![3e38; k], codes };
+        }),
+    ];
+    let bake = reference_bake().dir.clone();
+    let png = tmp.path().join("p.png");
+    for path in &absurd {
+        let mut cmd = tool("asset-info");
+        cmd.arg(path);
+        let r = run(cmd, "").expect_code(2);
+        assert!(r.stderr.contains("invalid payload: wavelet brdf"), "{r}");
+        let mut cmd = tool("brdf-preview");
+        cmd.arg(&bake).arg("--out").arg(&png).args(["--size", "16x16", "--brdf", "wavelet", "--wavelet"]).arg(path);
+        run(cmd, "").expect_one_error_line("invalid payload: wavelet brdf");
+    }
+
+    // Every coefficient at the bound: a valid asset whose reconstruction overflows.
+    let bound = (asset::WAVELET_LOG_BOUND * f64::from(payload.side)) as f32;
+    let overflow = write("overflow.asset", &move |p: &mut asset::WaveletBrdf| {
+        if let asset::WaveletCoefficients::Float(v) = &mut p.coefficients {
+            v.iter_mut().for_each(|c| *c = bound);
+        }
+    });
+    let mut cmd = tool("asset-info");
+    cmd.arg(&overflow);
+    run(cmd, "").expect_code(0);
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(&bake).arg("--out").arg(&png).args(["--size", "16x16", "--spp", "16", "--frames", "1"]);
+    cmd.args(["--brdf", "wavelet", "--wavelet"]).arg(&overflow);
+    run(cmd, "").expect_one_error_line(&format!("rendering {}: the GPU render has", overflow.display()));
+    assert!(!png.exists(), "a failed render wrote its picture");
+}
+
+/// What a newcomer meets: a PNG given as a table says it is a PNG; a folder that is not a bake
+/// says so and how to make one; an output whose folder is missing creates no folder (from the
+/// root or anywhere), while `--out-dir` is created itself; a successful headless preview prints no
+/// line starting with `error:`, even where no Wayland session is set up (XDG_RUNTIME_DIR unset).
+#[test]
+fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
+    let tmp = temp_dir();
+    let png = reference_bake().dir.join("importance.png");
+    let mut cmd = tool("merl-info");
+    cmd.arg(&png);
+    run(cmd, "").expect_error(&png, "not a MERL table: this is a PNG image");
+
+    let empty = tmp.path().join("not-a-bake");
+    std::fs::create_dir(&empty).unwrap();
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(&empty).args(["--out"]).arg(tmp.path().join("p.png"));
+    let r = run(cmd, "").expect_one_error_line("not a bake folder (it has no manifest.json)");
+    assert!(
+        r.stderr.contains(&format!("brdf-bake MATERIAL.binary --env ENV.hdr --out-dir {}", empty.display())),
+        "{r}"
+    );
+
+    let missing = tmp.path().join("nonexistent/dir");
+    let mut cmd = preview(&["--size", "16x16", "--out"]);
+    cmd.arg(missing.join("x.png"));
+    run(cmd, "").expect_one_error_line(&format!("the folder {} does not exist", missing.display()));
+    let mut cmd = tool("merl-synth");
+    cmd.args(["lambertian", "--out"]).arg(missing.join("x.binary"));
+    run(cmd, "").expect_one_error_line("does not exist");
+    let mut cmd = tool("brdf-wavelet");
+    cmd.arg(ggx_copper()).arg("--out-dir").arg(&missing).args(["--side", "4"]);
+    run(cmd, "").expect_one_error_line("its parent folder");
+    assert!(!tmp.path().join("nonexistent").exists(), "a missing folder was created");
+    let mut cmd = tool("brdf-wavelet");
+    cmd.arg(ggx_copper()).arg("--out-dir").arg(tmp.path().join("new")).args(["--side", "4"]);
+    run(cmd, "").expect_code(0);
+    assert!(tmp.path().join("new/wavelet-brdf.asset").is_file());
+
+    let mut cmd = preview(&["--size", "16x16", "--spp", "16", "--frames", "1", "--out"]);
+    cmd.arg(tmp.path().join("ok.png")).env_remove("XDG_RUNTIME_DIR");
+    let r = run(cmd, "").expect_code(0);
+    assert!(!r.stderr.contains("error:"), "a successful run printed an error line\n{r}");
+}
