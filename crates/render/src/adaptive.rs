@@ -144,24 +144,16 @@
 //! `V N` points (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
 //!
 //! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
-//! ... at the level given by the maximum frequency of the BRDF") reads the Phong layer
-//! [`Settings::layer_shift`] layers sharper than the one the bake's selection picks for the view
-//! ([`Material::view_layers`]), the sharpest at most. That selection was chosen for the
-//! full-resolution pre-filtered mode at 16 samples per pixel (crate `bake`, `stage::layers`),
-//! where a sharper layer's noise costs about what its blur saves: two layers sharper lose 1.4 to
-//! 1.8 dB there under potsdamer and gain nothing under quarry (`brdf-preview --mode prefiltered
-//! --spp 16 --converged 256`, 128 x 128 sphere: gold-paint and white-paint under potsdamer 40.43
-//! and 37.84 dB against 38.58 and 36.49; gold-paint under quarry 34.79 against 34.82). A shaded
-//! block takes tens to hundreds of samples, the budget of the pixels it stands for, and there
-//! the blur dominates (measured with blocks of at most 256 samples: the adaptive benchmark, 512
-//! x 512 sphere under potsdamer, 2 and 8 spp budgets, in dB, for 0 to 3 layers sharper):
-//! gold-paint 46.23 and 46.38, 50.53 and 51.00, 51.45 and 52.07, 51.53 and 52.15; white-paint
-//! 48.80 and 49.19, 49.61 and 50.09, 49.67 and 50.15, 49.63 and 50.10. Under quarry, whose sun a
-//! sharper layer keeps small and bright, the rare samples that find it cost more (0 to 2 layers
-//! sharper): gold-paint on the sphere 34.94 and 36.17, 35.13 and 37.87, 33.55 and 35.77, on the
-//! torus 32.40 and 35.01, 30.75 and 34.32, 29.36 and 31.88; white-paint on the sphere 35.12 and
-//! 36.13, then 35.09 and 35.77 for any shift. One layer takes most of the gain under potsdamer
-//! and little of the loss under quarry: the default ([`LAYER_SHIFT`]).
+//! ... at the level given by the maximum frequency of the BRDF") reads the Phong layers
+//! [`Settings::layer_shift`] layers sharper than the coordinate the bake's selection gives the
+//! view ([`Material::view_layers`], crate docs "The estimators"), the sharpest at most. That
+//! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
+//! `bake`, `stage::layers`), where a sharper layer's noise costs about what its blur saves. A
+//! shaded block takes tens to hundreds of samples, the budget of the pixels it stands for, and
+//! there the blur dominates: the default shift is one layer ([`LAYER_SHIFT`]). It was measured
+//! (the adaptive benchmark with the shift set by hand: 0 to 3 layers) when the estimator read
+//! one layer per view row and filtered the sun with the sky; with the layers blended and the
+//! peaks sampled unfiltered it has not been measured again.
 //!
 //! # Anti-aliasing (`001` section 4.3)
 //!

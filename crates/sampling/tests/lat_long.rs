@@ -120,13 +120,21 @@ fn pdf_agrees_with_sample_and_invert_undoes_it() {
     }
 }
 
-#[test]
-fn chi2_accepts_the_sampler_in_solid_angle() {
+/// The chi-square test of `n = 10^6` points `sample` draws (from independent uniform `u`, seeded)
+/// against the test map's distribution.
+fn chi2_against_the_distribution(sample: impl FnMut([f64; 2]) -> [f64; 2], seed: u64) -> sampling::chi2::Chi2 {
     let (weights, w, h) = weights();
     let d = LatLong::new(&weights, w, h).unwrap();
     let n = 1_000_000;
     let expected: Vec<f64> = expected(&d, w, h).iter().map(|p| p * n as f64).collect();
-    assert_accepts(chi2_test(&histogram(|u| d.sample(u).uv, n, 41), &expected), "lat-long sampler");
+    chi2_test(&histogram(sample, n, seed), &expected)
+}
+
+#[test]
+fn chi2_accepts_the_sampler_in_solid_angle() {
+    let (weights, w, h) = weights();
+    let d = LatLong::new(&weights, w, h).unwrap();
+    assert_accepts(chi2_against_the_distribution(|u| d.sample(u).uv, 41), "lat-long sampler");
 }
 
 #[test]
@@ -134,11 +142,8 @@ fn chi2_rejects_a_sampler_that_forgets_sin_theta() {
     // The texels drawn by their weights alone: the poles' small texels drawn as often as the
     // equator's, which the solid-angle density does not do.
     let (weights, w, h) = weights();
-    let d = LatLong::new(&weights, w, h).unwrap();
     let wrong = Distribution2D::new(&weights, w, h).unwrap();
-    let n = 1_000_000;
-    let expected: Vec<f64> = expected(&d, w, h).iter().map(|p| p * n as f64).collect();
-    assert_rejects(chi2_test(&histogram(|u| wrong.sample(u).p, n, 42), &expected), "sampler without sin theta");
+    assert_rejects(chi2_against_the_distribution(|u| wrong.sample(u).p, 42), "sampler without sin theta");
 }
 
 #[test]

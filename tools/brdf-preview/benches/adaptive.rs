@@ -28,160 +28,40 @@
 //! 5. where the adaptive frames' time goes (paper reading): G-buffer, prediction, pyramid and
 //!    plan, shading and up-sampling, against the brute force's whole frame.
 //!
-//! # The sun's plateau
+//! # The brute force's plateau
 //!
-//! Under quarry_01 the brute force's curve flattens: BRDF importance sampling finds the map's
-//! small sun rarely, and its error falls slower than one over the samples until most pixels'
-//! samples find it. Measured with `brdf-preview --converged 1024` on gold-paint / quarry / torus,
-//! 256 x 256, 256 spp: 38.9, 40.1, 41.8 and 47.0 dB (whole image) at 1, 4, 16 and 128 frames (the
-//! last every baked sample once), 1.2 and 1.7 dB per 4x where an estimator without rare events
-//! gains 6, and the mean luminance within 3.4%, 0.1%, 1.0% and 0.2% of the converged estimate: it
-//! converges to it, slowly, no bias. In this benchmark (512 x 512, one frame) gold-paint's and
-//! white-paint's brute force under quarry gains at most 0.6 dB per doubling from 32 to 256 spp
-//! (white-paint / quarry / torus 31.87, 32.27, 32.38 and 32.35 dB), where every case under
-//! potsdamer gains 3.1 to 4.4 dB (chrome's under quarry flattens too, at 44 dB, above its
-//! adaptive frames). An adaptive frame whose PSNR lands on that plateau has a speed-up that is
-//! the luck of its samples and the brute force's: with `--seed 0`, `1` and `2` (one build, `--
-//! --gpu --no-extras`) white-paint / quarry / torus at 16 spp gave 1.8x, 2.4x and 1.4x (1.4x to
-//! more than 11x over six seeds), gold-paint / quarry / torus at 4 spp 29.1x, 4.5x and 7.2x,
-//! white-paint / quarry / sphere pre-filtered at 2 spp 3.5x, 3.4x and 36.8x; the medians over
-//! the 24 rows moved with them, `adaptive` 7.4x, 5.3x and 5.2x, `adaptive-prefiltered` 9.7x,
-//! 6.8x and 10.3x. The PSNRs of gold-paint's and white-paint's rows under quarry moved by 0.1
-//! to 1.8 dB from one seed to another. So the report marks the rows on the plateau (`~`): the
-//! brute force's curve gains less than [`FLAT_DB_PER_DOUBLING`] per doubling between the two
-//! budgets around the adaptive PSNR, or never reaches it but by less than [`PLATEAU_DB`]; and
-//! it gives the summary over the rows off the plateau beside the one over all rows that issue
-//! 11 asks for. Off the plateau the medians held: `adaptive` 3.9x, 4.1x and 4.0x (8 of 16 rows
-//! at 4x in each: all 8 under quarry's sun are on it, and chrome's 8 miss),
-//! `adaptive-prefiltered` 9.8x, 10.2x and 10.3x (10, 11 and 12 of 21 at 10x; three of
-//! white-paint's rows under quarry on the plateau). A frame well above the plateau is a lower
-//! bound as before (`>`: gold-paint under quarry pre-filtered, 35.2 to 39.0 dB on the sphere
-//! against the brute force's best 31.1, 30.7 to 34.3 on the torus against 29.7: 18x to 42x).
+//! Where the brute force's curve flattens (its PSNR gains less than [`FLAT_DB_PER_DOUBLING`] per
+//! doubling of its samples around an adaptive frame's PSNR, or it never reaches it but by less
+//! than [`PLATEAU_DB`]), an equal-quality speed-up is the luck of the samples, and the report
+//! marks the row `~` and summarizes the rows off the plateau apart. A brute force that finds a
+//! small bright source only by chance flattens so: the reference mode before it sampled the
+//! environment did under quarry's sun. With multiple importance sampling of the environment it
+//! converges there like anywhere (gold-paint / quarry / sphere: 26.2 dB at 1 spp to 50.2 at 64,
+//! 4 dB per doubling).
 //!
-//! # On the GPU, and what was measured
+//! # On the GPU
 //!
 //! With `--gpu`, the brute force renders on the GPU (`gpu::preview`) and so do the adaptive
-//! frames, whole (`Renderer::render_adaptive`, as `brdf-preview` runs them: one submission
-//! under the area allocation, the default), timed without reading their buffers back and then
-//! rendered once more with them for the ceiling. The G-buffer is then the camera's,
-//! made once before the frames (`Renderer::adaptive_geometry`), as the brute force's raster pass
-//! is; on the CPU both rasterize in every frame.
+//! frames, whole (`Renderer::render_adaptive`, as `brdf-preview` runs them: one submission under
+//! the area allocation, the default), timed without reading their buffers back and then rendered
+//! once more with them for the ceiling. The G-buffer is then the camera's, made once before the
+//! frames (`Renderer::adaptive_geometry`), as the brute force's raster pass is; on the CPU both
+//! rasterize in every frame. On lavapipe the "GPU" is the machine's own cores: a frame's time is
+//! its work, not its waits.
 //!
-//! On an NVIDIA H100 (stop 25, before the changes of stop 26 below; `--gpu --no-extras`, all
-//! twelve cases; the medians as those reports printed them, the upper of the two middle rows:
-//! recomputed, 2.2x and 1.05x, and 2.15x and 1.4x for the earlier run) the adaptive frames
-//! take 2.7 to 3.9 ms, of which the GPU is busy 1.1 to 1.5 ms by its clock (prediction 0.3 ms; pyramids,
-//! plan and samples 0.4 to 0.5 ms; shading, up-sampling and output 0.4 to 0.8 ms): the rest is
-//! the submission, the wait and the image's read-back, about what the brute force's frame
-//! costs whole at 1 spp (1.8 to 2.6 ms; 8.7 to 15 ms at 256 spp). Median speed-up 2.5x for
-//! `adaptive` (6 of 24 rows at 4x, the best 5.1x), 1.1x pre-filtered (none at 10x); an earlier
-//! run (one timestamp fewer) on another H100 gave 2.3x (5 rows) and 1.4x. When the frame was two
-//! submissions with the allocation on the CPU between them (stop 24, another H100) its frames
-//! took 3.2 to 6.2 ms and the medians were 1.7x and 1.2x; with its plan and up-sampling on the
-//! CPU, 21 to 29 ms. Timings differ by about 1 ms from one H100 machine to the next (the brute
-//! force's 1 spp frame from 1.6 to 3.1 ms on the same case); the ratios are of the same run.
+//! # Measured
 //!
-//! Stop 28, after the plan counts each chunk's shaded blocks (the `adaptive_chunks` pass gone),
-//! the list skips chunks without one, and the output reads the depth alone: the builds before
-//! and after alternated twice (`-- --gpu --no-extras`, seed 0), pyramids, plan and samples 13.5
-//! and 13.4 ms on average before, 11.7 and 11.5 after; adaptive frames 99.8 and 96.8 ms on
-//! average before, 95.4 and 91.8 after. Medians over all rows: `adaptive` 7.9x and 8.2x before,
-//! 8.7x and 8.9x after; `adaptive-prefiltered` 9.6x and 9.6x, then 9.7x and 9.8x. Off the
-//! plateau: `adaptive` 4.0x and 4.0x, then 3.9x and 4.1x (8 of 16 rows at 4x in all four);
-//! `adaptive-prefiltered` 9.8x and 9.7x (10 of 21 at 10x), then 10.2x and 9.9x (11 and 10).
-//! The rows at the middle, white-paint / potsdamer / torus pre-filtered at 2 and 8 spp, gave
-//! 9.2x to 10.2x over the four runs: they sit on the goal's line.
-//!
-//! Stop 29, the frame's code as in stop 28, seeds 0 (with the extras), 1 and 2: medians over all
-//! rows `adaptive` 8.2x, 5.4x and 5.4x, `adaptive-prefiltered` 10.7x, 7.2x and 10.2x; off the
-//! plateau 3.8x, 3.8x and 4.1x (8 of 16 rows at 4x in each), and 11.0x, 10.7x and 10.6x (12, 12 and
-//! 11 of 21 at 10x); white-paint / potsdamer / torus pre-filtered at 2 and 8 spp, stop 28's middle
-//! rows, 9.4x to 11.4x. Chrome's rows (0.4x to 2.3x) are out of the goal's reach on this adapter:
-//! under the paper's reading its plans shade 2 to 15% of the pixels and stop at or near their
-//! ceiling (34.9 to 44.1 dB), which the brute force reaches at 4 to 16 spp in 76 to 136 ms, so 4x
-//! asks for a frame of 19 to 34 ms, what the prediction and the plan take by themselves (19 to 33
-//! ms on the GPU's clock); the readings that keep the mirror's detail shade 34 to 98% of the
-//! pixels, and a frame that skips the rest gains at most one over that fraction over a brute force
-//! as fast per sample (they measured 0.5x to 2.3x).
-//!
-//! Measured on lavapipe (`-- --gpu`, 2 cores, idle), paper reading, stop 27, after a shaded
-//! block may read several baked vectors (`render::adaptive`, "Samples": the cap was one vector
-//! of 256 samples, and the sphere's plans, which shade 2% of the pixels, left most of a large
-//! budget unspent): the builds before and after, run one after the other, then the new one
-//! again: `adaptive` median 10.3x before, 8.7x and 8.6x after, 15 of 24 rows at 4x or more in
-//! each; `adaptive-prefiltered` 7.1x before, 9.4x and 9.3x after (the middle rows 9.4x and
-//! 9.4x), 10 then 11 and 11 rows at 10x or more. At equal budget the frames are as good or
-//! better in 21 of the 24 rows of each mode (gold-paint / potsdamer / sphere at 16 spp 52.93 dB
-//! against 51.81, with 2075648 samples against 584704; white-paint / quarry / sphere
-//! pre-filtered at 8 spp 36.83 against 35.77, from 4.8x to more than 17x); where the extra
-//! samples buy little (near the ceiling) the frame takes longer for little gain (the same
-//! gold-paint row 203 ms against 96, 15.3x to 8.4x), and under quarry's sun three rows lose up
-//! to 0.4 dB (white-paint / quarry / sphere pre-filtered at 2 spp 34.67 against 35.09 dB: the
-//! coarse blocks take more of the budget than the cap left them). The torus's plans shade
-//! enough blocks that the cap rarely bound; its rows moved by the brute force's timing alone
-//! (its 1 spp frame 35 to 42 ms in these runs, 38 to 46 in stop 26). Other readings (the
-//! second run after): level-normalized 1.9x and 1.5x, the FFT oracle 3.6x and 3.0x, paper +
-//! lobe weight 8.3x and 9.1x. Adaptive frames 43 to 223 ms; 16x anti-aliasing 2.7x to 4.1x the
-//! time of none.
-//! Then, in the same stop, the WGSL without function-local arrays indexed by a variable
-//! (llvmpipe keeps those in scratch memory, about 1.5 ms a dispatch: `adaptive_allocate` took
-//! 1.7 to 2.0 ms though it runs one invocation over a few levels, 0.1 ms after; ARCHITECTURE,
-//! `gpu`): the builds before and after alternated twice (`-- --gpu --no-extras`), the pyramids,
-//! plan and samples 16.2 and 15.9 ms on average before, 13.0 and 12.8 after; `adaptive` median
-//! 8.75x and 8.45x before, 8.95x and 8.5x after (15 of 24 rows each); `adaptive-prefiltered`
-//! 9.35x and 8.65x before (11 rows at 10x), 10.2x and 10.1x after (13 rows: white-paint /
-//! potsdamer / torus at 2 and 8 spp, 10.2x and 10.0x in the second run, cross the line: the
-//! median sits at the goal, within the brute force's timing noise, not above it). Adaptive
-//! frames 40 to 218 ms, the brute force's 1 spp frame 34 to 40 ms.
-//!
-//! Stop 26 (the environment
-//! behind the mesh drawn once per camera, the prediction's curvature the CPU G-buffer's,
-//! `adaptive-prefiltered`'s blocks one layer sharper than the bake's pick: `render::adaptive`,
-//! "Shading"): `adaptive` median 11.0x, 15 of 24 rows at 4x or more; `adaptive-prefiltered`
-//! median 8.0x, 12 of 24 at 10x or more (the middle rows 5.6x and 10.4x; the other readings:
-//! level-normalized 1.6x and 1.4x, the FFT oracle 3.8x and 3.2x). The medians are of 24 rows,
-//! the mean of the middle two; the reports before stop 26 printed the upper of the two, and
-//! their runs' medians were, recomputed: stop 25 10.7x and 5.6x (printed 11.8x and 6.2x), then
-//! 8.6x and 5.0x (9.0x, 5.1x); stop 26 before the layer shift 10.1x and 5.6x. The layer shift
-//! moved gold-paint / potsdamer / sphere pre-filtered from 46.2 to 50.5 dB (8.9x to 16.3x at 2
-//! spp), the torus from 7.7x and 4.9x to 11.0x and 11.5x, white-paint / potsdamer / torus from
-//! 9.3x and 8.6x to 10.9x and 10.4x. The 12 rows below 10x are chrome's 8 (0.8x to 2.0x) and white-paint
-//! under quarry's 4 (2.7x to 5.6x), where the sun's rare samples keep the adaptive frame at 31
-//! to 36 dB, which the brute force reaches in 150 to 600 ms. The brute force's 1 spp frame took
-//! 38 to 46 ms; 16x anti-aliasing cost 2.8x to 4.9x the time of none. Adaptive frames 45 to 173
-//! ms: prediction 9.6 to 19 ms, pyramids, plan and samples 13 to 31, shading, up-sampling and
-//! output 20 to 147 (by lavapipe's clock).
-//! Earlier (stop 25, the frame one submission): `adaptive` 15 of 24 rows at 4x,
-//! `adaptive-prefiltered` 6 of 24 at 10x, in two runs that differed mostly in the brute force's
-//! speed (its 1 spp frame 41 to 54 ms, then 37 to 43). In two submissions (stop 24) and with the
-//! plan and the up-sampling on the CPU (stop 23) the same rows passed: on lavapipe the "GPU" is
-//! the same two cores, and a frame's time is its work, not its waits. Chrome misses in all its
-//! 16 rows (0.6x to 2.0x): its frames stop at their ceiling (34.9 to 44 dB: up-sampling a
-//! mirror's reflection loses its detail, and the readings that keep it shade 34 to 98% of the
-//! pixels), a PSNR the brute force reaches at 4 to 32 spp in 82 to 152 ms. The other that misses
-//! 4x: white-paint / quarry / torus at 16 spp (1.9x; in stop 25 two more of its rows, to 3.0x;
-//! its brute-force curve is on the sun's plateau, above).
-//! Drawing the environment behind the mesh once per camera rather than in every frame
-//! shortened the adaptive frames of gold-paint / potsdamer / torus by 1 to 19 ms (the builds
-//! before and after, alternated twice on an idle machine: `adaptive` 4 spp 65 to 67 ms against
-//! 74 to 84, 16 spp 139 to 142 against 149 to 161, pre-filtered 2 spp 49 to 50 against 55 to 58,
-//! 8 spp 87 to 94 against 95 to 96) and the brute force's 1 spp frame by 1 to 5 ms (40 to 41
-//! against 42 to 45); taking the curvature from the CPU's G-buffer shortened the prediction of
-//! gold-paint / potsdamer / sphere from 19 to 23 ms to 17 to 20.
-//! A coarser prediction does not pay for itself: with `--predict-level 3` (a 64th of the
-//! prediction pixels, a quarter of level 2's) `adaptive`'s median falls to 8.0x (14 rows at 4x;
-//! 10.7x at level 2 in the same stop) and the pre-filtered one stays at 5.9x (7 at 10x; 5.6x);
-//! the default stays 2. Again in stop 28 (seed 0, against the two runs at level 2 above): the
-//! frames 1 to 29 ms shorter, the ceilings 0.4 to 2.8 dB lower (gold-paint / potsdamer / sphere
-//! 52.09 dB against 53.01), so the low budgets gain (white-paint / potsdamer / torus
-//! pre-filtered at 2 spp 13.4x against 10.2x and 9.9x) and the budgets near the ceiling lose (at
-//! 8 spp 9.7x against 9.2x and 9.7x; white-paint / potsdamer / sphere 10.2x against 12.5x and
-//! 11.3x): medians off the plateau 3.7x (`adaptive`, 9 of 18 rows at 4x) and 10.2x (12 of 23
-//! at 10x), against 3.9x and 4.1x, 10.2x and 9.9x.
-//! On 2 cores the first run takes about 50 minutes (the twelve converged estimates, 2 to 4.5
-//! minutes each on the CPU), a rerun 5 to 15 (20 s to a minute a case, with the extras). At this
-//! size 16x anti-aliasing cost 3.5x to 5.5x the time of none on lavapipe in stop 25 (4.3x to 6.7x
-//! in stop 24).
+//! `cargo bench -p brdf-preview --bench adaptive -- --gpu` on lavapipe (2 cores, idle; the
+//! report's first lines give the commit; seed 0), paper reading: `adaptive` median speed-up 3.7x
+//! (0.4x to 15.1x; 11 of 24 rows at the issue's 4x), `adaptive-prefiltered` 6.9x (0.9x to 22.7x;
+//! 7 of 24 at 10x); no row on a plateau. By material: gold-paint 6.8x and 10.1x, white-paint 6.1x
+//! and 9.4x, chrome 1.1x and 2.2x (its frames stop at their ceiling, which the brute force
+//! reaches in a few samples). The other readings: level-normalized 2.9x and 2.8x, the FFT oracle
+//! 2.8x and 3.7x, paper with the lobe weight 4.0x and 6.6x. The brute force's frame takes 76 to
+//! 96 ms at 1 spp (two directions a sample: the material's and the environment's), the adaptive
+//! frames 112 to 752 ms and 64 to 330 ms; 16x anti-aliasing costs 1.5x to 2.1x the time of none.
+//! A first run takes about 30 minutes on 2 cores (the twelve converged estimates on the CPU,
+//! kept for later runs). Not measured on a GPU with these estimators.
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu] [-- --seed S]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
@@ -191,7 +71,7 @@
 use std::path::PathBuf;
 
 mod common;
-use common::{material_path, root, shared};
+use common::{Stamp, material_path, root, shared};
 use std::time::Instant;
 
 use bandwidth::Reading;
@@ -447,6 +327,8 @@ fn main() {
             None => "CPU renderer".to_string(),
         }
     ));
+    out(String::new());
+    out(format!("Measured at {}.", Stamp::now()));
     out(String::new());
     out(format!(
         "{size} x {size}, converged estimate {converged_samples} samples per strategy; brute force: the reference mode at 1 to 256 spp, one frame; \

@@ -75,7 +75,7 @@
 //! with numpy for the materials, made once under target/merl/).
 
 mod common;
-use common::{material_path, root, shared};
+use common::{Stamp, material_path, root, shared};
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -491,16 +491,6 @@ fn save_png(path: &Path, canvas: &Canvas) {
     write(path, &png);
 }
 
-fn git(args: &[&str]) -> String {
-    Command::new("git")
-        .args(args)
-        .current_dir(root())
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map_or_else(|| "unknown".into(), |o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-}
-
 fn main() {
     let options = options();
     let started = Instant::now();
@@ -516,13 +506,7 @@ fn main() {
     if !names.iter().any(|n| wanted(n)) {
         panic!("--cases {:?} matches none of: {}", options.cases.join(","), names.join(", "));
     }
-    let commit = format!(
-        "{}{}",
-        git(&["rev-parse", "--short", "HEAD"]),
-        if git(&["status", "--porcelain", "--untracked-files=no"]).is_empty() { "" } else { " (modified)" }
-    );
-    let host = std::fs::read_to_string("/etc/hostname").map_or_else(|_| "unknown".into(), |h| h.trim().to_string());
-    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let Stamp { commit, host, cores } = Stamp::now();
 
     let mut rows: Vec<Value> = Vec::new();
     let mut checks: Vec<Value> = Vec::new();

@@ -93,6 +93,7 @@ fn main() {
         }
     }
 
+    println!("Measured at {}.", common::Stamp::now());
     if calibrate {
         calibration(&cases, &scene, &exponents, quick);
     }
