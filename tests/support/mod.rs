@@ -259,6 +259,17 @@ pub fn nbrdf_table(name: &str) -> PathBuf {
 }
 
 /// A temporary folder under target/, removed when dropped.
+/// A PSNR a tool reported in JSON under `key` of `object`: `null` is an infinite one (identical
+/// pictures, which JSON cannot write as a number); a missing key fails the test, so that a report
+/// that lost its figure cannot pass a bar.
+pub fn reported_psnr(object: &serde_json::Value, key: &str) -> f64 {
+    match object.get(key) {
+        Some(serde_json::Value::Null) => f64::INFINITY,
+        Some(value) => value.as_f64().unwrap_or_else(|| panic!("{key} is not a number in {object}")),
+        None => panic!("no {key} in {object}"),
+    }
+}
+
 pub fn temp_dir() -> tempfile::TempDir {
     let base = root().join("target").join("test-tmp");
     std::fs::create_dir_all(&base).expect("creating target/test-tmp");

@@ -2,7 +2,7 @@
 //! view, and a sharper material never selects a broader layer.
 
 use brdf_atlas::Config;
-use brdf_atlas::view::{ViewReduction, select_layers_of_table};
+use brdf_atlas::view::select_layers_of_table;
 use merl::analytic::Analytic;
 
 /// The default layers' exponents.
@@ -60,24 +60,14 @@ fn layer_bandwidths_grow_like_sqrt_n() {
     assert!(b[2] > 1.2 * b[1] && b[1] > b[0] * 0.9, "{b:?}");
 }
 
-/// The maximum, the papers' literal reading, ties neighbouring layers (the estimator reads whole
-/// octaves, the layers are an octave apart): the reason the bake does not use it.
-#[test]
-fn the_maximum_cannot_tell_all_layers_apart() {
-    let config = config();
-    let b: Vec<f64> =
-        EXPONENTS.iter().map(|&n| brdf_atlas::view::layer_bandwidth(&config, n, ViewReduction::Max)).collect();
-    let ties = b.windows(2).filter(|w| (w[1] / w[0] - 1.0).abs() < 0.05).count();
-    assert!(ties > 0, "the maximum now separates every layer: {b:?}; revisit the reduction's choice");
-}
-
 /// A Lambertian table's lobe is a constant: it has no detail above the analysis's noise floor, so
 /// every view is flat and takes the broadest layer (the rounding noise of its lookups would read
 /// as the finest frequencies and pick the sharpest).
 #[test]
 fn a_lambertian_table_selects_the_broadest_layer_at_every_view() {
     let table = Analytic::Lambertian { albedo: [0.8, 0.5, 0.2] }.table(merl::Dims::MERL);
-    let selection = select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layers::DEFAULT_REDUCTION).unwrap();
+    let selection =
+        select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layers::DEFAULT_REDUCTION).unwrap();
     println!("lambertian: view bandwidths {:.3?}", selection.view_bandwidth);
     assert!(selection.view_bandwidth.iter().all(|&b| b == 0.0), "{:?}", selection.view_bandwidth);
     assert!(selection.view_layer.iter().all(|&l| l == 0), "{:?}", selection.view_layer);

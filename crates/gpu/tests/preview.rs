@@ -50,7 +50,12 @@ fn material(brdf: Analytic) -> Material {
     let table = brdf.table(Dims::MERL);
     let config = importance::Config { n_theta_o: 90, n_vectors: 8, n_samples: 64, ..Default::default() };
     let tables = importance::build(&table, &config).expect("a valid config");
-    Material { samples: SampleSet::new(&tables), table, view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0], wavelet: None }
+    Material {
+        samples: SampleSet::new(&tables),
+        table,
+        view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0],
+        wavelet: None,
+    }
 }
 
 fn lambertian() -> &'static Material {
@@ -584,133 +589,198 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
     }
 }
 
-/// Issue 11: an adaptive frame on the GPU (`Renderer::render_adaptive`: prediction, pyramids,
-/// plan, shading, up-sampling and output there) equals the CPU's frame with the same predictions
-/// (`render::adaptive::replay_predictor`): the same plan (every block's action, parents and
-/// samples; the weights, which the GPU computes in f32, within 1e-5 of the CPU's f64 ones
-/// rounded to f32: a few f32 ulps of each factor), and the image within the full-resolution
-/// modes' tolerances, with and without anti-aliasing, for both estimators, with the lobe weight
-/// and with the oracle's bandwidths in place of the prediction's; with the samples allocated on
-/// the GPU (the area allocation: one submission; at 64 samples per pixel levels reach the cap
-/// of 64) and on the host (the variance and the standard deviation); with the default cap,
-/// blocks of more samples than the 64 of a vector (several vectors; at 256 spp parts of 128
-/// samples, each across two vectors); and with the sphere filling the image, so that the blocks
-/// in its top-left corner, block 0 of their levels, are parents (the WGSL's search for a parent
-/// already counted must not take its unwritten slots for block 0). A budget below a sample per
-/// shaded block is the same error on either.
-#[test]
-fn adaptive_frames_on_the_gpu_equal_the_cpu() {
+/// One adaptive frame's settings for [`check_adaptive_frame`].
+struct AdaptiveCase {
+    /// The sphere filling the image rather than the default view.
+    filled: bool,
+    mode: Mode,
+    supersample: usize,
+    spp: u32,
+    lobe_weight: bool,
+    oracle: bool,
+    allocation: render::adaptive::Allocation,
+    max_spp: u32,
+}
+
+/// A block cap of one vector's samples (the test material's 64).
+const ONE_VECTOR: u32 = 64;
+
+impl AdaptiveCase {
+    fn new(mode: Mode, spp: u32) -> AdaptiveCase {
+        AdaptiveCase {
+            filled: false,
+            mode,
+            supersample: 1,
+            spp,
+            lobe_weight: false,
+            oracle: false,
+            allocation: render::adaptive::Allocation::Area,
+            max_spp: ONE_VECTOR,
+        }
+    }
+}
+
+/// Renders `case` on the GPU twice and on the CPU from the GPU's predictions, and holds them to
+/// each other: the same plan (weights to f32 rounding), samples and image, stages within the wall
+/// time (see [`adaptive_reference_frame_equals_the_cpu`] for what the cases cover).
+fn check_adaptive_frame(case: AdaptiveCase) {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let whole = sphere_scene(SIZE);
     // From 1.5 radii away the sphere subtends 84 degrees; a 30 degree view sees only the sphere.
-    let camera = Camera::orbit(glam::Vec3::ZERO, 1.5, 0.3, 0.2, 30f32.to_radians()).unwrap();
-    let filled = Scene { camera, ..whole.clone() };
-    use render::adaptive::Allocation::{Area, StdDev, Variance};
-    const ONE_VECTOR: u32 = 64;
-    const DEFAULT: u32 = render::adaptive::MAX_SPP;
-    for (scene, mode, supersample, spp, lobe_weight, oracle, allocation, max_spp) in [
-        (&whole, Mode::Reference, 1, 8, false, false, Area, ONE_VECTOR),
-        (&whole, Mode::Prefiltered, 1, 4, false, false, Area, ONE_VECTOR),
-        (&whole, Mode::Reference, 2, 4, false, false, Area, ONE_VECTOR),
-        (&whole, Mode::Reference, 1, 8, true, false, Variance, ONE_VECTOR),
-        (&whole, Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
-        (&whole, Mode::Reference, 1, 64, false, false, Area, ONE_VECTOR),
-        (&whole, Mode::Prefiltered, 1, 4, false, false, StdDev, ONE_VECTOR),
-        (&whole, Mode::Reference, 1, 256, false, false, Area, DEFAULT),
-        (&whole, Mode::Prefiltered, 1, 32, false, false, StdDev, DEFAULT),
-        (&filled, Mode::Reference, 1, 8, false, true, Area, ONE_VECTOR),
-    ] {
-        let settings = render::adaptive::Settings {
-            supersample,
-            max_spp,
-            lobe_weight,
-            allocation,
-            ..render::adaptive::Settings::new(mode, spp)
-        };
-        let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
-        let (w, h) = (render_scene.width, render_scene.height);
-        // An oracle that asks for every level somewhere: a ramp over the image.
-        let ramp: Vec<f64> = (0..w * h).map(|i| 0.6 * ((i % w) as f64 / w as f64).powi(3)).collect();
-        let mut renderer = renderer(&render_scene, material, lighting);
-        renderer.set_bandwidths(&bandwidths).unwrap();
-        let options = gpu::preview::FrameOptions { oracle: oracle.then_some(&ramp[..]), details: true };
-        let gpu_frame = renderer
-            .render_adaptive(material, lighting, &settings, options)
-            .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
-        // The same frame again on the same renderer: nothing of the first (the plan's counts per
-        // level and per chunk, which it adds to) carries over.
-        let again = renderer.render_adaptive(material, lighting, &settings, options).unwrap();
-        assert!(again.image.rgb == gpu_frame.image.rgb && again.samples == gpu_frame.samples, "a second frame differs");
-        let mut replay = render::adaptive::replay_predictor(&gpu_frame.details().predictions);
-        let hooks = render::adaptive::Hooks {
-            predictor: Some(&mut replay),
-            oracle: oracle.then_some(&ramp[..]),
-            ..Default::default()
-        };
-        let geometry = render::adaptive::Geometry::of_scene(scene, settings.supersample).unwrap();
-        if std::ptr::eq(scene, &filled) {
-            assert!(geometry.pixels().iter().all(Option::is_some), "the sphere fills the image");
-        }
-        let cpu_frame =
-            render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &settings, hooks).unwrap();
-        let worst = gpu_frame.details().plan.compare(&cpu_frame.details().plan, 1e-5).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(gpu_frame.shaded_per_level, cpu_frame.shaded_per_level);
-        assert_eq!((gpu_frame.samples, gpu_frame.budget), (cpu_frame.samples, cpu_frame.budget));
-        // One submission under the area allocation, its stages on the GPU's clock (where the
-        // adapter has one) within the frame's wall time; two otherwise.
-        let t = gpu_frame.timings;
-        assert_eq!(t.submissions, if allocation == Area { 1 } else { 2 });
-        // In two submissions the stages are differences of the wall clock's readings, and their
-        // sum may pass the last reading by a rounding (seen: 62.97396800000001 against
-        // 62.973968000000006).
-        let stages = t.predict_ms + t.plan_ms + t.shade_ms;
-        assert!(
-            stages > 0.0 && stages <= t.total_ms * (1.0 + 1e-12),
-            "stages {stages} ms of a frame of {} ms",
-            t.total_ms
-        );
-        if t.gpu_clock {
-            assert!(t.predict_ms > 0.0 && t.plan_ms > 0.0 && t.shade_ms > 0.0, "{t:?}");
-        }
-        let shaded: usize = cpu_frame.shaded_per_level.iter().sum();
-        assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
-        let most = (cpu_frame.details().plan.actions.iter().flatten())
-            .filter_map(|a| match *a {
-                render::adaptive::Action::Shade { samples, .. } => Some(samples),
-                _ => None,
-            })
-            .max();
-        if max_spp > ONE_VECTOR {
-            assert!(most > Some(ONE_VECTOR), "the largest block has {most:?} samples");
-        }
-        let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
-        log(&format!(
-            "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples \
-             (at most {most:?} a block), \
-             worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error {relative:.2e}, {} submissions, \
-             stages {:.2} + {:.2} + {:.2} ms of {:.2} (GPU clock: {})",
-            mode.name(),
-            allocation.name(),
-            if lobe_weight { " lobe weight" } else { "" },
-            if oracle { " oracle" } else { "" },
-            cpu_frame.shaded_per_level,
-            cpu_frame.samples,
-            t.submissions,
-            t.predict_ms,
-            t.plan_ms,
-            t.shade_ms,
-            t.total_ms,
-            t.gpu_clock,
-        ));
-        assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
+    let filled_camera = Camera::orbit(glam::Vec3::ZERO, 1.5, 0.3, 0.2, 30f32.to_radians()).unwrap();
+    let scene = if case.filled { Scene { camera: filled_camera, ..whole.clone() } } else { whole };
+    let AdaptiveCase { mode, supersample, spp, lobe_weight, oracle, allocation, max_spp, .. } = case;
+    let settings = render::adaptive::Settings {
+        supersample,
+        max_spp,
+        lobe_weight,
+        allocation,
+        ..render::adaptive::Settings::new(mode, spp)
+    };
+    let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
+    let (w, h) = (render_scene.width, render_scene.height);
+    // An oracle that asks for every level somewhere: a ramp over the image.
+    let ramp: Vec<f64> = (0..w * h).map(|i| 0.6 * ((i % w) as f64 / w as f64).powi(3)).collect();
+    let mut renderer = renderer(&render_scene, material, lighting);
+    renderer.set_bandwidths(&bandwidths).unwrap();
+    let options = gpu::preview::FrameOptions { oracle: oracle.then_some(&ramp[..]), details: true };
+    let gpu_frame = renderer
+        .render_adaptive(material, lighting, &settings, options)
+        .unwrap_or_else(|e| panic!("adaptive frame on the gpu: {e}"));
+    // The same frame again on the same renderer: nothing of the first (the plan's counts per
+    // level and per chunk, which it adds to) carries over.
+    let again = renderer.render_adaptive(material, lighting, &settings, options).unwrap();
+    assert!(again.image.rgb == gpu_frame.image.rgb && again.samples == gpu_frame.samples, "a second frame differs");
+    let mut replay = render::adaptive::replay_predictor(&gpu_frame.details().predictions);
+    let hooks = render::adaptive::Hooks {
+        predictor: Some(&mut replay),
+        oracle: oracle.then_some(&ramp[..]),
+        ..Default::default()
+    };
+    let geometry = render::adaptive::Geometry::of_scene(&scene, settings.supersample).unwrap();
+    if case.filled {
+        assert!(geometry.pixels().iter().all(Option::is_some), "the sphere fills the image");
     }
-    // Every render pixel at level 0 (an oracle at the Nyquist rate) with 2 x 2 anti-aliasing
-    // shades about 4 blocks per output pixel: 1 sample per output pixel cannot pay for them.
-    let render_scene = Scene { width: SIZE * 2, height: SIZE * 2, ..whole.clone() };
-    let mut renderer_2 = renderer(&render_scene, material, lighting);
-    renderer_2.set_bandwidths(&bandwidths).unwrap();
+    let cpu_frame =
+        render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &settings, hooks).unwrap();
+    let worst = gpu_frame.details().plan.compare(&cpu_frame.details().plan, 1e-5).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(gpu_frame.shaded_per_level, cpu_frame.shaded_per_level);
+    assert_eq!((gpu_frame.samples, gpu_frame.budget), (cpu_frame.samples, cpu_frame.budget));
+    // One submission under the area allocation, its stages on the GPU's clock (where the
+    // adapter has one) within the frame's wall time; two otherwise.
+    let t = gpu_frame.timings;
+    assert_eq!(t.submissions, if allocation == render::adaptive::Allocation::Area { 1 } else { 2 });
+    // In two submissions the stages are differences of the wall clock's readings, and their
+    // sum may pass the last reading by a rounding (seen: 62.97396800000001 against
+    // 62.973968000000006).
+    let stages = t.predict_ms + t.plan_ms + t.shade_ms;
+    assert!(stages > 0.0 && stages <= t.total_ms * (1.0 + 1e-12), "stages {stages} ms of a frame of {} ms", t.total_ms);
+    if t.gpu_clock {
+        assert!(t.predict_ms > 0.0 && t.plan_ms > 0.0 && t.shade_ms > 0.0, "{t:?}");
+    }
+    let shaded: usize = cpu_frame.shaded_per_level.iter().sum();
+    assert!(shaded > 0 && cpu_frame.shaded_fraction() < 1.0, "{shaded} shaded blocks");
+    let most = (cpu_frame.details().plan.actions.iter().flatten())
+        .filter_map(|a| match *a {
+            render::adaptive::Action::Shade { samples, .. } => Some(samples),
+            _ => None,
+        })
+        .max();
+    if max_spp > ONE_VECTOR {
+        assert!(most > Some(ONE_VECTOR), "the largest block has {most:?} samples");
+    }
+    let (psnr, relative) = compare(&gpu_frame.image, &cpu_frame.image);
+    log(&format!(
+        "adaptive {} {supersample}x{supersample} {spp} spp {}{}{}: {shaded} shaded blocks, levels {:?}, {} samples \
+         (at most {most:?} a block), worst weight difference {worst:.1e}, PSNR {psnr:.2} dB, relative error \
+         {relative:.2e}, {} submissions, stages {:.2} + {:.2} + {:.2} ms of {:.2} (GPU clock: {})",
+        mode.name(),
+        allocation.name(),
+        if lobe_weight { " lobe weight" } else { "" },
+        if oracle { " oracle" } else { "" },
+        cpu_frame.shaded_per_level,
+        cpu_frame.samples,
+        t.submissions,
+        t.predict_ms,
+        t.plan_ms,
+        t.shade_ms,
+        t.total_ms,
+        t.gpu_clock,
+    ));
+    assert!(psnr >= MIN_PSNR_DB && relative <= MAX_RELATIVE_ERROR, "{psnr} dB, {relative}");
+}
+
+/// The cases below cover the reference and the pre-convolved estimators, 2 x 2 anti-aliasing, the
+/// lobe weight, the oracle's bandwidths, the allocations on the GPU (area) and on the host
+/// (variance, standard deviation), blocks capped at one vector and blocks of several vectors (at
+/// 256 spp parts of 128 samples, each across two vectors), and the sphere filling the image, so
+/// that the blocks in its top-left corner, block 0 of their levels, are parents (the WGSL's
+/// search for a parent already counted must not take its unwritten slots for block 0).
+#[test]
+fn adaptive_reference_frame_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase::new(Mode::Reference, 8));
+}
+
+#[test]
+fn adaptive_prefiltered_frame_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase::new(Mode::Prefiltered, 4));
+}
+
+#[test]
+fn adaptive_anti_aliased_frame_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase { supersample: 2, ..AdaptiveCase::new(Mode::Reference, 4) });
+}
+
+#[test]
+fn adaptive_frame_with_the_lobe_weight_and_the_variance_allocation_equals_the_cpu() {
+    let allocation = render::adaptive::Allocation::Variance;
+    check_adaptive_frame(AdaptiveCase { lobe_weight: true, allocation, ..AdaptiveCase::new(Mode::Reference, 8) });
+}
+
+#[test]
+fn adaptive_frame_with_the_oracle_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase { oracle: true, ..AdaptiveCase::new(Mode::Reference, 8) });
+}
+
+#[test]
+fn adaptive_frame_of_a_large_budget_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase::new(Mode::Reference, 64));
+}
+
+#[test]
+fn adaptive_prefiltered_frame_with_the_std_dev_allocation_equals_the_cpu() {
+    let allocation = render::adaptive::Allocation::StdDev;
+    check_adaptive_frame(AdaptiveCase { allocation, ..AdaptiveCase::new(Mode::Prefiltered, 4) });
+}
+
+#[test]
+fn adaptive_frame_of_blocks_across_vectors_equals_the_cpu() {
+    let max_spp = render::adaptive::MAX_SPP;
+    check_adaptive_frame(AdaptiveCase { max_spp, ..AdaptiveCase::new(Mode::Reference, 256) });
+}
+
+#[test]
+fn adaptive_prefiltered_frame_of_blocks_across_vectors_equals_the_cpu() {
+    let (allocation, max_spp) = (render::adaptive::Allocation::StdDev, render::adaptive::MAX_SPP);
+    check_adaptive_frame(AdaptiveCase { allocation, max_spp, ..AdaptiveCase::new(Mode::Prefiltered, 32) });
+}
+
+#[test]
+fn adaptive_frame_filling_the_image_equals_the_cpu() {
+    check_adaptive_frame(AdaptiveCase { filled: true, oracle: true, ..AdaptiveCase::new(Mode::Reference, 8) });
+}
+
+/// Every render pixel at level 0 (an oracle at the Nyquist rate) with 2 x 2 anti-aliasing shades
+/// about 4 blocks per output pixel: 1 sample per output pixel cannot pay for them, the same error
+/// whether the GPU allocates (area) or the host (variance).
+#[test]
+fn an_adaptive_budget_below_a_sample_per_block_is_an_error() {
+    let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
+    let render_scene = Scene { width: SIZE * 2, height: SIZE * 2, ..sphere_scene(SIZE) };
+    let mut renderer = renderer(&render_scene, material, lighting);
+    renderer.set_bandwidths(&bandwidths).unwrap();
     let nyquist = vec![0.5; 4 * SIZE * SIZE];
-    for allocation in [Area, Variance] {
+    for allocation in [render::adaptive::Allocation::Area, render::adaptive::Allocation::Variance] {
         let settings = render::adaptive::Settings {
             supersample: 2,
             max_spp: 64,
@@ -718,11 +788,16 @@ fn adaptive_frames_on_the_gpu_equal_the_cpu() {
             ..render::adaptive::Settings::new(Mode::Reference, 1)
         };
         let options = gpu::preview::FrameOptions { oracle: Some(&nyquist), details: false };
-        let error = renderer_2.render_adaptive(material, lighting, &settings, options).expect_err("over budget");
+        let error = renderer.render_adaptive(material, lighting, &settings, options).expect_err("over budget");
         assert!(error.to_string().contains("less than one for each"), "{}: {error}", allocation.name());
     }
-    // The prediction needs the bandwidths; without them the frame is an error that says so.
-    let renderer = renderer(&whole, material, lighting);
+}
+
+/// The prediction needs the bandwidths; without them the frame is an error that says so.
+#[test]
+fn an_adaptive_frame_without_bandwidths_is_an_error() {
+    let (material, lighting) = (phong(), sky_lighting());
+    let renderer = renderer(&sphere_scene(SIZE), material, lighting);
     let settings = render::adaptive::Settings::new(Mode::Reference, 4);
     let error = renderer.render_adaptive(material, lighting, &settings, details()).expect_err("no bandwidths");
     assert!(error.to_string().contains("set_bandwidths"), "{error}");
