@@ -159,6 +159,7 @@ $(OUT)/%/manifest.json: $(IN)/%.binary $(ENV) $(BIN)/brdf-bake
 ## lint: clippy on everything, warnings as errors; rustdoc on the libraries, warnings as errors
 ## (the tools' doc comments are their --help text, where rustdoc's markup does not apply).
 lint:
+	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps --lib
 

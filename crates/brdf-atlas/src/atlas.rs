@@ -341,7 +341,8 @@ pub fn build_atlas(
         .enumerate()
         .map_init(Scratch::default, |scratch, (j, tile)| {
             let filled = analyser.render(&luminance, grid.theta_i(j), scratch);
-            let band_energy = crate::view::band_energy(&scratch.image, config.analysis_size, config.relative_noise_floor);
+            let band_energy =
+                crate::view::band_energy(&scratch.image, config.analysis_size, config.relative_noise_floor);
             analyser.analyse_scratch(scratch);
             let nyquist_texels = analyser.reduction().reduce(&scratch.cycles_per_radian, &scratch.level, tile);
             progress(config.lobes);

@@ -232,7 +232,11 @@ impl Slice {
     /// `sampling::Distribution2D::from_cdfs` of the stored CDFs, which samples them as they are).
     pub fn from_tables(theta_o: f64, rows: HalfVectorRows, dist: Distribution2D) -> Result<Slice, Error> {
         if dist.nv() != rows.len() {
-            return Err(Error::Table(format!("{} rows of half vectors, but the distribution has {}", rows.len(), dist.nv())));
+            return Err(Error::Table(format!(
+                "{} rows of half vectors, but the distribution has {}",
+                rows.len(),
+                dist.nv()
+            )));
         }
         if !(0.0..std::f64::consts::FRAC_PI_2).contains(&theta_o) {
             return Err(Error::Table(format!("theta_o {theta_o} is outside [0, pi/2)")));

@@ -110,7 +110,14 @@ fn pdf_half_vector(wi_local: DVec3, wo: DVec3) -> f64 {
 }
 
 /// One pixel's estimate.
-fn estimate(frame: &ShadingFrame, material: &Material, lighting: &Lighting, rounds: u32, seed: u64, pixel: u64) -> [f64; 3] {
+fn estimate(
+    frame: &ShadingFrame,
+    material: &Material,
+    lighting: &Lighting,
+    rounds: u32,
+    seed: u64,
+    pixel: u64,
+) -> [f64; 3] {
     let wo = frame.wo_local;
     let (level0, env) = (lighting.mips.level(0), &lighting.environment);
     let sequences = [0, 1, 2].map(|s| OwenSobol2D::for_vector(seed, 3 * pixel + s));
@@ -123,7 +130,9 @@ fn estimate(frame: &ShadingFrame, material: &Material, lighting: &Lighting, roun
         if f == [0.0; 3] {
             return;
         }
-        let p = env_pdf.unwrap_or_else(|| env.pdf(envmap::uv(wi).into())) + pdf_cosine(wi_local) + pdf_half_vector(wi_local, wo);
+        let p = env_pdf.unwrap_or_else(|| env.pdf(envmap::uv(wi).into()))
+            + pdf_cosine(wi_local)
+            + pdf_half_vector(wi_local, wo);
         if !(p > 0.0 && p.is_finite()) {
             return;
         }

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::raster::{self, GBuffer, Hit};
 use crate::{
-    Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, pixel_sequences, point, sample_range, view_layer,
+    Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, pixel_sequences, point, sample_range,
+    view_layer,
 };
 
 /// A rendered image: linear RGB radiance, interleaved, row-major with row 0 at the top, and
@@ -200,7 +201,11 @@ pub(crate) fn shade(
                     let (u, v) = envmap::uv(wi);
                     match filtered {
                         Some(Source::Layers(a, b, t)) => {
-                            let radiance = if t > 0.0 { blend(a.lookup_uv(u, v), b.lookup_uv(u, v), t) } else { a.lookup_uv(u, v) };
+                            let radiance = if t > 0.0 {
+                                blend(a.lookup_uv(u, v), b.lookup_uv(u, v), t)
+                            } else {
+                                a.lookup_uv(u, v)
+                            };
                             add(f, radiance, wi_local.z / sample.pdf);
                         }
                         Some(Source::Mips(mips)) => {

@@ -282,7 +282,8 @@ fn pre_convolved_blocks_read_the_layer_layer_shift_sharper() {
         };
         let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
         let layer = shift.min(2);
-        let moved = render::Material { view_layers: vec![layer as f32; material.view_layers.len()], ..material.clone() };
+        let moved =
+            render::Material { view_layers: vec![layer as f32; material.view_layers.len()], ..material.clone() };
         let full = render::render(
             &scene,
             &moved,

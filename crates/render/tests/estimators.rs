@@ -79,7 +79,8 @@ fn sunny_lighting(sun: f32) -> Lighting {
     let map = EnvMap::new(w, h, rgb).expect("finite, non-negative, 2:1");
     let exponents = vec![1, 4, 16, 64, 256];
     let config = prefilter::Config { exponents: exponents.clone(), width: 64, height: 32, ..Default::default() };
-    let layers = prefilter::prefilter(&map, &config).expect("a valid config").layers.into_iter().map(|l| l.map).collect();
+    let layers =
+        prefilter::prefilter(&map, &config).expect("a valid config").layers.into_iter().map(|l| l.map).collect();
     Lighting::new(MipChain::new(&map), layers, exponents).expect("a valid map")
 }
 
@@ -116,12 +117,17 @@ fn the_filtered_modes_hold_the_light_of_a_small_bright_source() {
             for mode in [Mode::Fis, Mode::Prefiltered] {
                 let settings = Settings { mode, spp: 16, frames: 8, seed: 4 };
                 let mean = |lighting: &Lighting| {
-                    metrics::mean_luminance(&render::render(&scene, &material, lighting, &settings).expect("valid inputs"))
+                    metrics::mean_luminance(
+                        &render::render(&scene, &material, lighting, &settings).expect("valid inputs"),
+                    )
                 };
                 let base = mean(&plain);
                 let error = |with_sun: f64| (with_sun - base - (truth_sunny - truth_plain)) / truth_sunny;
                 let (split, whole) = (error(mean(&sunny)), error(mean(&unsplit)));
-                println!("{} {name}, sun {side}: the sun's light off by {split:+.4} of the picture's (unsplit {whole:+.4})", mode.name());
+                println!(
+                    "{} {name}, sun {side}: the sun's light off by {split:+.4} of the picture's (unsplit {whole:+.4})",
+                    mode.name()
+                );
                 assert!(split.abs() < 0.03, "{} {name}, sun {side}: the sun's light off by {split:+.4}", mode.name());
                 worst_unsplit = worst_unsplit.max(whole.abs());
             }
@@ -153,4 +159,3 @@ fn the_prefiltered_mode_leaves_no_seam_where_the_layer_changes() {
     assert!(hi / lo > 1.8, "the row does not cross from one layer to the other: {lo} to {hi}");
     assert!(worst < 0.12, "a step of {:.1}% between neighbouring pixels", 100.0 * worst);
 }
-

@@ -125,5 +125,3 @@ fn pixels_directions_have_the_tables_density() {
         assert!(result.p_value > sampling::chi2::ACCEPT, "point {index}: {result:?}");
     }
 }
-
-

@@ -67,7 +67,10 @@ fn prefiltered_mode_needs_layers() {
     let no_rows = Material { view_layers: Vec::new(), ..material.clone() };
     expect_invalid(render::render(&scene, &no_rows, &lighting, &prefiltered), "at least one view-layer entry");
     let out_of_range = Material { view_layers: vec![0.0, 1.0], ..material.clone() };
-    expect_invalid(render::render(&scene, &out_of_range, &lighting, &prefiltered), "view layer coordinate 1 is outside 0 to 0");
+    expect_invalid(
+        render::render(&scene, &out_of_range, &lighting, &prefiltered),
+        "view layer coordinate 1 is outside 0 to 0",
+    );
 }
 
 #[test]

@@ -290,7 +290,12 @@ fn stored_tables_that_are_not_cdfs_are_refused() {
     let cases: [(&str, Vec<f64>, Vec<f64>, Error); 5] = [
         ("marginal not from 0", vec![0.1, 0.5, 1.0], conditional.to_vec(), Error::InvalidCdf { index: 0, value: 0.1 }),
         ("marginal not to 1", vec![0.0, 0.5, 0.9], conditional.to_vec(), Error::InvalidCdf { index: 2, value: 0.9 }),
-        ("decreasing", vec![0.0, 0.5, 1.0], vec![0.0, 0.6, 1.0, 0.0, 1.5, 1.0], Error::InvalidCdf { index: 5, value: 1.0 }),
+        (
+            "decreasing",
+            vec![0.0, 0.5, 1.0],
+            vec![0.0, 0.6, 1.0, 0.0, 1.5, 1.0],
+            Error::InvalidCdf { index: 5, value: 1.0 },
+        ),
         ("NaN", vec![0.0, f64::NAN, 1.0], conditional.to_vec(), Error::InvalidCdf { index: 1, value: f64::NAN }),
         ("wrong size", vec![0.0, 1.0], conditional.to_vec(), Error::WrongSize { len: 6, nu: 3, nv: 2 }),
     ];

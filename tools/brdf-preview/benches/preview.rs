@@ -129,7 +129,8 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
                 reductions
                     .iter()
                     .map(|&r| {
-                        let selection = brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection");
+                        let selection =
+                            brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection");
                         view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth)
                     })
                     .collect(),

@@ -280,7 +280,9 @@ impl Renderer {
         // (`check_settings` holds the rows in range where the lobe weight is on).
         let sharpness: Vec<f32> = match lighting.exponents.is_empty() {
             true => vec![0.0; material.view_layers.len()],
-            false => material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect(),
+            false => {
+                material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect()
+            }
         };
         let p = (width * height) as u32;
         // The candidates: blocks that hold a shadeable pixel, level by level.
