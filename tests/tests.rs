@@ -3,6 +3,7 @@
 
 mod support;
 
+mod architecture;
 mod asset_info;
 mod bake_folders;
 mod brdf_bake;
