@@ -140,7 +140,7 @@ demo: setup-gpu build
 	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --out-dir $(DEMO)/bake
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --mode prefiltered --size 384x384 --camera 200,15 --sheet $(DEMO)/sheet.png
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview-reference.png --size 384x384 --camera 200,15 --validate
-	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png, sheet.png"
+	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png (reference mode), preview-reference-difference.png (GPU against CPU, with its scale), sheet.png"
 
 ## bake: every MERL table in IN (*.binary) into OUT/<name>/, in parallel with -j; ENV=map.hdr adds
 ## the environment stages. E.g. make -j4 bake IN=target/merl OUT=target/bakes ENV=../shared/data/env/quarry_01_1k.hdr

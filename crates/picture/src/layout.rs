@@ -245,3 +245,48 @@ pub fn stack(parts: &[Canvas]) -> Canvas {
     }
     canvas
 }
+
+/// Two 8-bit RGB pictures of `width` x `height` compared: a heat map of the largest channel's
+/// absolute difference per pixel, in 8-bit levels, on a linear scale from 0 to the largest
+/// difference (at least 1, so identical pictures show the scale's bottom colour, not a stretched
+/// rounding), with its legend and a caption that gives the largest difference, where it is, and
+/// how many pixels differ. `what` names the two pictures (`"GPU - CPU"`).
+///
+/// # Panics
+/// If either picture is not `width * height * 3` bytes.
+pub fn difference(a: &[u8], b: &[u8], width: usize, height: usize, what: &str) -> Canvas {
+    assert!(a.len() == width * height * 3 && b.len() == a.len(), "pictures of {width} x {height} RGB");
+    let levels: Vec<u8> = a
+        .chunks_exact(3)
+        .zip(b.chunks_exact(3))
+        .map(|(p, q)| p.iter().zip(q).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0))
+        .collect();
+    let (largest_at, largest) = levels.iter().enumerate().max_by_key(|(i, v)| (**v, std::cmp::Reverse(*i))).unwrap();
+    let differing = levels.iter().filter(|&&v| v > 0).count();
+    let scale = crate::colormap::Scale::linear(0.0, f64::from((*largest).max(1)));
+    let image = Canvas::from_fn(width, height, |x, y| {
+        crate::colormap::inferno(scale.position(f64::from(levels[y * width + x])))
+    });
+    let zoom = (256 / width.max(height).max(1)).max(1);
+    let axes = (Axis::new("x, pixels", 0.0, width as f64), Axis::new("y, pixels", 0.0, height as f64));
+    let mut panels = Grid::new(1);
+    panels.add(heat_map(&image, zoom, &axes.0, &axes.1), format!("|{what}|"));
+    let panel_width = panels.width().max(360);
+    let text = match differing {
+        0 => "Per pixel, the largest channel's difference of the two 8-bit pictures. They are identical.".to_string(),
+        _ => format!(
+            "Per pixel, the largest channel's difference of the two 8-bit pictures. Largest: {largest} level{} \
+             (of 255) at x {}, y {}; {differing} of {} pixels differ.",
+            if *largest == 1 { "" } else { "s" },
+            largest_at % width,
+            largest_at / width,
+            width * height
+        ),
+    };
+    panels.footer(stack(&[
+        crate::legend::Legend::new(scale, crate::colormap::inferno, format!("|{what}|, 8-bit levels"))
+            .render(panel_width),
+        caption(&text, panel_width),
+    ]));
+    panels.render()
+}

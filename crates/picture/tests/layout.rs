@@ -1,5 +1,5 @@
 use picture::font::{GLYPH_H, text_width};
-use picture::layout::{Axis, CAPTION_MARGIN, Grid, TITLE_GAP, TITLE_SPACE, caption, heat_map, stack};
+use picture::layout::{Axis, CAPTION_MARGIN, Grid, TITLE_GAP, TITLE_SPACE, caption, difference, heat_map, stack};
 use picture::{BACKGROUND, Canvas, INK, TEXT_SCALE};
 
 use crate::bounding_box;
@@ -131,4 +131,44 @@ fn captions_and_stacks() {
     assert_eq!(bounding_box(&both, [1, 2, 3]), Some((0, 0, 40, 10)));
     assert_eq!(bounding_box(&both, [4, 5, 6]), Some((0, 10, 60, 15)));
     assert_eq!(stack(&[]).width, 0);
+}
+
+/// The difference figure's heat map, drawn independently: `hot` pixels at the top of the scale,
+/// every other at its bottom.
+fn expected_difference_map(side: usize, hot: &[(usize, usize)]) -> Canvas {
+    let image = Canvas::from_fn(side, side, |x, y| {
+        if hot.contains(&(x, y)) { picture::colormap::inferno(1.0) } else { picture::colormap::inferno(0.0) }
+    });
+    let zoom = 256 / side;
+    heat_map(&image, zoom, &Axis::new("x, pixels", 0.0, side as f64), &Axis::new("y, pixels", 0.0, side as f64))
+}
+
+#[test]
+fn a_difference_figure_maps_the_largest_channel_difference_on_its_own_scale() {
+    let side = 16;
+    let a = vec![100u8; side * side * 3];
+    let mut b = a.clone();
+    // Pixel (3, 5) differs by 40 levels in green and 7 in blue; pixel (10, 2) by 20 in red.
+    let at = |x: usize, y: usize| 3 * (y * side + x);
+    b[at(3, 5) + 1] += 40;
+    b[at(3, 5) + 2] -= 7;
+    b[at(10, 2)] += 20;
+    let figure = difference(&a, &b, side, side, "GPU - CPU");
+    // The largest difference is the scale's top; the other one sits at half of it.
+    let half = picture::colormap::inferno(0.5);
+    let mut expected = expected_difference_map(side, &[(3, 5)]);
+    let zoom = 256 / side;
+    let origin = expected.find(&Canvas::from_fn(zoom, zoom, |_, _| picture::colormap::inferno(1.0))).unwrap();
+    expected.fill_rect(
+        (origin.0 + (10 - 3) * zoom) as isize,
+        (origin.1 as isize) - (3 * zoom) as isize,
+        zoom,
+        zoom,
+        half,
+    );
+    assert!(figure.find(&expected).is_some(), "the heat map shows (3, 5) at the top and (10, 2) at half the scale");
+    // Identical pictures: every pixel at the bottom of a scale of at least one level.
+    let same = difference(&a, &a, side, side, "GPU - CPU");
+    assert!(same.find(&expected_difference_map(side, &[])).is_some(), "identical pictures map to the scale's bottom");
+    assert!(same.find(&expected).is_none());
 }

@@ -26,11 +26,10 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
-use rayon::prelude::*;
 use sampling::OwenSobol2D;
 
 use crate::error::Error;
-use crate::shade::{ShadingFrame, background, brdf, visibility};
+use crate::shade::{ShadingFrame, brdf, shade_rows, visibility};
 use crate::{Image, Lighting, Material, Scene};
 
 /// The converged estimate of every covered pixel with `samples_per_strategy` rounds (see the
@@ -43,29 +42,25 @@ pub fn converged(
     samples_per_strategy: u32,
     seed: u64,
 ) -> Result<Image, Error> {
+    converged_with_progress(scene, material, lighting, samples_per_strategy, seed, &|_, _| {})
+}
+
+/// [`converged`], calling `progress(rows done, rows)` as rows finish (a progress bar's hook).
+pub fn converged_with_progress(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    samples_per_strategy: u32,
+    seed: u64,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<Image, Error> {
     if samples_per_strategy == 0 {
         return Err(Error::Invalid("the converged estimate needs at least one sample per strategy".into()));
     }
     let gbuffer = visibility(scene)?;
-    let level0 = lighting.mips.level(0);
-    let rays = scene.camera.rays(scene.width, scene.height);
-    let eye = scene.camera.eye().as_dvec3();
     let width = scene.width;
-    let mut rgb = vec![0.0f32; 3 * width * scene.height];
-    rgb.par_chunks_mut(3 * width).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.chunks_exact_mut(3).enumerate() {
-            let value = match gbuffer.hit(x, y) {
-                Some(hit) => match ShadingFrame::new(hit, eye) {
-                    Some(frame) => {
-                        let pixel = (y * width + x) as u64;
-                        estimate(&frame, material, lighting, samples_per_strategy, seed, pixel)
-                    }
-                    None => [0.0; 3],
-                },
-                None => background(&rays, level0, x, y),
-            };
-            out.copy_from_slice(&value.map(|v| v as f32));
-        }
+    let rgb = shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
+        estimate(frame, material, lighting, samples_per_strategy, seed, (y * width + x) as u64)
     });
     Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
 }

@@ -214,7 +214,7 @@ pub use camera::{Camera, Rays};
 pub use error::Error;
 pub use lighting::{Lighting, PEAK_CONTRAST, Peaks};
 pub use mesh::Mesh;
-pub use shade::{Image, check_inputs, check_settings, render};
+pub use shade::{Image, check_inputs, check_settings, render, render_with_progress};
 
 use merl::MerlTable;
 use sampling::OwenSobol2D;

@@ -28,27 +28,57 @@ pub struct Image {
 /// Renders `scene` with `settings.mode` (see the crate documentation for every step). Runs in
 /// parallel over rows; the result does not depend on the number of threads.
 pub fn render(scene: &Scene, material: &Material, lighting: &Lighting, settings: &Settings) -> Result<Image, Error> {
+    render_with_progress(scene, material, lighting, settings, &|_, _| {})
+}
+
+/// [`render`], calling `progress(rows done, rows)` as rows finish (a progress bar's hook; from any
+/// thread, in no particular order of rows).
+pub fn render_with_progress(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    settings: &Settings,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<Image, Error> {
     check_inputs(material, lighting)?;
     check_settings(settings, material.samples.n_samples, lighting.layers.len(), &material.view_layers)?;
     let gbuffer = visibility(scene)?;
-    let eye = scene.camera.eye().as_dvec3();
-    let level0 = lighting.mips.level(0);
-    let rays = scene.camera.rays(scene.width, scene.height);
     let width = scene.width;
-    let mut rgb = vec![0.0f32; 3 * width * scene.height];
+    let rgb = shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
+        shade(frame, (y * width + x) as u32, material, lighting, settings, 0)
+    });
+    Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
+}
+
+/// Every pixel of `scene`: `pixel(frame, x, y)` where a triangle covers it and has a shading
+/// frame, black where the frame is degenerate, the environment (`level0`) where none covers it.
+/// In parallel over rows, calling `progress(rows done, rows)` as they finish.
+pub(crate) fn shade_rows(
+    scene: &Scene,
+    gbuffer: &GBuffer,
+    level0: &EnvMap,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    pixel: impl Fn(&ShadingFrame, usize, usize) -> [f64; 3] + Sync,
+) -> Vec<f32> {
+    let eye = scene.camera.eye().as_dvec3();
+    let rays = scene.camera.rays(scene.width, scene.height);
+    let (width, height) = (scene.width, scene.height);
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let mut rgb = vec![0.0f32; 3 * width * height];
     rgb.par_chunks_mut(3 * width).enumerate().for_each(|(y, row)| {
         for (x, out) in row.chunks_exact_mut(3).enumerate() {
             let value = match gbuffer.hit(x, y) {
                 Some(hit) => match ShadingFrame::new(hit, eye) {
-                    Some(frame) => shade(&frame, (y * width + x) as u32, material, lighting, settings, 0),
+                    Some(frame) => pixel(&frame, x, y),
                     None => [0.0; 3],
                 },
                 None => background(&rays, level0, x, y),
             };
             out.copy_from_slice(&value.map(|v| v as f32));
         }
+        progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, height as u64);
     });
-    Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
+    rgb
 }
 
 /// The G-buffer of a scene, after checking it.

@@ -16,52 +16,61 @@ mod adaptive;
 mod window;
 
 /// Render a baked material on a mesh under the bake's environment with wgpu (headless; --window
-/// for an interactive view), by one of the estimators of the papers:
+/// for an interactive view), by one of the estimators of the papers.
+///
+/// Modes (--mode):
 ///
 ///   reference    multiple importance sampling (balance heuristic) of the material's baked
 ///                importance tables (001 section 3.3) and the environment's own: unbiased; each
 ///                pixel draws its own directions, so its error is not its neighbours'
+///
 ///   fis          filtered importance sampling (002): each of the material's samples reads the
 ///                environment's mip chain at the level of its footprint's solid angle
+///
 ///   prefiltered  the Phong layers (001 sections 2.5 and 4.3) around the layer the bake's
 ///                selection gives the view, blended, read by few samples
 ///
-/// fis and prefiltered filter only the environment's smooth part: texels brighter than 4 times
-/// its mean luminance (a sun, a softbox) are its peaks, sampled from the unfiltered map by
-/// multiple importance sampling, so a small bright source keeps its light. What the filter does
-/// to the smooth part is an approximation: within 2.5% of the converged estimate's mean
-/// luminance on white-paint, gold-paint and chrome under quarry_01 and studio_small_03, at the
-/// default settings (cargo bench -p brdf-preview --bench mitsuba reports each mode's PSNR and
-/// luminance against the converged estimate and Mitsuba 3); more for a broad lobe under a sharp
-/// horizon (a Lambertian's broadest layer is read at cosine-distributed directions: twice blurred).
 ///   adaptive     bandwidth-driven multi-resolution shading (001 sections 2-3): the bake's
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
-///                variance; only the pixels of a pyramid whose level the prediction asks for are
-///                shaded (reference estimator), a budget of --spp samples per pixel on average
-///                is shared among them (--allocation), the rest is up-sampled; one frame is one
-///                submission on the GPU (two with the samples allocated on the CPU between them
-///                for --allocation variance or std-dev), its G-buffer made on the CPU once per
-///                camera (crate render, module adaptive, is the specification)
+///                variance; only the pixels the prediction asks for are shaded (reference
+///                estimator) with a budget of --spp samples per pixel on average (--allocation),
+///                the rest is up-sampled (crate render, module adaptive, is the specification)
+///
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
-/// The environment is drawn behind the mesh, so its orientation can be checked. Pictures are
-/// tone mapped: exposure 2^EV (by default the one that maps the environment's log-average
-/// luminance to 0.18), Reinhard's x / (1 + x) per channel, then the sRGB transfer function to 8
-/// bits; a caption strip below the image says what was rendered.
+/// Small bright sources: fis and prefiltered filter only the environment's smooth part. Texels
+/// brighter than 4 times its mean luminance (a sun, a softbox) are its peaks, sampled from the
+/// unfiltered map by multiple importance sampling, so a small bright source keeps its light.
+/// What the filter does to the smooth part is an approximation: within 2.5% of the converged
+/// estimate's mean luminance on white-paint, gold-paint and chrome under quarry_01 and
+/// studio_small_03 at the default settings (cargo bench -p brdf-preview --bench mitsuba); more
+/// for a broad lobe under a sharp horizon (a Lambertian's broadest layer is read at
+/// cosine-distributed directions: twice blurred).
 ///
-/// --brdf wavelet evaluates the BRDF from a Haar wavelet encoding of the table (brdf-wavelet),
-/// decoded per sample on the GPU, and also renders the same image from the table itself: it
-/// reports the PSNR and relative error of the wavelet image against it and writes
-/// OUT-table.png.
+/// Pictures: the environment is drawn behind the mesh, so its orientation can be checked.
+/// Pictures are tone mapped: exposure 2^EV (by default the one that maps the environment's
+/// log-average luminance to 0.18), Reinhard's x / (1 + x) per channel, then the sRGB transfer
+/// function to 8 bits; a caption strip below the image says what was rendered.
 ///
-/// --validate renders the same image on the CPU (crate render: the same estimator, the same
-/// samples) and reports the PSNR of the two 8-bit pictures and the relative error of their linear
-/// radiance, and writes OUT-difference.png (|GPU - CPU| x 4). --converged N also renders an
-/// independent estimate (multiple importance sampling of the environment, the cosine and the
-/// MERL grid's half vectors, N samples per strategy, no baked table) and reports PSNR and the
-/// ratio of mean luminances against it. --sheet writes a contact sheet of every picture in the
-/// bake.
+/// Checks:
+///
+///   --validate   renders the same image on the CPU (crate render: the same estimator, the same
+///                samples), reports the PSNR of the two 8-bit pictures and the relative error of
+///                their linear radiance, and writes OUT-difference.png (|GPU - CPU| in tone-mapped
+///                8-bit levels, with its scale)
+///
+///   --converged N
+///                also renders an independent estimate (multiple importance sampling of the
+///                environment, the cosine and the MERL grid's half vectors, N samples per
+///                strategy, no baked table) and reports PSNR and the ratio of mean luminances
+///
+///   --brdf wavelet
+///                evaluates the BRDF from its Haar wavelet encoding (brdf-wavelet), decoded per
+///                sample on the GPU, renders the same image from the table, reports the PSNR and
+///                relative error of the wavelet image against it and writes OUT-table.png
+///
+///   --sheet FILE writes a contact sheet of every picture in the bake
 ///
 /// Exit status: 0 ok, 1 --min-psnr was not met, 2 error (including no GPU adapter).
 #[derive(Debug, Parser)]
@@ -223,6 +232,10 @@ struct Args {
     /// written) on stdout; the report goes to stderr.
     #[arg(long)]
     json: bool,
+
+    /// No progress bar (it shows on a terminal once a run takes a second, never with --json).
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -349,6 +362,7 @@ fn run(args: Args) -> Result<ExitCode> {
         files.push((path.clone(), "contact-sheet", png(&sheet.rgb, sheet.width, sheet.height)?));
     }
     let mut problems = Vec::new();
+    let progress = cli::Progress::new(args.quiet || args.json);
     if args.out.is_some() || args.window {
         let Some(lighting) = &loaded.lighting else {
             bail!(
@@ -361,7 +375,7 @@ fn run(args: Args) -> Result<ExitCode> {
                 bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
             }
             let out = args.out.as_ref().expect("clap requires --out without --window");
-            let step = render_adaptive(&args, &loaded, lighting, out)?;
+            let step = render_adaptive(&args, &loaded, lighting, out, &progress)?;
             files.extend(step.files);
             report.extend(step.report);
             problems.extend(step.problems);
@@ -388,6 +402,7 @@ fn run(args: Args) -> Result<ExitCode> {
             let gpu = open_gpu()?;
             let out = args.out.as_ref().expect("clap requires --out without --window");
             let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
+            progress.step(format!("{} on the GPU", mode.name()));
             let start = Instant::now();
             let image = renderer.render_frames(&settings)?;
             check_finite(&args, &image.rgb, "the GPU render")?;
@@ -435,6 +450,7 @@ fn run(args: Args) -> Result<ExitCode> {
             if loaded.material.wavelet.is_some() {
                 // What the compression costs: the same render from the table itself.
                 let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
+                progress.step(format!("{} from the table on the GPU", mode.name()));
                 let table =
                     gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
                 check_finite(&args, &table.rgb, "the GPU render from the table")?;
@@ -449,14 +465,22 @@ fn run(args: Args) -> Result<ExitCode> {
                 value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
             }
             if args.validate {
-                let cpu = render::render(&scene, &loaded.material, lighting, &settings)?;
+                progress.step(format!("{} on the CPU (--validate)", mode.name()));
+                let cpu = render::render_with_progress(&scene, &loaded.material, lighting, &settings, &|done, all| {
+                    progress.work(done, all)
+                })?;
                 check_finite(&args, &cpu.rgb, "the CPU render")?;
                 let cpu_picture = metrics::tonemap(&cpu, &preview);
                 let psnr = metrics::psnr_db(&picture, &cpu_picture);
                 let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
                 let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
-                let difference = metrics::difference_rgb8(&picture, &cpu_picture);
-                files.push((sibling(out, "difference"), "difference", png(&difference, scene.width, scene.height)?));
+                let difference =
+                    picture::layout::difference(&picture, &cpu_picture, scene.width, scene.height, "GPU - CPU");
+                files.push((
+                    sibling(out, "difference"),
+                    "difference",
+                    png(&difference.rgb, difference.width, difference.height)?,
+                ));
                 report.push(format!(
                 "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
                  pixels covered by one renderer only",
@@ -468,8 +492,15 @@ fn run(args: Args) -> Result<ExitCode> {
                 check_psnr(&args, "against the CPU", psnr, &mut problems);
             }
             if let Some(n) = args.converged {
-                let converged =
-                    render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+                progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
+                let converged = render::converged::converged_with_progress(
+                    &scene,
+                    &loaded.material,
+                    lighting,
+                    n,
+                    u64::from(args.seed),
+                    &|done, all| progress.work(done, all),
+                )?;
                 check_finite(&args, &converged.rgb, "the converged estimate")?;
                 let converged_picture = metrics::tonemap(&converged, &preview);
                 let psnr = metrics::psnr_db(&picture, &converged_picture);
@@ -496,6 +527,7 @@ fn run(args: Args) -> Result<ExitCode> {
         }
     }
 
+    progress.finish();
     // Every output is made; now write them, so that an error leaves none behind.
     for (path, _, bytes) in &files {
         asset::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))?;
@@ -527,7 +559,13 @@ struct Step {
 
 /// `--mode adaptive` and `--mode adaptive-prefiltered`: one frame on the GPU
 /// (`gpu::preview::Renderer::render_adaptive`).
-fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighting, out: &Path) -> Result<Step> {
+fn render_adaptive(
+    args: &Args,
+    loaded: &bake::Loaded,
+    lighting: &render::Lighting,
+    out: &Path,
+    progress: &cli::Progress,
+) -> Result<Step> {
     let bandwidths = loaded.bandwidths.as_ref().ok_or_else(|| {
         anyhow!(
             "{}: the bake has no environment bandwidth and atlas: bake it with brdf-bake --env",
@@ -571,6 +609,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
     let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
     renderer.set_bandwidths(bandwidths)?;
+    progress.step(format!("{} on the GPU", args.mode.name()));
     // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
     // milliseconds): a frame first, so that ms_per_frame times the frame. The G-buffer and its
     // upload are the camera's, made once for all its frames as the other modes' raster pass is.
@@ -670,6 +709,7 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
         // The CPU's own prediction: the levels equal but where a direction on the edge of a
         // nearest texel reads its neighbour in f32 (the tests hold 98% of them equal). Only the
         // predictions are read, so its blocks are not shaded.
+        progress.step(format!("{} on the CPU (--validate)", args.mode.name()));
         let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
         let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
         let own = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
@@ -716,7 +756,15 @@ fn render_adaptive(args: &Args, loaded: &bake::Loaded, lighting: &render::Lighti
     }
     if args.validate || args.converged.is_some() {
         let n = args.converged.unwrap_or(256);
-        let converged = render::converged::converged(&scene, &loaded.material, lighting, n, u64::from(args.seed))?;
+        progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
+        let converged = render::converged::converged_with_progress(
+            &scene,
+            &loaded.material,
+            lighting,
+            n,
+            u64::from(args.seed),
+            &|done, all| progress.work(done, all),
+        )?;
         check_finite(args, &converged.rgb, "the converged estimate")?;
         let converged_picture = metrics::tonemap(&converged, &preview);
         let psnr = metrics::psnr_db(&picture, &converged_picture);
