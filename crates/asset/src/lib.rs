@@ -48,6 +48,7 @@
 //! ```
 
 mod container;
+mod describe;
 mod error;
 mod files;
 mod manifest;
@@ -57,6 +58,7 @@ pub use container::{
     FORMAT_VERSION, HEADER_BYTES, Header, MAGIC, PAYLOAD_LIMIT, PROVENANCE_LIMIT, READABLE_VERSIONS, decode,
     decode_with_header, encode, encode_checked, read_file, read_file_with_header, read_header, write_file,
 };
+pub use describe::Description;
 pub use error::Error;
 pub use files::{
     LinkedStatus, Staging, create_folder, hex, linked_file_status, remove_temporaries, sha256, sha256_file,
