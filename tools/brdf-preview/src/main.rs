@@ -492,19 +492,8 @@ fn run(args: Args) -> Result<ExitCode> {
                 check_psnr(&args, "against the CPU", psnr, &mut problems);
             }
             if let Some(n) = args.converged {
-                progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
-                let converged = render::converged::converged_with_progress(
-                    &scene,
-                    &loaded.material,
-                    lighting,
-                    n,
-                    u64::from(args.seed),
-                    &|done, all| progress.work(done, all),
-                )?;
-                check_finite(&args, &converged.rgb, "the converged estimate")?;
-                let converged_picture = metrics::tonemap(&converged, &preview);
-                let psnr = metrics::psnr_db(&picture, &converged_picture);
-                let relative = metrics::relative_error(&image.rgb, &converged.rgb);
+                let Converged { image: converged, picture: converged_picture, psnr, relative } =
+                    converged(&args, &scene, &loaded.material, lighting, n, (&image, &picture), &preview, &progress)?;
                 let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
                 files.push((
                     sibling(out, "converged"),
@@ -756,19 +745,8 @@ fn render_adaptive(
     }
     if args.validate || args.converged.is_some() {
         let n = args.converged.unwrap_or(256);
-        progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
-        let converged = render::converged::converged_with_progress(
-            &scene,
-            &loaded.material,
-            lighting,
-            n,
-            u64::from(args.seed),
-            &|done, all| progress.work(done, all),
-        )?;
-        check_finite(args, &converged.rgb, "the converged estimate")?;
-        let converged_picture = metrics::tonemap(&converged, &preview);
-        let psnr = metrics::psnr_db(&picture, &converged_picture);
-        let relative = metrics::relative_error(&frame.image.rgb, &converged.rgb);
+        let Converged { image: converged, picture: converged_picture, psnr, relative } =
+            converged(args, &scene, &loaded.material, lighting, n, (&frame.image, &picture), &preview, progress)?;
         files.push((sibling(out, "converged"), "converged", png(&converged_picture, scene.width, scene.height)?));
         report.push(format!(
             "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}",
@@ -805,6 +783,46 @@ fn render_adaptive(
 
 /// The GPU, without the spurious line a headless run prints where there is no Wayland session
 /// (`cli::without_stderr_lines`).
+/// The independent converged estimate of a render, and how far the render is from it.
+struct Converged {
+    image: render::Image,
+    /// Its tone-mapped picture.
+    picture: Vec<u8>,
+    /// PSNR of the render's picture against it.
+    psnr: f64,
+    /// Relative error of the render's radiance against it.
+    relative: f64,
+}
+
+/// Renders the converged estimate with `n` samples per strategy and measures `rendered` (the
+/// image and its picture) against it.
+#[allow(clippy::too_many_arguments)]
+fn converged(
+    args: &Args,
+    scene: &Scene,
+    material: &render::Material,
+    lighting: &render::Lighting,
+    n: u32,
+    (image, picture): (&render::Image, &[u8]),
+    preview: &envmap::Preview,
+    progress: &cli::Progress,
+) -> Result<Converged> {
+    progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
+    let converged = render::converged::converged_with_progress(
+        scene,
+        material,
+        lighting,
+        n,
+        u64::from(args.seed),
+        &|done, all| progress.work(done, all),
+    )?;
+    check_finite(args, &converged.rgb, "the converged estimate")?;
+    let converged_picture = metrics::tonemap(&converged, preview);
+    let psnr = metrics::psnr_db(picture, &converged_picture);
+    let relative = metrics::relative_error(&image.rgb, &converged.rgb);
+    Ok(Converged { image: converged, picture: converged_picture, psnr, relative })
+}
+
 fn open_gpu() -> Result<gpu::Gpu> {
     Ok(cli::without_stderr_lines(cli::is_wayland_session_warning, gpu::Gpu::new)?)
 }
