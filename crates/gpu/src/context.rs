@@ -109,6 +109,12 @@ impl Gpu {
         &self.queue
     }
 
+    /// Waits until the work submitted so far has finished.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    }
+
     /// The limits the device was created with (the adapter's own).
     pub fn limits(&self) -> wgpu::Limits {
         self.device.limits()

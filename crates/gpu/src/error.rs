@@ -32,6 +32,9 @@ pub enum GpuError {
     Poll(#[from] wgpu::PollError),
     #[error("reading results back from the GPU: {0}")]
     Readback(String),
+    /// A window's surface could not be made, configured or drawn into (`surface::WindowSurface`).
+    #[error("{0}")]
+    Surface(String),
     /// `preview::Presenter` draws 8-bit RGBA or BGRA targets (plain or sRGB) only.
     #[error("the presenter draws into 8-bit RGBA or BGRA targets, not {0:?}")]
     TargetFormat(wgpu::TextureFormat),

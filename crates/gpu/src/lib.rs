@@ -15,6 +15,7 @@ mod context;
 mod error;
 mod merl_lookup;
 pub mod preview;
+pub mod surface;
 
 pub use context::Gpu;
 pub use error::GpuError;

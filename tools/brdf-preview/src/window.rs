@@ -1,11 +1,10 @@
 //! `--window`: the interactive previewer. A winit window shows the running average of the GPU
 //! renderer (`gpu::preview::Renderer::accumulate`): every redraw adds frames (f = 0, 1, 2, ...)
 //! until [`MAX_FRAMES`], and the present pass (`gpu::preview::Presenter`) tone maps the average
-//! into the window like the pictures `--out` writes (`envmap::tonemap_rgb8`). The surface is a
-//! plain 8-bit format where the adapter offers one, so that the pass writes the sRGB-encoded bytes
-//! itself and the window shows the picture's bytes (up to a rare one-step rounding difference:
-//! the GPU applies the exposure in f32); an sRGB-only surface encodes in hardware, within one
-//! 8-bit step of them. `--window-screenshot` saves what the window shows and exits, for scripts.
+//! into the window like the pictures `--out` writes (`envmap::tonemap_rgb8`), on the window's
+//! surface (`gpu::surface`: the window shows the picture's bytes, up to a rare one-step rounding
+//! difference: the GPU applies the exposure in f32). `--window-screenshot` saves what the window
+//! shows and exits, for scripts.
 //!
 //! Controls: drag with the left button to orbit (azimuth, elevation), scroll to change the
 //! distance, 1/2/3 for the reference, fis and prefiltered modes, D to cycle the views (shaded,
@@ -19,8 +18,9 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use gpu::preview::{Presenter, Renderer, View};
+use gpu::surface::{Display, WindowSurface};
 use render::{Camera, Mode, Settings};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
@@ -53,11 +53,6 @@ const PIXELS_PER_LINE: f64 = 40.0;
 /// The camera stays this far from the centre: outside the unit sphere the meshes are scaled to,
 /// with the near plane (`distance / 100`) in front of them.
 const DISTANCE_RANGE: (f32, f32) = (1.2, 50.0);
-
-/// Redraws in a row that may get no surface texture (timeouts, a surface reconfigured or made
-/// again) before the window gives up: a resize takes one or two; a surface that stays lost would
-/// otherwise redraw forever.
-const MAX_SKIPPED: u32 = 100;
 
 /// Exposure change per key press, in stops.
 const EXPOSURE_STEP_EV: f32 = 0.5;
@@ -93,14 +88,11 @@ pub fn run(
     }
     let event_loop =
         EventLoop::new().map_err(|e| no_display(format!("opening the event loop: {}", winit_message(&e))))?;
-    // wgpu wants the display the surfaces will be on (only GLES uses it; Vulkan ignores it).
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
-        event_loop.owned_display_handle(),
-    )));
+    let display = Display::new(event_loop.owned_display_handle());
     let mut app = App {
         inputs: Inputs { material, lighting, scene, settings, preview },
         screenshot: options.window_screenshot.clone(),
-        instance,
+        display,
         state: None,
         outcome: None,
     };
@@ -153,7 +145,7 @@ struct Inputs<'a> {
 struct App<'a> {
     inputs: Inputs<'a>,
     screenshot: Option<PathBuf>,
-    instance: wgpu::Instance,
+    display: Display,
     /// Made once the event loop runs (winit opens windows only then).
     state: Option<State>,
     /// Set when the loop is asked to exit: what `run` returns.
@@ -184,10 +176,8 @@ impl Orbit {
 
 /// The window and everything drawn into it.
 struct State {
-    instance: wgpu::Instance,
     window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
+    surface: WindowSurface,
     gpu: gpu::Gpu,
     renderer: Renderer,
     presenter: Presenter,
@@ -204,8 +194,6 @@ struct State {
     /// The last measured time per frame, and how many frames a redraw adds.
     ms_per_frame: Option<f64>,
     frames_per_redraw: u32,
-    /// Redraws in a row that got no surface texture.
-    skipped: u32,
 }
 
 impl ApplicationHandler for App<'_> {
@@ -286,55 +274,16 @@ impl App<'_> {
                 .create_window(attributes)
                 .map_err(|e| no_display(format!("opening a window: {}", winit_message(&e))))?,
         );
-        let surface = self.instance.create_surface(window.clone()).context("creating the window's surface")?;
-        let gpu = gpu::Gpu::for_surface(&self.instance, &surface)?;
-        let caps = surface.get_capabilities(gpu.adapter());
-        let format = surface_format(&caps.formats).ok_or_else(|| {
-            anyhow!(
-                "the window's surface offers none of the 8-bit RGBA or BGRA formats the previewer draws: {:?}",
-                caps.formats
-            )
-        })?;
-        // A screenshot reads the surface texture itself where the surface allows it.
-        let usage = if self.screenshot.is_some() && caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC
-        } else {
-            wgpu::TextureUsages::RENDER_ATTACHMENT
-        };
         let size = window.inner_size();
-        let config = wgpu::SurfaceConfiguration {
-            usage,
-            format,
-            color_space: Default::default(),
-            width: size.width.max(1),
-            height: size.height.max(1),
-            // The one mode every surface supports (lavapipe presents to Xvfb with it).
-            present_mode: wgpu::PresentMode::Fifo,
-            desired_maximum_frame_latency: 2,
-            alpha_mode: if caps.alpha_modes.contains(&wgpu::CompositeAlphaMode::Opaque) {
-                wgpu::CompositeAlphaMode::Opaque
-            } else {
-                wgpu::CompositeAlphaMode::Auto
-            },
-            view_formats: vec![],
-        };
-        gpu.configure_surface(&surface, &config)?;
+        let (surface, gpu) =
+            WindowSurface::new(&self.display, window.clone(), (size.width, size.height), self.screenshot.is_some())?;
         let renderer = Renderer::new(&gpu, scene, self.inputs.material, self.inputs.lighting)?;
-        let presenter = Presenter::new(&gpu, format)?;
-        let read = if usage.contains(wgpu::TextureUsages::COPY_SRC) { "the surface" } else { "an offscreen copy" };
-        eprintln!(
-            "window: {}x{} on {}, surface {format:?}{}",
-            scene.width,
-            scene.height,
-            gpu.adapter_summary(),
-            if self.screenshot.is_some() { format!(", screenshot read from {read}") } else { String::new() }
-        );
+        let presenter = Presenter::new(&gpu, surface.format())?;
+        eprintln!("window: {}x{} on {}, {}", scene.width, scene.height, gpu.adapter_summary(), surface.describe());
         let home = Orbit::of(&scene.camera);
         Ok(State {
-            instance: self.instance.clone(),
             window,
             surface,
-            config,
             gpu,
             renderer,
             presenter,
@@ -348,7 +297,6 @@ impl App<'_> {
             dragging: false,
             ms_per_frame: None,
             frames_per_redraw: 1,
-            skipped: 0,
         })
     }
 
@@ -363,29 +311,24 @@ impl App<'_> {
         };
         state.accumulate(settings, self.inputs.scene, target)?;
         let frames = state.renderer.frames_accumulated();
-        let Some(texture) = state.acquire()? else {
+        let Some(texture) = state.surface.acquire(&state.gpu)? else {
             // Nothing to draw into this time (timed out, occluded, reconfigured): try again.
             state.window.request_redraw();
             return Ok(());
         };
-        let size = (texture.texture.width(), texture.texture.height());
-        let view = texture.texture.create_view(&Default::default());
-        state.presenter.draw(&state.renderer, &view, size, state.exposure_ev)?;
+        let size = texture.size();
+        texture.draw(&state.presenter, &state.renderer, state.exposure_ev)?;
         let due = frames >= target;
         if let (Some(path), true) = (&self.screenshot, due) {
-            let rgb = if state.config.usage.contains(wgpu::TextureUsages::COPY_SRC) {
-                state.presenter.read_rgb8(&texture.texture)?
-            } else {
-                state.presenter.draw_rgb8(&state.renderer, size, state.exposure_ev)?
-            };
+            let rgb = texture.read_rgb8(&state.presenter, &state.renderer, state.exposure_ev)?;
             envmap::write_png_rgb8(path, size.0 as usize, size.1 as usize, &rgb)
                 .with_context(|| format!("writing {}", path.display()))?;
             cli::outln!("{}: {}", path.display(), state.title(frames, target));
-            state.gpu.queue().present(texture);
+            texture.present(&state.gpu);
             self.finish(event_loop, Ok(()));
             return Ok(());
         }
-        state.gpu.queue().present(texture);
+        texture.present(&state.gpu);
         state.window.set_title(&state.title(frames, target));
         if !due {
             state.window.request_redraw();
@@ -418,62 +361,15 @@ impl State {
         let settings = Settings { mode: self.mode, frames, ..*settings };
         let start = Instant::now();
         self.renderer.accumulate(&settings, self.view)?;
-        self.gpu.device().poll(wgpu::PollType::wait_indefinitely())?;
+        self.gpu.wait()?;
         let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(frames);
         self.ms_per_frame = Some(ms);
         self.frames_per_redraw = ((REDRAW_BUDGET_MS / ms.max(1e-3)).floor() as u32).clamp(1, MAX_FRAMES_PER_REDRAW);
         Ok(())
     }
 
-    /// The surface's next texture, or `None` where this redraw has to be skipped; reconfigures
-    /// an outdated surface and makes a lost one again, and gives up after [`MAX_SKIPPED`] skips
-    /// in a row.
-    fn acquire(&mut self) -> Result<Option<wgpu::SurfaceTexture>> {
-        let texture = self.try_acquire()?;
-        self.skipped = if texture.is_some() { 0 } else { self.skipped + 1 };
-        if self.skipped > MAX_SKIPPED {
-            bail!("the window's surface gave no texture to draw into {MAX_SKIPPED} times in a row");
-        }
-        Ok(texture)
-    }
-
-    fn try_acquire(&mut self) -> Result<Option<wgpu::SurfaceTexture>> {
-        use wgpu::CurrentSurfaceTexture as Current;
-        match self.surface.get_current_texture() {
-            Current::Success(texture) => Ok(Some(texture)),
-            Current::Timeout | Current::Occluded => Ok(None),
-            // The surface changed (a resize under way): the texture must go before configuring.
-            Current::Suboptimal(texture) => {
-                drop(texture);
-                self.reconfigure()?;
-                Ok(None)
-            }
-            Current::Outdated => {
-                self.reconfigure()?;
-                Ok(None)
-            }
-            Current::Lost => {
-                self.surface =
-                    self.instance.create_surface(self.window.clone()).context("creating the window's surface again")?;
-                self.reconfigure()?;
-                Ok(None)
-            }
-            Current::Validation => Err(anyhow!("the window's surface reported a validation error")),
-        }
-    }
-
-    /// Configures the surface again for the window's size as the last resize reported it (not
-    /// asked of the window, which winit cannot answer for a window already gone).
-    fn reconfigure(&mut self) -> Result<()> {
-        Ok(self.gpu.configure_surface(&self.surface, &self.config)?)
-    }
-
     fn resize(&mut self, size: PhysicalSize<u32>) -> Result<()> {
-        // A minimized window reports 0 x 0, which no surface takes: keep the last size.
-        if size.width > 0 && size.height > 0 {
-            self.config.width = size.width;
-            self.config.height = size.height;
-            self.reconfigure()?;
+        if self.surface.resize(&self.gpu, (size.width, size.height))? {
             self.window.request_redraw();
         }
         Ok(())
@@ -572,13 +468,6 @@ impl State {
     }
 }
 
-/// The surface format to draw: a plain 8-bit one where offered, into which the present pass
-/// writes the picture's sRGB-encoded bytes itself; else an sRGB one, which encodes in hardware.
-fn surface_format(offered: &[wgpu::TextureFormat]) -> Option<wgpu::TextureFormat> {
-    use wgpu::TextureFormat as F;
-    [F::Bgra8Unorm, F::Rgba8Unorm, F::Bgra8UnormSrgb, F::Rgba8UnormSrgb].into_iter().find(|f| offered.contains(f))
-}
-
 #[cfg(test)]
 mod tests {
     use std::collections::HashMap;
@@ -622,13 +511,5 @@ mod tests {
             "failed to open connection to X server"
         );
         assert_eq!(winit_message(&"X11 error"), "X11 error");
-    }
-
-    #[test]
-    fn a_plain_surface_format_is_preferred_to_an_srgb_one() {
-        use wgpu::TextureFormat as F;
-        assert_eq!(surface_format(&[F::Bgra8UnormSrgb, F::Bgra8Unorm]), Some(F::Bgra8Unorm));
-        assert_eq!(surface_format(&[F::Rgba16Float, F::Rgba8UnormSrgb]), Some(F::Rgba8UnormSrgb));
-        assert_eq!(surface_format(&[F::Rgb10a2Unorm]), None);
     }
 }
