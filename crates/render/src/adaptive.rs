@@ -1382,6 +1382,29 @@ pub fn exact_shader(reference: &Image) -> impl FnMut(&[(u32, u32)]) -> Estimates
     }
 }
 
+/// The plan's ceiling: the frame planned again from `predictions` (an earlier frame's, such as
+/// the GPU's) with every shaded block given its value in `reference` (a converged estimate at the
+/// render's size), so that its error against `reference` is the up-sampling's alone, the quality
+/// no budget can pass. `oracle` as in [`Hooks`].
+#[allow(clippy::too_many_arguments)]
+pub fn ceiling(
+    geometry: &Geometry,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+    predictions: &[Prediction],
+    reference: &Image,
+    oracle: Option<&[f64]>,
+) -> Result<Adaptive, Error> {
+    let hooks = Hooks {
+        oracle,
+        predictor: Some(&mut replay_predictor(predictions)),
+        shader: Some(&mut exact_shader(reference)),
+    };
+    render_with(geometry, material, lighting, bandwidths, settings, hooks)
+}
+
 /// [`render`] from the `geometry` of the frame's camera (made for `settings.supersample`),
 /// with what `hooks` gives instead of computing it here. `oracle` replaces the predicted
 /// bandwidths (the prediction still runs, for the variance). `predictor`: given the

@@ -76,7 +76,7 @@ use std::time::Instant;
 
 use bandwidth::Reading;
 use render::adaptive::{self, Bandwidths, EnvBandwidth};
-use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
+use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["gold-paint", "white-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
@@ -122,10 +122,7 @@ fn environment_bandwidth(environment: &str, reading: Reading) -> EnvBandwidth {
 }
 
 fn scene(mesh: &str, size: usize) -> Scene {
-    let mesh = match mesh {
-        "sphere" => Mesh::sphere(1.0, 128, 64),
-        _ => Mesh::torus(0.7, 0.3, 128, 48),
-    };
+    let mesh = preview::mesh(mesh).expect("a named mesh");
     Scene {
         mesh,
         camera: Camera::orbit(glam::Vec3::ZERO, 3.2, 0.0, 0.5, 45f32.to_radians()).unwrap(),
@@ -481,21 +478,18 @@ fn main() {
                             let p = psnr(&frame.image);
                             // The same plan with every shaded block given its converged value:
                             // the up-sampling's error alone, the PSNR no budget can pass.
-                            let ceiling = psnr(
-                                &adaptive_frame(
-                                    &frame_geometry(),
-                                    &loaded.material,
-                                    lighting,
-                                    bandwidths,
-                                    &settings,
-                                    adaptive::Hooks {
-                                        oracle,
-                                        predictor: Some(&mut adaptive::replay_predictor(&frame.details().predictions)),
-                                        shader: Some(&mut adaptive::exact_shader(&reference)),
-                                    },
-                                )
-                                .image,
-                            );
+                            let ceiling = adaptive::ceiling(
+                                &frame_geometry(),
+                                &loaded.material,
+                                lighting,
+                                bandwidths,
+                                &settings,
+                                &frame.details().predictions,
+                                &reference,
+                                oracle,
+                            )
+                            .expect("the ceiling's frame");
+                            let ceiling = psnr(&ceiling.image);
                             let brute = brute_match(&curve, p);
                             let speedup = brute.ms() / ms;
                             out(format!(

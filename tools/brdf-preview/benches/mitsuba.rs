@@ -177,7 +177,7 @@ fn scene(azimuth: f32, elevation: f32, size: usize) -> Scene {
     let default = Camera::default();
     let camera = Camera::orbit(default.target(), default.distance(), azimuth, elevation, default.fov_y())
         .expect("a valid camera");
-    Scene { mesh: Mesh::sphere(1.0, 128, 64), camera, width: size, height: size }
+    Scene { mesh: preview::mesh("sphere").expect("the sphere"), camera, width: size, height: size }
 }
 
 /// Our images of a case, as `brdf-preview` renders them by default (its `run`): the converged

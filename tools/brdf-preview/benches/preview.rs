@@ -21,7 +21,7 @@ use common::shared;
 use std::time::Instant;
 
 use brdf_atlas::view::{ViewReduction, select_layers_of_table, view_coordinates};
-use render::{Camera, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
+use render::{Camera, Lighting, Material, Mode, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k.hdr", "quarry_01_1k.hdr"];
@@ -44,7 +44,7 @@ struct Case {
 }
 
 fn scene() -> Scene {
-    Scene { mesh: Mesh::sphere(1.0, 128, 64), camera: Camera::default(), width: SIZE, height: SIZE }
+    Scene { mesh: preview::mesh("sphere").expect("the sphere"), camera: Camera::default(), width: SIZE, height: SIZE }
 }
 
 fn main() {

@@ -2,18 +2,12 @@
 //! it ships; validates the GPU image against the CPU reference renderer. Argument parsing,
 //! loading and printing around `bake::load`, `gpu::preview` and `render`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, ValueEnum};
-use picture::Canvas;
-use render::{Camera, Mesh, Mode, Scene, Settings, metrics};
-use serde_json::json;
-
-mod adaptive;
-mod window;
+use preview::{Brdf, Mode, Outcome, Request};
 
 /// Render a baked material on a mesh under the bake's environment with wgpu (headless; --window
 /// for an interactive view), by one of the estimators of the papers.
@@ -225,8 +219,10 @@ struct Args {
     #[arg(long)]
     window: bool,
 
-    #[command(flatten)]
-    window_options: window::Options,
+    /// With --window: once --frames frames are accumulated (1 for a debug view), save what the
+    /// window shows (PNG) and exit. For scripts and CI (e.g. under xvfb-run).
+    #[arg(long, value_name = "FILE.png", requires = "window")]
+    window_screenshot: Option<PathBuf>,
 
     /// Print one JSON object (mode, psnr_db, relative_error, ms_per_frame, ... and the files
     /// written) on stdout; the report goes to stderr.
@@ -251,30 +247,6 @@ enum ModeArg {
     Prefiltered,
     Adaptive,
     AdaptivePrefiltered,
-}
-
-impl ModeArg {
-    /// The estimator of the shaded pixels.
-    fn estimator(self) -> Mode {
-        match self {
-            ModeArg::Reference | ModeArg::Adaptive => Mode::Reference,
-            ModeArg::Fis => Mode::Fis,
-            ModeArg::Prefiltered | ModeArg::AdaptivePrefiltered => Mode::Prefiltered,
-        }
-    }
-
-    fn is_adaptive(self) -> bool {
-        matches!(self, ModeArg::Adaptive | ModeArg::AdaptivePrefiltered)
-    }
-
-    /// The name on the command line and in JSON.
-    fn name(self) -> &'static str {
-        match self {
-            ModeArg::Adaptive => "adaptive",
-            ModeArg::AdaptivePrefiltered => "adaptive-prefiltered",
-            other => other.estimator().name(),
-        }
-    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -335,235 +307,27 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    // Where the outputs go must exist before anything is rendered.
-    for path in args.out.iter().chain(&args.sheet) {
-        check_output_folder(path)?;
-    }
-    let mut loaded = bake::load(&args.bake, args.material.as_deref())?;
-    if args.brdf == BrdfArg::Wavelet {
-        let (path, brdf) = match &args.wavelet {
-            Some(path) => (path.clone(), bake::load_wavelet(path, &loaded)?),
-            None => bake::bake_wavelet(&loaded)?,
-        };
-        let levels = brdf.grid().levels() as f64;
-        if !(0.0..=levels).contains(&args.wavelet_lod) {
-            bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", args.wavelet_lod, path.display());
-        }
-        loaded.material.wavelet = Some(render::Wavelet { brdf, lod: args.wavelet_lod });
-    } else if args.wavelet.is_some() {
-        bail!("--wavelet names the asset for --brdf wavelet; add --brdf wavelet to render with it");
-    }
-    // (path, role, PNG bytes): every output is encoded before any is written.
-    let mut files: Vec<(PathBuf, &'static str, Vec<u8>)> = Vec::new();
-    let mut report = Vec::new();
-    let mut value = json!({});
-    if let Some(path) = &args.sheet {
-        let sheet = contact_sheet(&loaded)?;
-        files.push((path.clone(), "contact-sheet", png(&sheet.rgb, sheet.width, sheet.height)?));
-    }
-    let mut problems = Vec::new();
-    let progress = cli::Progress::new(args.quiet || args.json);
-    if args.out.is_some() || args.window {
-        let Some(lighting) = &loaded.lighting else {
-            bail!(
-                "{}: the bake has no environment, nothing to light the material with: bake it with brdf-bake --env",
-                args.bake.display()
-            );
-        };
-        if args.mode.is_adaptive() {
-            if args.window {
-                bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
-            }
-            let out = args.out.as_ref().expect("clap requires --out without --window");
-            let step = render_adaptive(&args, &loaded, lighting, out, &progress)?;
-            files.extend(step.files);
-            report.extend(step.report);
-            problems.extend(step.problems);
-            value = step.value;
-        } else {
-            let mode = args.mode.estimator();
-            let settings = Settings::previewer(mode, &loaded.material.samples, args.spp, args.frames, args.seed);
-            let scene = scene(&args)?;
-            let pixels = (scene.width * scene.height) as u128;
-            let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
-            let renders = if loaded.material.wavelet.is_some() { 2 } else { 1 };
-            check_work(
-                &args,
-                &[
-                    ("on the GPU", renders * gpu_samples),
-                    ("for --validate on the CPU", if args.validate { gpu_samples } else { 0 }),
-                    ("for --converged on the CPU", pixels * 3 * u128::from(args.converged.unwrap_or(0))),
-                ],
-            )?;
-            let preview = preview(&args, lighting);
-            if args.window {
-                return window::run(&loaded.material, lighting, &scene, &settings, &preview, &args.window_options);
-            }
-            let gpu = open_gpu()?;
-            let out = args.out.as_ref().expect("clap requires --out without --window");
-            let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
-            progress.step(format!("{} on the GPU", mode.name()));
-            let start = Instant::now();
-            let image = renderer.render_frames(&settings)?;
-            check_finite(&args, &image.rgb, "the GPU render")?;
-            let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
-            let picture = metrics::tonemap(&image, &preview);
-            let names = names(&loaded.manifest);
-            let brdf = match &loaded.material.wavelet {
-                Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
-                None => "table".to_string(),
-            };
-            let caption = format!(
-                "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
-                names,
-                mode.name(),
-                settings.spp,
-                settings.frames,
-                scene.width,
-                scene.height,
-                preview.exposure_ev
-            );
-            let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-            files.push((out.clone(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?));
-            report.push(format!(
-                "{}: {} on {} ({}), {:.1} ms per frame",
-                out.display(),
-                mode.name(),
-                gpu.adapter_summary(),
-                args.mesh,
-                ms_per_frame
-            ));
-            value = json!({
-                "bake": args.bake.display().to_string(),
-                "mode": mode.name(),
-                "brdf": match args.brdf { BrdfArg::Table => "table", BrdfArg::Wavelet => "wavelet" },
-                "spp": settings.spp,
-                "frames": settings.frames,
-                "width": scene.width,
-                "height": scene.height,
-                "exposure_ev": preview.exposure_ev,
-                "adapter": gpu.adapter_summary(),
-                "ms_per_frame": ms_per_frame,
-                "mean_luminance": metrics::mean_luminance(&image),
-            });
-
-            if loaded.material.wavelet.is_some() {
-                // What the compression costs: the same render from the table itself.
-                let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
-                progress.step(format!("{} from the table on the GPU", mode.name()));
-                let table =
-                    gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
-                check_finite(&args, &table.rgb, "the GPU render from the table")?;
-                let table_picture = metrics::tonemap(&table, &preview);
-                let psnr = metrics::psnr_db(&picture, &table_picture);
-                let relative = metrics::relative_error(&image.rgb, &table.rgb);
-                files.push((sibling(out, "table"), "table", png(&table_picture, scene.width, scene.height)?));
-                report.push(format!(
-                "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB,                  relative error {relative:.3}",
-                db(psnr)
-            ));
-                value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
-            }
-            if args.validate {
-                progress.step(format!("{} on the CPU (--validate)", mode.name()));
-                let cpu = render::render_with_progress(&scene, &loaded.material, lighting, &settings, &|done, all| {
-                    progress.work(done, all)
-                })?;
-                check_finite(&args, &cpu.rgb, "the CPU render")?;
-                let cpu_picture = metrics::tonemap(&cpu, &preview);
-                let psnr = metrics::psnr_db(&picture, &cpu_picture);
-                let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
-                let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
-                let difference =
-                    picture::layout::difference(&picture, &cpu_picture, scene.width, scene.height, "GPU - CPU");
-                files.push((
-                    sibling(out, "difference"),
-                    "difference",
-                    png(&difference.rgb, difference.width, difference.height)?,
-                ));
-                report.push(format!(
-                "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
-                 pixels covered by one renderer only",
-                db(psnr)
-            ));
-                value["psnr_db"] = json_db(psnr);
-                value["relative_error"] = json!(relative);
-                value["coverage_mismatches"] = json!(coverage);
-                check_psnr(&args, "against the CPU", psnr, &mut problems);
-            }
-            if let Some(n) = args.converged {
-                let Converged { image: converged, picture: converged_picture, psnr, relative } =
-                    converged(&args, &scene, &loaded.material, lighting, n, (&image, &picture), &preview, &progress)?;
-                let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
-                files.push((
-                    sibling(out, "converged"),
-                    "converged",
-                    png(&converged_picture, scene.width, scene.height)?,
-                ));
-                report.push(format!(
-                "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
-                 mean luminance ratio {luminance_ratio:.4}",
-                db(psnr)
-            ));
-                value["converged"] = json!({
-                    "samples_per_strategy": n,
-                    "psnr_db": json_db(psnr),
-                    "relative_error": relative,
-                    "mean_luminance_ratio": luminance_ratio,
-                });
-                check_psnr(&args, "against the converged estimate", psnr, &mut problems);
-            }
-        }
-    }
-
-    progress.finish();
-    // Every output is made; now write them, so that an error leaves none behind.
-    for (path, _, bytes) in &files {
-        asset::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))?;
-    }
-    let written: Vec<String> = files.iter().map(|(p, _, _)| p.display().to_string()).collect();
-    value["files"] = files
-        .iter()
-        .map(|(path, role, bytes)| {
-            json!({
-                "path": path.display().to_string(),
-                "format": "png",
-                "role": role,
-                "size_bytes": bytes.len(),
-                "sha256": asset::hex(&asset::sha256(bytes)),
-            })
-        })
-        .collect();
-    Ok(cli::finish(args.json, &value, &report, &problems, &written))
-}
-
-/// What one rendering step made: files (path, role, PNG bytes), report lines, problems and the
-/// JSON object.
-struct Step {
-    files: Vec<(PathBuf, &'static str, Vec<u8>)>,
-    report: Vec<String>,
-    problems: Vec<String>,
-    value: serde_json::Value,
-}
-
-/// `--mode adaptive` and `--mode adaptive-prefiltered`: one frame on the GPU
-/// (`gpu::preview::Renderer::render_adaptive`).
-fn render_adaptive(
-    args: &Args,
-    loaded: &bake::Loaded,
-    lighting: &render::Lighting,
-    out: &Path,
-    progress: &cli::Progress,
-) -> Result<Step> {
-    let bandwidths = loaded.bandwidths.as_ref().ok_or_else(|| {
-        anyhow!(
-            "{}: the bake has no environment bandwidth and atlas: bake it with brdf-bake --env",
-            args.bake.display()
-        )
-    })?;
-    let mode = args.mode.estimator();
-    let settings = render::adaptive::Settings {
-        supersample: args.aa,
+    let request = Request {
+        bake: args.bake,
+        out: args.out,
+        material: args.material,
+        brdf: match args.brdf {
+            BrdfArg::Table => Brdf::Table,
+            BrdfArg::Wavelet => Brdf::Wavelet,
+        },
+        wavelet: args.wavelet,
+        wavelet_lod: args.wavelet_lod,
+        mesh: args.mesh,
+        mode: match args.mode {
+            ModeArg::Reference => Mode::Reference,
+            ModeArg::Fis => Mode::Fis,
+            ModeArg::Prefiltered => Mode::Prefiltered,
+            ModeArg::Adaptive => Mode::Adaptive,
+            ModeArg::AdaptivePrefiltered => Mode::AdaptivePrefiltered,
+        },
+        spp: args.spp,
+        frames: args.frames,
+        aa: args.aa,
         predict_level: args.predict_level,
         allocation: match args.allocation {
             AllocationArg::Variance => render::adaptive::Allocation::Variance,
@@ -572,414 +336,64 @@ fn render_adaptive(
         },
         lobe_weight: args.lobe_weight,
         layer_shift: args.layer_shift,
+        debug_views: args.debug_views,
+        size: args.size,
+        exposure: args.exposure,
+        camera: args.camera,
         seed: args.seed,
-        ..render::adaptive::Settings::new(mode, args.spp.unwrap_or(if mode == Mode::Reference { 8 } else { 4 }))
+        validate: args.validate,
+        converged: args.converged,
+        min_psnr: args.min_psnr,
+        max_samples: args.max_samples,
+        sheet: args.sheet,
+        window: args.window,
+        window_screenshot: args.window_screenshot,
     };
-    let scene = scene(args)?;
-    let ss = settings.supersample;
-    let pixels = (scene.width * ss * scene.height * ss) as u128;
-    let frame_samples = pixels * u128::from(settings.spp);
-    let converged_samples = if args.validate || args.converged.is_some() {
-        (scene.width * scene.height) as u128 * 3 * u128::from(args.converged.unwrap_or(256))
-    } else {
-        0
-    };
-    check_work(
-        args,
-        &[
-            // A first frame compiles the pipelines, then the frame that is timed.
-            ("on the GPU", 2 * frame_samples),
-            ("for --validate on the CPU", if args.validate { frame_samples } else { 0 }),
-            ("for the converged estimate on the CPU", converged_samples),
-        ],
-    )?;
-    let preview = preview(args, lighting);
-    let gpu = open_gpu()?;
-    let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
-    let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
-    renderer.set_bandwidths(bandwidths)?;
-    progress.step(format!("{} on the GPU", args.mode.name()));
-    // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
-    // milliseconds): a frame first, so that ms_per_frame times the frame. The G-buffer and its
-    // upload are the camera's, made once for all its frames as the other modes' raster pass is.
-    renderer.render_adaptive(&loaded.material, lighting, &settings, Default::default())?;
-    let geometry = renderer.adaptive_geometry(ss)?;
-    // The frame's buffers come back after its timings, for the views and the checks that read them.
-    let details = args.debug_views || args.validate || args.converged.is_some();
-    let options = gpu::preview::FrameOptions { details, ..Default::default() };
-    let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
-    check_finite(args, &frame.image.rgb, "the GPU's adaptive frame")?;
-    let t = frame.timings;
-    let ms_per_frame = t.total_ms;
-    let picture = metrics::tonemap(&frame.image, &preview);
-    let aa = settings.supersample * settings.supersample;
-    // The pre-convolved estimator's layers, where they are not the bake's.
-    let layers = match (mode, settings.layer_shift) {
-        (Mode::Prefiltered, n) if n > 0 => format!(" ({n} layer{} sharper)", if n == 1 { "" } else { "s" }),
-        _ => String::new(),
-    };
-    let caption = format!(
-        "{} | {}{layers} | {} spp budget, {} samples | shaded fraction {:.3} | AA {aa}x | {}x{} | exposure {:+.2} EV",
-        names(&loaded.manifest),
-        args.mode.name(),
-        settings.spp,
-        frame.samples,
-        frame.shaded_fraction(),
-        scene.width,
-        scene.height,
-        preview.exposure_ev
-    );
-    let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-    let mut files = vec![(out.to_path_buf(), "preview", png(&captioned.rgb, captioned.width, captioned.height)?)];
-    if args.debug_views {
-        let sheet = adaptive::debug_views(
-            &frame,
-            settings.allocation,
-            &picture,
-            &format!("{}: {}", args.mode.name(), names(&loaded.manifest)),
-        );
-        files.push((sibling(out, "debug"), "debug-views", png(&sheet.rgb, sheet.width, sheet.height)?));
-    }
-    let steps = match (t.submissions, t.gpu_clock) {
-        (1, true) => format!(
-            "one submission; on the GPU's clock prediction {:.1}, pyramids, plan and samples {:.1}, shading, \
-             up-sampling and output {:.1}",
-            t.predict_ms, t.plan_ms, t.shade_ms
-        ),
-        (1, false) => "one submission".to_string(),
-        _ => format!(
-            "prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on the CPU, shading, up-sampling and output \
-             {:.1} on the GPU",
-            t.predict_ms, t.plan_ms, t.shade_ms
-        ),
-    };
-    let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU before, once: {:.1}); \
-         shaded fraction {:.4}, {} samples of a budget of {}",
-        out.display(),
-        args.mode.name(),
-        gpu.adapter_summary(),
-        args.mesh,
-        t.gbuffer_ms,
-        frame.shaded_fraction(),
-        frame.samples,
-        frame.budget
-    )];
-    let mut value = json!({
-        "bake": args.bake.display().to_string(),
-        "mode": args.mode.name(),
-        "adapter": gpu.adapter_summary(),
-        "spp": settings.spp,
-        "aa": aa,
-        "predict_level": settings.predict_level,
-        "allocation": settings.allocation.name(),
-        "lobe_weight": settings.lobe_weight,
-        "layer_shift": settings.layer_shift,
-        "width": scene.width,
-        "height": scene.height,
-        "exposure_ev": preview.exposure_ev,
-        "ms_per_frame": ms_per_frame,
-        "timings_ms": {
-            "gbuffer": t.gbuffer_ms,
-            "prediction": t.predict_ms,
-            "plan_and_samples": t.plan_ms,
-            "shading": t.shade_ms,
-            "submissions": t.submissions,
-            "gpu_clock": t.gpu_clock,
-        },
-        "shaded_fraction": frame.shaded_fraction(),
-        "shaded_per_level": frame.shaded_per_level,
-        "samples": frame.samples,
-        "budget": frame.budget,
-        "mean_luminance": metrics::mean_luminance(&frame.image),
-    });
-    let mut problems = Vec::new();
-    if args.validate {
-        // The CPU's own prediction: the levels equal but where a direction on the edge of a
-        // nearest texel reads its neighbour in f32 (the tests hold 98% of them equal). Only the
-        // predictions are read, so its blocks are not shaded.
-        progress.step(format!("{} on the CPU (--validate)", args.mode.name()));
-        let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
-        let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
-        let own = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let predicted =
-            frame.details().predictions.iter().zip(&own.details().predictions).filter(|(g, _)| g.level >= 0);
-        let (pixels, differ) =
-            predicted.fold((0usize, 0usize), |(n, d), (g, c)| (n + 1, d + usize::from(g.level != c.level)));
-        // The same frame with the GPU's predictions on the CPU: the plan is the same (the weights
-        // to f32 rounding: the GPU's are f32), the values equal to rounding.
-        let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
-        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
-        let cpu = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let cpu_picture = metrics::tonemap(&cpu.image, &preview);
-        let psnr = metrics::psnr_db(&picture, &cpu_picture);
-        let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
-        let plan = frame.details().plan.compare(&cpu.details().plan, 1e-5);
-        let same_plan = plan.is_ok();
-        report.push(format!(
-            "against the CPU: {differ} of {pixels} pixels predicted at another level than the CPU predicts; \
-             with the GPU's predictions ({}): PSNR {} dB, relative error {relative:.2e}",
-            match &plan {
-                Ok(worst) => format!("the same plan, weights within {worst:.1e}"),
-                Err(e) => format!("NOT the same plan: {e}"),
-            },
-            db(psnr)
-        ));
-        value["cpu"] = json!({
-            "psnr_db": json_db(psnr),
-            "relative_error": relative,
-            "same_plan": same_plan,
-            "prediction": { "pixels": pixels, "levels_differ": differ },
-        });
-        if !same_plan {
-            problems.push(
-                "the GPU's adaptive frame was planned differently from the CPU's with the same predictions".to_string(),
-            );
-        }
-        if 50 * differ > pixels {
-            problems.push(format!(
-                "{differ} of {pixels} pixels were predicted at another level on the GPU than on the CPU"
-            ));
-        }
-        check_psnr(args, "against the CPU", psnr, &mut problems);
-    }
-    if args.validate || args.converged.is_some() {
-        let n = args.converged.unwrap_or(256);
-        let Converged { image: converged, picture: converged_picture, psnr, relative } =
-            converged(args, &scene, &loaded.material, lighting, n, (&frame.image, &picture), &preview, progress)?;
-        files.push((sibling(out, "converged"), "converged", png(&converged_picture, scene.width, scene.height)?));
-        report.push(format!(
-            "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}",
-            db(psnr)
-        ));
-        value["psnr_db"] = json_db(psnr);
-        value["relative_error"] = json!(relative);
-        value["converged"] = json!({ "samples_per_strategy": n, "psnr_db": json_db(psnr), "relative_error": relative });
-        check_psnr(args, "against the converged estimate", psnr, &mut problems);
-        if ss == 1 {
-            // The same plan with the converged values in its shaded blocks: the up-sampling's
-            // error alone, the PSNR no budget can pass (render pixels are the converged
-            // estimate's pixels only without anti-aliasing).
-            let mut exact = render::adaptive::exact_shader(&converged);
-            let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
-            let hooks = render::adaptive::Hooks {
-                predictor: Some(&mut replay),
-                shader: Some(&mut exact),
-                ..Default::default()
-            };
-            let ceiling =
-                render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-            let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &preview), &converged_picture);
-            report.push(format!(
-                "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
-                 near it, more --spp does not help, the up-sampling is the error",
-                db(ceiling)
-            ));
-            value["ceiling_db"] = json_db(ceiling);
-        }
-    }
-    Ok(Step { files, report, problems, value })
-}
-
-/// The GPU, without the spurious line a headless run prints where there is no Wayland session
-/// (`cli::without_stderr_lines`).
-/// The independent converged estimate of a render, and how far the render is from it.
-struct Converged {
-    image: render::Image,
-    /// Its tone-mapped picture.
-    picture: Vec<u8>,
-    /// PSNR of the render's picture against it.
-    psnr: f64,
-    /// Relative error of the render's radiance against it.
-    relative: f64,
-}
-
-/// Renders the converged estimate with `n` samples per strategy and measures `rendered` (the
-/// image and its picture) against it.
-#[allow(clippy::too_many_arguments)]
-fn converged(
-    args: &Args,
-    scene: &Scene,
-    material: &render::Material,
-    lighting: &render::Lighting,
-    n: u32,
-    (image, picture): (&render::Image, &[u8]),
-    preview: &envmap::Preview,
-    progress: &cli::Progress,
-) -> Result<Converged> {
-    progress.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
-    let converged = render::converged::converged_with_progress(
-        scene,
-        material,
-        lighting,
-        n,
-        u64::from(args.seed),
-        &|done, all| progress.work(done, all),
-    )?;
-    check_finite(args, &converged.rgb, "the converged estimate")?;
-    let converged_picture = metrics::tonemap(&converged, preview);
-    let psnr = metrics::psnr_db(picture, &converged_picture);
-    let relative = metrics::relative_error(&image.rgb, &converged.rgb);
-    Ok(Converged { image: converged, picture: converged_picture, psnr, relative })
-}
-
-fn open_gpu() -> Result<gpu::Gpu> {
-    Ok(cli::without_stderr_lines(cli::is_wayland_session_warning, gpu::Gpu::new)?)
-}
-
-/// An output's folder must exist: found before the render rather than after it (nothing is
-/// created; `asset::write_atomic`).
-fn check_output_folder(path: &Path) -> Result<()> {
-    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !folder.is_dir() {
-        bail!("writing {}: the folder {} does not exist (create it first)", path.display(), folder.display());
-    }
-    Ok(())
-}
-
-/// The work the arguments ask for, `(what, samples)` by part, within --max-samples; otherwise an
-/// error that gives the parts and how to lift the ceiling.
-fn check_work(args: &Args, parts: &[(&str, u128)]) -> Result<()> {
-    let total: u128 = parts.iter().map(|(_, n)| n).sum();
-    if total <= u128::from(args.max_samples) {
-        return Ok(());
-    }
-    let listed: Vec<String> = parts.iter().filter(|(_, n)| *n > 0).map(|(what, n)| format!("{n} {what}")).collect();
-    bail!(
-        "this run would take {total} samples ({}; --size, --spp, --frames and --converged set them), above the \
-         ceiling of {} (--max-samples): ask for less, or raise --max-samples for a deliberate long run",
-        listed.join(", "),
-        args.max_samples
-    )
-}
-
-/// A render with a pixel that is not a finite number is an error naming what it was rendered
-/// from (a damaged or absurd asset can make a BRDF overflow), never a picture with exit 0.
-fn check_finite(args: &Args, rgb: &[f32], what: &str) -> Result<()> {
-    let bad = rgb.chunks_exact(3).filter(|p| p.iter().any(|v| !v.is_finite())).count();
-    if bad == 0 {
-        return Ok(());
-    }
-    let source = match (args.brdf, &args.wavelet) {
-        (BrdfArg::Wavelet, Some(path)) => path.display().to_string(),
-        (BrdfArg::Wavelet, None) => format!("the wavelet-brdf asset of {}", args.bake.display()),
-        (BrdfArg::Table, _) => format!("the bake in {}", args.bake.display()),
-    };
-    bail!(
-        "rendering {source}: {what} has {bad} of {} pixels that are not finite numbers (an asset's values overflow)",
-        rgb.len() / 3
-    )
-}
-
-/// How pictures are tone mapped: --exposure, or the environment's automatic exposure.
-fn preview(args: &Args, lighting: &render::Lighting) -> envmap::Preview {
-    match args.exposure {
-        Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
-        None => metrics::auto_preview(lighting.mips.level(0)),
-    }
-}
-
-/// An 8-bit RGB picture as PNG bytes.
-fn png(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>> {
-    Ok(envmap::encode_png_rgb8(width, height, rgb)?)
-}
-
-/// Every picture of the bake on one labelled page (`bake::sheet`).
-fn contact_sheet(loaded: &bake::Loaded) -> Result<Canvas> {
-    Ok(bake::sheet::contact_sheet(&loaded.dir, &loaded.manifest)?)
-}
-
-/// The scene the arguments describe.
-fn scene(args: &Args) -> Result<Scene> {
-    let mesh = match args.mesh.as_str() {
-        "sphere" => Mesh::sphere(1.0, 128, 64),
-        "torus" => Mesh::torus(0.7, 0.3, 128, 48),
-        path => {
-            // A regular file only (a FIFO or a device is refused without blocking), its size
-            // checked against the mesh limit before it is read.
-            let bytes = fsguard::read_regular(Path::new(path), Mesh::MAX_OBJ_BYTES as u64)
-                .with_context(|| format!("reading {path}"))?;
-            let text = String::from_utf8(bytes).map_err(|_| anyhow!("reading {path}: not utf-8 text (an obj file)"))?;
-            Mesh::from_obj(&text).with_context(|| format!("reading {path}"))?
-        }
-    };
-    let default = Camera::default();
-    let (azimuth, elevation) = args.camera;
-    let camera = Camera::orbit(
-        default.target(),
-        default.distance(),
-        azimuth.to_radians(),
-        elevation.to_radians(),
-        default.fov_y(),
-    )
-    .map_err(|e| anyhow!("--camera: {e}"))?;
-    Ok(Scene { mesh, camera, width: args.size.0, height: args.size.1 })
-}
-
-/// "material under environment", from the manifest.
-fn names(manifest: &asset::BakeManifest) -> String {
-    match &manifest.environment {
-        Some(env) => format!("{} under {}", manifest.material.name, env.name),
-        None => manifest.material.name.clone(),
-    }
-}
-
-/// `out` with `-suffix` before its extension: preview.png -> preview-difference.png.
-fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    out.with_file_name(format!("{stem}-{suffix}.png"))
-}
-
-fn db(psnr: f64) -> String {
-    if psnr.is_finite() { format!("{psnr:.2}") } else { "infinite (identical)".to_string() }
-}
-
-/// PSNR in JSON: a number, or null for identical pictures (JSON has no infinity).
-fn json_db(psnr: f64) -> serde_json::Value {
-    if psnr.is_finite() { json!(psnr) } else { serde_json::Value::Null }
-}
-
-fn check_psnr(args: &Args, what: &str, psnr: f64, problems: &mut Vec<String>) {
-    if let Some(min) = args.min_psnr
-        && psnr < min
-    {
-        problems.push(format!("PSNR {what} is {psnr:.2} dB, below --min-psnr {min}"));
-    }
-}
-
-/// The picture with a strip of text below it.
-fn with_caption(rgb: &[u8], width: usize, height: usize, caption: &str) -> Canvas {
-    let scale = if width >= 480 { 2 } else { 1 };
-    let line = picture::font::LINE_HEIGHT * scale;
-    let lines = wrap(caption, (width.saturating_sub(8)) / (picture::font::ADVANCE * scale));
-    let mut canvas = Canvas::new(width, height + 8 + lines.len() * line, picture::BACKGROUND);
-    canvas.blit_rgb8(width, height, rgb, 0, 0, 1);
-    for (i, text) in lines.iter().enumerate() {
-        canvas.text(4, (height + 5 + i * line) as isize, text, scale, picture::INK);
-    }
-    canvas
-}
-
-/// Breaks `text` at ` | ` separators (then anywhere) into lines of at most `columns` characters.
-fn wrap(text: &str, columns: usize) -> Vec<String> {
-    let columns = columns.max(8);
-    let mut lines: Vec<String> = Vec::new();
-    for part in text.split(" | ") {
-        match lines.last_mut() {
-            Some(last) if last.len() + 3 + part.len() <= columns => {
-                last.push_str(" | ");
-                last.push_str(part);
+    let host = Host(cli::Progress::new(args.quiet || args.json));
+    let outcome = preview::run(&request, &host);
+    host.0.finish();
+    let rendered = match outcome? {
+        Outcome::Window(shown) => {
+            if let Some(line) = shown {
+                cli::outln!("{line}");
             }
-            _ => {
-                let mut rest = part;
-                while rest.len() > columns {
-                    let (head, tail) = rest.split_at(rest.floor_char_boundary(columns));
-                    lines.push(head.to_string());
-                    rest = tail;
-                }
-                lines.push(rest.to_string());
-            }
+            return Ok(ExitCode::SUCCESS);
         }
+        Outcome::Rendered(rendered) => rendered,
+    };
+    // Every output is made; now write them, so that an error leaves none behind.
+    for file in &rendered.files {
+        asset::write_atomic(&file.path, &file.bytes).with_context(|| format!("writing {}", file.path.display()))?;
     }
-    lines
+    let written: Vec<String> = rendered.files.iter().map(|f| f.path.display().to_string()).collect();
+    let mut value = rendered.json;
+    value["files"] = rendered
+        .files
+        .iter()
+        .map(|f| {
+            let path = f.path.display().to_string();
+            let output = asset::StageOutput::of_bytes(&path, asset::FileFormat::Png, f.role, &f.bytes)
+                .expect("a PNG needs no header read");
+            serde_json::to_value(output).expect("an output serializes")
+        })
+        .collect();
+    Ok(cli::finish(args.json, &value, &rendered.report, &rendered.problems, &written))
+}
+
+/// The progress bar, and the GPU opened without the spurious line a headless run prints where
+/// there is no Wayland session (`cli::without_stderr_lines`).
+struct Host(cli::Progress);
+
+impl preview::Host for Host {
+    fn step(&self, what: String) {
+        self.0.step(what);
+    }
+
+    fn work(&self, done: u64, total: u64) {
+        self.0.work(done, total);
+    }
+
+    fn open_gpu(&self) -> Result<gpu::Gpu, gpu::GpuError> {
+        cli::without_stderr_lines(cli::is_wayland_session_warning, gpu::Gpu::new)
+    }
 }

@@ -1,4 +1,4 @@
-//! `--window`: the interactive previewer. A winit window shows the running average of the GPU
+//! The interactive previewer. A winit window shows the running average of the GPU
 //! renderer (`gpu::preview::Renderer::accumulate`): every redraw adds frames (f = 0, 1, 2, ...)
 //! until [`MAX_FRAMES`], and the present pass (`gpu::preview::Presenter`) tone maps the average
 //! into the window like the pictures `--out` writes (`envmap::tonemap_rgb8`), on the window's
@@ -13,12 +13,10 @@
 //! camera, mode or view starts the accumulation again; the exposure only redraws.
 
 use std::ffi::OsString;
-use std::path::PathBuf;
-use std::process::ExitCode;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
 use gpu::preview::{Presenter, Renderer, View};
 use gpu::surface::{Display, WindowSurface};
 use render::{Camera, Mode, Settings};
@@ -28,6 +26,10 @@ use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, Window
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
+
+use crate::Error;
+
+type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Frames a view accumulates before the window stops drawing: far beyond where the average
 /// stops changing visibly (the noise falls as 1 / sqrt(frames)), and a bound on the work of a
@@ -61,16 +63,9 @@ const KEY_HELP: &str = "brdf-preview window: drag (left button) to orbit, scroll
                         D cycles views (shaded, normals, prefiltered layer, sample slice), +/- exposure, R resets the \
                         camera, Esc/Q quits";
 
-/// The window's options beside `--window`.
-#[derive(Debug, clap::Args)]
-pub struct Options {
-    /// With --window: once --frames frames are accumulated (1 for a debug view), save what the
-    /// window shows (PNG) and exit. For scripts and CI (e.g. under xvfb-run).
-    #[arg(long, value_name = "FILE.png", requires = "window")]
-    pub window_screenshot: Option<PathBuf>,
-}
-
-/// Opens a window showing the scene, rendered with the GPU renderer, until it is closed. Fails
+/// Opens a window showing the scene, rendered with the GPU renderer, until it is closed; with
+/// `screenshot`, saves what the window shows once `settings.frames` frames are accumulated (1
+/// for a debug view) and closes it, returning a line that says what the picture shows. Fails
 /// with "--window needs a display: ...; render to a file with --out" where no window can open.
 pub fn run(
     material: &render::Material,
@@ -78,8 +73,8 @@ pub fn run(
     scene: &render::Scene,
     settings: &render::Settings,
     preview: &envmap::Preview,
-    options: &Options,
-) -> Result<ExitCode> {
+    screenshot: Option<&Path>,
+) -> Result<Option<String>> {
     // Elsewhere (macOS, Windows) there is always a display to ask.
     if cfg!(all(unix, not(target_os = "macos")))
         && let Some(reason) = missing_display(|name| std::env::var_os(name))
@@ -91,22 +86,23 @@ pub fn run(
     let display = Display::new(event_loop.owned_display_handle());
     let mut app = App {
         inputs: Inputs { material, lighting, scene, settings, preview },
-        screenshot: options.window_screenshot.clone(),
+        screenshot: screenshot.map(Path::to_path_buf),
+        shown: None,
         display,
         state: None,
         outcome: None,
     };
     eprintln!("{KEY_HELP}");
-    event_loop.run_app(&mut app).map_err(|e| anyhow!("running the window's event loop: {e}"))?;
+    event_loop.run_app(&mut app).map_err(|e| Error::Window(format!("running the window's event loop: {e}")))?;
     match app.outcome {
         Some(Err(e)) => Err(e),
-        Some(Ok(())) | None => Ok(ExitCode::SUCCESS),
+        Some(Ok(())) | None => Ok(app.shown),
     }
 }
 
 /// The error of a machine where no window can open.
-fn no_display(reason: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("--window needs a display: {reason}; render to a file with --out")
+fn no_display(reason: impl std::fmt::Display) -> Error {
+    Error::Window(format!("--window needs a display: {reason}; render to a file with --out"))
 }
 
 /// A winit error without the source location winit puts before an OS error ("os error at
@@ -145,6 +141,8 @@ struct Inputs<'a> {
 struct App<'a> {
     inputs: Inputs<'a>,
     screenshot: Option<PathBuf>,
+    /// What the screenshot shows, once saved.
+    shown: Option<String>,
     display: Display,
     /// Made once the event loop runs (winit opens windows only then).
     state: Option<State>,
@@ -322,8 +320,8 @@ impl App<'_> {
         if let (Some(path), true) = (&self.screenshot, due) {
             let rgb = texture.read_rgb8(&state.presenter, &state.renderer, state.exposure_ev)?;
             envmap::write_png_rgb8(path, size.0 as usize, size.1 as usize, &rgb)
-                .with_context(|| format!("writing {}", path.display()))?;
-            cli::outln!("{}: {}", path.display(), state.title(frames, target));
+                .map_err(|e| Error::Invalid(format!("writing {}: {e}", path.display())))?;
+            self.shown = Some(format!("{}: {}", path.display(), state.title(frames, target)));
             texture.present(&state.gpu);
             self.finish(event_loop, Ok(()));
             return Ok(());

@@ -1,0 +1,380 @@
+//! The previewer as a library: a bake rendered on the GPU by one of the papers' estimators
+//! (`render` specifies them, `gpu` runs them), checked against the same render on the CPU, the
+//! independent converged estimate and the table its wavelet encoding compresses, as captioned
+//! pictures and a report ([`run`]); and the interactive window ([`window`]). `brdf-preview` is
+//! its command line: a [`Request`]'s fields are that tool's options, and messages name them as
+//! the options they are (`--spp`, `--max-samples`).
+//!
+//! Nothing is written here: [`run`] returns every picture as PNG bytes with the path and role it
+//! is for ([`Output`]), so that the caller writes them together or not at all.
+
+mod adaptive;
+mod checks;
+mod views;
+pub mod window;
+
+pub use checks::mesh;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use render::{Mode as Estimator, Settings, metrics};
+use serde_json::json;
+
+use crate::checks::{
+    Converged, check_finite, check_psnr, check_work, contact_sheet, converged, db, json_db, names, png, preview, scene,
+    sibling, with_caption,
+};
+
+/// An error that stops a preview: the request's own (a bake that cannot serve it, work over the
+/// ceiling), a file's, or the renderers'. Messages are one lower-case line naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The request cannot be served as asked.
+    #[error("{0}")]
+    Invalid(String),
+    #[error(transparent)]
+    Bake(#[from] bake::Error),
+    #[error(transparent)]
+    Render(#[from] render::Error),
+    #[error(transparent)]
+    Gpu(#[from] gpu::GpuError),
+    #[error(transparent)]
+    Picture(#[from] envmap::Error),
+    /// The window could not open or run.
+    #[error("{0}")]
+    Window(String),
+}
+
+/// `return Err(Error::Invalid(format!(...)))`.
+macro_rules! bail {
+    ($($message:tt)*) => {
+        return Err($crate::Error::Invalid(format!($($message)*)))
+    };
+}
+pub(crate) use bail;
+
+/// What a preview renders: one of the papers' estimators at full resolution, or one adaptive
+/// frame shaded by one of them where the predicted bandwidth asks for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Reference,
+    Fis,
+    Prefiltered,
+    Adaptive,
+    AdaptivePrefiltered,
+}
+
+impl Mode {
+    /// The estimator of the shaded pixels.
+    pub fn estimator(self) -> Estimator {
+        match self {
+            Mode::Reference | Mode::Adaptive => Estimator::Reference,
+            Mode::Fis => Estimator::Fis,
+            Mode::Prefiltered | Mode::AdaptivePrefiltered => Estimator::Prefiltered,
+        }
+    }
+
+    pub fn is_adaptive(self) -> bool {
+        matches!(self, Mode::Adaptive | Mode::AdaptivePrefiltered)
+    }
+
+    /// The name on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Adaptive => "adaptive",
+            Mode::AdaptivePrefiltered => "adaptive-prefiltered",
+            other => other.estimator().name(),
+        }
+    }
+}
+
+/// Which BRDF the estimators evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Brdf {
+    /// The MERL table (nearest lookup).
+    Table,
+    /// Its Haar wavelet encoding (Claustres et al. 2007), decoded on the GPU.
+    Wavelet,
+}
+
+/// A preview, as `brdf-preview`'s options ask for it (its `--help` says what each does).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Request {
+    pub bake: PathBuf,
+    /// The picture to write (`None` with `window` or with only a `sheet`).
+    pub out: Option<PathBuf>,
+    pub material: Option<PathBuf>,
+    pub brdf: Brdf,
+    pub wavelet: Option<PathBuf>,
+    pub wavelet_lod: f64,
+    /// `sphere`, `torus` or the path of a Wavefront OBJ file.
+    pub mesh: String,
+    pub mode: Mode,
+    pub spp: Option<u32>,
+    pub frames: Option<u32>,
+    pub aa: usize,
+    pub predict_level: usize,
+    pub allocation: render::adaptive::Allocation,
+    pub lobe_weight: bool,
+    pub layer_shift: u32,
+    pub debug_views: bool,
+    /// Width and height.
+    pub size: (usize, usize),
+    pub exposure: Option<f32>,
+    /// Azimuth and elevation, degrees.
+    pub camera: (f32, f32),
+    pub seed: u32,
+    pub validate: bool,
+    pub converged: Option<u32>,
+    pub min_psnr: Option<f64>,
+    pub max_samples: u64,
+    pub sheet: Option<PathBuf>,
+    /// Open the interactive window instead of rendering `out`.
+    pub window: bool,
+    /// With `window`: save what the window shows once its frames are done, and close it.
+    pub window_screenshot: Option<PathBuf>,
+}
+
+/// A picture a preview made: where it goes, what it is (`preview`, `difference`, `converged`,
+/// `table`, `debug-views`, `contact-sheet`) and its PNG bytes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Output {
+    pub path: PathBuf,
+    pub role: &'static str,
+    pub bytes: Vec<u8>,
+}
+
+/// What a preview made: its pictures, a report for people, the problems its checks found (a
+/// PSNR under `min_psnr`, an adaptive frame planned differently on the GPU and the CPU) and its
+/// figures as one JSON object (without the files, which the caller describes once written).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rendered {
+    pub files: Vec<Output>,
+    pub report: Vec<String>,
+    pub problems: Vec<String>,
+    pub json: serde_json::Value,
+}
+
+/// How a preview ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    Rendered(Rendered),
+    /// The window was closed; with a screenshot, a line saying what it shows.
+    Window(Option<String>),
+}
+
+/// What the caller lends a preview: a progress bar, and the way to open the GPU.
+pub trait Host: Sync {
+    /// A new step begins (`"reference on the GPU"`).
+    fn step(&self, _what: String) {}
+    /// Within the current step, `done` of `total` units are done (from any thread).
+    fn work(&self, _done: u64, _total: u64) {}
+    /// The GPU the renders run on.
+    fn open_gpu(&self) -> Result<gpu::Gpu, gpu::GpuError> {
+        gpu::Gpu::new()
+    }
+}
+
+/// A host with no progress bar that opens the GPU plainly.
+impl Host for () {}
+
+/// Renders, checks and pictures a bake as `request` asks (or opens its window).
+pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
+    // Where the outputs go must exist before anything is rendered.
+    for path in request.out.iter().chain(&request.sheet) {
+        checks::check_output_folder(path)?;
+    }
+    let mut loaded = bake::load(&request.bake, request.material.as_deref())?;
+    if request.brdf == Brdf::Wavelet {
+        let (path, brdf) = match &request.wavelet {
+            Some(path) => (path.clone(), bake::load_wavelet(path, &loaded)?),
+            None => bake::bake_wavelet(&loaded)?,
+        };
+        let levels = brdf.grid().levels() as f64;
+        if !(0.0..=levels).contains(&request.wavelet_lod) {
+            bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", request.wavelet_lod, path.display());
+        }
+        loaded.material.wavelet = Some(render::Wavelet { brdf, lod: request.wavelet_lod });
+    } else if request.wavelet.is_some() {
+        bail!("--wavelet names the asset for --brdf wavelet; add --brdf wavelet to render with it");
+    }
+    // Every output is encoded before any is written.
+    let mut files: Vec<Output> = Vec::new();
+    let mut report = Vec::new();
+    let mut value = json!({});
+    if let Some(path) = &request.sheet {
+        let sheet = contact_sheet(&loaded)?;
+        files.push(Output {
+            path: path.clone(),
+            role: "contact-sheet",
+            bytes: png(&sheet.rgb, sheet.width, sheet.height)?,
+        });
+    }
+    let mut problems = Vec::new();
+    if request.out.is_some() || request.window {
+        let Some(lighting) = &loaded.lighting else {
+            bail!(
+                "{}: the bake has no environment, nothing to light the material with: bake it with brdf-bake --env",
+                request.bake.display()
+            );
+        };
+        if request.mode.is_adaptive() {
+            if request.window {
+                bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
+            }
+            let out = request.out.as_ref().expect("clap requires --out without --window");
+            let step = adaptive::render(request, &loaded, lighting, out, host)?;
+            files.extend(step.files);
+            report.extend(step.report);
+            problems.extend(step.problems);
+            value = step.json;
+        } else {
+            let mode = request.mode.estimator();
+            let settings =
+                Settings::previewer(mode, &loaded.material.samples, request.spp, request.frames, request.seed);
+            let scene = scene(request)?;
+            let pixels = (scene.width * scene.height) as u128;
+            let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
+            let renders = if loaded.material.wavelet.is_some() { 2 } else { 1 };
+            check_work(
+                request,
+                &[
+                    ("on the GPU", renders * gpu_samples),
+                    ("for --validate on the CPU", if request.validate { gpu_samples } else { 0 }),
+                    ("for --converged on the CPU", pixels * 3 * u128::from(request.converged.unwrap_or(0))),
+                ],
+            )?;
+            let preview = preview(request, lighting);
+            if request.window {
+                let screenshot = request.window_screenshot.as_deref();
+                let shown = window::run(&loaded.material, lighting, &scene, &settings, &preview, screenshot)?;
+                return Ok(Outcome::Window(shown));
+            }
+            let gpu = host.open_gpu()?;
+            let out = request.out.as_ref().expect("clap requires --out without --window");
+            let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
+            host.step(format!("{} on the GPU", mode.name()));
+            let start = Instant::now();
+            let image = renderer.render_frames(&settings)?;
+            check_finite(request, &image.rgb, "the GPU render")?;
+            let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
+            let picture = metrics::tonemap(&image, &preview);
+            let names = names(&loaded.manifest);
+            let brdf = match &loaded.material.wavelet {
+                Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
+                None => "table".to_string(),
+            };
+            let caption = format!(
+                "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+                names,
+                mode.name(),
+                settings.spp,
+                settings.frames,
+                scene.width,
+                scene.height,
+                preview.exposure_ev
+            );
+            let captioned = with_caption(&picture, scene.width, scene.height, &caption);
+            files.push(Output {
+                path: out.clone(),
+                role: "preview",
+                bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
+            });
+            report.push(format!(
+                "{}: {} on {} ({}), {:.1} ms per frame",
+                out.display(),
+                mode.name(),
+                gpu.adapter_summary(),
+                request.mesh,
+                ms_per_frame
+            ));
+            value = json!({
+                "bake": request.bake.display().to_string(),
+                "mode": mode.name(),
+                "brdf": match request.brdf { Brdf::Table => "table", Brdf::Wavelet => "wavelet" },
+                "spp": settings.spp,
+                "frames": settings.frames,
+                "width": scene.width,
+                "height": scene.height,
+                "exposure_ev": preview.exposure_ev,
+                "adapter": gpu.adapter_summary(),
+                "ms_per_frame": ms_per_frame,
+                "mean_luminance": metrics::mean_luminance(&image),
+            });
+
+            if loaded.material.wavelet.is_some() {
+                // What the compression costs: the same render from the table itself.
+                let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
+                host.step(format!("{} from the table on the GPU", mode.name()));
+                let table =
+                    gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
+                check_finite(request, &table.rgb, "the GPU render from the table")?;
+                let table_picture = metrics::tonemap(&table, &preview);
+                let psnr = metrics::psnr_db(&picture, &table_picture);
+                let relative = metrics::relative_error(&image.rgb, &table.rgb);
+                files.push(Output {
+                    path: sibling(out, "table"),
+                    role: "table",
+                    bytes: png(&table_picture, scene.width, scene.height)?,
+                });
+                report.push(format!(
+                "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB,                  relative error {relative:.3}",
+                db(psnr)
+            ));
+                value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
+            }
+            if request.validate {
+                host.step(format!("{} on the CPU (--validate)", mode.name()));
+                let cpu = render::render_with_progress(&scene, &loaded.material, lighting, &settings, &|done, all| {
+                    host.work(done, all)
+                })?;
+                check_finite(request, &cpu.rgb, "the CPU render")?;
+                let cpu_picture = metrics::tonemap(&cpu, &preview);
+                let psnr = metrics::psnr_db(&picture, &cpu_picture);
+                let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
+                let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
+                let difference =
+                    picture::layout::difference(&picture, &cpu_picture, scene.width, scene.height, "GPU - CPU");
+                files.push(Output {
+                    path: sibling(out, "difference"),
+                    role: "difference",
+                    bytes: png(&difference.rgb, difference.width, difference.height)?,
+                });
+                report.push(format!(
+                "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
+                 pixels covered by one renderer only",
+                db(psnr)
+            ));
+                value["psnr_db"] = json_db(psnr);
+                value["relative_error"] = json!(relative);
+                value["coverage_mismatches"] = json!(coverage);
+                check_psnr(request, "against the CPU", psnr, &mut problems);
+            }
+            if let Some(n) = request.converged {
+                let Converged { image: converged, picture: converged_picture, psnr, relative } =
+                    converged(request, &scene, &loaded.material, lighting, n, (&image, &picture), &preview, host)?;
+                let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
+                files.push(Output {
+                    path: sibling(out, "converged"),
+                    role: "converged",
+                    bytes: png(&converged_picture, scene.width, scene.height)?,
+                });
+                report.push(format!(
+                "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
+                 mean luminance ratio {luminance_ratio:.4}",
+                db(psnr)
+            ));
+                value["converged"] = json!({
+                    "samples_per_strategy": n,
+                    "psnr_db": json_db(psnr),
+                    "relative_error": relative,
+                    "mean_luminance_ratio": luminance_ratio,
+                });
+                check_psnr(request, "against the converged estimate", psnr, &mut problems);
+            }
+        }
+    }
+
+    Ok(Outcome::Rendered(Rendered { files, report, problems, json: value }))
+}
