@@ -13,6 +13,8 @@
 
 mod context;
 mod error;
+#[cfg(test)]
+mod layout;
 mod merl_lookup;
 pub mod preview;
 pub mod surface;

@@ -33,71 +33,42 @@
 use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 use glam::DVec3;
-use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings};
+use render::{Camera, Image, Mode, Settings};
 use wgpu::util::DeviceExt;
 
-use crate::context::{Gpu, check_buffer_fits};
+use crate::context::check_buffer_fits;
 use crate::error::GpuError;
-use crate::merl_lookup::{
-    MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, read_back_with, table_bytes,
-};
+use crate::merl_lookup::{capture_errors, read_back_with};
 
-mod adaptive;
-mod present;
+pub(crate) mod adaptive;
+pub(crate) mod present;
+mod setup;
+mod tables;
+pub(crate) mod uniforms;
 
 pub use adaptive::FrameOptions;
 pub use present::{PREVIEW_PRESENT_WGSL, Presenter};
 
+use setup::{storage_entry, uniform_entry};
+use tables::*;
+use uniforms::*;
+
 /// The raster pass: vertex and fragment entry points `raster_vertex`, `raster_fragment`.
-pub const PREVIEW_RASTER_WGSL: &str = include_str!("preview_raster.wgsl");
+pub const PREVIEW_RASTER_WGSL: &str = include_str!("../preview_raster.wgsl");
 
 /// The shading pass, compiled after [`MERL_LOOKUP_WGSL`]: entry point `shade_frame`.
-pub const PREVIEW_SHADE_WGSL: &str = include_str!("preview_shade.wgsl");
+pub const PREVIEW_SHADE_WGSL: &str = include_str!("../preview_shade.wgsl");
 
 /// An adaptive frame after its prediction, compiled after [`PREVIEW_SHADE_WGSL`]: entry points
 /// `adaptive_levels`, `adaptive_reduce`, `adaptive_plan`, `adaptive_scatter`, `adaptive_upsample`,
 /// `adaptive_output` (`Renderer::render_adaptive`).
-pub const PREVIEW_ADAPTIVE_WGSL: &str = include_str!("preview_adaptive.wgsl");
+pub const PREVIEW_ADAPTIVE_WGSL: &str = include_str!("../preview_adaptive.wgsl");
 
 /// The wavelet BRDF decoder (`haar_brdf::WaveletBrdf::eval` in WGSL) and `material_brdf`, the BRDF
 /// the shading pass reads.
-pub const BRDF_WAVELET_WGSL: &str = include_str!("brdf_wavelet.wgsl");
-
-/// `WaveletParams` of `brdf_wavelet.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct WaveletUniform {
-    side: u32,
-    levels: u32,
-    enabled: u32,
-    lod: f32,
-    mean: [f32; 3],
-    epsilon: f32,
-}
-
-impl WaveletUniform {
-    fn new(wavelet: Option<&render::Wavelet>) -> WaveletUniform {
-        match wavelet {
-            Some(w) => {
-                let grid = w.brdf.grid();
-                WaveletUniform {
-                    side: grid.side() as u32,
-                    levels: grid.levels() as u32,
-                    enabled: 1,
-                    lod: w.lod as f32,
-                    mean: w.brdf.channel_mean().map(|m| m as f32),
-                    epsilon: w.brdf.epsilon() as f32,
-                }
-            }
-            None => WaveletUniform { side: 2, levels: 1, enabled: 0, lod: 0.0, mean: [1.0; 3], epsilon: 0.01 },
-        }
-    }
-}
-
-/// Must equal `SHADE_WORKGROUP` in the WGSL (checked by a test below).
-const SHADE_WORKGROUP: u32 = 8;
+pub const BRDF_WAVELET_WGSL: &str = include_str!("../brdf_wavelet.wgsl");
 
 /// Frames recorded into one command buffer: enough to amortize a submission, few enough that no
 /// single submission runs for long on a slow adapter.
@@ -106,78 +77,6 @@ const FRAMES_PER_SUBMIT: u32 = 16;
 /// The G-buffer: the covering triangle's index plus one, 0 where none covers the pixel.
 const TRIANGLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Values per vertex in the mesh buffer: clip-space position, snapped viewport x and y,
-/// position, normal (`preview_shade.wgsl`).
-const VERTEX_FLOATS: u64 = 12;
-
-/// `Shade` of the WGSL.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct ShadeUniform {
-    eye: [f32; 4],
-    ray_forward: [f32; 4],
-    ray_right: [f32; 4],
-    ray_up: [f32; 4],
-    width: u32,
-    height: u32,
-    seed: u32,
-    mode: u32,
-    spp: u32,
-    n_slices: u32,
-    n_vectors: u32,
-    n_samples: u32,
-    n_levels: u32,
-    n_view_rows: u32,
-    n_layers: u32,
-    layer_shift: u32,
-    maps: MapLayout,
-    tables: TableLayout,
-}
-
-/// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,
-/// `peak_map` of the WGSL): map 0 is level 0 of the environment whole; the chain and the layers
-/// the filtered estimators read are the smooth part's where the environment has peaks
-/// (`render::Lighting::smooth_mips`), then come the peaks' level 0.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct MapLayout {
-    mips_first: u32,
-    layers_first: u32,
-    peak_map: u32,
-}
-
-/// `Shade::peak_map` where the environment has no peaks (`NO_MAP` of the WGSL).
-const NO_MAP: u32 = u32::MAX;
-
-/// Where the sampling tables start in the `tables` buffer (`Shade::brdf_rows` to
-/// `peak_conditional` of the WGSL; [`sampling_tables`]).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct TableLayout {
-    brdf_rows: u32,
-    brdf_sectors: u32,
-    t_edges: u32,
-    brdf_marginal: u32,
-    brdf_conditional: u32,
-    env_marginal: u32,
-    env_conditional: u32,
-    peak_marginal: u32,
-    peak_conditional: u32,
-}
-
-/// `Predict` of the WGSL.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct PredictUniform {
-    n_b: u32,
-    env_width: u32,
-    env_height: u32,
-    lobes_x: u32,
-    lobes_y: u32,
-    tile: u32,
-    radians_per_pixel: f32,
-    _pad: u32,
-}
 
 /// The bandwidths the prediction of adaptive frames reads ([`Renderer::set_bandwidths`]).
 #[derive(Debug)]
@@ -186,19 +85,6 @@ struct Prediction {
     uniform: wgpu::Buffer,
     group: wgpu::BindGroup,
 }
-
-/// `MODE_*` of the WGSL.
-fn mode_index(mode: Mode) -> u32 {
-    match mode {
-        Mode::Reference => 0,
-        Mode::Fis => 1,
-        Mode::Prefiltered => 2,
-    }
-}
-
-/// `MODE_GBUFFER_*` of the WGSL: the shading pass writes the G-buffer instead of shading.
-const MODE_GBUFFER_POSITION: u32 = 3;
-const MODE_GBUFFER_NORMAL: u32 = 4;
 
 /// What [`Renderer::accumulate`] adds up at each pixel: the estimate of the settings' mode, or a
 /// debug view of what the estimators read there. Pixels no triangle covers show the environment
@@ -247,11 +133,6 @@ impl View {
         }
     }
 }
-
-/// `MODE_DEBUG_*` of the WGSL.
-const MODE_DEBUG_NORMAL: u32 = 5;
-const MODE_DEBUG_LAYER: u32 = 6;
-const MODE_DEBUG_SLICE: u32 = 7;
 
 /// What the accumulation buffer holds: the sum of frames `0 .. frames` of one render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -359,315 +240,6 @@ impl Drop for Renderer {
 }
 
 impl Renderer {
-    /// Checks the inputs as `render::render` does, uploads the mesh, the MERL table, the samples,
-    /// the mip chain, the prefiltered layers and the view-layer table, and draws the G-buffer
-    /// (the triangle at each pixel centre).
-    /// Fails with [`GpuError::Scene`] on inconsistent inputs and [`GpuError::AdapterLimit`] where
-    /// a buffer or the image exceeds what the adapter can hold.
-    pub fn new(gpu: &Gpu, scene: &Scene, material: &Material, lighting: &Lighting) -> Result<Renderer, GpuError> {
-        check_scene(scene, material, lighting)?;
-        let (width, height) = (scene.width as u32, scene.height as u32);
-        let limits = gpu.limits();
-        let info = gpu.adapter_info();
-        if width.max(height) > limits.max_texture_dimension_2d {
-            return Err(GpuError::AdapterLimit {
-                adapter: gpu.adapter_summary(),
-                limit: "max_texture_dimension_2d",
-                have: limits.max_texture_dimension_2d.into(),
-                need: width.max(height).into(),
-                what: "the image",
-            });
-        }
-
-        let table = &material.table;
-        check_buffer_fits(&limits, info, table_bytes(table.dims()), "the MERL table")?;
-        if let Some(w) = &material.wavelet {
-            check_buffer_fits(&limits, info, 4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
-        }
-        let samples = &material.samples;
-        check_buffer_fits(&limits, info, 16 * samples.texels.len() as u64, "the importance samples")?;
-        let (env_maps, env_texels, maps) = env_buffers(lighting);
-        check_buffer_fits(&limits, info, 4 * env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
-        let (tables, sampling_layout) = sampling_tables(material, lighting);
-        check_buffer_fits(&limits, info, 4 * tables.len() as u64, "the sampling tables")?;
-        let pixels = u64::from(width) * u64::from(height);
-        check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
-        // Clip-space positions, positions and normals interleaved: one storage buffer for all
-        // three, so that the shading pass stays within the 8 storage buffers every adapter offers.
-        let n_vertices = scene.mesh.positions.len() as u64;
-        check_buffer_fits(&limits, info, 4 * VERTEX_FLOATS * n_vertices, "the mesh's vertices")?;
-        check_buffer_fits(&limits, info, 4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
-
-        let device = gpu.device().clone();
-        let queue = gpu.queue().clone();
-        let frame_stride = u64::from(limits.min_uniform_buffer_offset_alignment).max(16);
-        let renderer = capture_errors(&device, || {
-            let storage = |label: &str, contents: &[u8]| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-            };
-            let uniform = |label: &str, size: u64| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-
-            // The mesh, read by both passes.
-            // Written by `rasterize`, with the camera's projection.
-            let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview mesh vertices"),
-                size: 4 * VERTEX_FLOATS * n_vertices,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let index_buffer = storage("preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
-
-            // The raster pass.
-            let vertex = wgpu::ShaderStages::VERTEX;
-            let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview raster"),
-                entries: &[storage_entry(0, vertex, true), storage_entry(1, vertex, true)],
-            });
-            let raster_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("preview_raster.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(PREVIEW_RASTER_WGSL.into()),
-            });
-            let raster_pipeline = raster_pipeline(&device, &raster_layout, &raster_module);
-            let raster_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview raster"),
-                layout: &raster_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: vertex_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: index_buffer.as_entire_binding() },
-                ],
-            });
-            let target = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
-            use wgpu::TextureUsages as T;
-            let triangle_target =
-                target("preview gbuffer triangle", TRIANGLE_FORMAT, T::RENDER_ATTACHMENT | T::TEXTURE_BINDING);
-            let depth_target = target("preview depth", DEPTH_FORMAT, T::RENDER_ATTACHMENT);
-
-            // The shading pass.
-            let compute = wgpu::ShaderStages::COMPUTE;
-            let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("merl table"),
-                entries: &[
-                    uniform_entry(0, compute, false),
-                    storage_entry(1, compute, true),
-                    uniform_entry(2, compute, false),
-                    storage_entry(3, compute, true),
-                    storage_entry(4, compute, true),
-                ],
-            });
-            let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview bake"),
-                entries: &(0..7).map(|binding| storage_entry(binding, compute, true)).collect::<Vec<_>>(),
-            });
-            let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview render"),
-                entries: &[
-                    uniform_entry(0, compute, false),
-                    uniform_entry(1, compute, true),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 2,
-                        visibility: compute,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Uint,
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
-                    storage_entry(3, compute, false),
-                    storage_entry(4, compute, false),
-                ],
-            });
-            let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("preview_shade.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(
-                    format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}\n{PREVIEW_ADAPTIVE_WGSL}")
-                        .into(),
-                ),
-            });
-            // A pipeline of the shading module: groups 0 to 2, and `group3` where the entry has one.
-            let compute_pipeline = |group3: Option<&wgpu::BindGroupLayout>, entry: &'static str| {
-                let layouts = [Some(&table_layout), Some(&bake_layout), Some(&render_layout), group3];
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(entry),
-                    bind_group_layouts: &layouts[..3 + usize::from(group3.is_some())],
-                    immediate_size: 0,
-                });
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&layout),
-                    module: &shade_module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            };
-            let shade_pipeline = compute_pipeline(None, "shade_frame");
-            let backdrop_pipeline = compute_pipeline(None, "shade_backdrop");
-            let blocks_pipeline = compute_pipeline(None, "shade_blocks");
-            let predict_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview predict"),
-                entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
-            });
-            let predict_pipeline = compute_pipeline(Some(&predict_layout), "predict_blocks");
-            let adaptive_layout = adaptive::layout(&device);
-            let adaptive_pipelines = adaptive::Pipelines::new(|entry| compute_pipeline(Some(&adaptive_layout), entry));
-
-            let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("merl dims"),
-                contents: bytemuck::bytes_of(&MerlDimsUniform::new(table.dims())),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let table_buffer = storage("merl table", bytemuck::cast_slice(&gpu_table_values(table)));
-            let wavelet = WaveletUniform::new(material.wavelet.as_ref());
-            let wavelet_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("wavelet params"),
-                contents: bytemuck::bytes_of(&wavelet),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            // Without a wavelet the shader never reads these; a binding cannot be empty.
-            let (map, slices) = match &material.wavelet {
-                Some(w) => (w.brdf.map(), w.brdf.slices()),
-                None => (&[0u32][..], &[0f32][..]),
-            };
-            let wavelet_map_buffer = storage("wavelet map", bytemuck::cast_slice(map));
-            let wavelet_slices_buffer = storage("wavelet slices", bytemuck::cast_slice(slices));
-            let table_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("merl table"),
-                layout: &table_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: dims_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: table_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: wavelet_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: wavelet_map_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: wavelet_slices_buffer.as_entire_binding() },
-                ],
-            });
-            let samples_buffer = storage("preview samples", bytemuck::cast_slice(&samples.texels));
-            let maps_buffer = storage("preview env maps", bytemuck::cast_slice(&env_maps));
-            let texels_buffer = storage("preview env texels", bytemuck::cast_slice(&env_texels));
-            // A binding cannot be empty; a table nobody reads (the mode check rejects the
-            // prefiltered mode without one) holds one unused entry.
-            let view_layers = if material.view_layers.is_empty() { &[0.0][..] } else { &material.view_layers[..] };
-            let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(view_layers));
-            let tables_buffer = storage("preview sampling tables", bytemuck::cast_slice(&tables));
-            let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview bake"),
-                layout: &bake_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: samples_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: maps_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: texels_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: view_layers_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: vertex_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: index_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 6, resource: tables_buffer.as_entire_binding() },
-                ],
-            });
-
-            let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
-            let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
-            let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview accumulation"),
-                size: 16 * pixels,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let backdrop = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview backdrop"),
-                size: 16 * pixels,
-                usage: wgpu::BufferUsages::STORAGE,
-                mapped_at_creation: false,
-            });
-            let view = |texture: &wgpu::Texture| texture.create_view(&Default::default());
-            let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview render"),
-                layout: &render_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: shade_uniform.as_entire_binding() },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &frame_uniform,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(16),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&view(&triangle_target)),
-                    },
-                    wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: backdrop.as_entire_binding() },
-                ],
-            });
-            Renderer {
-                device: device.clone(),
-                queue: queue.clone(),
-                width,
-                height,
-                camera: scene.camera,
-                n_indices: scene.mesh.indices.len() as u32,
-                raster_pipeline,
-                vertex_buffer,
-                mesh: scene.mesh.clone(),
-                geometry: RefCell::new(None),
-                raster_group,
-                triangle_target,
-                depth_target,
-                shade_pipeline,
-                backdrop_pipeline,
-                blocks_pipeline,
-                predict_pipeline,
-                predict_layout,
-                prediction: None,
-                adaptive_pipelines,
-                adaptive_layout,
-                adaptive: RefCell::new(None),
-                adapter_info: info.clone(),
-                table_group,
-                bake_group,
-                render_group,
-                shade_uniform,
-                frame_uniform,
-                frame_stride,
-                accumulation,
-                progress: Cell::new(None),
-                n_slices: samples.n_slices as u32,
-                n_vectors: samples.n_vectors as u32,
-                n_samples: samples.n_samples as u32,
-                n_levels: lighting.mips.n_levels() as u32,
-                n_layers: lighting.layers.len(),
-                view_layers: material.view_layers.clone(),
-                maps,
-                tables: sampling_layout,
-            }
-        })?;
-        renderer.rasterize()?;
-        Ok(renderer)
-    }
-
     /// Pixels of the image: entries of the accumulation buffer.
     fn pixels(&self) -> u64 {
         u64::from(self.width) * u64::from(self.height)
@@ -1184,227 +756,4 @@ fn rgb_of(rgba: &[u8], divisor: f32) -> Vec<f32> {
 fn no_bandwidths() -> GpuError {
     render::Error::Invalid("an adaptive frame's prediction needs the bandwidths: Renderer::set_bandwidths".into())
         .into()
-}
-
-/// The checks of `render::render` on the scene, the material and the lighting, before anything is
-/// allocated from them.
-fn check_scene(scene: &Scene, material: &Material, lighting: &Lighting) -> Result<(), GpuError> {
-    scene.mesh.validate()?;
-    render::raster::check_size(scene.width, scene.height)?;
-    Ok(render::check_inputs(material, lighting)?)
-}
-
-/// The maps' descriptors `(width, height, offset, 0)` (the mip levels, then the prefiltered
-/// layers) and their texels, concatenated.
-fn env_buffers(lighting: &Lighting) -> (Vec<[u32; 4]>, Vec<f32>, MapLayout) {
-    let level0 = lighting.mips.level(0);
-    let (smooth_mips, layers) = (lighting.smooth_mips().levels(), lighting.smooth_layers());
-    // Without peaks the smooth chain is the chain, and map 0 its level 0.
-    let (whole, peak) = match &lighting.peaks {
-        Some(peaks) => (std::slice::from_ref(level0), Some(&peaks.map)),
-        None => (&[][..], None),
-    };
-    let maps = MapLayout {
-        mips_first: whole.len() as u32,
-        layers_first: (whole.len() + smooth_mips.len()) as u32,
-        peak_map: peak.map_or(NO_MAP, |_| (whole.len() + smooth_mips.len() + layers.len()) as u32),
-    };
-    let mut descriptors = Vec::new();
-    let mut texels = Vec::new();
-    for map in whole.iter().chain(smooth_mips).chain(layers).chain(peak) {
-        descriptors.push([map.width() as u32, map.height() as u32, texels.len() as u32, 0]);
-        texels.extend_from_slice(map.rgb());
-    }
-    (descriptors, texels, maps)
-}
-
-/// The CDF tables the shading pass samples, in one buffer: the material's half-vector rows and
-/// every slice's tables, level 0's distribution and the peaks' (level 0's again where there are
-/// none: a binding cannot be empty, and no mode reads them then), all `f32` as the CPU's
-/// distributions hold them (`sampling::Distribution2D::from_cdfs`), so both pick the same bins.
-fn sampling_tables(material: &Material, lighting: &Lighting) -> (Vec<f32>, TableLayout) {
-    let mut data: Vec<f32> = Vec::new();
-    let mut put = |values: &mut dyn Iterator<Item = f64>| -> u32 {
-        let first = data.len() as u32;
-        data.extend(values.map(|v| v as f32));
-        first
-    };
-    let slices = &material.samples.tables;
-    let rows = slices.first().map_or(1, |s| s.distribution().nv());
-    let sectors = slices.first().map_or(1, |s| s.distribution().nu());
-    let t_edges = put(&mut slices.first().map_or(&[0.0, 1.0][..], |s| s.rows().t_edges()).iter().copied());
-    let brdf_marginal = put(&mut slices.iter().flat_map(|s| s.distribution().marginal().cdf().iter().copied()));
-    let brdf_conditional = put(&mut slices.iter().flat_map(|s| s.distribution().conditional_cdf().iter().copied()));
-    let environment = lighting.environment.distribution();
-    let env_marginal = put(&mut environment.marginal().cdf().iter().copied());
-    let env_conditional = put(&mut environment.conditional_cdf().iter().copied());
-    let peaks = lighting.peaks.as_ref().map_or(environment, |p| p.sampling.distribution());
-    let peak_marginal = put(&mut peaks.marginal().cdf().iter().copied());
-    let peak_conditional = put(&mut peaks.conditional_cdf().iter().copied());
-    let layout = TableLayout {
-        brdf_rows: rows as u32,
-        brdf_sectors: sectors as u32,
-        t_edges,
-        brdf_marginal,
-        brdf_conditional,
-        env_marginal,
-        env_conditional,
-        peak_marginal,
-        peak_conditional,
-    };
-    (data, layout)
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: dynamic,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn raster_pipeline(
-    device: &wgpu::Device,
-    layout: &wgpu::BindGroupLayout,
-    module: &wgpu::ShaderModule,
-) -> wgpu::RenderPipeline {
-    let target =
-        Some(wgpu::ColorTargetState { format: TRIANGLE_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("preview raster"),
-        layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("preview raster"),
-            bind_group_layouts: &[Some(layout)],
-            immediate_size: 0,
-        })),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("raster_vertex"),
-            compilation_options: Default::default(),
-            // The vertex shader reads the mesh from storage buffers.
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            // Back faces are drawn: the CPU keeps them, and the shading frame blackens them.
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            // Strictly less: of two equal depths the triangle drawn first stays, as on the CPU.
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some("raster_fragment"),
-            compilation_options: Default::default(),
-            targets: &[target],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn workgroup_size_matches_the_shader() {
-        let decl = format!("const SHADE_WORKGROUP: u32 = {SHADE_WORKGROUP}u;");
-        assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
-    }
-
-    #[test]
-    fn rasterization_constants_match_the_cpu_rasterizer() {
-        let guard_band = format!("const GUARD_BAND: f32 = {:?};", render::raster::GUARD_BAND);
-        let subpixels = format!("const SUBPIXELS: f32 = {:?};", (1u32 << render::raster::SUBPIXEL_BITS) as f32);
-        for decl in [guard_band, subpixels] {
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
-        }
-    }
-
-    #[test]
-    fn host_layouts_match_the_wgsl_structs() {
-        // WGSL `Shade`: four vec4<f32> (64 bytes) and 24 u32 (96, the last 12 the map and table
-        // layouts, flattened in the WGSL): 160, a multiple of its 16-byte alignment.
-        assert_eq!(size_of::<ShadeUniform>(), 160);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, width), 64);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, n_view_rows), 100);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, layer_shift), 108);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, maps), 112);
-        assert_eq!(std::mem::offset_of!(ShadeUniform, tables), 124);
-        assert_eq!(size_of::<MapLayout>() + size_of::<TableLayout>(), 48);
-        // The WGSL's fields in the same order.
-        let fields = [
-            "layer_shift: u32",
-            "mips_first: u32",
-            "layers_first: u32",
-            "peak_map: u32",
-            "brdf_rows: u32",
-            "brdf_sectors: u32",
-            "t_edges: u32",
-            "brdf_marginal: u32",
-            "brdf_conditional: u32",
-            "env_marginal: u32",
-            "env_conditional: u32",
-            "peak_marginal: u32",
-            "peak_conditional: u32",
-        ];
-        let at: Vec<usize> = fields
-            .iter()
-            .map(|f| PREVIEW_SHADE_WGSL.find(f).unwrap_or_else(|| panic!("the WGSL has no `{f}`")))
-            .collect();
-        assert!(at.windows(2).all(|w| w[0] < w[1]), "the WGSL's `Shade` orders its fields otherwise");
-    }
-
-    #[test]
-    fn sampling_constants_match_the_cpu() {
-        let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
-        let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
-        for decl in [salt, no_map] {
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
-        }
-    }
-
-    #[test]
-    fn mode_indices_match_the_shader() {
-        let modes = [
-            ("REFERENCE", mode_index(Mode::Reference)),
-            ("FIS", mode_index(Mode::Fis)),
-            ("PREFILTERED", mode_index(Mode::Prefiltered)),
-            ("GBUFFER_POSITION", MODE_GBUFFER_POSITION),
-            ("GBUFFER_NORMAL", MODE_GBUFFER_NORMAL),
-            ("DEBUG_NORMAL", MODE_DEBUG_NORMAL),
-            ("DEBUG_LAYER", MODE_DEBUG_LAYER),
-            ("DEBUG_SLICE", MODE_DEBUG_SLICE),
-        ];
-        for (name, index) in modes {
-            let decl = format!("const MODE_{name}: u32 = {index}u;");
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
-        }
-    }
 }

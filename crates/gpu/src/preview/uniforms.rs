@@ -1,0 +1,181 @@
+//! What the host shares with the WGSL: the uniforms' layouts and the constants both sides name,
+//! with the tests that hold them to the shader's.
+
+use bytemuck::{Pod, Zeroable};
+use render::Mode;
+
+/// `WaveletParams` of `brdf_wavelet.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct WaveletUniform {
+    pub(crate) side: u32,
+    pub(crate) levels: u32,
+    pub(crate) enabled: u32,
+    pub(crate) lod: f32,
+    pub(crate) mean: [f32; 3],
+    pub(crate) epsilon: f32,
+}
+
+impl WaveletUniform {
+    pub(crate) fn new(wavelet: Option<&render::Wavelet>) -> WaveletUniform {
+        match wavelet {
+            Some(w) => {
+                let grid = w.brdf.grid();
+                WaveletUniform {
+                    side: grid.side() as u32,
+                    levels: grid.levels() as u32,
+                    enabled: 1,
+                    lod: w.lod as f32,
+                    mean: w.brdf.channel_mean().map(|m| m as f32),
+                    epsilon: w.brdf.epsilon() as f32,
+                }
+            }
+            None => WaveletUniform { side: 2, levels: 1, enabled: 0, lod: 0.0, mean: [1.0; 3], epsilon: 0.01 },
+        }
+    }
+}
+
+/// Must equal `SHADE_WORKGROUP` in the WGSL (checked by a test below).
+pub(crate) const SHADE_WORKGROUP: u32 = 8;
+
+/// Values per vertex in the mesh buffer: clip-space position, snapped viewport x and y,
+/// position, normal (`preview_shade.wgsl`).
+pub(crate) const VERTEX_FLOATS: u64 = 12;
+
+/// `Shade` of the WGSL.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub(crate) struct ShadeUniform {
+    pub(crate) eye: [f32; 4],
+    pub(crate) ray_forward: [f32; 4],
+    pub(crate) ray_right: [f32; 4],
+    pub(crate) ray_up: [f32; 4],
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) seed: u32,
+    pub(crate) mode: u32,
+    pub(crate) spp: u32,
+    pub(crate) n_slices: u32,
+    pub(crate) n_vectors: u32,
+    pub(crate) n_samples: u32,
+    pub(crate) n_levels: u32,
+    pub(crate) n_view_rows: u32,
+    pub(crate) n_layers: u32,
+    pub(crate) layer_shift: u32,
+    pub(crate) maps: MapLayout,
+    pub(crate) tables: TableLayout,
+}
+
+/// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,
+/// `peak_map` of the WGSL): map 0 is level 0 of the environment whole; the chain and the layers
+/// the filtered estimators read are the smooth part's where the environment has peaks
+/// (`render::Lighting::smooth_mips`), then come the peaks' level 0.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub(crate) struct MapLayout {
+    pub(crate) mips_first: u32,
+    pub(crate) layers_first: u32,
+    pub(crate) peak_map: u32,
+}
+
+/// `Shade::peak_map` where the environment has no peaks (`NO_MAP` of the WGSL).
+pub(crate) const NO_MAP: u32 = u32::MAX;
+
+/// Where the sampling tables start in the `tables` buffer (`Shade::brdf_rows` to
+/// `peak_conditional` of the WGSL; [`sampling_tables`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub(crate) struct TableLayout {
+    pub(crate) brdf_rows: u32,
+    pub(crate) brdf_sectors: u32,
+    pub(crate) t_edges: u32,
+    pub(crate) brdf_marginal: u32,
+    pub(crate) brdf_conditional: u32,
+    pub(crate) env_marginal: u32,
+    pub(crate) env_conditional: u32,
+    pub(crate) peak_marginal: u32,
+    pub(crate) peak_conditional: u32,
+}
+
+/// `Predict` of the WGSL.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub(crate) struct PredictUniform {
+    pub(crate) n_b: u32,
+    pub(crate) env_width: u32,
+    pub(crate) env_height: u32,
+    pub(crate) lobes_x: u32,
+    pub(crate) lobes_y: u32,
+    pub(crate) tile: u32,
+    pub(crate) radians_per_pixel: f32,
+    pub(crate) _pad: u32,
+}
+
+/// `MODE_*` of the WGSL.
+pub(crate) fn mode_index(mode: Mode) -> u32 {
+    match mode {
+        Mode::Reference => 0,
+        Mode::Fis => 1,
+        Mode::Prefiltered => 2,
+    }
+}
+
+/// `MODE_GBUFFER_*` of the WGSL: the shading pass writes the G-buffer instead of shading.
+pub(crate) const MODE_GBUFFER_POSITION: u32 = 3;
+
+pub(crate) const MODE_GBUFFER_NORMAL: u32 = 4;
+
+/// `MODE_DEBUG_*` of the WGSL.
+pub(crate) const MODE_DEBUG_NORMAL: u32 = 5;
+
+pub(crate) const MODE_DEBUG_LAYER: u32 = 6;
+
+pub(crate) const MODE_DEBUG_SLICE: u32 = 7;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::preview::PREVIEW_SHADE_WGSL;
+
+    #[test]
+    fn workgroup_size_matches_the_shader() {
+        let decl = format!("const SHADE_WORKGROUP: u32 = {SHADE_WORKGROUP}u;");
+        assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+    }
+
+    #[test]
+    fn rasterization_constants_match_the_cpu_rasterizer() {
+        let guard_band = format!("const GUARD_BAND: f32 = {:?};", render::raster::GUARD_BAND);
+        let subpixels = format!("const SUBPIXELS: f32 = {:?};", (1u32 << render::raster::SUBPIXEL_BITS) as f32);
+        for decl in [guard_band, subpixels] {
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
+    }
+
+    #[test]
+    fn sampling_constants_match_the_cpu() {
+        let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
+        let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
+        for decl in [salt, no_map] {
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
+    }
+
+    #[test]
+    fn mode_indices_match_the_shader() {
+        let modes = [
+            ("REFERENCE", mode_index(Mode::Reference)),
+            ("FIS", mode_index(Mode::Fis)),
+            ("PREFILTERED", mode_index(Mode::Prefiltered)),
+            ("GBUFFER_POSITION", MODE_GBUFFER_POSITION),
+            ("GBUFFER_NORMAL", MODE_GBUFFER_NORMAL),
+            ("DEBUG_NORMAL", MODE_DEBUG_NORMAL),
+            ("DEBUG_LAYER", MODE_DEBUG_LAYER),
+            ("DEBUG_SLICE", MODE_DEBUG_SLICE),
+        ];
+        for (name, index) in modes {
+            let decl = format!("const MODE_{name}: u32 = {index}u;");
+            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        }
+    }
+}
