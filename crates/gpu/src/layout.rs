@@ -7,15 +7,13 @@
 
 use std::mem::{offset_of, size_of};
 
-use crate::MERL_LOOKUP_WGSL;
 use crate::merl_lookup::{DirPair, GpuSample, MerlDimsUniform};
 use crate::preview::adaptive::AdaptivePass;
 use crate::preview::present::PresentUniform;
 use crate::preview::uniforms::{PredictUniform, ShadeUniform, WaveletUniform};
-use crate::preview::{BRDF_WAVELET_WGSL, PREVIEW_ADAPTIVE_WGSL, PREVIEW_PRESENT_WGSL, PREVIEW_SHADE_WGSL};
-
-/// The batch lookup's shader (its pair and sample structs).
-const MERL_BATCH_WGSL: &str = include_str!("merl_lookup_batch.wgsl");
+use crate::wgsl::{
+    BRDF_WAVELET, MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_ADAPTIVE, PREVIEW_BINDINGS, PREVIEW_PREDICT, PREVIEW_PRESENT,
+};
 
 /// A host struct: the WGSL source and struct it mirrors, its size, and its members' WGSL names
 /// with their Rust offsets, in order (a nested Rust struct's members flattened, as the WGSL has
@@ -69,16 +67,16 @@ fn wgsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
 
 fn shared_structs() -> Vec<Shared> {
     vec![
-        shared!(MERL_LOOKUP_WGSL, "MerlDims", MerlDimsUniform {
+        shared!(MERL_LOOKUP.source, "MerlDims", MerlDimsUniform {
             "n_theta_h" => n_theta_h, "n_theta_d" => n_theta_d, "n_phi_d" => n_phi_d, "phi_d_range" => phi_d_range,
         }),
-        shared!(MERL_BATCH_WGSL, "MerlDirPair", DirPair { "wi" => wi, "wo" => wo }),
-        shared!(MERL_BATCH_WGSL, "MerlSample", GpuSample { "rgb" => rgb, "cell" => cell }),
-        shared!(BRDF_WAVELET_WGSL, "WaveletParams", WaveletUniform {
+        shared!(MERL_LOOKUP_BATCH.source, "MerlDirPair", DirPair { "wi" => wi, "wo" => wo }),
+        shared!(MERL_LOOKUP_BATCH.source, "MerlSample", GpuSample { "rgb" => rgb, "cell" => cell }),
+        shared!(BRDF_WAVELET.source, "WaveletParams", WaveletUniform {
             "side" => side, "levels" => levels, "enabled" => enabled, "lod" => lod, "mean" => mean,
             "epsilon" => epsilon,
         }),
-        shared!(PREVIEW_SHADE_WGSL, "Shade", ShadeUniform {
+        shared!(PREVIEW_BINDINGS.source, "Shade", ShadeUniform {
             "eye" => eye, "ray_forward" => ray_forward, "ray_right" => ray_right, "ray_up" => ray_up,
             "width" => width, "height" => height, "seed" => seed, "mode" => mode, "spp" => spp,
             "n_slices" => n_slices, "n_vectors" => n_vectors, "n_samples" => n_samples, "n_levels" => n_levels,
@@ -89,18 +87,18 @@ fn shared_structs() -> Vec<Shared> {
             "env_marginal" => tables.env_marginal, "env_conditional" => tables.env_conditional,
             "peak_marginal" => tables.peak_marginal, "peak_conditional" => tables.peak_conditional,
         }),
-        shared!(PREVIEW_SHADE_WGSL, "Predict", PredictUniform {
+        shared!(PREVIEW_PREDICT.source, "Predict", PredictUniform {
             "n_b" => n_b, "env_width" => env_width, "env_height" => env_height, "lobes_x" => lobes_x,
             "lobes_y" => lobes_y, "tile" => tile, "radians_per_pixel" => radians_per_pixel, "_pad" => _pad,
         }),
-        shared!(PREVIEW_ADAPTIVE_WGSL, "AdaptivePass", AdaptivePass {
+        shared!(PREVIEW_ADAPTIVE.source, "AdaptivePass", AdaptivePass {
             "level" => level, "top" => top, "width" => width, "height" => height, "out_width" => out_width,
             "out_height" => out_height, "ss" => ss, "count" => count, "level_table" => level_table,
             "sharpness" => sharpness, "n_rows" => n_rows, "oracle" => oracle, "depth_sigma" => depth_sigma,
             "rescue_below" => rescue_below, "candidates" => candidates, "budget" => budget, "max_spp" => max_spp,
             "capacity" => capacity, "allocate" => allocate, "_pad" => _pad,
         }),
-        shared!(PREVIEW_PRESENT_WGSL, "Present", PresentUniform {
+        shared!(PREVIEW_PRESENT.source, "Present", PresentUniform {
             "image_size" => image_size, "frames" => frames, "view" => view, "exposure" => exposure,
             "srgb_target" => srgb_target, "n_indices" => n_indices, "_pad" => _pad, "origin" => origin,
             "scale" => scale, "_pad2" => _pad2,

@@ -1,6 +1,6 @@
 //! The GPU side of the toolchain: a wgpu device ([`Gpu`], headless, or able to present to a
 //! window's surface that the caller made: the crate knows no windowing library), the WGSL port of
-//! the MERL nearest lookup ([`MERL_LOOKUP_WGSL`]) and the previewer's renderer
+//! the MERL nearest lookup ([`wgsl::MERL_LOOKUP`]) and the previewer's renderer
 //! ([`preview::Renderer`]), which shades with it, accumulates frames progressively and is drawn,
 //! tone mapped, into a texture or a window by [`preview::Presenter`]. [`MerlLookup`] runs that
 //! port on batches of direction pairs and reads the results back, so that tests can hold the
@@ -8,7 +8,7 @@
 //! way to the CPU renderer of the `render` crate, and the present pass to `envmap::tonemap_rgb8`.
 //!
 //! Architecture Invariant: the WGSL is the only copy of the lookup on the GPU. The previewer
-//! includes [`MERL_LOOKUP_WGSL`] rather than a rewrite, so the agreement the tests establish is
+//! includes [`wgsl::MERL_LOOKUP`] rather than a rewrite, so the agreement the tests establish is
 //! the agreement of what is drawn.
 
 mod context;
@@ -18,7 +18,8 @@ mod layout;
 mod merl_lookup;
 pub mod preview;
 pub mod surface;
+pub mod wgsl;
 
 pub use context::Gpu;
 pub use error::GpuError;
-pub use merl_lookup::{GpuSample, MERL_LOOKUP_WGSL, MerlDimsUniform, MerlLookup, gpu_table_values};
+pub use merl_lookup::{GpuSample, MerlDimsUniform, MerlLookup, gpu_table_values};

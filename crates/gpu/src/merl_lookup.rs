@@ -10,15 +10,6 @@ use merl::{Dims, MerlTable};
 use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
 
-/// The WGSL source of the lookup: its functions (`merl_half_diff`, `merl_nearest_cell`,
-/// `merl_lookup_nearest`, ...) and the table's bindings (group 0), with no entry point, so that
-/// every shader that looks up the table starts with this text.
-pub const MERL_LOOKUP_WGSL: &str = include_str!("merl_lookup.wgsl");
-
-/// The compute entry point `merl_lookup_batch` and its batch bindings (group 1), compiled after
-/// [`MERL_LOOKUP_WGSL`].
-const MERL_LOOKUP_BATCH_WGSL: &str = include_str!("merl_lookup_batch.wgsl");
-
 /// Must equal `MERL_WORKGROUP_SIZE` in the WGSL (checked by a test below).
 const WORKGROUP_SIZE: u32 = 64;
 
@@ -119,7 +110,7 @@ impl MerlLookup {
             use wgpu::util::DeviceExt;
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("merl_lookup_batch.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(format!("{MERL_LOOKUP_WGSL}\n{MERL_LOOKUP_BATCH_WGSL}").into()),
+                source: wgpu::ShaderSource::Wgsl(crate::wgsl::module(&[&crate::wgsl::MERL_LOOKUP_BATCH]).into()),
             });
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("merl_lookup_batch"),
@@ -297,14 +288,14 @@ mod tests {
     #[test]
     fn workgroup_size_matches_the_shader() {
         let decl = format!("const MERL_WORKGROUP_SIZE: u32 = {WORKGROUP_SIZE}u;");
-        assert!(MERL_LOOKUP_BATCH_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        assert!(crate::wgsl::MERL_LOOKUP_BATCH.source.contains(&decl), "the WGSL does not declare `{decl}`");
     }
 
     #[test]
     fn the_shared_lookup_has_no_entry_point_or_batch_binding() {
-        // Other shaders start with MERL_LOOKUP_WGSL and bind their own groups from 1 on.
+        // Other shaders start with merl_lookup.wgsl and bind their own groups from 1 on.
         for batch_only in ["@compute", "@group(1)", "merl_samples"] {
-            assert!(!MERL_LOOKUP_WGSL.contains(batch_only), "MERL_LOOKUP_WGSL contains `{batch_only}`");
+            assert!(!crate::wgsl::MERL_LOOKUP.source.contains(batch_only), "merl_lookup.wgsl contains `{batch_only}`");
         }
     }
 

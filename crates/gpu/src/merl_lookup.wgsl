@@ -7,7 +7,8 @@
 //! Conventions are those of the `merl` crate: radians, `z` is the surface normal, `wi` and `wo`
 //! point away from the surface. Group 0 is the table, in every shader that includes this file.
 
-const MERL_HALF_PI: f32 = 1.5707963267948966;
+const PI: f32 = 3.14159265358979;
+const HALF_PI: f32 = 1.5707963267948966;
 
 struct MerlDims {
     n_theta_h: u32,
@@ -71,8 +72,8 @@ fn merl_half_diff(wi: vec3<f32>, wo: vec3<f32>) -> MerlHalfDiff {
 // Continuous grid coordinates (theta_h, theta_d, phi_d): sample i sits at coordinate i, the lower
 // edge of cell i.
 fn merl_grid_coords(dims: MerlDims, hd: MerlHalfDiff) -> vec3<f32> {
-    let x_h = sqrt(max(hd.theta_h, 0.0) / MERL_HALF_PI) * f32(dims.n_theta_h);
-    let x_d = hd.theta_d / MERL_HALF_PI * f32(dims.n_theta_d);
+    let x_h = sqrt(max(hd.theta_h, 0.0) / HALF_PI) * f32(dims.n_theta_h);
+    let x_d = hd.theta_d / HALF_PI * f32(dims.n_theta_d);
     var phi_d = hd.phi_d;
     if (phi_d < 0.0) {
         // With 180 cells this is reciprocity (swapping wi and wo adds pi to phi_d); with 360 it

@@ -856,15 +856,15 @@ mod tests {
         CHUNK, CONTROL_ARGS, CONTROL_CHUNKS, CONTROL_COUNTS, CONTROL_PARTS, CONTROL_SAMPLES, CONTROL_SHADED,
         CONTROL_STATUS, MAX_LEVELS, PART, parts,
     };
-    use crate::preview::PREVIEW_ADAPTIVE_WGSL;
+    use crate::wgsl::PREVIEW_ADAPTIVE;
 
     #[test]
     fn the_constants_match_the_wgsl() {
         let weight = format!("const MIN_WEIGHT: f32 = {:e};", render::adaptive::MIN_WEIGHT);
-        let declared = PREVIEW_ADAPTIVE_WGSL.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
+        let declared = PREVIEW_ADAPTIVE.source.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
         let value: f64 = declared.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
         assert_eq!(value, render::adaptive::MIN_WEIGHT, "{declared} against {weight}");
-        assert!(PREVIEW_ADAPTIVE_WGSL.contains("const NONE: u32 = 0xffffffffu;"));
+        assert!(PREVIEW_ADAPTIVE.source.contains("const NONE: u32 = 0xffffffffu;"));
         for (name, value) in [
             ("CONTROL_SHADED", CONTROL_SHADED),
             ("CONTROL_STATUS", CONTROL_STATUS),
@@ -878,10 +878,10 @@ mod tests {
             ("RUN", CHUNK / 64),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
-            assert!(PREVIEW_ADAPTIVE_WGSL.contains(&line), "the WGSL lacks {line}");
+            assert!(PREVIEW_ADAPTIVE.source.contains(&line), "the WGSL lacks {line}");
         }
         // Per level 4 words from CONTROL_LEVELS, for every level, before the chunks.
-        assert!(PREVIEW_ADAPTIVE_WGSL.contains("const CONTROL_LEVELS: u32 = 32u;"));
+        assert!(PREVIEW_ADAPTIVE.source.contains("const CONTROL_LEVELS: u32 = 32u;"));
         assert!(32 + 4 * MAX_LEVELS as u32 <= CONTROL_CHUNKS && CONTROL_COUNTS as usize + MAX_LEVELS <= 32);
     }
 

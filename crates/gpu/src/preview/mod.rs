@@ -5,7 +5,7 @@
 //! vertices at the pixel centre the way the specification does (from the snapped coordinates,
 //! where a rasterizer's own interpolation may differ by a fraction of a sub-pixel), shades one
 //! frame per dispatch and adds it into an accumulation buffer (`preview_shade.wgsl`, compiled
-//! after [`MERL_LOOKUP_WGSL`], whose nearest lookup is the BRDF). The environment behind the
+//! with the files it needs, `crate::wgsl`). The environment behind the
 //! mesh, the same in every frame of a camera, is drawn once with the G-buffer and read where no
 //! triangle covers a pixel (by the adaptive frames too). [`Renderer::render_frames`]
 //! reads back the average of the frames; [`Renderer::accumulate`] keeps adding frames across
@@ -49,26 +49,11 @@ mod tables;
 pub(crate) mod uniforms;
 
 pub use adaptive::FrameOptions;
-pub use present::{PREVIEW_PRESENT_WGSL, Presenter};
+pub use present::Presenter;
 
 use setup::{storage_entry, uniform_entry};
 use tables::*;
 use uniforms::*;
-
-/// The raster pass: vertex and fragment entry points `raster_vertex`, `raster_fragment`.
-pub const PREVIEW_RASTER_WGSL: &str = include_str!("../preview_raster.wgsl");
-
-/// The shading pass, compiled after [`MERL_LOOKUP_WGSL`]: entry point `shade_frame`.
-pub const PREVIEW_SHADE_WGSL: &str = include_str!("../preview_shade.wgsl");
-
-/// An adaptive frame after its prediction, compiled after [`PREVIEW_SHADE_WGSL`]: entry points
-/// `adaptive_levels`, `adaptive_reduce`, `adaptive_plan`, `adaptive_scatter`, `adaptive_upsample`,
-/// `adaptive_output` (`Renderer::render_adaptive`).
-pub const PREVIEW_ADAPTIVE_WGSL: &str = include_str!("../preview_adaptive.wgsl");
-
-/// The wavelet BRDF decoder (`haar_brdf::WaveletBrdf::eval` in WGSL) and `material_brdf`, the BRDF
-/// the shading pass reads.
-pub const BRDF_WAVELET_WGSL: &str = include_str!("../brdf_wavelet.wgsl");
 
 /// Frames recorded into one command buffer: enough to amortize a submission, few enough that no
 /// single submission runs for long on a slow adapter.

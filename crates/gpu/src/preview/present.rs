@@ -9,9 +9,6 @@ use crate::context::Gpu;
 use crate::error::GpuError;
 use crate::merl_lookup::{capture_errors, read_back};
 
-/// The present pass: vertex and fragment entry points `present_vertex`, `present_fragment`.
-pub const PREVIEW_PRESENT_WGSL: &str = include_str!("../preview_present.wgsl");
-
 /// Entries of the palette (`palette` in the WGSL).
 const PALETTE_SIZE: usize = 256;
 
@@ -83,7 +80,7 @@ impl Presenter {
             });
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_present.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(PREVIEW_PRESENT_WGSL.into()),
+                source: wgpu::ShaderSource::Wgsl(crate::wgsl::PREVIEW_PRESENT.source.into()),
             });
             let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("preview present"),
@@ -294,13 +291,13 @@ mod tests {
             [("SHADED", View::Shaded), ("NORMAL", View::Normal), ("LAYER", View::Layer), ("SLICE", View::Slice)];
         for (name, view) in views {
             let decl = format!("const VIEW_{name}: u32 = {}u;", view_index(view));
-            assert!(PREVIEW_PRESENT_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+            assert!(crate::wgsl::PREVIEW_PRESENT.source.contains(&decl), "the WGSL does not declare `{decl}`");
         }
     }
 
     #[test]
     fn palette_size_matches_the_shader() {
         let decl = format!("array<vec4<f32>, {PALETTE_SIZE}>");
-        assert!(PREVIEW_PRESENT_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        assert!(crate::wgsl::PREVIEW_PRESENT.source.contains(&decl), "the WGSL does not declare `{decl}`");
     }
 }

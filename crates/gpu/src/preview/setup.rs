@@ -6,7 +6,7 @@ use wgpu::util::DeviceExt;
 
 use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
-use crate::merl_lookup::{MERL_LOOKUP_WGSL, MerlDimsUniform, capture_errors, gpu_table_values, table_bytes};
+use crate::merl_lookup::{MerlDimsUniform, capture_errors, gpu_table_values, table_bytes};
 
 use super::*;
 
@@ -88,7 +88,7 @@ impl Renderer {
             });
             let raster_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_raster.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(PREVIEW_RASTER_WGSL.into()),
+                source: wgpu::ShaderSource::Wgsl(crate::wgsl::PREVIEW_RASTER.source.into()),
             });
             let raster_pipeline = raster_pipeline(&device, &raster_layout, &raster_module);
             let raster_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -154,8 +154,12 @@ impl Renderer {
             let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("preview_shade.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(
-                    format!("{MERL_LOOKUP_WGSL}\n{BRDF_WAVELET_WGSL}\n{PREVIEW_SHADE_WGSL}\n{PREVIEW_ADAPTIVE_WGSL}")
-                        .into(),
+                    crate::wgsl::module(&[
+                        &crate::wgsl::PREVIEW_SHADE,
+                        &crate::wgsl::PREVIEW_PREDICT,
+                        &crate::wgsl::PREVIEW_ADAPTIVE,
+                    ])
+                    .into(),
                 ),
             });
             // A pipeline of the shading module: groups 0 to 2, and `group3` where the entry has one.

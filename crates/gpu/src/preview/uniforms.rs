@@ -135,12 +135,12 @@ pub(crate) const MODE_DEBUG_SLICE: u32 = 7;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::preview::PREVIEW_SHADE_WGSL;
+    use crate::wgsl::{PREVIEW_BINDINGS, PREVIEW_SAMPLING};
 
     #[test]
     fn workgroup_size_matches_the_shader() {
         let decl = format!("const SHADE_WORKGROUP: u32 = {SHADE_WORKGROUP}u;");
-        assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        assert!(PREVIEW_BINDINGS.source.contains(&decl), "the WGSL does not declare `{decl}`");
     }
 
     #[test]
@@ -148,7 +148,7 @@ mod tests {
         let guard_band = format!("const GUARD_BAND: f32 = {:?};", render::raster::GUARD_BAND);
         let subpixels = format!("const SUBPIXELS: f32 = {:?};", (1u32 << render::raster::SUBPIXEL_BITS) as f32);
         for decl in [guard_band, subpixels] {
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+            assert!(PREVIEW_BINDINGS.source.contains(&decl), "the WGSL does not declare `{decl}`");
         }
     }
 
@@ -156,8 +156,8 @@ mod tests {
     fn sampling_constants_match_the_cpu() {
         let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
         let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
-        for decl in [salt, no_map] {
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+        for (wgsl, decl) in [(&PREVIEW_SAMPLING, salt), (&PREVIEW_BINDINGS, no_map)] {
+            assert!(wgsl.source.contains(&decl), "{} does not declare `{decl}`", wgsl.file);
         }
     }
 
@@ -175,7 +175,7 @@ mod tests {
         ];
         for (name, index) in modes {
             let decl = format!("const MODE_{name}: u32 = {index}u;");
-            assert!(PREVIEW_SHADE_WGSL.contains(&decl), "the WGSL does not declare `{decl}`");
+            assert!(PREVIEW_BINDINGS.source.contains(&decl), "the WGSL does not declare `{decl}`");
         }
     }
 }

@@ -1,0 +1,135 @@
+//! What the previewer's shading module binds and every part of it shares: the constants (the
+//! modes, the rasterizer's), group 1 (what the scene, material and lighting upload once) and
+//! group 2 (the render: `Shade`, `Frame`, the G-buffer, the accumulation, the backdrop).
+
+
+// The host rounds the image up to whole workgroups of this size (`SHADE_WORKGROUP` in Rust; a
+// test there checks the two agree).
+const SHADE_WORKGROUP: u32 = 8u;
+
+const MODE_REFERENCE: u32 = 0u;
+const MODE_FIS: u32 = 1u;
+const MODE_PREFILTERED: u32 = 2u;
+// Not estimators: write the G-buffer's interpolated (position, triangle) or (normal, covered) of
+// each pixel in place of the sum, so that tests can hold visibility to `render::raster` alone.
+const MODE_GBUFFER_POSITION: u32 = 3u;
+const MODE_GBUFFER_NORMAL: u32 = 4u;
+// Debug views, accumulated like the estimators (so that their average is the value) and with the
+// environment behind the mesh as in every mode: per covered pixel the interpolated normal; or
+// (index, 1, 0) with the prefiltered layer the view-layer table picks (-1 without a table) or
+// the sample slice, and (0, 0, 0) where the pixel has no shading frame (black in the picture).
+const MODE_DEBUG_NORMAL: u32 = 5u;
+const MODE_DEBUG_LAYER: u32 = 6u;
+const MODE_DEBUG_SLICE: u32 = 7u;
+
+// `render::raster::GUARD_BAND`: triangles reaching beyond it are clipped on the CPU. (A test in
+// Rust checks both constants against `render::raster`.)
+const GUARD_BAND: f32 = 4.0;
+// 2^`render::raster::SUBPIXEL_BITS`: viewport coordinates snap to 1/256 pixel.
+const SUBPIXELS: f32 = 256.0;
+
+// Group 1: the samples, every environment map, the view-layer table and the mesh.
+
+// `render::SampleSet::texels`: (wi_local.xyz, pdf), slice-major, then vector, then sample.
+@group(1) @binding(0) var<storage, read> samples: array<vec4<f32>>;
+// One lat-long map per entry: (width, height, offset of its first value in `env_texels`, unused).
+// Entries 0 .. n_levels are the mip chain (level 0 first), then one per prefiltered layer.
+@group(1) @binding(1) var<storage, read> env_maps: array<vec4<u32>>;
+// Every map's texels, RGB interleaved and row-major like `envmap::EnvMap::rgb`. Storage rather
+// than textures: float32 textures need not be filterable, and doing the bilinear weights by hand
+// makes them the CPU's arithmetic.
+@group(1) @binding(2) var<storage, read> env_texels: array<f32>;
+// `render::Material::view_layers`: each view row's Phong layer coordinate.
+@group(1) @binding(3) var<storage, read> view_layers: array<f32>;
+// The mesh, as `preview_raster.wgsl` reads it: twelve values per vertex, three indices per
+// triangle. Per vertex: the clip-space position with the current camera and the snapped viewport
+// x and y in 1/256 pixels (integers, exact in f32 within the guard band; 0 outside the clip
+// volume), both as `render::raster` computes them on the CPU, then the position and the normal.
+// The CPU's rather than the GPU's own: a GPU may fuse multiply-adds and divide to 2.5 ULP
+// (Vulkan allows both), which moves a vertex whose coordinate lies near a rounding tie by a
+// sub-pixel step, and a small triangle's interpolation with it.
+@group(1) @binding(4) var<storage, read> mesh_vertices: array<f32>;
+@group(1) @binding(5) var<storage, read> mesh_indices: array<u32>;
+// The CDF tables the estimators sample, f32 as the CPU samples them (`render::SampleSet::tables`,
+// `render::Lighting::environment` and the peaks' `sampling`), where `Shade` says they start.
+@group(1) @binding(6) var<storage, read> sampling_tables: array<f32>;
+
+// Group 2: the render.
+
+struct Shade {
+    // The camera: the eye, and the pixel ray's basis as `render::Camera::ray` builds it,
+    // `forward`, `right tan(fov_y / 2) aspect` and `up tan(fov_y / 2)`.
+    eye: vec4<f32>,
+    ray_forward: vec4<f32>,
+    ray_right: vec4<f32>,
+    ray_up: vec4<f32>,
+    width: u32,
+    height: u32,
+    seed: u32,
+    mode: u32,
+    spp: u32,
+    n_slices: u32,
+    n_vectors: u32,
+    n_samples: u32,
+    // Mip levels (of `mips_first`'s chain).
+    n_levels: u32,
+    n_view_rows: u32,
+    // Prefiltered layers; the prefiltered estimator reads the layers `layer_shift` layers sharper
+    // than the view's (an adaptive frame's shaded blocks: `render::adaptive::Settings`).
+    n_layers: u32,
+    layer_shift: u32,
+    // Maps in `env_maps` (map 0 is level 0 of the environment, whole): the first level of the mip
+    // chain the fis estimator reads and the first Phong layer (`render::Lighting::smooth_mips` and
+    // `smooth_layers`), and the peaks' level 0 (`NO_MAP` where the environment has none).
+    mips_first: u32,
+    layers_first: u32,
+    peak_map: u32,
+    // In `sampling_tables`: the BRDF tables' rows (of half vectors) and sectors (of phi_h); where the row
+    // edges `t = 1 - cos theta_h` (R + 1), the slices' marginal CDFs (R + 1 each) and their
+    // conditional CDFs (R rows of C + 1 each) start.
+    brdf_rows: u32,
+    brdf_sectors: u32,
+    t_edges: u32,
+    brdf_marginal: u32,
+    brdf_conditional: u32,
+    // Level 0's distribution and the peaks': marginal (H + 1) and conditional (H rows of W + 1)
+    // CDFs over map 0's texels.
+    env_marginal: u32,
+    env_conditional: u32,
+    peak_marginal: u32,
+    peak_conditional: u32,
+}
+
+// `Shade::peak_map` where the environment has no peaks.
+const NO_MAP: u32 = 0xffffffffu;
+
+// Its own uniform, at a dynamic offset: one command buffer holds many frames.
+struct Frame {
+    index: u32,
+}
+
+@group(2) @binding(0) var<uniform> shade: Shade;
+@group(2) @binding(1) var<uniform> frame: Frame;
+// The index plus one of the triangle that covers the pixel centre, 0 where none does.
+@group(2) @binding(2) var gbuffer_triangle: texture_2d<u32>;
+// Per pixel: the sum of the frames' radiance, and in w whether a triangle covers it.
+@group(2) @binding(3) var<storage, read_write> accumulation: array<vec4<f32>>;
+// Per pixel: the environment seen along its camera ray, drawn where no triangle covers the pixel
+// (`shade_backdrop`, once per camera with the G-buffer).
+@group(2) @binding(4) var<storage, read_write> backdrop: array<vec4<f32>>;
+
+// The item of invocation `local` of workgroup `group` in a list of items (`shade_blocks`,
+// `predict_blocks`) dispatched as a power of two of workgroups (`Renderer::run_items`): the
+// workgroups take their runs of 64 items in bit-reversed order. A driver that hands each thread
+// a contiguous range of workgroups (lavapipe does) then gives every thread an even share of any
+// contiguous run of items: an adaptive frame's shaded blocks come level by level, and a coarse
+// level's get many times the samples of a fine level's.
+fn item_index(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
+    let g = group.y * groups.x + group.x;
+    let bits = countTrailingZeros(groups.x * groups.y);
+    var run = 0u;
+    if (bits > 0u) {
+        run = reverseBits(g) >> (32u - bits);
+    }
+    return run * 64u + local;
+}
