@@ -1,0 +1,362 @@
+//! An adaptive frame's state on the GPU, made once per geometry (camera and supersampling),
+//! prediction level and pyramid top: the records, levels and candidates uploaded, one buffer per
+//! kind; the pipelines of `preview_adaptive.wgsl` and their bind group layout.
+
+use std::sync::Arc;
+
+use render::adaptive::Geometry;
+use render::{Lighting, Material};
+
+use super::*;
+use crate::context::check_buffer_fits;
+use crate::error::GpuError;
+use crate::merl_lookup::capture_errors;
+use crate::preview::Renderer;
+
+/// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
+/// and pyramid top: `preview_adaptive.wgsl`'s state.
+#[derive(Debug)]
+pub(crate) struct State {
+    pub(super) geometry: Arc<Geometry>,
+    /// The prediction level and the pyramid's top.
+    pub(super) key: (usize, usize),
+    /// `(width, height, first block)` per level.
+    pub(super) levels: Vec<(u32, u32, u32)>,
+    pub(super) blocks: u32,
+    /// Blocks that hold a shadeable pixel, per level (`preview_adaptive.wgsl`'s candidates).
+    pub(super) candidates_per_level: Vec<u32>,
+    /// The pass uniform with the tables' offsets (the per-pass fields zero).
+    pub(super) base: AdaptivePass,
+    /// The prediction pixels (`render::adaptive::prediction_pixels`), as `predict_blocks`'
+    /// items.
+    pub(super) items: wgpu::Buffer,
+    pub(super) n_items: u32,
+    /// Shadeable render pixels, and output pixels a triangle covers.
+    pub(super) shadeable: usize,
+    pub(super) covered_output: u64,
+    pub(super) buffers: Buffers,
+    pub(super) uniform: wgpu::Buffer,
+    pub(super) group: wgpu::BindGroup,
+    /// For the frame's read-backs (the control words, the list, the image), kept from frame to
+    /// frame.
+    pub(super) readback: wgpu::Buffer,
+    /// The workgroups of `shade_blocks` and of `adaptive_scatter` where the GPU allocates,
+    /// copied from the control words: an indirect dispatch's buffer may not be bound beside it.
+    pub(super) indirect: wgpu::Buffer,
+    /// Where the adapter has timestamp queries: the one-submission frame's stages.
+    pub(super) clock: Option<Clock>,
+}
+
+/// Four timestamps of a one-submission frame (the starts of its three passes: the prediction; the
+/// pyramids, the plan, the samples and the list; the shading, up-sampling and output; and the end
+/// of the last), and the buffer they resolve into.
+#[derive(Debug)]
+pub(super) struct Clock {
+    pub(super) set: wgpu::QuerySet,
+    pub(super) resolved: wgpu::Buffer,
+}
+
+/// Bytes of [`Clock`]'s timestamps.
+pub(super) const CLOCK_BYTES: u64 = 4 * 8;
+
+/// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
+#[derive(Debug)]
+pub(super) struct Buffers {
+    pub(super) records_surface: wgpu::Buffer,
+    pub(super) records_lobe: wgpu::Buffer,
+    pub(super) bandwidths: wgpu::Buffer,
+    pub(super) levels: wgpu::Buffer,
+    pub(super) parents: wgpu::Buffer,
+    pub(super) weights: wgpu::Buffer,
+    pub(super) values: wgpu::Buffer,
+    pub(super) list: wgpu::Buffer,
+    pub(super) tables: wgpu::Buffer,
+    pub(super) control: wgpu::Buffer,
+}
+
+impl Buffers {
+    pub(super) fn in_binding_order(&self) -> [&wgpu::Buffer; 10] {
+        [
+            &self.records_surface,
+            &self.records_lobe,
+            &self.bandwidths,
+            &self.levels,
+            &self.parents,
+            &self.weights,
+            &self.values,
+            &self.list,
+            &self.tables,
+            &self.control,
+        ]
+    }
+}
+
+/// Slots of the pass uniform: levels, `top` reductions, plan, scatter, `top` up-samplings,
+/// output.
+pub(super) fn slots(top: usize) -> u64 {
+    2 * top as u64 + 4
+}
+
+impl Renderer {
+    /// The state for `geometry` and `settings`, made and uploaded when the geometry, the
+    /// prediction level or the top changed since the last frame.
+    pub(super) fn adaptive_state(
+        &self,
+        geometry: &Arc<Geometry>,
+        settings: &render::adaptive::Settings,
+        material: &Material,
+        lighting: &Lighting,
+    ) -> Result<(), GpuError> {
+        let (width, height) = geometry.render_size();
+        let top = render::adaptive::top_level(width, height, settings.max_level);
+        let l = settings.prediction_level(top);
+        // The geometry is one supersampling's: it and these two fix the state.
+        let key = (l, top);
+        if let Some(state) = self.adaptive.borrow().as_ref()
+            && Arc::ptr_eq(&state.geometry, geometry)
+            && state.key == key
+        {
+            return Ok(());
+        }
+        let pixels = geometry.pixels();
+        let shadeable: Vec<bool> = pixels.iter().map(Option::is_some).collect();
+        let (at, of_pixel) = render::adaptive::prediction_pixels(&shadeable, (width, height), l);
+        let mut levels = Vec::with_capacity(top + 1);
+        let (mut w, mut h, mut blocks) = (width as u32, height as u32, 0u32);
+        for _ in 0..=top {
+            levels.push((w, h, blocks));
+            blocks += w * h;
+            (w, h) = (w.div_ceil(2), h.div_ceil(2));
+        }
+        if levels.len() > MAX_LEVELS {
+            return Err(render::Error::Invalid(format!(
+                "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
+                levels.len()
+            ))
+            .into());
+        }
+        // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
+        // (`check_settings` holds the rows in range where the lobe weight is on).
+        let sharpness: Vec<f32> = match lighting.exponents.is_empty() {
+            true => vec![0.0; material.view_layers.len()],
+            false => {
+                material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect()
+            }
+        };
+        let p = (width * height) as u32;
+        // The candidates: blocks that hold a shadeable pixel, level by level.
+        let mut any_shadeable: Vec<bool> = shadeable.clone();
+        let mut candidates: Vec<u32> = (0..p).filter(|&i| shadeable[i as usize]).collect();
+        let mut candidates_per_level = vec![candidates.len() as u32];
+        for k in 1..levels.len() {
+            let ((w, h, first), (cw, ch, _)) = (levels[k], levels[k - 1]);
+            let child = &any_shadeable;
+            let mine: Vec<bool> = (0..w * h)
+                .map(|b| {
+                    let (bx, by) = (b % w, b / w);
+                    (0..4).any(|j| {
+                        let (cx, cy) = (2 * bx + j % 2, 2 * by + j / 2);
+                        cx < cw && cy < ch && child[(cy * cw + cx) as usize]
+                    })
+                })
+                .collect();
+            let before = candidates.len();
+            candidates.extend((0..w * h).filter(|&b| mine[b as usize]).map(|b| first + b));
+            candidates_per_level.push((candidates.len() - before) as u32);
+            any_shadeable = mine;
+        }
+        let n_candidates = candidates.len() as u32;
+        let candidates_at = 4 * (levels.len() as u32 + 1);
+        let sharpness_at = candidates_at + n_candidates;
+        let limits = self.device.limits();
+        // The largest of the buffers: a vec4 per block.
+        let fits = |bytes: u64| check_buffer_fits(&limits, &self.adapter_info, bytes, "an adaptive frame's buffers");
+        fits(16 * u64::from(blocks))?;
+        fits(16 * u64::from(p))?;
+        let base = AdaptivePass {
+            top: top as u32,
+            width: width as u32,
+            height: height as u32,
+            out_width: geometry.size().0 as u32,
+            out_height: geometry.size().1 as u32,
+            ss: settings.supersample as u32,
+            level_table: 0,
+            sharpness: sharpness_at,
+            n_rows: sharpness.len() as u32,
+            candidates: candidates_at,
+            capacity: p,
+            ..Default::default()
+        };
+        let (mut surface, mut lobe) = (vec![[0f32; 4]; p as usize], vec![[0u32; 4]; p as usize]);
+        for (i, (s, l)) in surface.iter_mut().zip(&mut lobe).enumerate() {
+            let f = |v: f64| (v as f32).to_bits();
+            match &pixels[i] {
+                Some(px) => {
+                    let [nx, ny] = px.screen_normal;
+                    *s = [px.depth, px.cos_o, nx, ny].map(|v| v as f32);
+                    *l = [f(px.mirror.x), f(px.mirror.y), f(px.mirror.z), of_pixel[i]];
+                }
+                None => {
+                    // The WGSL's output tells covered pixels without a shading frame by a depth
+                    // of 0: a shaded pixel's is positive.
+                    s[0] = if geometry.covers(i) { 0.0 } else { -1.0 };
+                    l[3] = NONE;
+                }
+            }
+        }
+        let mut first_candidate = 0;
+        let mut table: Vec<u32> = Vec::with_capacity(4 * (levels.len() + 1));
+        for (&(w, h, first), &n) in levels.iter().zip(&candidates_per_level) {
+            table.extend([w, h, first, first_candidate]);
+            first_candidate += n;
+        }
+        table.extend([0, 0, blocks, first_candidate]);
+        table.extend(&candidates);
+        table.extend(sharpness.iter().map(|v| v.to_bits()));
+        // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
+        let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
+        let items = crate::preview::prediction_items(&at, pixels);
+        let state = capture_errors(&self.device, || {
+            use wgpu::BufferUsages as U;
+            use wgpu::util::DeviceExt;
+            let init = |label: &str, contents: &[u8]| {
+                self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                })
+            };
+            let empty = |label: &str, bytes: u64| {
+                self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes.max(16),
+                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
+            let buffers = Buffers {
+                records_surface: init("adaptive records", bytemuck::cast_slice(&surface)),
+                records_lobe: init("adaptive records", bytemuck::cast_slice(&lobe)),
+                bandwidths: empty("adaptive bandwidths", 4 * u64::from(p)),
+                levels: init("adaptive levels", bytemuck::cast_slice(&idle)),
+                parents: empty("adaptive parents", 16 * u64::from(blocks)),
+                weights: empty("adaptive weights", 16 * u64::from(blocks)),
+                values: empty("adaptive values", 16 * u64::from(blocks)),
+                list: empty("adaptive list", 16 * u64::from(blocks)),
+                tables: init("adaptive tables", bytemuck::cast_slice(&table)),
+                control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(CHUNK))),
+            };
+            let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("adaptive prediction pixels"),
+                contents: bytemuck::cast_slice(if items.is_empty() { &[[0u32; 4]][..] } else { &items }),
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
+            let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive passes"),
+                size: slot_stride(self.frame_stride) * slots(top),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
+                }),
+            }];
+            for (binding, buffer) in (3..).zip(buffers.in_binding_order()) {
+                entries.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
+            }
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("adaptive"),
+                layout: &self.adaptive_layout,
+                entries: &entries,
+            });
+            let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
+            let readback = self.readback_buffer(
+                (16 * u64::from(blocks)).max(16 * out_pixels + 4 * u64::from(CONTROL_CHUNKS) + CLOCK_BYTES),
+            );
+            let clock = self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Clock {
+                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("adaptive stages"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 4,
+                }),
+                resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("adaptive stages"),
+                    size: CLOCK_BYTES,
+                    usage: U::QUERY_RESOLVE | U::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+            });
+            let indirect = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive indirect dispatches"),
+                size: 24,
+                usage: U::INDIRECT | U::COPY_DST,
+                mapped_at_creation: false,
+            });
+            State {
+                readback,
+                indirect,
+                clock,
+                geometry: Arc::clone(geometry),
+                key,
+                levels,
+                blocks,
+                candidates_per_level,
+                base,
+                items: items_buffer,
+                n_items: at.len() as u32,
+                shadeable: shadeable.iter().filter(|&&s| s).count(),
+                covered_output: geometry.output_coverage().iter().filter(|&&c| c).count() as u64,
+                buffers,
+                uniform,
+                group,
+            }
+        })?;
+        *self.adaptive.borrow_mut() = Some(state);
+        Ok(())
+    }
+}
+
+/// The adaptive frame's pipelines (`preview_adaptive.wgsl`), group 3 from
+/// [`Renderer`]'s `adaptive_layout`.
+#[derive(Debug)]
+pub(crate) struct Pipelines {
+    pub levels: wgpu::ComputePipeline,
+    pub reduce: wgpu::ComputePipeline,
+    pub plan: wgpu::ComputePipeline,
+    pub scatter: wgpu::ComputePipeline,
+    pub upsample: wgpu::ComputePipeline,
+    pub output: wgpu::ComputePipeline,
+    pub allocate: wgpu::ComputePipeline,
+    pub offsets: wgpu::ComputePipeline,
+    pub list: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    pub(crate) fn new(make: impl Fn(&'static str) -> wgpu::ComputePipeline) -> Pipelines {
+        Pipelines {
+            levels: make("adaptive_levels"),
+            reduce: make("adaptive_reduce"),
+            plan: make("adaptive_plan"),
+            scatter: make("adaptive_scatter"),
+            upsample: make("adaptive_upsample"),
+            output: make("adaptive_output"),
+            allocate: make("adaptive_allocate"),
+            offsets: make("adaptive_offsets"),
+            list: make("adaptive_list"),
+        }
+    }
+}
+
+/// The layout of group 3 of the adaptive passes: binding 2 the pass uniform (one slot per pass),
+/// 3 to 12 the state's buffers ([`Buffers`]; the records and the tables read-only).
+pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let mut entries = vec![crate::preview::uniform_entry(2, compute, true)];
+    entries
+        .extend((3..=12).map(|binding| crate::preview::storage_entry(binding, compute, matches!(binding, 3 | 4 | 11))));
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("adaptive"), entries: &entries })
+}
