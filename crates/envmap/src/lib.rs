@@ -74,7 +74,7 @@ pub use read::{
     read_image, read_image_from_memory,
 };
 pub use write::{
-    Preview, SampleType, ToneMap, encode_exr, encode_png_rgb8, tonemap, tonemap_rgb8, write_exr, write_png_rgb8,
+    SampleType, ToneMap, ToneMapping, encode_exr, encode_png_rgb8, tonemap, tonemap_rgb8, write_exr, write_png_rgb8,
 };
 
 /// Rec. 709 luminance of a linear RGB triple (weights 0.2126, 0.7152, 0.0722).

@@ -146,31 +146,31 @@ pub fn encode_png_rgb8(width: usize, height: usize, rgb8: &[u8]) -> Result<Vec<u
     Ok(bytes)
 }
 
-/// How linear radiance becomes an 8-bit preview.
+/// How linear radiance becomes an 8-bit picture: the exposure, then the tone curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Preview {
+pub struct ToneMapping {
     /// Radiance is multiplied by `2^exposure_ev` first.
     pub exposure_ev: f32,
     pub tone_map: ToneMap,
 }
 
-impl Preview {
-    /// Reinhard's key: [`Preview::auto`] maps a map's log-average luminance to this.
+impl ToneMapping {
+    /// Reinhard's key: [`ToneMapping::auto`] maps a map's log-average luminance to this.
     pub const KEY: f64 = 0.18;
 
     /// The preview of pictures lit by `map`: the exposure that maps the map's log-average
-    /// luminance ([`EnvMap::log_average_luminance`]) to [`Preview::KEY`], then Reinhard (Reinhard
+    /// luminance ([`EnvMap::log_average_luminance`]) to [`ToneMapping::KEY`], then Reinhard (Reinhard
     /// et al. 2002: a scene's "key" sets its exposure). Every picture of a comparison shares it.
-    pub fn auto(map: &EnvMap) -> Preview {
+    pub fn auto(map: &EnvMap) -> ToneMapping {
         let exposure_ev = (Self::KEY / map.log_average_luminance()).log2() as f32;
-        Preview { exposure_ev, tone_map: ToneMap::Reinhard }
+        ToneMapping { exposure_ev, tone_map: ToneMap::Reinhard }
     }
 }
 
-impl Default for Preview {
+impl Default for ToneMapping {
     /// No exposure change, Reinhard: suns and lamps stay visible without a chosen exposure.
     fn default() -> Self {
-        Preview { exposure_ev: 0.0, tone_map: ToneMap::Reinhard }
+        ToneMapping { exposure_ev: 0.0, tone_map: ToneMap::Reinhard }
     }
 }
 
@@ -186,14 +186,14 @@ pub enum ToneMap {
 
 /// Tone maps interleaved linear RGB (or any number of channels: each value is mapped alone) to
 /// 8-bit sRGB. NaN maps to 0.
-pub fn tonemap_rgb8(rgb: &[f32], preview: &Preview) -> Vec<u8> {
+pub fn tonemap_rgb8(rgb: &[f32], preview: &ToneMapping) -> Vec<u8> {
     let scale = f64::from(preview.exposure_ev).exp2();
     rgb.iter().map(|&value| (tonemap_value(f64::from(value), scale, preview.tone_map) * 255.0).round() as u8).collect()
 }
 
 /// One value as [`tonemap_rgb8`] shows it, before the rounding to 8 bits: the sRGB-encoded
 /// level in `[0, 1]`. NaN maps to 0.
-pub fn tonemap(value: f64, preview: &Preview) -> f64 {
+pub fn tonemap(value: f64, preview: &ToneMapping) -> f64 {
     tonemap_value(value, f64::from(preview.exposure_ev).exp2(), preview.tone_map)
 }
 
@@ -233,7 +233,7 @@ impl EnvMap {
     }
 
     /// Writes a tone-mapped 8-bit sRGB PNG preview of the map.
-    pub fn write_preview_png(&self, path: &Path, preview: &Preview) -> Result<(), Error> {
+    pub fn write_preview_png(&self, path: &Path, preview: &ToneMapping) -> Result<(), Error> {
         write_png_rgb8(path, self.width(), self.height(), &tonemap_rgb8(self.rgb(), preview))
     }
 

@@ -1,6 +1,6 @@
 //! Outputs: EXR round trips, PNG previews, and the errors of both writers.
 
-use envmap::{EnvMap, Preview, SampleType, ToneMap};
+use envmap::{EnvMap, SampleType, ToneMap, ToneMapping};
 use rand::{Rng, SeedableRng};
 
 use crate::shared_env;
@@ -103,23 +103,23 @@ fn png_preview_reads_back() {
     let dir = tempfile::tempdir().expect("temporary folder");
     let path = dir.path().join("preview.png");
     let map = envmap::load(&shared_env().join("studio_small_03_1k.hdr")).expect("studio");
-    map.write_preview_png(&path, &Preview::default()).expect("write");
+    map.write_preview_png(&path, &ToneMapping::default()).expect("write");
     assert_only(dir.path(), &["preview.png"]);
     let image = image::open(&path).expect("png");
     assert_eq!((image.width(), image.height()), (1024, 512));
     assert_eq!(image.color(), image::ColorType::Rgb8);
-    let want = envmap::tonemap_rgb8(map.rgb(), &Preview::default());
+    let want = envmap::tonemap_rgb8(map.rgb(), &ToneMapping::default());
     assert_eq!(image.into_rgb8().into_raw(), want);
 }
 
 /// Known values of the curves: sRGB(0.5) = 0.7354 -> 188, sRGB(0.0031308) = 0.0404 -> 10.
 #[test]
 fn tone_mapping() {
-    let clamp = Preview { exposure_ev: 0.0, tone_map: ToneMap::Clamp };
+    let clamp = ToneMapping { exposure_ev: 0.0, tone_map: ToneMap::Clamp };
     assert_eq!(envmap::tonemap_rgb8(&[0.0, 0.5, 1.0, 7.0, 0.003_130_8], &clamp), [0, 188, 255, 255, 10]);
-    let reinhard = Preview::default();
+    let reinhard = ToneMapping::default();
     assert_eq!(envmap::tonemap_rgb8(&[0.0, 1.0, f32::INFINITY, f32::NAN, -1.0], &reinhard), [0, 188, 255, 0, 0]);
-    let brighter = Preview { exposure_ev: 1.0, tone_map: ToneMap::Clamp };
+    let brighter = ToneMapping { exposure_ev: 1.0, tone_map: ToneMap::Clamp };
     assert_eq!(envmap::tonemap_rgb8(&[0.25, 0.5], &brighter), [188, 255]);
 }
 

@@ -6,7 +6,7 @@
 use std::f64::consts::FRAC_PI_2;
 use std::sync::OnceLock;
 
-use envmap::{EnvMap, MipChain, Preview, ToneMap};
+use envmap::{EnvMap, MipChain, ToneMap, ToneMapping};
 use gpu::preview::{Presenter, Renderer, View};
 use merl::Dims;
 use merl::analytic::Analytic;
@@ -118,7 +118,7 @@ fn accumulating_frame_by_frame_is_one_render_of_as_many_frames() {
 fn the_present_pass_tone_maps_like_the_pictures() {
     let mut renderer = renderer();
     let image = renderer.render_frames(&settings(2)).expect("rendering");
-    let auto = render::metrics::auto_preview(lighting().mips.level(0)).exposure_ev;
+    let auto = render::metrics::auto_tone_mapping(lighting().mips.level(0)).exposure_ev;
     for format in [
         wgpu::TextureFormat::Rgba8Unorm,
         wgpu::TextureFormat::Bgra8Unorm,
@@ -127,14 +127,14 @@ fn the_present_pass_tone_maps_like_the_pictures() {
     ] {
         let presenter = Presenter::new(gpu(), format).expect("a presenter");
         for exposure_ev in [auto, auto + 3.0] {
-            let expected = envmap::tonemap_rgb8(&image.rgb, &Preview { exposure_ev, tone_map: ToneMap::Reinhard });
+            let expected = envmap::tonemap_rgb8(&image.rgb, &ToneMapping { exposure_ev, tone_map: ToneMap::Reinhard });
             let drawn = presenter.draw_rgb8(&renderer, (SIZE as u32, SIZE as u32), exposure_ev).expect("presenting");
             assert_eq!(drawn.len(), expected.len());
             let differences: Vec<u8> = drawn.iter().zip(&expected).map(|(a, b)| a.abs_diff(*b)).collect();
             let largest = differences.iter().copied().max().unwrap_or(0);
             let differing = differences.iter().filter(|&&d| d > 0).count();
             // How far the exact level of each differing value is from a rounding boundary.
-            let preview = Preview { exposure_ev, tone_map: ToneMap::Reinhard };
+            let preview = ToneMapping { exposure_ev, tone_map: ToneMap::Reinhard };
             let from_boundary = |j: usize| {
                 let level = 255.0 * envmap::tonemap(f64::from(image.rgb[j]), &preview);
                 (level - level.floor() - 0.5).abs()

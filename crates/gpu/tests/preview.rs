@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use envmap::{EnvMap, MipChain, Preview};
+use envmap::{EnvMap, MipChain, ToneMapping};
 use gpu::GpuError;
 use gpu::preview::Renderer;
 use merl::Dims;
@@ -130,8 +130,8 @@ fn render_cpu(scene: &Scene, material: &Material, lighting: &Lighting, settings:
 }
 
 /// The exposure every picture of a comparison shares: the sky's automatic one.
-fn preview() -> Preview {
-    render::metrics::auto_preview(sky())
+fn preview() -> ToneMapping {
+    render::metrics::auto_tone_mapping(sky())
 }
 
 /// PSNR of the pictures and relative error of the linear values, GPU against CPU.

@@ -1,7 +1,7 @@
 //! The contact sheet: the source and every layer as one 8-bit picture for a person to look at, a
 //! labelled grid of panels tone mapped alike, with the exposure written under it.
 
-use envmap::{EnvMap, MipChain, Preview};
+use envmap::{EnvMap, MipChain, ToneMapping};
 use picture::layout::{Grid, caption};
 use picture::{Canvas, format_number};
 
@@ -48,7 +48,7 @@ pub fn contact_sheet(source: &MipChain, layers: &[(u32, &EnvMap)]) -> ContactShe
     panels.push(panel);
     panels.extend(layers.iter().map(|(_, layer)| layer.rgb().to_vec()));
 
-    let preview = Preview::auto(source.level(0));
+    let preview = ToneMapping::auto(source.level(0));
     let exposure_ev = preview.exposure_ev;
     let zoom = (MIN_PANEL_WIDTH / w.max(1)).max(1);
     let mut grid = Grid::new(COLUMNS);

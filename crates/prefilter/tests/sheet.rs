@@ -24,7 +24,7 @@ fn titled_panels_in_a_grid() {
     let titles = panel_titles(exponents.iter().copied());
     assert_eq!(titles, ["source", "n = 1", "n = 16", "n = 256", "n = 1024"]);
     let title_height = Canvas::label("n").height + TITLE_GAP;
-    let preview = envmap::Preview { exposure_ev: sheet.exposure_ev, tone_map: envmap::ToneMap::Reinhard };
+    let preview = envmap::ToneMapping { exposure_ev: sheet.exposure_ev, tone_map: envmap::ToneMap::Reinhard };
     let mut corners = Vec::new();
     for (k, title) in titles.iter().enumerate() {
         let (x, y) = canvas.find(&Canvas::label(title)).unwrap_or_else(|| panic!("no title {title:?}"));

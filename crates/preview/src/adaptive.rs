@@ -8,7 +8,7 @@ use render::{Mode as Estimator, Scene, metrics};
 use serde_json::json;
 
 use crate::checks::{
-    Converged, check_finite, check_psnr, check_work, converged, db, json_db, names, png, preview, scene, sibling,
+    Converged, check_finite, check_psnr, check_work, converged, db, json_db, names, png, scene, sibling, tone_mapping,
     with_caption,
 };
 use crate::{Error, Host, Output, Rendered, Request};
@@ -55,7 +55,7 @@ pub(crate) fn render(
             ("for the converged estimate on the CPU", converged_samples),
         ],
     )?;
-    let preview = preview(request, lighting);
+    let tone_mapping = tone_mapping(request, lighting);
     let gpu = host.open_gpu()?;
     let render_scene = Scene { width: scene.width * ss, height: scene.height * ss, ..scene.clone() };
     let mut renderer = gpu::preview::Renderer::new(&gpu, &render_scene, &loaded.material, lighting)?;
@@ -73,7 +73,7 @@ pub(crate) fn render(
     check_finite(request, &frame.image.rgb, "the GPU's adaptive frame")?;
     let t = frame.timings;
     let ms_per_frame = t.total_ms;
-    let picture = metrics::tonemap(&frame.image, &preview);
+    let picture = metrics::tonemap(&frame.image, &tone_mapping);
     let aa = settings.supersample * settings.supersample;
     // The pre-convolved estimator's layers, where they are not the bake's.
     let layers = match (mode, settings.layer_shift) {
@@ -89,7 +89,7 @@ pub(crate) fn render(
         frame.shaded_fraction(),
         scene.width,
         scene.height,
-        preview.exposure_ev
+        tone_mapping.exposure_ev
     );
     let captioned = with_caption(&picture, scene.width, scene.height, &caption);
     let mut files = vec![Output {
@@ -147,7 +147,7 @@ pub(crate) fn render(
         "layer_shift": settings.layer_shift,
         "width": scene.width,
         "height": scene.height,
-        "exposure_ev": preview.exposure_ev,
+        "exposure_ev": tone_mapping.exposure_ev,
         "ms_per_frame": ms_per_frame,
         "timings_ms": {
             "gbuffer": t.gbuffer_ms,
@@ -181,7 +181,7 @@ pub(crate) fn render(
         let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
         let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
         let cpu = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let cpu_picture = metrics::tonemap(&cpu.image, &preview);
+        let cpu_picture = metrics::tonemap(&cpu.image, &tone_mapping);
         let psnr = metrics::psnr_db(&picture, &cpu_picture);
         let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
         let plan = frame.details().plan.compare(&cpu.details().plan, 1e-5);
@@ -216,7 +216,7 @@ pub(crate) fn render(
     if request.validate || request.converged.is_some() {
         let n = request.converged.unwrap_or(256);
         let Converged { image: converged, picture: converged_picture, psnr, relative } =
-            converged(request, &scene, &loaded.material, lighting, n, (&frame.image, &picture), &preview, host)?;
+            converged(request, &scene, &loaded.material, lighting, n, (&frame.image, &picture), &tone_mapping, host)?;
         files.push(Output {
             path: sibling(out, "converged"),
             role: "converged",
@@ -245,7 +245,7 @@ pub(crate) fn render(
                 &converged,
                 None,
             )?;
-            let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &preview), &converged_picture);
+            let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &tone_mapping), &converged_picture);
             report.push(format!(
                 "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
                  near it, more --spp does not help, the up-sampling is the error",

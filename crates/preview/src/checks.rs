@@ -30,7 +30,7 @@ pub(crate) fn converged(
     lighting: &render::Lighting,
     n: u32,
     (image, picture): (&render::Image, &[u8]),
-    preview: &envmap::Preview,
+    tone_mapping: &envmap::ToneMapping,
     host: &dyn Host,
 ) -> Result<Converged, Error> {
     host.step(format!("converged estimate, {n} samples per strategy, on the CPU"));
@@ -43,7 +43,7 @@ pub(crate) fn converged(
         &|done, all| host.work(done, all),
     )?;
     check_finite(request, &converged.rgb, "the converged estimate")?;
-    let converged_picture = metrics::tonemap(&converged, preview);
+    let converged_picture = metrics::tonemap(&converged, tone_mapping);
     let psnr = metrics::psnr_db(picture, &converged_picture);
     let relative = metrics::relative_error(&image.rgb, &converged.rgb);
     Ok(Converged { image: converged, picture: converged_picture, psnr, relative })
@@ -94,10 +94,10 @@ pub(crate) fn check_finite(request: &Request, rgb: &[f32], what: &str) -> Result
 }
 
 /// How pictures are tone mapped: --exposure, or the environment's automatic exposure.
-pub(crate) fn preview(request: &Request, lighting: &render::Lighting) -> envmap::Preview {
+pub(crate) fn tone_mapping(request: &Request, lighting: &render::Lighting) -> envmap::ToneMapping {
     match request.exposure {
-        Some(ev) => envmap::Preview { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
-        None => metrics::auto_preview(lighting.mips.level(0)),
+        Some(ev) => envmap::ToneMapping { exposure_ev: ev, tone_map: envmap::ToneMap::Reinhard },
+        None => metrics::auto_tone_mapping(lighting.mips.level(0)),
     }
 }
 

@@ -22,8 +22,8 @@ use render::{Mode as Estimator, Settings, metrics};
 use serde_json::json;
 
 use crate::checks::{
-    Converged, check_finite, check_psnr, check_work, contact_sheet, converged, db, json_db, names, png, preview, scene,
-    sibling, with_caption,
+    Converged, check_finite, check_psnr, check_work, contact_sheet, converged, db, json_db, names, png, scene, sibling,
+    tone_mapping, with_caption,
 };
 
 /// An error that stops a preview: the request's own (a bake that cannot serve it, work over the
@@ -245,10 +245,10 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                     ("for --converged on the CPU", pixels * 3 * u128::from(request.converged.unwrap_or(0))),
                 ],
             )?;
-            let preview = preview(request, lighting);
+            let tone_mapping = tone_mapping(request, lighting);
             if request.window {
                 let screenshot = request.window_screenshot.as_deref();
-                let shown = window::run(&loaded.material, lighting, &scene, &settings, &preview, screenshot)?;
+                let shown = window::run(&loaded.material, lighting, &scene, &settings, &tone_mapping, screenshot)?;
                 return Ok(Outcome::Window(shown));
             }
             let gpu = host.open_gpu()?;
@@ -259,7 +259,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             let image = renderer.render_frames(&settings)?;
             check_finite(request, &image.rgb, "the GPU render")?;
             let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
-            let picture = metrics::tonemap(&image, &preview);
+            let picture = metrics::tonemap(&image, &tone_mapping);
             let names = names(&loaded.manifest);
             let brdf = match &loaded.material.wavelet {
                 Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
@@ -273,7 +273,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                 settings.frames,
                 scene.width,
                 scene.height,
-                preview.exposure_ev
+                tone_mapping.exposure_ev
             );
             let captioned = with_caption(&picture, scene.width, scene.height, &caption);
             files.push(Output {
@@ -297,7 +297,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                 "frames": settings.frames,
                 "width": scene.width,
                 "height": scene.height,
-                "exposure_ev": preview.exposure_ev,
+                "exposure_ev": tone_mapping.exposure_ev,
                 "adapter": gpu.adapter_summary(),
                 "ms_per_frame": ms_per_frame,
                 "mean_luminance": metrics::mean_luminance(&image),
@@ -310,7 +310,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                 let table =
                     gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
                 check_finite(request, &table.rgb, "the GPU render from the table")?;
-                let table_picture = metrics::tonemap(&table, &preview);
+                let table_picture = metrics::tonemap(&table, &tone_mapping);
                 let psnr = metrics::psnr_db(&picture, &table_picture);
                 let relative = metrics::relative_error(&image.rgb, &table.rgb);
                 files.push(Output {
@@ -330,7 +330,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                     host.work(done, all)
                 })?;
                 check_finite(request, &cpu.rgb, "the CPU render")?;
-                let cpu_picture = metrics::tonemap(&cpu, &preview);
+                let cpu_picture = metrics::tonemap(&cpu, &tone_mapping);
                 let psnr = metrics::psnr_db(&picture, &cpu_picture);
                 let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
                 let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
@@ -353,7 +353,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             }
             if let Some(n) = request.converged {
                 let Converged { image: converged, picture: converged_picture, psnr, relative } =
-                    converged(request, &scene, &loaded.material, lighting, n, (&image, &picture), &preview, host)?;
+                    converged(request, &scene, &loaded.material, lighting, n, (&image, &picture), &tone_mapping, host)?;
                 let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
                 files.push(Output {
                     path: sibling(out, "converged"),

@@ -72,7 +72,7 @@ pub fn run(
     lighting: &render::Lighting,
     scene: &render::Scene,
     settings: &render::Settings,
-    preview: &envmap::Preview,
+    tone_mapping: &envmap::ToneMapping,
     screenshot: Option<&Path>,
 ) -> Result<Option<String>> {
     // Elsewhere (macOS, Windows) there is always a display to ask.
@@ -85,7 +85,7 @@ pub fn run(
         EventLoop::new().map_err(|e| no_display(format!("opening the event loop: {}", winit_message(&e))))?;
     let display = Display::new(event_loop.owned_display_handle());
     let mut app = App {
-        inputs: Inputs { material, lighting, scene, settings, preview },
+        inputs: Inputs { material, lighting, scene, settings, tone_mapping },
         screenshot: screenshot.map(Path::to_path_buf),
         shown: None,
         display,
@@ -135,7 +135,7 @@ struct Inputs<'a> {
     lighting: &'a render::Lighting,
     scene: &'a render::Scene,
     settings: &'a render::Settings,
-    preview: &'a envmap::Preview,
+    tone_mapping: &'a envmap::ToneMapping,
 }
 
 struct App<'a> {
@@ -290,7 +290,7 @@ impl App<'_> {
             drawn: home,
             mode: self.inputs.settings.mode,
             view: View::Shaded,
-            exposure_ev: self.inputs.preview.exposure_ev,
+            exposure_ev: self.inputs.tone_mapping.exposure_ev,
             cursor: None,
             dragging: false,
             ms_per_frame: None,

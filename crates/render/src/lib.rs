@@ -178,7 +178,7 @@
 //! `x / (1 + x)` per channel, the sRGB transfer function). PSNR is taken on those 8-bit images
 //! over all pixels and channels; the relative error is `|a - b| / |b|` (Euclidean norms over all
 //! linear values). Every picture of a comparison shares one exposure, by default the environment's
-//! ([`metrics::auto_preview`], `envmap::Preview::auto`: its solid-angle-weighted log-average
+//! ([`metrics::auto_tone_mapping`], `envmap::ToneMapping::auto`: its solid-angle-weighted log-average
 //! luminance maps to 0.18, as on `envmap-prefilter`'s contact sheet); the difference picture is `|a - b|` of the 8-bit
 //! values times 4, clamped.
 //!

@@ -2,7 +2,7 @@
 //! a comparison), an automatic exposure, PSNR on the 8-bit pictures, the relative error of the
 //! linear values, the mean luminance of the covered pixels and an amplified difference picture.
 
-use envmap::{EnvMap, Preview};
+use envmap::{EnvMap, ToneMapping};
 
 use crate::Image;
 
@@ -11,14 +11,14 @@ pub const DIFFERENCE_GAIN: u32 = 4;
 
 /// The 8-bit sRGB picture of an image (`envmap::tonemap_rgb8`: exposure, then the curve, then
 /// the sRGB transfer function), interleaved RGB.
-pub fn tonemap(image: &Image, preview: &Preview) -> Vec<u8> {
+pub fn tonemap(image: &Image, preview: &ToneMapping) -> Vec<u8> {
     envmap::tonemap_rgb8(&image.rgb, preview)
 }
 
-/// The preview every picture of a comparison shares: `envmap::Preview::auto` of the environment
+/// The preview every picture of a comparison shares: `envmap::ToneMapping::auto` of the environment
 /// (its log-average luminance maps to 0.18, then Reinhard's curve).
-pub fn auto_preview(map: &EnvMap) -> Preview {
-    Preview::auto(map)
+pub fn auto_tone_mapping(map: &EnvMap) -> ToneMapping {
+    ToneMapping::auto(map)
 }
 
 /// Peak signal-to-noise ratio of two 8-bit pictures over all pixels and channels,

@@ -53,7 +53,7 @@ fn the_reference_modes_error_carries_no_structure() {
     let truth = converged(&scene, material, &lighting, 256, 9).expect("valid inputs");
     let residual: Vec<f64> = luminance(&image).iter().zip(luminance(&truth)).map(|(a, b)| a - b).collect();
     let linear = neighbour_correlation(&residual, &image.covered, scene.width);
-    let preview = metrics::auto_preview(lighting.mips.level(0));
+    let preview = metrics::auto_tone_mapping(lighting.mips.level(0));
     let (a, b) = (metrics::tonemap(&image, &preview), metrics::tonemap(&truth, &preview));
     let picture: Vec<f64> = a.iter().zip(&b).map(|(&x, &y)| f64::from(x) - f64::from(y)).collect();
     let picture: Vec<f64> = picture.chunks_exact(3).map(|c| c.iter().sum()).collect();

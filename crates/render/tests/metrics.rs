@@ -1,6 +1,6 @@
 //! The numbers and pictures that compare renders.
 
-use envmap::{EnvMap, Preview, ToneMap};
+use envmap::{EnvMap, ToneMap, ToneMapping};
 use render::{Image, metrics};
 
 use crate::support;
@@ -52,13 +52,13 @@ fn auto_exposure_maps_the_log_average_to_the_key() {
     let map: EnvMap = support::sky_lighting().mips.level(0).clone();
     // A constant map of luminance 0.18 (less the 1e-4 offset) needs no exposure change.
     let grey = EnvMap::constant(16, 8, [0.18 - 1e-4; 3]).expect("2:1");
-    assert!(metrics::auto_preview(&grey).exposure_ev.abs() < 1e-5);
+    assert!(metrics::auto_tone_mapping(&grey).exposure_ev.abs() < 1e-5);
     // Four times brighter everywhere: two stops less.
     let bright = EnvMap::constant(16, 8, [4.0 * 0.18 - 1e-4; 3]).expect("2:1");
-    assert!((metrics::auto_preview(&bright).exposure_ev + 2.0).abs() < 1e-4);
-    let preview = metrics::auto_preview(&map);
+    assert!((metrics::auto_tone_mapping(&bright).exposure_ev + 2.0).abs() < 1e-4);
+    let preview = metrics::auto_tone_mapping(&map);
     assert_eq!(preview.tone_map, ToneMap::Reinhard);
     let image = Image { width: 1, height: 1, rgb: vec![0.1, 1.0, 10.0], covered: vec![true] };
     assert_eq!(metrics::tonemap(&image, &preview), envmap::tonemap_rgb8(&image.rgb, &preview));
-    assert_ne!(metrics::tonemap(&image, &Preview::default()), metrics::tonemap(&image, &preview));
+    assert_ne!(metrics::tonemap(&image, &ToneMapping::default()), metrics::tonemap(&image, &preview));
 }

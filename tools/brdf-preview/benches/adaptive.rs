@@ -255,7 +255,7 @@ fn brute_match(curve: &[(f64, f64)], psnr: f64) -> Match {
 /// [0, 1], before 8-bit quantization (whose steps would read as detail everywhere), windows
 /// whose RMS is below an 8-bit step's (1 / 255 / sqrt(12)) reading 0: detail the pictures the
 /// PSNR compares cannot show. Per window centre, cycles per pixel.
-fn picture_fft(image: &Image, preview: &envmap::Preview) -> bandwidth::WindowedFftMap {
+fn picture_fft(image: &Image, preview: &envmap::ToneMapping) -> bandwidth::WindowedFftMap {
     let luminance: Vec<f64> = image
         .rgb
         .chunks_exact(3)
@@ -361,7 +361,7 @@ fn main() {
             let loaded = bake(material, env);
             let lighting = loaded.lighting.as_ref().expect("an environment");
             let atlas = loaded.bandwidths.as_ref().expect("bandwidths").brdf.clone();
-            let preview = metrics::auto_preview(lighting.mips.level(0));
+            let preview = metrics::auto_tone_mapping(lighting.mips.level(0));
             for mesh in MESHES {
                 let name = format!("{material} / {env} / {mesh}");
                 if !wanted(mesh) {

@@ -16,7 +16,7 @@
 //! the previewer's defaults (`render::Settings::previewer`). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
 //! renderer computes; a convex sphere has no interreflection), 4096 spp, two seeds. Per case and
 //! mode: the PSNR against Mitsuba's seed 0 on the 8-bit pictures (`render::metrics`, one exposure
-//! for all: `metrics::auto_preview` of the map), over the whole picture (the background included,
+//! for all: `metrics::auto_tone_mapping` of the map), over the whole picture (the background included,
 //! as `metrics::psnr_db` takes it) and over the sphere alone; the ratio of the sphere's mean
 //! luminance to Mitsuba's and the same per channel. Mitsuba's floor: its seed 1 against its seed
 //! 0, the same figures. An image without error scores about 3 dB above the floor (it differs from
@@ -457,7 +457,7 @@ fn db_json(db: f64) -> Value {
 /// `image` against `against` over the `compared` pixels: PSNR of the 8-bit pictures
 /// (`render::metrics`, one exposure for both), and the ratios of the mean luminance and of each
 /// channel's mean.
-fn compare(image: &Image, against: &Image, compared: &Compared, preview: &envmap::Preview) -> Figures {
+fn compare(image: &Image, against: &Image, compared: &Compared, preview: &envmap::ToneMapping) -> Figures {
     let (a, b) = (metrics::tonemap(image, preview), metrics::tonemap(against, preview));
     let only = |picture: &[u8], mask: &[bool]| -> Vec<u8> {
         picture.chunks_exact(3).zip(mask).filter(|(_, m)| **m).flat_map(|(p, _)| p.to_vec()).collect()
@@ -525,7 +525,7 @@ fn main() {
             let bake_s = start.elapsed().as_secs_f64();
             let lighting = loaded.lighting.as_ref().expect("the bake has an environment");
             let level0 = lighting.mips.level(0);
-            let preview = metrics::auto_preview(level0);
+            let preview = metrics::auto_tone_mapping(level0);
             for view in VIEWS {
                 let name = format!("{material_name} / {map_name} / {view}");
                 if !wanted(&name) {

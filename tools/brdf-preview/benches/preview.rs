@@ -38,7 +38,7 @@ struct Case {
     table: merl::MerlTable,
     samples: render::SampleSet,
     lighting: Lighting,
-    preview: envmap::Preview,
+    preview: envmap::ToneMapping,
     converged: render::Image,
     converged_picture: Vec<u8>,
 }
@@ -61,7 +61,7 @@ fn main() {
         let config = prefilter::Config { exponents: exponents.clone(), ..prefilter::Config::default() };
         let layers =
             prefilter::prefilter(&map, &config).expect("prefiltering").layers.into_iter().map(|l| l.map).collect();
-        let preview = metrics::auto_preview(&map);
+        let preview = metrics::auto_tone_mapping(&map);
         let lighting = Lighting::new(envmap::MipChain::new(&map), layers, exponents.clone()).expect("a valid map");
         environments.push((env.trim_end_matches(".hdr").to_string(), lighting, preview));
     }
