@@ -47,7 +47,7 @@ fn wavelet_bilinear(w: vec3<f32>) -> WaveletBilinear {
     );
 }
 
-// Coefficient position `p` of outgoing cell `o`.
+// Coefficient position `p` of outgoing cell `o` (`haar_brdf::WaveletBrdf::coefficient`).
 fn wavelet_coefficient(p: u32, o: u32) -> vec3<f32> {
     let at = (wavelet_map[p] * wavelet.side * wavelet.side + o) * 3u;
     return vec3<f32>(wavelet_slices[at], wavelet_slices[at + 1u], wavelet_slices[at + 2u]);

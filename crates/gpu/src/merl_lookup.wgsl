@@ -34,6 +34,7 @@ struct MerlHalfDiff {
 // GLSL.std.450 leaves atan2(0, 0) undefined, and it occurs at the poles: in the mirror
 // configuration h is the normal, and for wi = wo the difference vector is h. Rust's atan2 gives 0
 // there; any azimuth is right at a pole, so agreeing with the CPU is all that matters.
+// No Rust twin: Rust's `f64::atan2` already gives 0 at (0, 0).
 fn merl_atan2(y: f32, x: f32) -> f32 {
     if (x == 0.0 && y == 0.0) {
         return 0.0;
@@ -43,16 +44,19 @@ fn merl_atan2(y: f32, x: f32) -> f32 {
 
 // atan2 rather than acos: acos loses all precision near the pole, where MERL's square-root spacing
 // of theta_h puts its finest cells (cell 1 starts at 1.9e-4 rad).
+// `merl::coords::theta_of`.
 fn merl_theta_of(v: vec3<f32>) -> f32 {
     return merl_atan2(length(v.xy), v.z);
 }
 
+// `merl::coords::rotate_z`: `v` turned by `angle` about `z`.
 fn merl_rotate_z(v: vec3<f32>, angle: f32) -> vec3<f32> {
     let s = sin(angle);
     let c = cos(angle);
     return vec3<f32>(v.x * c - v.y * s, v.x * s + v.y * c, v.z);
 }
 
+// `merl::coords::rotate_y`: `v` turned by `angle` about `y`.
 fn merl_rotate_y(v: vec3<f32>, angle: f32) -> vec3<f32> {
     let s = sin(angle);
     let c = cos(angle);
@@ -71,6 +75,7 @@ fn merl_half_diff(wi: vec3<f32>, wo: vec3<f32>) -> MerlHalfDiff {
 
 // Continuous grid coordinates (theta_h, theta_d, phi_d): sample i sits at coordinate i, the lower
 // edge of cell i.
+// `merl::Dims::grid_coords`.
 fn merl_grid_coords(dims: MerlDims, hd: MerlHalfDiff) -> vec3<f32> {
     let x_h = sqrt(max(hd.theta_h, 0.0) / HALF_PI) * f32(dims.n_theta_h);
     let x_d = hd.theta_d / HALF_PI * f32(dims.n_theta_d);
@@ -84,7 +89,7 @@ fn merl_grid_coords(dims: MerlDims, hd: MerlHalfDiff) -> vec3<f32> {
     return vec3<f32>(x_h, x_d, x_p);
 }
 
-// Truncate and clamp, as the reference MERL reader does.
+// Truncate and clamp, as the reference MERL reader does (`merl::Dims::nearest_cell`).
 fn merl_axis_index(x: f32, n: u32) -> u32 {
     return u32(clamp(floor(x), 0.0, f32(n - 1u)));
 }
@@ -99,11 +104,13 @@ fn merl_nearest_cell(dims: MerlDims, hd: MerlHalfDiff) -> u32 {
 }
 
 // BRDF of a cell in 1/sr; negative in every channel where the table holds no data.
+// `merl::MerlTable::raw_cell`, uploaded already times `merl::SCALE`.
 fn merl_cell_value(cell: u32) -> vec3<f32> {
     let cells = merl_dims.n_theta_h * merl_dims.n_theta_d * merl_dims.n_phi_d;
     return vec3<f32>(merl_table[cell], merl_table[cells + cell], merl_table[2u * cells + cell]);
 }
 
+// Whether a cell holds data: the test of `merl::MerlTable::cell_value`.
 fn merl_has_data(rgb: vec3<f32>) -> bool {
     return all(rgb >= vec3<f32>(0.0));
 }

@@ -22,6 +22,8 @@ struct MerlSample {
 // Bound to exactly the pairs of this dispatch, so its length is the batch size.
 @group(1) @binding(1) var<storage, read_write> merl_samples: array<MerlSample>;
 
+// One pair per invocation: `merl::MerlTable::lookup_half_diff` with `Interp::Nearest`, and the
+// cell's index.
 @compute @workgroup_size(MERL_WORKGROUP_SIZE)
 fn merl_lookup_batch(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

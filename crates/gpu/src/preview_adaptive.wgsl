@@ -104,16 +104,19 @@ const ACTION_UPSAMPLE: u32 = 3u;
 const MIN_WEIGHT: f32 = 7.888609052210118e-31;
 
 // The item of this invocation in a dispatch of `(x, y)` workgroups of 64.
+// No Rust twin: workgroup indexing.
 fn adaptive_item(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
     return workgroup_index(group, groups) * 64u + local;
 }
 
 // The index of workgroup `group` in a dispatch of `(x, y)` workgroups.
+// No Rust twin: workgroup indexing.
 fn workgroup_index(group: vec3<u32>, groups: vec3<u32>) -> u32 {
     return group.y * groups.x + group.x;
 }
 
 // a / b rounded up.
+// No Rust twin: Rust's `u32::div_ceil`.
 fn div_ceil(a: u32, b: u32) -> u32 {
     return (a + b - 1u) / b;
 }
@@ -126,6 +129,7 @@ struct Record {
     prediction: u32,
 }
 
+// Render pixel `pixel`'s `render::adaptive::Pixel`, as `preview/adaptive/state.rs` packs it.
 fn record(pixel: u32) -> Record {
     let a = records_surface[pixel];
     let b = records_lobe[pixel];
@@ -139,17 +143,20 @@ fn record(pixel: u32) -> Record {
 }
 
 // Level k's width, height and first block.
+// `render::adaptive::Level`'s size, and where its blocks start.
 fn level_info(k: u32) -> vec3<u32> {
     let i = adapt.level_table + 4u * k;
     return vec3<u32>(tables[i], tables[i + 1u], tables[i + 2u]);
 }
 
 // The candidates of every level.
+// No Rust twin: the CPU runs over every block, not a list of candidates.
 fn candidates_total() -> u32 {
     return tables[adapt.level_table + 4u * (adapt.top + 1u) + 3u];
 }
 
 // The level of block `block` (its index among every level's blocks).
+// No Rust twin: the CPU keeps each level's blocks apart (`render::adaptive::Plan`).
 fn level_of_block(block: u32) -> u32 {
     var k = 0u;
     while (k < adapt.top && block >= level_info(k + 1u).z) {
@@ -159,12 +166,14 @@ fn level_of_block(block: u32) -> u32 {
 }
 
 // Level k's first candidate and their count.
+// No Rust twin: the CPU runs over every block, not a list of candidates.
 fn level_candidates(k: u32) -> vec2<u32> {
     let i = adapt.level_table + 4u * k + 3u;
     return vec2<u32>(tables[i], tables[i + 4u] - tables[i]);
 }
 
 // Candidate `i` of level k, as the index of the block within its level; NONE past the last.
+// No Rust twin: the CPU runs over every block, not a list of candidates.
 fn candidate(k: u32, i: u32) -> u32 {
     let range = level_candidates(k);
     if (i >= range.y) {
@@ -173,6 +182,7 @@ fn candidate(k: u32, i: u32) -> u32 {
     return tables[adapt.candidates + range.x + i] - level_info(k).z;
 }
 
+// The min pyramid's entry: `render::adaptive::Level`'s `min_level`.
 fn min_level(block: u32) -> i32 {
     return bitcast<i32>(levels[block].x);
 }
@@ -202,7 +212,8 @@ fn block_pixel(k: u32, bx: u32, by: u32) -> u32 {
 
 // Level 0 of the pyramids: each shadeable render pixel's level and variance from its prediction
 // (in `accumulation`, as `predict_blocks` leaves it), or the oracle's bandwidth. A prediction whose pixel the GPU's raster does not find shadeable (-1) stands for
-// the Nyquist rate, as `Renderer::predict_blocks` reads it.
+// the Nyquist rate, as `Renderer::predict_blocks` reads it. Level 0 of `render::adaptive::pyramid`,
+// with the oracle as `render::adaptive::render_with` reads it.
 @compute @workgroup_size(64)
 fn adaptive_levels(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -230,6 +241,7 @@ fn adaptive_levels(
 
 // Level `adapt.level` of the pyramids from the level below: the least level and the largest
 // variance of each block's children.
+// `render::adaptive::pyramid` above level 0.
 @compute @workgroup_size(64)
 fn adaptive_reduce(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -275,12 +287,14 @@ fn lobe_similarity(xi_i: vec3<f32>, l_i: f32, xi_j: vec3<f32>, l_j: f32) -> f32 
     return 4.0 * sqrt(a_i * a_j) * sinh_over;
 }
 
+// The lobe's sharpness at a pixel's view row: the `lambda` of `render::adaptive::upsample_weights`.
 fn sharpness(r: Record) -> f32 {
     let row = min(u32((1.0 - r.cos_o) * f32(adapt.n_rows)), adapt.n_rows - 1u);
     return bitcast<f32>(tables[adapt.sharpness + row]);
 }
 
 // A block's pixel centre along one axis: b 2^k + floor(2^k / 2) + 1/2.
+// The `centre` of `render::adaptive::upsample_weights`.
 fn block_centre(b: u32, k: u32) -> f32 {
     return f32(b * (1u << k) + (1u << k) / 2u) + 0.5;
 }
@@ -405,10 +419,12 @@ fn adaptive_plan(
 // but a count is a power of two, so shifts, sums and comparisons do. The largest, a share's
 // numerator (`W + spare 2^k`: the budget below 2^32, k at most 15) times 2^16, stays below
 // 2^64.
+// No Rust twin: 64-bit integer emulation; the CPU (`render::adaptive::area_allocation`) uses u128.
 fn wide(x: u32) -> Wide {
     return Wide(0u, x);
 }
 
+// No Rust twin: 64-bit integer emulation; the CPU uses u128.
 fn wide_shl(a: Wide, s: u32) -> Wide {
     if (s == 0u) {
         return a;
@@ -419,25 +435,29 @@ fn wide_shl(a: Wide, s: u32) -> Wide {
     return Wide((a.hi << s) | (a.lo >> (32u - s)), a.lo << s);
 }
 
+// No Rust twin: 64-bit integer emulation; the CPU uses u128.
 fn wide_sub(a: Wide, b: Wide) -> Wide {
     return wide_add(a, wide_negate(b));
 }
 
 // a <= b, unsigned.
+// No Rust twin: 64-bit integer emulation; the CPU uses u128.
 fn wide_le(a: Wide, b: Wide) -> bool {
     return a.hi < b.hi || (a.hi == b.hi && a.lo <= b.lo);
 }
 
+// No Rust twin: a control word (read).
 fn control_word(i: u32) -> u32 {
     return atomicLoad(&control[i]);
 }
 
+// No Rust twin: a control word (written).
 fn set_control(i: u32, value: u32) {
     atomicStore(&control[i], value);
 }
 
-// Workgroups of 64 for `count` items as (x, y), at least one: `groups` of `preview/adaptive.rs`,
-// and with `power_of_two` the power of two of `item_groups` (`item_index`'s order).
+// Workgroups of 64 for `count` items as (x, y), at least one: `gpu::preview::adaptive::groups`,
+// and with `power_of_two` the power of two of `gpu::preview::item_groups` (`item_index`'s order).
 fn set_groups(at: u32, count: u32, power_of_two: bool) {
     var n = max(div_ceil(count, 64u), 1u);
     if (power_of_two && n > 1u) {
@@ -449,6 +469,7 @@ fn set_groups(at: u32, count: u32, power_of_two: bool) {
 }
 
 // The parts of a level's `count` blocks of `samples` samples, the first `doubled` of twice that.
+// The items `gpu::preview::adaptive::parts` makes of them.
 fn level_items(count: u32, doubled: u32, samples: u32, part: u32) -> u32 {
     return doubled * div_ceil(2u * samples, part) + (count - doubled) * div_ceil(samples, part);
 }
@@ -600,6 +621,8 @@ var<workgroup> chunk_empty: u32;
 
 // The inclusive prefix sum of `value` over a workgroup of `size` (at most 256) invocations
 // (Hillis and Steele).
+// No Rust twin: GPU plumbing (the CPU builds the list in one loop,
+// `render::adaptive::render_with`).
 fn workgroup_scan(local: u32, value: u32, size: u32) -> u32 {
     scan_words[local] = value;
     workgroupBarrier();
@@ -616,18 +639,22 @@ fn workgroup_scan(local: u32, value: u32, size: u32) -> u32 {
 }
 
 // Whether candidate `c` (in the plan's order: level by level, by block) is shaded.
+// The blocks whose `render::adaptive::Action` is `Shade`: those `render::adaptive::render_with`
+// lists.
 fn shaded_candidate(c: u32) -> bool {
     let action = levels[tables[adapt.candidates + c]].z & 0xffu;
     return action == ACTION_SHADE || action == ACTION_RESCUED;
 }
 
 // Invocation `local`'s RUN of chunk `chunk`'s CHUNK candidates, as (first, end).
+// No Rust twin: how `adaptive_list` splits the candidates among invocations.
 fn run_range(chunk: u32, local: u32) -> vec2<u32> {
     let first = chunk * CHUNK + local * RUN;
     return vec2<u32>(first, min(first + RUN, candidates_total()));
 }
 
 // The shaded candidates among invocation `local`'s run of chunk `chunk`.
+// No Rust twin: how `adaptive_list` splits the candidates among invocations.
 fn run_count(chunk: u32, local: u32) -> u32 {
     let run = run_range(chunk, local);
     var sum = 0u;
@@ -640,6 +667,7 @@ fn run_count(chunk: u32, local: u32) -> u32 {
 // The list in the plan's order, step 1 of 2, one workgroup of 256: the shaded candidates before
 // each chunk of CHUNK, in place of its own, which the plan counted (each invocation sums a
 // stretch of chunks, a prefix sum over the stretches, then each goes through its stretch again).
+// No Rust twin: a prefix sum, for `adaptive_list`.
 @compute @workgroup_size(256)
 fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
     let chunks = div_ceil(candidates_total(), CHUNK);
@@ -662,7 +690,8 @@ fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
 // runs them slowly; many invocations: a GPU hides its memory's latency with them): each shaded
 // candidate's entry at its rank. Where the GPU allocates, also its samples (the first of its
 // level that `adaptive_allocate` doubled get twice its level's) and its parts in
-// `shade_blocks`' items, as `preview/adaptive.rs`'s `parts` lays them out.
+// `shade_blocks`' items, as `gpu::preview::adaptive::parts` lays them out. The CPU's list: the
+// shaded blocks of `render::adaptive::render_with`, in the same order.
 @compute @workgroup_size(64)
 fn adaptive_list(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -703,6 +732,7 @@ fn adaptive_list(
 }
 
 // Shaded block `block`'s entry in the list, at `rank`.
+// The entry and items of `gpu::preview::adaptive::parts`.
 fn list_entry(block: u32, rank: u32) {
     let k = level_of_block(block);
     let me = level_info(k);
@@ -736,6 +766,7 @@ fn list_entry(block: u32, rank: u32) {
 // The shaded blocks' estimates in place: the sum of each one's parts (`accumulation`, as
 // `shade_blocks` leaves them; the list's entry `i` holds the block, its first part and their count).
 // Dispatched for the list (`CONTROL_ARGS` + 3 where the GPU allocates).
+// The shaded blocks' values in `render::adaptive::render_with` (the `Action::Shade` arm).
 @compute @workgroup_size(64)
 fn adaptive_scatter(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -755,6 +786,7 @@ fn adaptive_scatter(
 }
 
 // Level `adapt.level`'s up-sampled blocks: the weighted means of their parents' values.
+// The `Action::Upsample` arm of `render::adaptive::render_with`.
 @compute @workgroup_size(64)
 fn adaptive_upsample(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -783,6 +815,7 @@ fn adaptive_upsample(
 // The output image into `accumulation`: each output pixel the mean of its ss x ss render
 // pixels (level 0's values, the environment (`backdrop`) where no triangle covers the pixel, black
 // where one covers it without a shading frame), w = 1 where a triangle covers any of them.
+// `render::adaptive::render_with`'s render pixels then `render::adaptive::frame::downsample`.
 @compute @workgroup_size(64)
 fn adaptive_output(
     @builtin(workgroup_id) group: vec3<u32>,

@@ -124,6 +124,7 @@ struct Frame {
 // a contiguous range of workgroups (lavapipe does) then gives every thread an even share of any
 // contiguous run of items: an adaptive frame's shaded blocks come level by level, and a coarse
 // level's get many times the samples of a fine level's.
+// No Rust twin: the order of a dispatch's items (`gpu::preview::item_groups` sizes it).
 fn item_index(group: vec3<u32>, local: u32, groups: vec3<u32>) -> u32 {
     let g = group.y * groups.x + group.x;
     let bits = countTrailingZeros(groups.x * groups.y);

@@ -31,6 +31,7 @@ fn env_uv(w: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(u, theta / PI);
 }
 
+// `envmap::EnvMap::texel` of the map whose texels start at `base`, at index `index`.
 fn env_texel(base: u32, index: u32) -> vec3<f32> {
     let i = base + 3u * index;
     return vec3<f32>(env_texels[i], env_texels[i + 1u], env_texels[i + 2u]);
@@ -113,13 +114,14 @@ struct LayerBlend {
     t: f32,
 }
 
+// The prefiltered mode's layers in `render::shade::shade`.
 fn layer_blend(frame: ShadingFrame) -> LayerBlend {
     let x = min(view_layer_coordinate(frame) + f32(shade.layer_shift), f32(shade.n_layers - 1u));
     let k = u32(floor(x));
     return LayerBlend(k, x - f32(k));
 }
 
-// The blended layers at `uv`.
+// The blended layers at `uv`: `render::shade::blend` of two `envmap::EnvMap::lookup_uv`.
 fn layers_bilinear(blend: LayerBlend, uv: vec2<f32>) -> vec3<f32> {
     let a = env_bilinear(shade.layers_first + blend.k, uv);
     if (blend.t > 0.0) {
@@ -131,6 +133,7 @@ fn layers_bilinear(blend: LayerBlend, uv: vec2<f32>) -> vec3<f32> {
 
 // What a debug mode shows at a pixel with a shading frame: (index, 1, 0): the sample slice, or
 // the prefiltered layer coordinate (-1 without a table).
+// No Rust twin: the CPU renderer has no debug views.
 fn debug_index(frame: ShadingFrame) -> vec3<f32> {
     if (shade.mode == MODE_DEBUG_SLICE) {
         return vec3<f32>(f32(slice_of(frame)), 1.0, 0.0);

@@ -8,21 +8,26 @@ struct Hit {
     normal: vec3<f32>,
 }
 
+// Vertex `v`'s clip-space position, as the host computed it with `render::raster::project`.
 fn mesh_clip(v: u32) -> vec4<f32> {
     let i = 12u * v;
     return vec4<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u], mesh_vertices[i + 3u]);
 }
 
+// Vertex `v`'s snapped viewport coordinates, as the host computed them with
+// `render::raster::snapped`.
 fn mesh_snapped(v: u32) -> vec2<i32> {
     let i = 12u * v + 4u;
     return vec2<i32>(i32(mesh_vertices[i]), i32(mesh_vertices[i + 1u]));
 }
 
+// Vertex `v`'s world position (`render::Mesh`).
 fn mesh_position(v: u32) -> vec3<f32> {
     let i = 12u * v + 6u;
     return vec3<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u]);
 }
 
+// Vertex `v`'s normal (`render::Mesh`).
 fn mesh_normal(v: u32) -> vec3<f32> {
     let i = 12u * v + 9u;
     return vec3<f32>(mesh_vertices[i], mesh_vertices[i + 1u], mesh_vertices[i + 2u]);
@@ -45,17 +50,20 @@ struct Wide {
     lo: u32,
 }
 
+// No Rust twin: 64-bit integer emulation; the CPU uses i64 (`render::raster::for_each_covered`).
 fn wide_add(a: Wide, b: Wide) -> Wide {
     let lo = a.lo + b.lo;
     return Wide(a.hi + b.hi + select(0u, 1u, lo < a.lo), lo);
 }
 
+// No Rust twin: 64-bit integer emulation; the CPU uses i64.
 fn wide_negate(a: Wide) -> Wide {
     let lo = ~a.lo + 1u;
     return Wide(~a.hi + select(0u, 1u, lo == 0u), lo);
 }
 
 // a b exactly, for |a|, |b| < 2^31: the magnitude from 16-bit halves, then the sign.
+// No Rust twin: 64-bit integer emulation; the CPU uses i64.
 fn wide_product(a: i32, b: i32) -> Wide {
     let ua = u32(abs(a));
     let ub = u32(abs(b));
@@ -76,6 +84,7 @@ fn wide_product(a: i32, b: i32) -> Wide {
 
 // The nearest f32, to within two roundings (relative error below 2^-23): the high word is exact
 // (below 2^24), and when it is not zero the low word's rounding is 2^-25 of the value at most.
+// No Rust twin: 64-bit integer emulation; the CPU converts its i64 with `as f64`.
 fn wide_to_f32(a: Wide) -> f32 {
     if ((a.hi & 0x80000000u) != 0u) {
         let m = wide_negate(a);
@@ -111,6 +120,7 @@ fn snapped_weights(snapped: array<vec2<i32>, 3>, w: vec3<f32>, x: u32, y: u32) -
 // or the guard band): those of the point where the pixel ray meets the triangle's plane. The
 // CPU interpolates the clipped polygon's snapped vertices, which comes to the same up to that
 // snapping: such triangles are rare in a preview (the near plane is at 1% of the distance).
+// No Rust twin: the CPU clips (`render::raster::clip_polygon`) instead.
 fn ray_weights(p: array<vec3<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
     let eye = shade.eye.xyz;
     let dir = camera_ray(x, y);
@@ -180,6 +190,7 @@ struct MaybeFrame {
     frame: ShadingFrame,
 }
 
+// `render::shade::ShadingFrame::new`.
 fn shading_frame(hit: Hit) -> MaybeFrame {
     var none: MaybeFrame;
     none.valid = false;
@@ -214,6 +225,8 @@ struct Surface {
     frame: ShadingFrame,
 }
 
+// `render::adaptive::geometry::shading_frame` where `render::adaptive::geometry::pixels` finds the
+// pixel shadeable.
 fn surface_at(x: i32, y: i32) -> Surface {
     var none: Surface;
     none.found = false;
@@ -232,10 +245,12 @@ fn surface_at(x: i32, y: i32) -> Surface {
     return Surface(true, hit, maybe.frame);
 }
 
+// `render::shade::ShadingFrame::to_world`.
 fn to_world(frame: ShadingFrame, local: vec3<f32>) -> vec3<f32> {
     return local.x * frame.t + local.y * frame.b + local.z * frame.n;
 }
 
+// `render::shade::ShadingFrame::to_local`.
 fn to_local(frame: ShadingFrame, world: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(world, frame.t), dot(world, frame.b), dot(world, frame.n));
 }

@@ -45,6 +45,7 @@ struct Present {
 // `Renderer`'s accumulation: per pixel the sum of the frames and, in w, whether a triangle covers it.
 @group(0) @binding(2) var<storage, read> accumulation: array<vec4<f32>>;
 
+// No Rust twin: the full-screen triangle of a draw.
 @vertex
 fn present_vertex(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     // (-1, -1), (3, -1), (-1, 3): one triangle that covers the target.
@@ -62,15 +63,18 @@ fn tonemap(radiance: vec3<f32>) -> vec3<f32> {
     return srgb_encode(finite / (1.0 + finite));
 }
 
+// `envmap::write::srgb_encode`.
 fn srgb_encode(x: vec3<f32>) -> vec3<f32> {
     return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));
 }
 
+// No Rust twin: undoes `envmap::write::srgb_encode` for a target that encodes by itself.
 fn srgb_decode(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
 }
 
 // The encoded colour of one image pixel.
+// The shaded view's is `envmap::tonemap_rgb8`'s; the debug views have no Rust twin.
 fn pixel_colour(sum: vec4<f32>) -> vec3<f32> {
     let value = sum.xyz / f32(present.frames);
     let covered = sum.w > 0.0;
@@ -92,6 +96,7 @@ fn pixel_colour(sum: vec4<f32>) -> vec3<f32> {
     return palette[u32(round(t * 255.0))].rgb;
 }
 
+// No Rust twin: the image placed in the target; each pixel's colour is `pixel_colour`'s.
 @fragment
 fn present_fragment(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     // The fragment's position is its pixel centre: (x + 1/2, y + 1/2).

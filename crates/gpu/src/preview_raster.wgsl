@@ -21,6 +21,8 @@ struct VertexOut {
     @location(0) @interpolate(flat) triangle: u32,
 }
 
+// The hardware rasterizes by the rules of `render::raster::rasterize` (the clip positions are
+// `render::raster::project`'s).
 @vertex
 fn raster_vertex(@builtin(vertex_index) corner: u32) -> VertexOut {
     let v = 12u * mesh_indices[corner];
@@ -28,6 +30,7 @@ fn raster_vertex(@builtin(vertex_index) corner: u32) -> VertexOut {
     return VertexOut(clip, corner / 3u);
 }
 
+// The triangle that `render::raster::rasterize` finds at the pixel, plus one.
 @fragment
 fn raster_fragment(in: VertexOut) -> @location(0) u32 {
     return in.triangle + 1u;

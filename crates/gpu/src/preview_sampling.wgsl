@@ -89,12 +89,14 @@ fn cdf_bin(first: u32, n: u32, u: f32) -> u32 {
 }
 
 // Where `u` lies within bin `i` of the CDF table at `sampling_tables[first]`, in [0, 1).
+// The fraction `t` of `sampling::Distribution1D::sample`.
 fn cdf_fraction(first: u32, i: u32, u: f32) -> f32 {
     let c0 = sampling_tables[first + i];
     return min((u - c0) / (sampling_tables[first + i + 1u] - c0), ONE_BELOW);
 }
 
 // The width of bin `i` of the CDF table at `sampling_tables[first]`: its probability.
+// `sampling::distribution1d::Piecewise::bin_pdf` over the bin count.
 fn cdf_width(first: u32, i: u32) -> f32 {
     return sampling_tables[first + i + 1u] - sampling_tables[first + i];
 }
@@ -191,6 +193,7 @@ struct LightSample {
 }
 
 // `pdf_uv / (2 pi^2 sin(pi v))`, 0 where sin(pi v) is not positive.
+// `sampling::latlong::solid_angle_density`.
 fn solid_angle_density(pdf_uv: f32, v: f32) -> f32 {
     let sin_theta = sin(PI * v);
     if (!(sin_theta > 0.0 && pdf_uv > 0.0)) {
@@ -201,6 +204,7 @@ fn solid_angle_density(pdf_uv: f32, v: f32) -> f32 {
 
 // The density over (u, v) of texel (x, y): its row's probability times its own within the row,
 // over the texel's area.
+// `sampling::Distribution2D::pdf`.
 fn latlong_texel_density(d: LatLong, x: u32, y: u32) -> f32 {
     let size = env_maps[0];
     let p_row = cdf_width(d.marginal, y);

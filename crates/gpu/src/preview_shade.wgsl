@@ -11,6 +11,7 @@
 //! group 2 the render.
 
 // One frame's estimate at a covered pixel: 1 / spp of `estimate_sum` over its spp terms.
+// One frame of the loop over frames in `render::shade::shade`.
 fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
     return estimate_sum(frame, pixel, f, spp, 0u, spp) / f32(spp);
 }
@@ -24,6 +25,7 @@ struct SampledLight {
     distribution: LatLong,
 }
 
+// The `sampled` light of `render::shade::shade`.
 fn sampled_light() -> SampledLight {
     if (shade.mode == MODE_REFERENCE) {
         return SampledLight(true, 0u, LatLong(shade.env_marginal, shade.env_conditional));
@@ -90,6 +92,8 @@ fn shade_backdrop(@builtin(global_invocation_id) gid: vec3<u32>) {
     backdrop[gid.y * shade.width + gid.x] = vec4<f32>(env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y))), 0.0);
 }
 
+// One frame of every pixel: `render::shade::shade_rows` with `render::shade::shade` (the G-buffer
+// and debug modes have no Rust twin).
 @compute @workgroup_size(SHADE_WORKGROUP, SHADE_WORKGROUP)
 fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= shade.width || gid.y >= shade.height) {

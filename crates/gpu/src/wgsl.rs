@@ -234,6 +234,126 @@ mod tests {
         }
     }
 
+    /// Each function of a WGSL source (a line that starts with `fn NAME(`) with its comment
+    /// block: the `//` and attribute lines directly above it, without their `//`, joined by
+    /// spaces.
+    fn function_comments(source: &str) -> Vec<(String, String)> {
+        let lines: Vec<&str> = source.lines().collect();
+        let mut out = Vec::new();
+        for (i, line) in lines.iter().enumerate() {
+            let Some(name) = line.strip_prefix("fn ").and_then(|rest| rest.split_once('(')).map(|(name, _)| name)
+            else {
+                continue;
+            };
+            let above = lines[..i].iter().rev().take_while(|l| l.starts_with("//") || l.starts_with('@'));
+            let mut block: Vec<&str> = above.map(|l| l.trim_start_matches('/').trim()).collect();
+            block.reverse();
+            out.push((name.to_string(), block.join(" ")));
+        }
+        out
+    }
+
+    /// The paths a comment names in backticks: the leading `a::b::c` of every code span that
+    /// starts with one.
+    fn backticked_paths(comment: &str) -> Vec<Vec<String>> {
+        comment
+            .split('`')
+            .skip(1)
+            .step_by(2)
+            .filter_map(|span| {
+                let end = span.find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).unwrap_or(span.len());
+                let segments: Vec<String> = span[..end].split("::").map(str::to_string).collect();
+                let words = segments.iter().all(|s| s.starts_with(|c: char| c.is_alphabetic() || c == '_'));
+                (segments.len() > 1 && words).then_some(segments)
+            })
+            .collect()
+    }
+
+    /// The workspace's crates (`crates/<dir>`, named with `_` for `-`) with the names declared
+    /// under their `src/`: items (`fn`, `struct`, `enum`, `const`, `static`, `type`, `trait`,
+    /// `mod`), public fields (`pub name:`) and the modules that files and folders make.
+    fn workspace_declarations() -> BTreeMap<String, BTreeSet<String>> {
+        fn walk(dir: &std::path::Path, names: &mut BTreeSet<String>) {
+            for entry in std::fs::read_dir(dir).unwrap().map(Result::unwrap) {
+                let path = entry.path();
+                let stem = path.file_stem().unwrap().to_string_lossy().to_string();
+                if path.is_dir() {
+                    names.insert(stem);
+                    walk(&path, names);
+                } else if path.extension().is_some_and(|e| e == "rs") {
+                    names.insert(stem);
+                    let code = code(&std::fs::read_to_string(&path).unwrap());
+                    for line in code.lines() {
+                        let words: Vec<String> = tokens(line).into_iter().map(|(_, w)| w).collect();
+                        for pair in words.windows(2) {
+                            let item = ["fn", "struct", "enum", "const", "static", "type", "trait", "mod"];
+                            if item.contains(&pair[0].as_str()) {
+                                names.insert(pair[1].clone());
+                            }
+                        }
+                        let field = line.trim_start().strip_prefix("pub").map(|rest| {
+                            let rest = rest.trim_start();
+                            rest.strip_prefix('(').and_then(|r| r.split_once(')')).map_or(rest, |(_, r)| r.trim_start())
+                        });
+                        if let Some((name, _)) = field.and_then(|f| f.split_once(':'))
+                            && !name.is_empty()
+                            && name.chars().all(|c| c.is_alphanumeric() || c == '_')
+                        {
+                            names.insert(name.to_string());
+                        }
+                    }
+                }
+            }
+        }
+        let crates = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+        let mut out = BTreeMap::new();
+        for entry in std::fs::read_dir(crates).unwrap().map(Result::unwrap) {
+            let src = entry.path().join("src");
+            if src.is_dir() {
+                let mut names = BTreeSet::new();
+                walk(&src, &mut names);
+                out.insert(entry.file_name().to_string_lossy().replace('-', "_"), names);
+            }
+        }
+        out
+    }
+
+    /// Every WGSL function names its CPU twin (a backticked path into a workspace crate, e.g.
+    /// `` `render::pcg_hash` ``) in the comment block right above it, or says `No Rust twin:` and
+    /// why; and every workspace path such a block names is declared in that crate, each segment
+    /// after the crate's name (a path that starts with no crate's name, such as
+    /// `Renderer::run_items`, is prose and not checked).
+    #[test]
+    fn every_wgsl_function_names_its_rust_twin_or_says_why_not() {
+        let crates = workspace_declarations();
+        assert!(crates.contains_key("render") && crates.contains_key("haar_brdf"), "crates: {:?}", crates.keys());
+        let mut wrong = Vec::new();
+        let mut functions = 0;
+        for w in ALL {
+            for (name, comment) in function_comments(w.source) {
+                functions += 1;
+                let paths = backticked_paths(&comment);
+                let twins: Vec<&Vec<String>> = paths.iter().filter(|p| crates.contains_key(&p[0])).collect();
+                if twins.is_empty() && !comment.contains("No Rust twin:") {
+                    wrong.push(format!("{}: fn {name} names no Rust twin and does not say `No Rust twin:`", w.file));
+                }
+                for path in twins {
+                    let declared = &crates[&path[0]];
+                    if let Some(missing) = path[1..].iter().find(|s| !declared.contains(*s)) {
+                        wrong.push(format!(
+                            "{}: fn {name} names `{}`, but crates/{}/src declares no {missing}",
+                            w.file,
+                            path.join("::"),
+                            path[0].replace('_', "-")
+                        ));
+                    }
+                }
+            }
+        }
+        assert!(functions > 100, "{functions} functions found");
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    }
+
     /// A module holds each file once, after the files it needs.
     #[test]
     fn a_module_composes_its_files_once_in_dependency_order() {
