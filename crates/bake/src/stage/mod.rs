@@ -5,6 +5,7 @@ pub mod atlas;
 pub mod env_bandwidth;
 pub mod importance;
 pub mod layers;
+pub mod material_info;
 pub mod pca;
 pub mod prefilter;
 pub mod wavelet;
