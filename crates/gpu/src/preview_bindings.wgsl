@@ -98,6 +98,12 @@ struct Shade {
     env_conditional: u32,
     peak_marginal: u32,
     peak_conditional: u32,
+    // The length of the list a pass over items reads (`predict_blocks`, `shade_blocks`): their
+    // items arrive in `accumulation`.
+    items: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // `Shade::peak_map` where the environment has no peaks.

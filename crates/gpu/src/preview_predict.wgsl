@@ -129,7 +129,7 @@ fn predict_pixel(x: u32, y: u32, curvature: f32) -> vec2<f32> {
 }
 
 // The bandwidth buffer of an adaptive frame at its prediction pixels
-// (`render::adaptive::prediction_pixels`): item `i` of `shade.spp` items arrives in
+// (`render::adaptive::prediction_pixels`): item `i` of `shade.items` items arrives in
 // `accumulation[i]` as the bits of (pixel, its G-buffer curvature as f32, 0, 0) and leaves as
 // (bandwidth, variance, 0, 1).
 @compute @workgroup_size(64)
@@ -139,7 +139,7 @@ fn predict_blocks(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let i = item_index(group, local, groups);
-    if (i >= shade.spp) {
+    if (i >= shade.items) {
         return;
     }
     let item = bitcast<vec4<u32>>(accumulation[i]);

@@ -134,7 +134,7 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
     accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));
 }
 
-// The shaded blocks of an adaptive frame (`render::adaptive`), in parts: item `i` of `shade.spp`
+// The shaded blocks of an adaptive frame (`render::adaptive`), in parts: item `i` of `shade.items`
 // items arrives in `accumulation[i]` as the bits of (pixel, samples, first, count) and leaves as
 // terms `first .. first + count` of the pixel's estimate with that many samples
 // (`render::adaptive`'s shading, the same estimator as `shade_frame`) over `samples`, w = 1: the
@@ -150,7 +150,7 @@ fn shade_blocks(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let i = item_index(group, local, groups);
-    if (i >= shade.spp) {
+    if (i >= shade.items) {
         return;
     }
     let item = bitcast<vec4<u32>>(accumulation[i]);

@@ -496,7 +496,7 @@ impl Renderer {
 
     /// Runs an entry that takes a list of items (`predict_blocks`): the items
     /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
-    /// count in the shade uniform's `spp`, with `mode` and `seed`; `group` is group 3. Returns
+    /// count in the shade uniform's `items`, with `mode` and `seed`; `group` is group 3. Returns
     /// the first `items.len()` entries the pass leaves.
     fn run_items(
         &self,
@@ -508,7 +508,8 @@ impl Renderer {
     ) -> Result<Vec<[f32; 4]>, GpuError> {
         self.progress.set(None);
         let count = items.len() as u32;
-        let shade = self.shade_uniform(mode_index(mode), &Settings { mode, spp: count, frames: 1, seed });
+        let settings = Settings { mode, spp: 1, frames: 1, seed };
+        let shade = ShadeUniform { items: count, ..self.shade_uniform(mode_index(mode), &settings) };
         let (x, y) = item_groups(count);
         let encoder = capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
@@ -700,6 +701,10 @@ impl Renderer {
             layer_shift: 0,
             maps: self.maps,
             tables: self.tables,
+            items: 0,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 

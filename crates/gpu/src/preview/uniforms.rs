@@ -64,6 +64,12 @@ pub(crate) struct ShadeUniform {
     pub(crate) layer_shift: u32,
     pub(crate) maps: MapLayout,
     pub(crate) tables: TableLayout,
+    /// The length of the list a pass over items reads (`Renderer::run_items`, an adaptive
+    /// frame's parts); 0 for the passes over pixels.
+    pub(crate) items: u32,
+    pub(crate) _pad0: u32,
+    pub(crate) _pad1: u32,
+    pub(crate) _pad2: u32,
 }
 
 /// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,

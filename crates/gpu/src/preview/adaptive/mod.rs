@@ -220,9 +220,10 @@ impl Renderer {
         // `shade_blocks`' parts): the estimator, the seed, the pre-convolved estimator's layers.
         let shade_uniform = |items: u32| super::ShadeUniform {
             layer_shift: settings.layer_shift,
+            items,
             ..self.shade_uniform(
                 super::mode_index(settings.mode),
-                &render::Settings { mode: settings.mode, spp: items, frames: 1, seed: settings.seed },
+                &render::Settings { mode: settings.mode, spp: 1, frames: 1, seed: settings.seed },
             )
         };
         // The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling
@@ -322,12 +323,12 @@ impl Renderer {
                 run(&mut cpass, &pipelines.list, plan_slot, super::workgroups(chunks));
             }
             if on_gpu {
-                let spp_at = std::mem::offset_of!(super::ShadeUniform, spp) as u64;
+                let items_at = std::mem::offset_of!(super::ShadeUniform, items) as u64;
                 encoder.copy_buffer_to_buffer(
                     &state.buffers.control,
                     4 * u64::from(CONTROL_PARTS),
                     &self.shade_uniform,
-                    spp_at,
+                    items_at,
                     4,
                 );
                 encoder.copy_buffer_to_buffer(
