@@ -1,5 +1,5 @@
 //! The WGSL files and what each needs: a shader module is a file composed after every file it
-//! needs ([`Wgsl::compose`]), so that no file relies on names that happen to be pasted before it.
+//! needs ([`module`]), so that no file relies on names that happen to be pasted before it.
 //! A test holds each file's list to what it uses: every name it uses that another file declares
 //! comes from a file it lists, and it lists no file it does not use.
 

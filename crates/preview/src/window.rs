@@ -1,6 +1,6 @@
 //! The interactive previewer. A winit window shows the running average of the GPU
 //! renderer (`gpu::preview::Renderer::accumulate`): every redraw adds frames (f = 0, 1, 2, ...)
-//! until [`MAX_FRAMES`], and the present pass (`gpu::preview::Presenter`) tone maps the average
+//! until `MAX_FRAMES` (1024), and the present pass (`gpu::preview::Presenter`) tone maps the average
 //! into the window like the pictures `--out` writes (`envmap::tonemap_rgb8`), on the window's
 //! surface (`gpu::surface`: the window shows the picture's bytes, up to a rare one-step rounding
 //! difference: the GPU applies the exposure in f32). `--window-screenshot` saves what the window
