@@ -1,9 +1,10 @@
-// An adaptive frame on the GPU after its prediction (`render::adaptive`, step for step; compiled
-// after `preview_shade.wgsl`, whose background, camera ray and accumulation buffer it uses): the
+// An adaptive frame on the GPU after its prediction (`render::adaptive`, step for step; with the
+// files `gpu::wgsl` lists: the accumulation and backdrop of `preview_bindings.wgsl`, the wide
+// integers of `preview_geometry.wgsl`): the
 // levels of the bandwidth buffer, the min and max pyramids, the plan, the samples (the area
 // allocation) and the list of shaded blocks, the shaded blocks' estimates put in place, the
 // up-sampling from coarse to fine and the output image. `Renderer::render_adaptive`
-// (`preview/adaptive.rs`) records the passes (and, for the other allocations, allocates the
+// (`preview/adaptive/mod.rs`) records the passes (and, for the other allocations, allocates the
 // samples on the host between two submissions).
 //
 // Group 3, bindings 2 and up (bindings 0 and 1 are the prediction's): one uniform slot per pass,
@@ -415,7 +416,7 @@ fn adaptive_plan(
     levels[block].z = action;
 }
 
-// The allocation's 64-bit values, `preview_shade.wgsl`'s `Wide` read as unsigned: every factor
+// The allocation's 64-bit values, `preview_geometry.wgsl`'s `Wide` read as unsigned: every factor
 // but a count is a power of two, so shifts, sums and comparisons do. The largest, a share's
 // numerator (`W + spare 2^k`: the budget below 2^32, k at most 15) times 2^16, stays below
 // 2^64.
@@ -485,7 +486,7 @@ var<workgroup> alloc_full: array<bool, MAX_LEVELS>;
 var<workgroup> alloc_done: array<bool, MAX_LEVELS>;
 
 // `render::adaptive::area_allocation` of the shaded blocks per level (`adaptive_plan`'s counts),
-// step for step in integers, and `preview/adaptive.rs`'s `parts` of its samples: the samples per
+// step for step in integers, and `gpu::preview::adaptive::parts` of its samples: the samples per
 // part, each level's first item and first rank, the items in all and the workgroups of
 // `shade_blocks` and of the list's passes. One invocation: a few levels.
 @compute @workgroup_size(1)

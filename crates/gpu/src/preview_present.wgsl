@@ -7,7 +7,7 @@
 //! NaN value to 0, Reinhard's x / (1 + x) per channel (infinity to 1), then the sRGB transfer
 //! function; the target's conversion to 8 bits rounds. An sRGB target encodes by itself, so the
 //! pass decodes first and the hardware encodes again. The debug views of the shading pass
-//! (`MODE_DEBUG_*` of `preview_shade.wgsl`) are shown at covered pixels as colours instead:
+//! (`MODE_DEBUG_*` of `preview_bindings.wgsl`) are shown at covered pixels as colours instead:
 //! normals as (n + 1) / 2, layer and slice indices in viridis (index 0 dark blue, the last
 //! yellow), pixels without a shading frame black, a layer index of -1 (no view-layer table)
 //! grey.

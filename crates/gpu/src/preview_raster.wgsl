@@ -2,7 +2,7 @@
 //! itself, whose rules the `render` crate's specification follows (no culling, depth test LESS so
 //! that ties keep the triangle drawn first, no multisampling). It writes the triangle's index plus
 //! one (0: none) and nothing else: the shading pass interpolates the vertices itself
-//! (`preview_shade.wgsl`, `interpolate_hit`), from the snapped coordinates as the specification
+//! (`preview_geometry.wgsl`, `interpolate_hit`), from the snapped coordinates as the specification
 //! says, where a rasterizer's own interpolation is free to differ (lavapipe's is off by up to
 //! 1/500 of a pixel's footprint at grazing angles).
 //!

@@ -68,7 +68,7 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///
 /// Exit status: 0 ok, 1 --min-psnr was not met, 2 error (including no GPU adapter).
 #[derive(Debug, Parser)]
-#[command(version, about, long_about, allow_negative_numbers = true)]
+#[command(version, about, long_about, verbatim_doc_comment, allow_negative_numbers = true)]
 struct Args {
     /// The bake's folder (made by brdf-bake, with --env for rendering).
     bake: PathBuf,

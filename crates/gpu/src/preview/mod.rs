@@ -603,7 +603,7 @@ impl Renderer {
     /// Draws the G-buffer with the current camera, and the environment behind the mesh.
     fn rasterize(&self) -> Result<(), GpuError> {
         // The CPU's projection and snapping, which the passes read rather than compute
-        // (`preview_shade.wgsl`).
+        // (`preview_geometry.wgsl`).
         let clip = render::raster::project(&self.mesh.positions, self.view_proj());
         let (width, height) = (self.width(), self.height());
         let vertices: Vec<[f32; VERTEX_FLOATS as usize]> =

@@ -39,7 +39,7 @@ impl WaveletUniform {
 pub(crate) const SHADE_WORKGROUP: u32 = 8;
 
 /// Values per vertex in the mesh buffer: clip-space position, snapped viewport x and y,
-/// position, normal (`preview_shade.wgsl`).
+/// position, normal (`preview_geometry.wgsl`).
 pub(crate) const VERTEX_FLOATS: u64 = 12;
 
 /// `Shade` of the WGSL.
