@@ -9,15 +9,12 @@
 // milliseconds per frame of N whole-image draws of one frame. Chromium runs with WebGL 2 on
 // SwiftShader (--use-angle=swiftshader --enable-unsafe-swiftshader): the same on every machine.
 // Errors: one line `error: ...` on stderr, exit 2.
-import { createServer } from 'node:http';
-import { existsSync, readFileSync, realpathSync, statSync, writeFileSync } from 'node:fs';
-import { extname, join, resolve, sep } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { existsSync, realpathSync, writeFileSync } from 'node:fs';
+import { resolve } from 'node:path';
 import { deflateSync } from 'node:zlib';
 
-const here = fileURLToPath(new URL('.', import.meta.url));
-const packageRoot = resolve(here, '..');
-const repoRoot = resolve(packageRoot, '..', '..');
+import { launch, serve } from './serve.mjs';
+
 
 function fail(message) {
     console.error(`error: ${message}`);
@@ -46,27 +43,6 @@ function parseArgs(argv) {
         if (args[k] !== undefined) args[k] = Number(args[k]);
     }
     return args;
-}
-
-// A static server: /bake/ is the bake folder, /engines/three/ this package; nothing else.
-function serve(bakeDir) {
-    const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json' };
-    const roots = [['/bake/', bakeDir], ['/engines/three/', packageRoot]];
-    const server = createServer((request, response) => {
-        const path = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
-        for (const [prefix, dir] of roots) {
-            if (!path.startsWith(prefix)) continue;
-            const file = resolve(dir, '.' + sep + path.slice(prefix.length));
-            if ((file === dir || file.startsWith(dir + sep)) && existsSync(file) && statSync(file).isFile()) {
-                response.writeHead(200, { 'content-type': types[extname(file)] ?? 'application/octet-stream' });
-                response.end(readFileSync(file));
-                return;
-            }
-        }
-        response.writeHead(404);
-        response.end();
-    });
-    return new Promise((ok) => server.listen(0, '127.0.0.1', () => ok(server)));
 }
 
 const CRC_TABLE = Array.from({ length: 256 }, (_, n) => {
@@ -111,28 +87,10 @@ const args = parseArgs(process.argv.slice(2));
 if (!existsSync(args.chromium)) {
     fail(`${args.chromium} does not exist: the three.js tests need Chromium (apt-get install chromium, or set CHROMIUM)`);
 }
-let puppeteer;
-try {
-    puppeteer = (await import('puppeteer-core')).default;
-} catch {
-    fail(`puppeteer-core is not installed in ${packageRoot}: run make setup (npm ci in engines/three)`);
-}
 const bakeDir = realpathSync(resolve(args.bake));
 const server = await serve(bakeDir);
 const origin = `http://127.0.0.1:${server.address().port}`;
-const browser = await puppeteer.launch({
-    executablePath: args.chromium,
-    headless: true,
-    args: [
-        '--no-sandbox',
-        '--use-angle=swiftshader',
-        '--enable-unsafe-swiftshader',
-        '--ignore-gpu-blocklist',
-        '--disable-gpu-watchdog',
-        '--disable-background-timer-throttling',
-    ],
-    protocolTimeout: 0,
-});
+const browser = await launch(args.chromium).catch((e) => fail(e.message));
 try {
     const page = await browser.newPage();
     const errors = [];
