@@ -72,6 +72,8 @@ fn read_data(path: &Path) -> prefilter::ktx::DecodedData {
 #[test]
 fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
     let dir = bake("white-paint", "potsdamer_platz_1k");
+    // A valid manifest (data-schema's JSON schema) listing every file of the folder.
+    crate::brdf_bake::check_complete(&dir);
     let stage = figures(&dir);
     let roles: Vec<(&str, &str)> = stage["outputs"]
         .as_array()
@@ -187,6 +189,17 @@ fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
             assert!((cdf[len - 1] - 1.0).abs() < 1e-6, "distribution {d}, row {row} ends at {}", cdf[len - 1]);
         }
     }
+}
+
+/// The engine textures hold the lighting: without an environment the bake refuses to start.
+#[test]
+fn engine_textures_need_an_environment() {
+    let tmp = crate::support::temp_dir();
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(crate::support::ggx_copper()).arg("--engine-textures").arg("--out-dir").arg(tmp.path().join("bake"));
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("--env"), "{r}");
+    assert!(!tmp.path().join("bake").exists(), "{r}");
 }
 
 /// An 8-bit RGB picture: the first `height` rows of a PNG (brdf-preview's has a caption below).
