@@ -202,6 +202,19 @@ fn engine_textures_need_an_environment() {
     assert!(!tmp.path().join("bake").exists(), "{r}");
 }
 
+/// The loader refuses every manifest path that would leave the bake folder (`node --test` on
+/// `engines/three/test/loader.test.mjs`).
+#[test]
+fn the_loader_keeps_manifest_paths_inside_the_bake() {
+    assert!(
+        root().join("engines/three/node_modules/three").is_dir(),
+        "three is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"
+    );
+    let mut node = Command::new("node");
+    node.arg("--test").arg(root().join("engines/three/test/loader.test.mjs"));
+    run(node, "").expect_code(0);
+}
+
 /// An 8-bit RGB picture: the first `height` rows of a PNG (brdf-preview's has a caption below).
 fn picture(path: &Path, width: usize, height: usize) -> Vec<u8> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
