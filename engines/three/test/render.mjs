@@ -87,6 +87,7 @@ const args = parseArgs(process.argv.slice(2));
 if (!existsSync(args.chromium)) {
     fail(`${args.chromium} does not exist: the three.js tests need Chromium (apt-get install chromium, or set CHROMIUM)`);
 }
+if (!existsSync(resolve(args.bake, 'manifest.json'))) fail(`${args.bake}: not a bake folder (it has no manifest.json)`);
 const bakeDir = realpathSync(resolve(args.bake));
 const server = await serve(bakeDir);
 const origin = `http://127.0.0.1:${server.address().port}`;

@@ -3,7 +3,7 @@
 //
 //   node test/screenshot.mjs --bake DIR --out FILE.png [--mode reference|prefiltered]
 //        [--camera AZ,EL] [--chromium PATH]
-import { realpathSync } from 'node:fs';
+import { existsSync, realpathSync } from 'node:fs';
 import { resolve } from 'node:path';
 
 import { launch, serve } from './serve.mjs';
@@ -12,6 +12,10 @@ const args = { mode: 'prefiltered', camera: '30,15', chromium: process.env.CHROM
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
 if (!args.bake || !args.out) {
     console.error('error: usage: node test/screenshot.mjs --bake DIR --out FILE.png');
+    process.exit(2);
+}
+if (!existsSync(resolve(args.bake, 'manifest.json'))) {
+    console.error(`error: ${args.bake}: not a bake folder (it has no manifest.json)`);
     process.exit(2);
 }
 const server = await serve(realpathSync(resolve(args.bake)));
