@@ -3,10 +3,12 @@
 // `tests/three.rs` compares with brdf-preview's picture of the same bake and mode.
 //
 //   node test/render.mjs --bake DIR --mode reference|prefiltered --size WxH --out FILE.png
-//        [--spp N] [--frames N] [--seed N] [--camera AZ,EL] [--timing N] [--chromium PATH]
+//        [--spp N] [--frames N] [--seed N] [--camera AZ,EL] [--chromium PATH]
+//   node test/render.mjs --bake DIR --mode reference|prefiltered --size WxH --timing N [--spp N]
 //
-// Prints one JSON line: the renderer, the render's milliseconds and, with --timing N, the
-// milliseconds per frame of N whole-image draws of one frame. Chromium runs with WebGL 2 on
+// Prints one JSON line: the renderer and the render's milliseconds; with --timing N (and no
+// --out), the milliseconds per frame of N whole-image draws of one frame each to the canvas,
+// after one untimed draw of a pixel (which compiles the shaders and uploads the textures). Chromium runs with WebGL 2 on
 // SwiftShader (--use-angle=swiftshader --enable-unsafe-swiftshader): the same on every machine.
 // Errors: one line `error: ...` on stderr, exit 2.
 import { existsSync, realpathSync, writeFileSync } from 'node:fs';
@@ -29,7 +31,7 @@ function parseArgs(argv) {
         if (!key || value === undefined) fail(`expected --option value pairs, found ${argv.slice(i).join(' ')}`);
         args[key] = value;
     }
-    for (const required of ['bake', 'mode', 'size', 'out']) {
+    for (const required of ['bake', 'mode', 'size', ...(args.timing ? [] : ['out'])]) {
         if (args[required] === undefined) fail(`--${required} is required`);
     }
     const size = /^(\d+)x(\d+)$/.exec(args.size);
@@ -112,9 +114,10 @@ try {
         azimuth: args.azimuth,
         elevation: args.elevation,
         timing: args.timing,
+        picture: args.out !== undefined,
     }).catch((e) => fail(`rendering ${args.bake} (${args.mode}): ${e.message}; ${errors.join('; ')}`));
     if (errors.length > 0) fail(`the page reported errors: ${errors.join('; ')}`);
-    writeFileSync(args.out, png(result.rgb, args.width, args.height));
+    if (args.out !== undefined) writeFileSync(args.out, png(result.rgb, args.width, args.height));
     console.log(JSON.stringify({
         out: args.out, mode: args.mode, width: args.width, height: args.height,
         renderer: result.renderer, render_ms: result.renderMs, ms_per_frame: result.msPerFrame ?? null,
