@@ -12,7 +12,14 @@
 import * as THREE from 'three';
 import { read as readKtx2 } from 'three/addons/libs/ktx-parse.module.js';
 
-import { BACKGROUND_FRAGMENT, BACKGROUND_VERTEX, SURFACE_FRAGMENT, SURFACE_VERTEX } from './shade.glsl.js';
+import {
+    BACKGROUND_FRAGMENT,
+    BACKGROUND_VERTEX,
+    GBUFFER_FRAGMENT,
+    QUAD_VERTEX,
+    SURFACE_FRAGMENT,
+    SURFACE_VERTEX,
+} from './shade.glsl.js';
 
 /** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
 export const MODES = { reference: 0, prefiltered: 2 };
@@ -186,7 +193,48 @@ export class Bake {
      * brdf-preview's --seed. The pixel index (which samples a pixel takes) counts rows from the
      * top of the drawing buffer, whose size the material reads from the renderer at each draw.
      */
-    createMaterial({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0, exposureEv, toneMap = true } = {}) {
+    createMaterial(options = {}) {
+        const material = new THREE.RawShaderMaterial({
+            name: `brdf-bake ${options.mode ?? 'reference'}`,
+            glslVersion: THREE.GLSL3,
+            vertexShader: SURFACE_VERTEX,
+            fragmentShader: SURFACE_FRAGMENT,
+            // render::raster culls no back face: at a silhouette a pixel may see one.
+            side: THREE.DoubleSide,
+            uniforms: this.shadingUniforms(options),
+        });
+        material.onBeforeRender = (renderer) => resolution(renderer, material.uniforms.uResolution.value);
+        return material;
+    }
+
+    /**
+     * The material's estimators as a full-screen pass over a G-buffer (`exactCoverage`): what a
+     * pixel covers is read from `gbuffer` rather than rasterized at the pixel, and uncovered
+     * pixels show the environment. `options` as for `createMaterial`.
+     */
+    createDeferred(gbuffer, options = {}) {
+        const material = new THREE.RawShaderMaterial({
+            name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
+            glslVersion: THREE.GLSL3,
+            defines: { DEFERRED: 1 },
+            vertexShader: QUAD_VERTEX,
+            fragmentShader: SURFACE_FRAGMENT,
+            depthTest: false,
+            depthWrite: false,
+            uniforms: {
+                ...this.shadingUniforms(options),
+                uGPosition: { value: gbuffer.target.textures[0] },
+                uGNormal: { value: gbuffer.target.textures[1] },
+                uGScale: { value: gbuffer.scale },
+            },
+        });
+        const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
+        mesh.frustumCulled = false;
+        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
+        return mesh;
+    }
+
+    shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0, exposureEv, toneMap = true }) {
         if (!(mode in MODES)) {
             throw new BakeError(`error: unknown mode ${mode}: reference or prefiltered`);
         }
@@ -197,34 +245,24 @@ export class Bake {
         if (!(spp > 0 && (spp & (spp - 1)) === 0 && f.samples % spp === 0)) {
             throw new BakeError(`error: spp ${spp} must be a power of two dividing the bake's ${f.samples} samples`);
         }
-        const material = new THREE.RawShaderMaterial({
-            name: `brdf-bake ${mode}`,
-            glslVersion: THREE.GLSL3,
-            vertexShader: SURFACE_VERTEX,
-            fragmentShader: SURFACE_FRAGMENT,
-            // render::raster culls no back face: at a silhouette a pixel may see one.
-            side: THREE.DoubleSide,
-            uniforms: {
-                ...this.textureUniforms(),
-                ...this.toneUniforms(exposureEv, toneMap),
-                uPhiDRange: { value: f.phi_d_range },
-                uMode: { value: MODES[mode] },
-                uSeed: { value: seed >>> 0 },
-                uSpp: { value: spp },
-                uSlices: { value: f.slices },
-                uVectors: { value: f.vectors },
-                uSamples: { value: f.samples },
-                uRows: { value: f.rows },
-                uSectors: { value: f.sectors },
-                uPeaks: { value: Boolean(f.peaks) },
-                uFirstFrame: { value: firstFrame },
-                uFrameCount: { value: frames },
-                uDivisor: { value: divisor ?? frames },
-                uResolution: { value: new THREE.Vector2(1, 1) },
-            },
-        });
-        material.onBeforeRender = (renderer) => resolution(renderer, material.uniforms.uResolution.value);
-        return material;
+        return {
+            ...this.textureUniforms(),
+            ...this.toneUniforms(exposureEv, toneMap),
+            uPhiDRange: { value: f.phi_d_range },
+            uMode: { value: MODES[mode] },
+            uSeed: { value: seed >>> 0 },
+            uSpp: { value: spp },
+            uSlices: { value: f.slices },
+            uVectors: { value: f.vectors },
+            uSamples: { value: f.samples },
+            uRows: { value: f.rows },
+            uSectors: { value: f.sectors },
+            uPeaks: { value: Boolean(f.peaks) },
+            uFirstFrame: { value: firstFrame },
+            uFrameCount: { value: frames },
+            uDivisor: { value: divisor ?? frames },
+            ...rayUniforms(),
+        };
     }
 
     /**
@@ -243,28 +281,13 @@ export class Bake {
             uniforms: {
                 uEnvironment: { value: this.textures.uEnvironment },
                 ...this.toneUniforms(exposureEv, toneMap),
-                uRayForward: { value: new THREE.Vector3() },
-                uRayRight: { value: new THREE.Vector3() },
-                uRayUp: { value: new THREE.Vector3() },
-                uResolution: { value: new THREE.Vector2(1, 1) },
+                ...rayUniforms(),
             },
         });
         const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
         mesh.frustumCulled = false;
         mesh.renderOrder = -Infinity;
-        mesh.onBeforeRender = (renderer, scene, camera) => {
-            const u = material.uniforms;
-            resolution(renderer, u.uResolution.value);
-            // render::Camera::basis: the columns of the camera's world matrix (right, up, back).
-            const e = camera.matrixWorld.elements;
-            const right = new THREE.Vector3(e[0], e[1], e[2]).normalize();
-            const up = new THREE.Vector3(e[4], e[5], e[6]).normalize();
-            const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
-            const aspect = u.uResolution.value.x / u.uResolution.value.y;
-            u.uRayForward.value.set(-e[8], -e[9], -e[10]).normalize();
-            u.uRayRight.value.copy(right).multiplyScalar(tanHalf * aspect);
-            u.uRayUp.value.copy(up).multiplyScalar(tanHalf);
-        };
+        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
         return mesh;
     }
 
@@ -282,6 +305,73 @@ export class Bake {
     dispose() {
         Object.values(this.textures).forEach((t) => t.dispose());
     }
+}
+
+function rayUniforms() {
+    return {
+        uResolution: { value: new THREE.Vector2(1, 1) },
+        uRayForward: { value: new THREE.Vector3() },
+        uRayRight: { value: new THREE.Vector3() },
+        uRayUp: { value: new THREE.Vector3() },
+    };
+}
+
+// The image size and the pixel rays' basis (render::Camera::basis: the columns of the camera's
+// world matrix are right, up and back) for the draw about to run.
+function setRay(u, renderer, camera) {
+    resolution(renderer, u.uResolution.value);
+    const e = camera.matrixWorld.elements;
+    const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
+    const aspect = u.uResolution.value.x / u.uResolution.value.y;
+    u.uRayForward.value.set(-e[8], -e[9], -e[10]).normalize();
+    u.uRayRight.value.set(e[0], e[1], e[2]).normalize().multiplyScalar(tanHalf * aspect);
+    u.uRayUp.value.set(e[4], e[5], e[6]).normalize().multiplyScalar(tanHalf);
+}
+
+/**
+ * The G-buffer of `geometry` seen by `camera` at `width x height` with brdf-preview's coverage:
+ * render::raster snaps vertices to 1/256 pixel, as lavapipe does, where a WebGL implementation
+ * may snap coarser (SwiftShader: 1/16), and a pixel whose centre lies that close to a silhouette
+ * edge would be covered by one renderer only. So the mesh is drawn at `scale` (16) times the size,
+ * shifted by half a pixel of that size so that texel `(S x + S / 2, S y + S / 2)` is centred on
+ * pixel `(x, y)`'s centre: its coverage is that of the pixel centre with vertices on a grid of
+ * 1 / (16 S) pixel. Only those texels are written (position, and normal with w = 1), into two
+ * float textures of `S width x S height` (128 MB for 128 x 128): for tests and stills, not for
+ * frames. `createDeferred` shades from it.
+ */
+export function exactCoverage(renderer, geometry, camera, width, height, scale = 16) {
+    const target = new THREE.WebGLRenderTarget(scale * width, scale * height, {
+        count: 2,
+        type: THREE.FloatType,
+        format: THREE.RGBAFormat,
+        depthBuffer: true,
+        minFilter: THREE.NearestFilter,
+        magFilter: THREE.NearestFilter,
+        generateMipmaps: false,
+    });
+    const material = new THREE.RawShaderMaterial({
+        name: 'brdf-bake g-buffer',
+        glslVersion: THREE.GLSL3,
+        vertexShader: SURFACE_VERTEX,
+        fragmentShader: GBUFFER_FRAGMENT,
+        side: THREE.DoubleSide,
+        uniforms: { uGScale: { value: scale } },
+    });
+    const scene = new THREE.Scene();
+    scene.add(new THREE.Mesh(geometry, material));
+    const shifted = camera.clone();
+    // Half a texel right and up: three's view offset moves the frustum, so the picture moves the
+    // other way (x from the left, y from the top).
+    shifted.setViewOffset(scale * width, scale * height, -0.5, 0.5, scale * width, scale * height);
+    const previous = { target: renderer.getRenderTarget(), color: renderer.getClearColor(new THREE.Color()), alpha: renderer.getClearAlpha() };
+    renderer.setRenderTarget(target);
+    renderer.setClearColor(0x000000, 0);
+    renderer.clear();
+    renderer.render(scene, shifted);
+    renderer.setRenderTarget(previous.target);
+    renderer.setClearColor(previous.color, previous.alpha);
+    material.dispose();
+    return { target, scale };
 }
 
 function resolution(renderer, target) {

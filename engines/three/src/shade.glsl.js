@@ -89,6 +89,25 @@ vec3 tonemap(vec3 radiance) {
 vec4 present(vec3 value) {
     return vec4(uToneMap ? tonemap(value) : value, 1.0);
 }
+
+// The image size, and the pixel ray's basis as render::Camera::ray builds it: forward,
+// right tan(fov_y / 2) aspect, up tan(fov_y / 2).
+uniform uvec2 uResolution;
+uniform vec3 uRayForward;
+uniform vec3 uRayRight;
+uniform vec3 uRayUp;
+
+// camera_ray: the ray from the eye through the centre of pixel (x, y), row 0 at the top.
+vec3 camera_ray(uint x, uint y) {
+    float x_ndc = 2.0 * (float(x) + 0.5) / float(uResolution.x) - 1.0;
+    float y_ndc = 1.0 - 2.0 * (float(y) + 0.5) / float(uResolution.y);
+    return normalize(uRayForward + x_ndc * uRayRight + y_ndc * uRayUp);
+}
+
+// render::shade::background (shade_backdrop): level 0 along the pixel's ray.
+vec3 background(uint x, uint y) {
+    return env_bilinear(uEnvironment, 0, env_uv(camera_ray(x, y)));
+}
 `;
 
 // The background: level 0 along each pixel's camera ray (render::Camera::ray).
@@ -102,25 +121,12 @@ void main() {
 
 export const BACKGROUND_FRAGMENT = /* glsl */ `
 ${COMMON}
-// The pixel ray's basis as render::Camera::ray builds it: forward, right tan(fov_y / 2) aspect,
-// up tan(fov_y / 2); and the image size.
-uniform vec3 uRayForward;
-uniform vec3 uRayRight;
-uniform vec3 uRayUp;
-uniform uvec2 uResolution;
 out vec4 outColor;
-
-// camera_ray: the ray from the eye through the centre of pixel (x, y), row 0 at the top.
-vec3 camera_ray(uint x, uint y) {
-    float x_ndc = 2.0 * (float(x) + 0.5) / float(uResolution.x) - 1.0;
-    float y_ndc = 1.0 - 2.0 * (float(y) + 0.5) / float(uResolution.y);
-    return normalize(uRayForward + x_ndc * uRayRight + y_ndc * uRayUp);
-}
 
 void main() {
     uvec2 p = uvec2(gl_FragCoord.xy);
     uint y = uResolution.y - 1u - p.y;
-    outColor = present(env_bilinear(uEnvironment, 0, env_uv(camera_ray(p.x, y))));
+    outColor = present(background(p.x, y));
 }
 `;
 
@@ -174,12 +180,20 @@ uniform bool uPeaks;
 uniform uint uFirstFrame;
 uniform uint uFrameCount;
 uniform float uDivisor;
-uniform uvec2 uResolution;
 // The eye (three.js sets it from the camera).
 uniform vec3 cameraPosition;
 
+#ifdef DEFERRED
+// The G-buffer of exactCoverage (index.js): the interpolated position, and the interpolated
+// normal with w = 1 where a triangle covers the sample, read at texel (S x + S / 2, S y + S / 2)
+// for pixel (x, y) (rows from the bottom in both).
+uniform sampler2D uGPosition;
+uniform sampler2D uGNormal;
+uniform int uGScale;
+#else
 in vec3 vPosition;
 in vec3 vNormal;
+#endif
 out vec4 outColor;
 
 // ---- merl_lookup.wgsl: merl::half_diff, merl::Dims::nearest_cell, merl::MerlTable::cell_value.
@@ -597,12 +611,26 @@ void main() {
     uvec2 p = uvec2(gl_FragCoord.xy);
     // Row 0 at the top, as render's pixel index counts.
     uint pixel = (uResolution.y - 1u - p.y) * uResolution.x + p.x;
+#ifdef DEFERRED
+    ivec2 g = ivec2(p) * uGScale + uGScale / 2;
+    vec4 gn = texelFetch(uGNormal, g, 0);
+    if (gn.w == 0.0) {
+        // No triangle covers the pixel: the environment behind.
+        outColor = present(background(p.x, uResolution.y - 1u - p.y));
+        return;
+    }
+    vec3 position = texelFetch(uGPosition, g, 0).xyz;
+    vec3 normal = gn.xyz;
+#else
+    vec3 position = vPosition;
+    vec3 normal = vNormal;
+#endif
     // glam's normalize_or_zero.
-    float length_squared = dot(vNormal, vNormal);
-    vec3 n = length_squared > 0.0 ? vNormal / sqrt(length_squared) : vec3(0.0);
+    float length_squared = dot(normal, normal);
+    vec3 n = length_squared > 0.0 ? normal / sqrt(length_squared) : vec3(0.0);
     ShadingFrame frame;
     vec3 radiance = vec3(0.0);
-    if (shading_frame(vPosition, n, frame)) {
+    if (shading_frame(position, n, frame)) {
         vec3 sum = vec3(0.0);
         for (uint f = uFirstFrame; f < uFirstFrame + uFrameCount; f++) {
             sum += estimate_sum(frame, pixel, f, uSpp) / float(uSpp);
@@ -610,5 +638,33 @@ void main() {
         radiance = sum / uDivisor;
     }
     outColor = present(radiance);
+}
+`;
+
+// exactCoverage's G-buffer pass (index.js): at S times the size, only the texel of each pixel's
+// centre (S x + S / 2, S y + S / 2) is written: the interpolated position and normal (w = 1).
+export const GBUFFER_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+uniform int uGScale;
+in vec3 vPosition;
+in vec3 vNormal;
+layout(location = 0) out vec4 gPosition;
+layout(location = 1) out vec4 gNormal;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    if (p.x % uGScale != uGScale / 2 || p.y % uGScale != uGScale / 2) {
+        discard;
+    }
+    gPosition = vec4(vPosition, 1.0);
+    gNormal = vec4(vNormal, 1.0);
+}
+`;
+
+// exactCoverage's shading pass: a full-screen quad.
+export const QUAD_VERTEX = /* glsl */ `
+in vec3 position;
+void main() {
+    gl_Position = vec4(position.xy, 0.0, 1.0);
 }
 `;

@@ -3,8 +3,11 @@
 // `tests/three.rs` compares with brdf-preview's picture of the same bake and mode.
 //
 //   node test/render.mjs --bake DIR --mode reference|prefiltered --size WxH --out FILE.png
-//        [--spp N] [--frames N] [--seed N] [--camera AZ,EL] [--chromium PATH]
+//        [--spp N] [--frames N] [--seed N] [--camera AZ,EL] [--coverage exact|forward] [--chromium PATH]
 //   node test/render.mjs --bake DIR --mode reference|prefiltered --size WxH --timing N [--spp N]
+//
+// --coverage exact (the default) rasterizes the mesh at brdf-preview's sub-pixel precision
+// (exactCoverage in src/index.js), forward draws it with the material as a scene does.
 //
 // Prints one JSON line: the renderer and the render's milliseconds; with --timing N (and no
 // --out), the milliseconds per frame of N whole-image draws of one frame each to the canvas,
@@ -115,6 +118,7 @@ try {
         elevation: args.elevation,
         timing: args.timing,
         picture: args.out !== undefined,
+        coverage: args.coverage ?? 'exact',
     }).catch((e) => fail(`rendering ${args.bake} (${args.mode}): ${e.message}; ${errors.join('; ')}`));
     if (errors.length > 0) fail(`the page reported errors: ${errors.join('; ')}`);
     if (args.out !== undefined) writeFileSync(args.out, png(result.rgb, args.width, args.height));
