@@ -396,7 +396,7 @@ fn problem(case: &Case, coverage: &str) -> Option<String> {
 /// The CI case: gold-paint under quarry_01 (a sun: the peaks and their sampling tables in use) in
 /// both modes drawn exactly, the prefiltered mode at brdf-preview's defaults (8 frames of 16
 /// samples), the reference mode at 4 of its 32 frames of 64 samples (the same samples as
-/// brdf-preview's first 4 frames; all 32 take SwiftShader about 150 s); and the prefiltered mode
+/// brdf-preview's first 4 frames, to keep make test short); and the prefiltered mode
 /// drawn forward, as a scene draws the material.
 #[test]
 fn three_js_renders_a_bake_as_brdf_preview_does() {
