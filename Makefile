@@ -147,7 +147,8 @@ bench: setup-gpu setup-mitsuba
 ## three-cases: the three.js material in headless Chromium against brdf-preview on the issue's six
 ## cases (white-paint, gold-paint, chrome under quarry_01 and potsdamer_platz, 128 x 128, both
 ## modes at brdf-preview's default samples) and against the converged estimate; prints the table.
-## About 20 minutes on 2 cores (SwiftShader's reference renders); pictures in target/three-cases/.
+## About 10 minutes on 2 cores (most of it SwiftShader's reference renders); pictures in
+## target/three-cases/.
 three-cases: setup test-data
 	$(CARGO) test --test tests -- --ignored three::three_js_equals_brdf_preview_on_the_six_cases --nocapture
 
