@@ -9,10 +9,11 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python setup-node setup-ktx setup-mitsuba build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
+.PHONY: setup setup-gpu setup-python setup-node setup-chromium setup-ktx setup-mitsuba three-cases build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
-## setup: everything the tests need (setup-gpu, setup-python, setup-node, setup-ktx). Idempotent.
-setup: setup-gpu setup-python setup-node setup-ktx
+## setup: everything the tests need (setup-gpu, setup-python, setup-node, setup-chromium,
+## setup-ktx). Idempotent.
+setup: setup-gpu setup-python setup-node setup-chromium setup-ktx
 
 ## setup-gpu: the software Vulkan driver (lavapipe), for brdf-preview and the GPU tests on machines
 ## without a GPU driver. Installed only when missing; quiet.
@@ -43,7 +44,8 @@ setup-mitsuba: setup-python
 	fi
 
 ## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
-## tests run on the KTX2 files with node. Installs node and npm from Debian when missing.
+## tests run on the KTX2 files with node, and engines/three's packages (three and puppeteer-core,
+## pinned by its lock file). Installs node and npm from Debian when missing.
 setup-node:
 	@if ! command -v npm >/dev/null 2>&1; then \
 	  echo "installing nodejs and npm (to read the KTX2 outputs with ktx-parse in the tests)"; \
@@ -52,6 +54,18 @@ setup-node:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
 	fi
 	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
+	@test -d engines/three/node_modules/puppeteer-core || npm ci --silent --prefix engines/three
+
+## setup-chromium: Debian's Chromium, the real browser tests/three.rs renders the three.js material
+## in (headless, WebGL 2 on SwiftShader, driven by puppeteer-core from engines/three; no browser
+## download). Installed only when missing; quiet.
+setup-chromium:
+	@if ! command -v chromium >/dev/null 2>&1; then \
+	  echo "installing chromium (the browser the three.js tests render in)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; \
+	fi
 
 ## setup-ktx: Khronos' KTX2 validator, ktx2check (KTX-Software 4.0.0, whose sources the
 ## libktx-rs-sys crate carries: fetched from crates.io by cargo vendor), built with cmake into
@@ -129,6 +143,14 @@ bench: setup-gpu setup-mitsuba
 	$(CARGO) bench -p haar-brdf --bench table1
 	$(CARGO) bench -p brdf-preview --bench adaptive -- --gpu
 	$(CARGO) bench -p brdf-preview --bench mitsuba
+
+## three-cases: the three.js material in headless Chromium against brdf-preview on the issue's six
+## cases (white-paint, gold-paint, chrome under quarry_01 and potsdamer_platz, 128 x 128, both
+## modes at brdf-preview's default samples) and against the converged estimate; prints the table.
+## About 10 minutes on 2 cores (most of it SwiftShader's reference renders); pictures in
+## target/three-cases/.
+three-cases: setup test-data
+	$(CARGO) test --test tests -- --ignored three::three_js_equals_brdf_preview_on_the_six_cases --nocapture
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
 ## procedural calibration sky), then render previews (pre-convolved; reference, validated against

@@ -17,3 +17,4 @@ mod json_output;
 mod merl_info;
 mod preview;
 mod ranges_and_messages;
+mod three;

@@ -75,6 +75,26 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     let table = merl::MerlTable::parse(&table_bytes).map_err(|e| Error::read(&table_path, e))?;
     drop(table_bytes);
 
+    let (material, lighting) = assemble(table, manifest.environment.is_some(), &file)?;
+    let bandwidths = match &lighting {
+        Some(_) => Some(bandwidths(&file)?),
+        None => None,
+    };
+    Ok(Loaded { dir: dir.to_path_buf(), manifest, material, lighting, bandwidths })
+}
+
+/// A bake's outputs by role: the path that names the file in errors, and its bytes.
+pub(crate) type Outputs<'a> = dyn Fn(&str) -> Result<(PathBuf, Vec<u8>), Error> + 'a;
+
+/// The material (the importance samples, and with an environment the view layers of the layer
+/// selection) and, with an environment, the lighting, from a bake's outputs as `file` gives them
+/// by role: what [`load`] reads from a folder, and what the engine textures are made of while a
+/// bake runs (`stage::engine`), so that both are the same numbers.
+pub(crate) fn assemble(
+    table: merl::MerlTable,
+    has_environment: bool,
+    file: &Outputs,
+) -> Result<(render::Material, Option<render::Lighting>), Error> {
     let (samples_path, samples_bytes) = file("importance-samples")?;
     let samples = match read_payload(&samples_path, &samples_bytes)? {
         Payload::ImportanceSamples(s) => sample_set(s).map_err(|e| Error::read(&samples_path, e))?,
@@ -82,10 +102,8 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
             return Err(Error::read(&samples_path, format!("expected importance samples, found {}", other.kind())));
         }
     };
-
     let mut view_layers = Vec::new();
-    let mut bandwidths = None;
-    let lighting = if manifest.environment.is_some() {
+    let lighting = if has_environment {
         let (asset_path, asset_bytes) = file("prefiltered-envmap")?;
         let Payload::PrefilteredEnvmap(prefiltered) = read_payload(&asset_path, &asset_bytes)? else {
             return Err(Error::read(&asset_path, "expected a prefiltered-envmap asset"));
@@ -117,27 +135,25 @@ pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
             ));
         }
         view_layers = brdf_atlas::view::view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth);
-        let (bandwidth_path, bandwidth_bytes) = file("environment-bandwidth")?;
-        let image = envmap::read_image_from_memory(&bandwidth_bytes, &envmap::Limits::default())
-            .map_err(|e| Error::read(&bandwidth_path, e))?;
-        let grey = image.rgb.chunks_exact(3).map(|t| t[0]).collect();
-        let environment = render::adaptive::EnvBandwidth::new(image.width, image.height, grey)
-            .map_err(|e| Error::read(&bandwidth_path, e))?;
-        let (atlas_path, atlas_bytes) = file("bandwidth-atlas")?;
-        let brdf = crate::stage::atlas::from_payload(read_payload(&atlas_path, &atlas_bytes)?)
-            .map_err(|e| Error::read(&atlas_path, e))?;
-        bandwidths = Some(render::adaptive::Bandwidths { environment, brdf });
         Some(render::Lighting::new(mips, layers, prefiltered.exponents).map_err(|e| Error::read(&mips_path, e))?)
     } else {
         None
     };
-    Ok(Loaded {
-        dir: dir.to_path_buf(),
-        manifest,
-        material: render::Material { table, samples, view_layers, wavelet: None },
-        lighting,
-        bandwidths,
-    })
+    Ok((render::Material { table, samples, view_layers, wavelet: None }, lighting))
+}
+
+/// What adaptive shading predicts from: the environment's bandwidth and the material's atlas.
+fn bandwidths(file: &Outputs) -> Result<render::adaptive::Bandwidths, Error> {
+    let (bandwidth_path, bandwidth_bytes) = file("environment-bandwidth")?;
+    let image = envmap::read_image_from_memory(&bandwidth_bytes, &envmap::Limits::default())
+        .map_err(|e| Error::read(&bandwidth_path, e))?;
+    let grey = image.rgb.chunks_exact(3).map(|t| t[0]).collect();
+    let environment = render::adaptive::EnvBandwidth::new(image.width, image.height, grey)
+        .map_err(|e| Error::read(&bandwidth_path, e))?;
+    let (atlas_path, atlas_bytes) = file("bandwidth-atlas")?;
+    let brdf = crate::stage::atlas::from_payload(read_payload(&atlas_path, &atlas_bytes)?)
+        .map_err(|e| Error::read(&atlas_path, e))?;
+    Ok(render::adaptive::Bandwidths { environment, brdf })
 }
 
 /// Reads a `wavelet-brdf` asset (`brdf-wavelet`) for the material of a loaded bake: it must have

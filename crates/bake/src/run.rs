@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use asset::{BakeManifest, SourceFile, Tool};
 use serde_json::json;
 
-use crate::stage::{atlas, env_bandwidth, importance, layers, pca, prefilter, wavelet};
-use crate::{Error, Program, Source, Staged, object};
+use crate::stage::{atlas, engine, env_bandwidth, importance, layers, pca, prefilter, wavelet};
+use crate::{Error, OutFile, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
 pub const MANIFEST: &str = asset::MANIFEST_FILE;
@@ -31,6 +31,9 @@ pub struct BakeConfig {
     pub prefilter: ::prefilter::Config,
     /// How a view's lobe and a layer's lobe become the numbers the layer selection compares.
     pub layer_reduction: brdf_atlas::view::ViewReduction,
+    /// With an environment, also write the engine textures (`stage::engine`): what the
+    /// estimators read, as KTX2 data textures for engines.
+    pub engine_textures: bool,
     /// Bake even when the folder's manifest says it is up to date.
     pub force: bool,
 }
@@ -49,6 +52,7 @@ impl BakeConfig {
             env_bandwidth: env_bandwidth::Settings::default(),
             prefilter: ::prefilter::Config::default(),
             layer_reduction: layers::DEFAULT_REDUCTION,
+            engine_textures: false,
             force: false,
         }
     }
@@ -56,6 +60,11 @@ impl BakeConfig {
     /// Checks every stage's settings, so that a bake that cannot finish refuses to start (and
     /// leaves the folder as it was).
     pub fn check(&self) -> Result<(), Error> {
+        if self.engine_textures && self.environment.is_none() {
+            return Err(Error::Invalid(
+                "the engine textures hold the lighting too: they need an environment (--env)".into(),
+            ));
+        }
         self.importance.check().map_err(|e| Error::stage("importance samples", e))?;
         if !self.importance.n_samples.is_power_of_two() {
             return Err(Error::Invalid(format!(
@@ -119,6 +128,7 @@ impl BakeConfig {
                 }),
             ),
             ("layer_reduction", json!(self.layer_reduction.name())),
+            ("engine_textures", json!(self.engine_textures)),
         ])
     }
 }
@@ -221,7 +231,12 @@ pub fn run_bake(
         progress(Progress::Stage { index: next, count: stages.len(), name });
         next += 1;
     };
+    // The outputs the engine textures are made of, as `load` would read them back.
+    let kept: std::cell::RefCell<Vec<OutFile>> = std::cell::RefCell::new(Vec::new());
     let mut record = |staged: Staged, manifest: &mut BakeManifest| -> Result<(), Error> {
+        if config.engine_textures {
+            kept.borrow_mut().extend(staged.files.iter().filter(|f| ENGINE_INPUTS.contains(&f.role)).cloned());
+        }
         let mut stage = staged.stage(&mut staging)?;
         // The manifest keeps what validation found, so that a rerun that finds the bake up to
         // date reports (and exits with) the same.
@@ -257,7 +272,6 @@ pub fn run_bake(
         begin("wavelet encoding");
         record(wavelet::run(&table, &material_source, program, settings)?, &mut manifest)?;
     }
-    drop(table);
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
         begin("environment bandwidth");
@@ -270,6 +284,19 @@ pub fn run_bake(
         let (staged, _) =
             layers::run(&atlas_build, &config.atlas, exponents, config.layer_reduction, &material_source, program)?;
         record(staged, &mut manifest)?;
+        if config.engine_textures {
+            begin("engine textures");
+            let file = |role: &str| -> Result<(PathBuf, Vec<u8>), Error> {
+                let kept = kept.borrow();
+                let f = kept.iter().find(|f| f.role == role).ok_or_else(|| {
+                    Error::Internal(format!("the engine textures need the {role} output, which no stage made"))
+                })?;
+                Ok((out.join(&f.name), f.bytes.clone()))
+            };
+            let (material, lighting) = crate::load::assemble(table, true, &file)?;
+            let lighting = lighting.ok_or_else(|| Error::Internal("the bake's lighting is missing".into()))?;
+            record(engine::run(&material, &lighting, program)?, &mut manifest)?;
+        }
     }
 
     folder.switch(staging, previous.as_ref(), &manifest)?;
@@ -332,7 +359,7 @@ pub fn write_stage(
 }
 
 /// The stages' names (`Staged::name`) in the order `run_bake` runs them.
-const STAGE_ORDER: [&str; 7] = [
+const STAGE_ORDER: [&str; 8] = [
     "importance",
     "bandwidth-atlas",
     "bandwidth-pca",
@@ -340,7 +367,12 @@ const STAGE_ORDER: [&str; 7] = [
     "environment-bandwidth",
     "prefilter",
     "layer-selection",
+    "engine-textures",
 ];
+
+/// The roles of the outputs the engine textures are made of (`load::assemble` reads them).
+const ENGINE_INPUTS: [&str; 5] =
+    ["importance-samples", "prefiltered-envmap", "environment-mips", "phong-layers", "layer-selection"];
 
 /// A bake's folder held by one writer: created if it was missing (the folder itself, never a
 /// chain of parents) and locked (`flock(2)` on the folder) for as long as this value lives.
@@ -442,6 +474,9 @@ fn stage_names(config: &BakeConfig) -> Vec<&'static str> {
     }
     if config.environment.is_some() {
         names.extend(["environment bandwidth", "phong layers and mip chain", "layer selection"]);
+        if config.engine_textures {
+            names.push("engine textures");
+        }
     }
     names
 }

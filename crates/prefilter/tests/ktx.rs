@@ -244,3 +244,62 @@ fn depth_and_supercompression_are_refused() {
         assert!(error.contains(expected), "{at} = {value}: {error}");
     }
 }
+
+/// A data texture ([`ktx::encode_data`]) of every shape, checked field by field with `ktx2` and
+/// read back exactly by [`ktx::decode_data`].
+fn check_data(shape: ktx::DataShape, orientation: &[u8]) {
+    let values: Vec<f32> = (0..shape.values()).map(|i| (i as f32 * 0.37).sin() * 1e5 - 3.25).collect();
+    let bytes = ktx::encode_data(shape, &values, "prefilter tests").unwrap();
+    let reader = Reader::new(&bytes[..]).unwrap();
+    let header = reader.header();
+    let format = if shape.channels == 1 { Format::R32_SFLOAT } else { Format::R32G32B32A32_SFLOAT };
+    assert_eq!(header.format, Some(format));
+    assert_eq!(header.type_size, 4);
+    let dims = (header.pixel_width, header.pixel_height, header.pixel_depth, header.layer_count, header.face_count);
+    let expected = (shape.width as u32, shape.height as u32, shape.depth as u32, shape.layers as u32, 1);
+    assert_eq!(dims, expected);
+    assert_eq!((header.level_count, header.supercompression_scheme), (1, None));
+    let (expected_dfd, _) = Basic::from_format_with(
+        format,
+        false,
+        Some(TransferFunction::Linear),
+        Some(ColorPrimaries::BT709),
+        Some(ColorModel::RGBSDA),
+    )
+    .unwrap();
+    assert_eq!(reader.basic_dfd(), Some(&expected_dfd), "the descriptor ktx2 builds for {format:?}");
+    let pairs: Vec<(&str, &[u8])> = reader.key_value_data().collect();
+    assert_eq!(pairs, vec![("KTXorientation", orientation), ("KTXwriter", b"prefilter tests\0")]);
+    let (offset, length, _) = level_index(&bytes, 1)[0];
+    assert_eq!(offset % (4 * shape.channels as u64).max(4), 0, "level 0 is aligned to its texel");
+    assert_eq!((offset + length) as usize, bytes.len());
+    let decoded = ktx::decode_data(&bytes).unwrap();
+    assert_eq!(decoded.shape, shape);
+    assert_eq!(decoded.values, values, "single floats read back exactly");
+}
+
+#[test]
+fn data_textures_of_every_shape_read_back_exactly() {
+    let shape = |width, height, depth, layers, channels| ktx::DataShape { width, height, depth, layers, channels };
+    check_data(shape(7, 3, 0, 0, 1), b"rd\0");
+    check_data(shape(5, 4, 0, 3, 1), b"rd\0");
+    check_data(shape(6, 2, 0, 2, 4), b"rd\0");
+    check_data(shape(4, 3, 5, 0, 4), b"rdi\0");
+}
+
+#[test]
+fn data_textures_that_cannot_be_written_are_refused() {
+    let shape = |width, height, depth, layers, channels| ktx::DataShape { width, height, depth, layers, channels };
+    let refused = |s: ktx::DataShape, values: &[f32]| ktx::encode_data(s, values, "t").unwrap_err().to_string();
+    assert!(refused(shape(2, 2, 0, 0, 3), &[0.0; 12]).contains("1 or 4"));
+    assert!(refused(shape(0, 2, 0, 0, 1), &[]).contains("empty"));
+    assert!(refused(shape(2, 2, 2, 2, 1), &[0.0; 16]).contains("not both"));
+    assert!(refused(shape(2, 2, 0, 0, 1), &[0.0; 3]).contains("needs 4 values, found 3"));
+    assert!(refused(shape(2, 1, 0, 0, 1), &[0.0, f32::NAN]).contains("not finite"));
+    // A colour texture is not a data texture, and a truncated one is refused.
+    let colour =
+        ktx::encode(Shape { width: 2, height: 1, layers: 0, faces: 1 }, &[vec![&[0.0f32; 6][..]]], Storage::Auto, "t");
+    assert!(ktx::decode_data(&colour.unwrap().bytes).unwrap_err().contains("expected an r32f or rgba32f"));
+    let bytes = ktx::encode_data(shape(3, 2, 0, 0, 4), &[1.0; 24], "t").unwrap();
+    assert!(ktx::decode_data(&bytes[..bytes.len() - 4]).is_err());
+}

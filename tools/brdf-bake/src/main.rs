@@ -16,8 +16,9 @@ use serde_json::json;
 /// full 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset,
 /// .png), with --wavelet-ratio its Haar wavelet encoding (wavelet-brdf.asset, .png; what
 /// brdf-preview --brdf wavelet reads), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
-/// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png);
-/// then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool
+/// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png),
+/// the layer selection (layer-selection.asset) and with --engine-textures the engine textures
+/// (engine-*.ktx2); then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool
 /// version and each stage's validation figures), written last.
 ///
 /// A rerun with the same inputs (by sha256), parameters and tool version finds the manifest up to
@@ -95,6 +96,15 @@ struct Args {
     #[arg(long, value_name = "paper|level-normalized", default_value = "paper", requires = "env")]
     env_reading: bandwidth::Reading,
 
+    /// Also write the engine textures (engine-*.ktx2): everything brdf-preview's reference and
+    /// prefiltered estimators read (the MERL table as a 3D texture, the importance tables, the
+    /// view rows' layer coordinates, level 0 and its peaks, their sampling tables, the smooth
+    /// Phong layers), as single-float KTX2 data textures that engines index directly
+    /// (data-schema/engine-textures.md; engines/three renders them in three.js). About 60 MB for a
+    /// MERL table under a 1024 x 512 map.
+    #[arg(long, requires = "env")]
+    engine_textures: bool,
+
     /// Store the environment's KTX2 files as half floats even where texels exceed 65504, clamping
     /// them (the default stores such a file as single floats).
     #[arg(long)]
@@ -153,6 +163,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.prefilter.cube = args.cube;
     config.prefilter.ggx_levels = args.ggx_levels.unwrap_or(0);
     config.prefilter.chain = args.chain;
+    config.engine_textures = args.engine_textures;
     config.env_bandwidth.max_memory = args.max_memory;
     config.env_bandwidth.config.reading = args.env_reading;
     let progress = cli::Progress::new(args.quiet);

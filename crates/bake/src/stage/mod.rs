@@ -2,6 +2,7 @@
 //! its errors), computes everything, and returns a [`crate::Staged`] without touching the disk.
 
 pub mod atlas;
+pub mod engine;
 pub mod env_bandwidth;
 pub mod importance;
 pub mod layers;
@@ -14,7 +15,7 @@ pub mod wavelet;
 /// ...; `data-schema/README.md` lists them by role): a rebake removes a file of the previous
 /// manifest only under such a name, so that no manifest can make it remove anything else.
 pub fn is_output_name(name: &str) -> bool {
-    const NAMES: [&str; 24] = [
+    const NAMES: [&str; 30] = [
         importance::ASSET,
         importance::PICTURE,
         atlas::ASSET,
@@ -39,6 +40,12 @@ pub fn is_output_name(name: &str) -> bool {
         prefilter::engine::DFG_KTX2,
         prefilter::engine::DFG_PNG,
         layers::ASSET,
+        engine::MERL_KTX2,
+        engine::BRDF_TABLES_KTX2,
+        engine::VIEW_LAYERS_KTX2,
+        engine::ENVIRONMENT_KTX2,
+        engine::LIGHT_TABLES_KTX2,
+        engine::LAYERS_KTX2,
     ];
     let layer_exr = name
         .strip_prefix("layer-n")

@@ -1,0 +1,449 @@
+// A bake of the BRDF toolchain (`brdf-bake --engine-textures`) as three.js materials: the
+// reference and prefiltered estimators of `brdf-preview`, with the same samples, the same
+// per-pixel sample choice and the same tone mapping, in GLSL ES 3.0 (`shade.glsl.js`). The
+// engine textures are described in `data-schema/engine-textures.md`; this file reads them and
+// sets the shader's inputs.
+//
+//     import { loadBake, previewSphere, orbitCamera } from '@brdf-toolchain/three';
+//     const bake = await loadBake('bakes/gold-paint/');
+//     const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: 'prefiltered' }));
+//     scene.add(bake.createBackground(), mesh);
+
+import * as THREE from 'three';
+import { read as readKtx2 } from 'three/addons/libs/ktx-parse.module.js';
+
+import {
+    BACKGROUND_FRAGMENT,
+    BACKGROUND_VERTEX,
+    GBUFFER_FRAGMENT,
+    QUAD_VERTEX,
+    SURFACE_FRAGMENT,
+    SURFACE_VERTEX,
+} from './shade.glsl.js';
+
+/** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
+export const MODES = { reference: 0, prefiltered: 2 };
+
+/** The stage of the manifest that lists the engine textures. */
+export const STAGE = 'engine-textures';
+
+/** The roles of the engine textures and the uniforms they bind. */
+const TEXTURES = {
+    'engine-merl': 'uMerl',
+    'engine-brdf-tables': 'uBrdfTables',
+    'engine-light-tables': 'uLightTables',
+    'engine-view-layers': 'uViewLayers',
+    'engine-environment': 'uEnvironment',
+    'engine-layers': 'uLayers',
+};
+
+// KTX2 vkFormat codes of the data textures.
+const VK_FORMAT_R32_SFLOAT = 100;
+const VK_FORMAT_R32G32B32A32_SFLOAT = 109;
+
+/** An error in a bake's files, naming the file. */
+export class BakeError extends Error {}
+
+/**
+ * Resolves a path a manifest names inside the bake folder `base` (a URL ending in `/`): a
+ * relative path of `/`-separated components, none empty, `.` or `..`, without `\`, `:`, `?` or
+ * `#` (the manifest's own rule, data-schema/README.md "Paths", and no scheme or query that
+ * would take a fetch elsewhere). Anything else is refused.
+ */
+export function resolveInside(base, path) {
+    const components = typeof path === 'string' ? path.split('/') : [''];
+    const bad = components.some((c) => c === '' || c === '.' || c === '..' || /[\\:?#\0%]/.test(c));
+    if (bad) {
+        throw new BakeError(`error: manifest.json: the output path ${JSON.stringify(path)} leaves the bake folder`);
+    }
+    const url = new URL(components.map(encodeURIComponent).join('/'), base);
+    if (url.origin !== base.origin || !url.pathname.startsWith(base.pathname)) {
+        throw new BakeError(`error: manifest.json: the output path ${JSON.stringify(path)} leaves the bake folder`);
+    }
+    return url;
+}
+
+async function fetchBytes(url, what) {
+    const response = await fetch(url);
+    if (!response.ok) {
+        throw new BakeError(`error: ${what}: HTTP ${response.status} fetching ${url}`);
+    }
+    return new Uint8Array(await response.arrayBuffer());
+}
+
+async function sha256Hex(bytes) {
+    if (!globalThis.crypto?.subtle) {
+        return null;
+    }
+    const digest = new Uint8Array(await crypto.subtle.digest('SHA-256', bytes));
+    return Array.from(digest, (b) => b.toString(16).padStart(2, '0')).join('');
+}
+
+/**
+ * A data texture of the bake (KTX2, one level, R32_SFLOAT or R32G32B32A32_SFLOAT, 2D, 2D array or
+ * 3D) as a three.js texture read with texelFetch: nearest filtering, no mipmaps, no flip (row 0
+ * of the file is row 0 of the texture).
+ */
+export function dataTexture(bytes, name) {
+    let container;
+    try {
+        container = readKtx2(bytes);
+    } catch (e) {
+        throw new BakeError(`error: ${name}: not a ktx2 file: ${e.message}`);
+    }
+    const { vkFormat, pixelWidth: w, pixelHeight: h, pixelDepth: d, layerCount: layers, levels } = container;
+    const channels = { [VK_FORMAT_R32_SFLOAT]: 1, [VK_FORMAT_R32G32B32A32_SFLOAT]: 4 }[vkFormat];
+    if (!channels || container.supercompressionScheme !== 0 || levels.length !== 1 || container.faceCount !== 1) {
+        throw new BakeError(`error: ${name}: expected one level of r32f or rgba32f texels, found vkFormat ${vkFormat}`);
+    }
+    const level = levels[0].levelData;
+    const expected = 4 * channels * w * Math.max(h, 1) * Math.max(d, 1) * Math.max(layers, 1);
+    if (level.byteLength !== expected) {
+        throw new BakeError(`error: ${name}: level 0 holds ${level.byteLength} bytes, expected ${expected}`);
+    }
+    // Copied so that the floats are aligned whatever the level's offset in the file.
+    const data = new Float32Array(level.slice().buffer);
+    const format = channels === 1 ? THREE.RedFormat : THREE.RGBAFormat;
+    let texture;
+    if (d > 0) {
+        texture = new THREE.Data3DTexture(data, w, h, d);
+    } else if (layers > 0) {
+        texture = new THREE.DataArrayTexture(data, w, h, layers);
+    } else {
+        texture = new THREE.DataTexture(data, w, h);
+    }
+    texture.format = format;
+    texture.type = THREE.FloatType;
+    texture.minFilter = THREE.NearestFilter;
+    texture.magFilter = THREE.NearestFilter;
+    texture.generateMipmaps = false;
+    texture.flipY = false;
+    texture.unpackAlignment = 4;
+    texture.needsUpdate = true;
+    return texture;
+}
+
+/**
+ * Reads the bake at `url` (a folder served over HTTP, with or without the trailing `/`): its
+ * `manifest.json`, then every engine texture the manifest lists (by role, resolved inside the
+ * folder, its size and, where the page has WebCrypto, its SHA-256 checked against the manifest).
+ */
+export async function loadBake(url) {
+    const base = new URL(String(url).endsWith('/') ? String(url) : `${url}/`, globalThis.location?.href);
+    const manifestBytes = await fetchBytes(new URL('manifest.json', base), 'manifest.json');
+    let manifest;
+    try {
+        manifest = JSON.parse(new TextDecoder().decode(manifestBytes));
+    } catch (e) {
+        throw new BakeError(`error: ${base}manifest.json: not json: ${e.message}`);
+    }
+    const stage = (manifest.stages ?? []).find((s) => s.name === STAGE);
+    if (!stage) {
+        throw new BakeError(
+            `error: ${base}manifest.json: the bake has no engine textures: bake it with brdf-bake --engine-textures`,
+        );
+    }
+    const textures = {};
+    await Promise.all(
+        Object.entries(TEXTURES).map(async ([role, uniform]) => {
+            const output = stage.outputs.find((o) => o.role === role);
+            if (!output) {
+                throw new BakeError(`error: ${base}manifest.json: the engine textures have no ${role} output`);
+            }
+            const fileUrl = resolveInside(base, output.path);
+            const bytes = await fetchBytes(fileUrl, output.path);
+            if (bytes.byteLength !== output.size_bytes) {
+                throw new BakeError(
+                    `error: ${fileUrl}: ${bytes.byteLength} bytes, the manifest says ${output.size_bytes}`,
+                );
+            }
+            const hash = await sha256Hex(bytes);
+            if (hash !== null && hash !== output.sha256) {
+                throw new BakeError(`error: ${fileUrl}: not the file the manifest describes (its sha256 differs)`);
+            }
+            textures[uniform] = dataTexture(bytes, String(fileUrl));
+        }),
+    );
+    return new Bake(manifest, stage.figures, textures);
+}
+
+/** A loaded bake: its manifest, the engine textures' figures and the textures. */
+export class Bake {
+    constructor(manifest, figures, textures) {
+        this.manifest = manifest;
+        this.figures = figures;
+        this.textures = textures;
+    }
+
+    /** brdf-preview's defaults for `mode`: `{ spp, frames }` (render::Settings::previewer). */
+    defaults(mode) {
+        const d = this.figures.previewer?.[mode];
+        if (!d) {
+            throw new BakeError(`error: the bake's engine textures have no defaults for mode ${mode}`);
+        }
+        return d;
+    }
+
+    /**
+     * A material that shades a mesh with the bake's `mode` ('reference' or 'prefiltered'): per
+     * pixel, frames `firstFrame .. firstFrame + frames` of `spp` samples each, their sum divided
+     * by `divisor` (default `frames`: their average), tone mapped with `exposureEv` (default the
+     * environment's automatic exposure, as brdf-preview's) unless `toneMap` is false (then linear
+     * radiance, for a float target). `spp` and `frames` default to brdf-preview's; `seed` is
+     * brdf-preview's --seed. The pixel index (which samples a pixel takes) counts rows from the
+     * top of the drawing buffer, whose size the material reads from the renderer at each draw.
+     */
+    createMaterial(options = {}) {
+        const material = new THREE.RawShaderMaterial({
+            name: `brdf-bake ${options.mode ?? 'reference'}`,
+            glslVersion: THREE.GLSL3,
+            vertexShader: SURFACE_VERTEX,
+            fragmentShader: SURFACE_FRAGMENT,
+            // render::raster culls no back face: at a silhouette a pixel may see one.
+            side: THREE.DoubleSide,
+            uniforms: this.shadingUniforms(options),
+        });
+        material.onBeforeRender = (renderer) => resolution(renderer, material.uniforms.uResolution.value);
+        return material;
+    }
+
+    /**
+     * The material's estimators as a full-screen pass over a G-buffer (`exactCoverage`): what a
+     * pixel covers is read from `gbuffer` rather than rasterized at the pixel, and uncovered
+     * pixels show the environment. `options` as for `createMaterial`.
+     */
+    createDeferred(gbuffer, options = {}) {
+        const material = new THREE.RawShaderMaterial({
+            name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
+            glslVersion: THREE.GLSL3,
+            defines: { DEFERRED: 1 },
+            vertexShader: QUAD_VERTEX,
+            fragmentShader: SURFACE_FRAGMENT,
+            depthTest: false,
+            depthWrite: false,
+            uniforms: {
+                ...this.shadingUniforms(options),
+                uGPosition: { value: gbuffer.target.textures[0] },
+                uGNormal: { value: gbuffer.target.textures[1] },
+                uGScale: { value: gbuffer.scale },
+            },
+        });
+        const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
+        mesh.frustumCulled = false;
+        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
+        return mesh;
+    }
+
+    shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0, exposureEv, toneMap = true }) {
+        if (!(mode in MODES)) {
+            throw new BakeError(`error: unknown mode ${mode}: reference or prefiltered`);
+        }
+        const f = this.figures;
+        const defaults = this.defaults(mode);
+        spp = spp ?? defaults.spp;
+        frames = frames ?? defaults.frames;
+        if (!(spp > 0 && (spp & (spp - 1)) === 0 && f.samples % spp === 0)) {
+            throw new BakeError(`error: spp ${spp} must be a power of two dividing the bake's ${f.samples} samples`);
+        }
+        return {
+            ...this.textureUniforms(),
+            ...this.toneUniforms(exposureEv, toneMap),
+            uPhiDRange: { value: f.phi_d_range },
+            uMode: { value: MODES[mode] },
+            uSeed: { value: seed >>> 0 },
+            uSpp: { value: spp },
+            uSlices: { value: f.slices },
+            uVectors: { value: f.vectors },
+            uSamples: { value: f.samples },
+            uRows: { value: f.rows },
+            uSectors: { value: f.sectors },
+            uPeaks: { value: Boolean(f.peaks) },
+            uFirstFrame: { value: firstFrame },
+            uFrameCount: { value: frames },
+            uDivisor: { value: divisor ?? frames },
+            ...rayUniforms(),
+        };
+    }
+
+    /**
+     * The environment behind everything: level 0 along each pixel's camera ray
+     * (render::Camera::ray), tone mapped like the material. A full-screen quad drawn first, not
+     * tested against or written to depth.
+     */
+    createBackground({ exposureEv, toneMap = true } = {}) {
+        const material = new THREE.RawShaderMaterial({
+            name: 'brdf-bake background',
+            glslVersion: THREE.GLSL3,
+            vertexShader: BACKGROUND_VERTEX,
+            fragmentShader: BACKGROUND_FRAGMENT,
+            depthTest: false,
+            depthWrite: false,
+            uniforms: {
+                uEnvironment: { value: this.textures.uEnvironment },
+                ...this.toneUniforms(exposureEv, toneMap),
+                ...rayUniforms(),
+            },
+        });
+        const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
+        mesh.frustumCulled = false;
+        mesh.renderOrder = -Infinity;
+        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
+        return mesh;
+    }
+
+    textureUniforms() {
+        return Object.fromEntries(Object.entries(this.textures).map(([name, texture]) => [name, { value: texture }]));
+    }
+
+    toneUniforms(exposureEv, toneMap) {
+        return {
+            uExposure: { value: 2 ** (exposureEv ?? this.figures.exposure_ev) },
+            uToneMap: { value: toneMap },
+        };
+    }
+
+    dispose() {
+        Object.values(this.textures).forEach((t) => t.dispose());
+    }
+}
+
+function rayUniforms() {
+    return {
+        uResolution: { value: new THREE.Vector2(1, 1) },
+        uRayForward: { value: new THREE.Vector3() },
+        uRayRight: { value: new THREE.Vector3() },
+        uRayUp: { value: new THREE.Vector3() },
+    };
+}
+
+// The image size and the pixel rays' basis (render::Camera::basis: the columns of the camera's
+// world matrix are right, up and back) for the draw about to run.
+function setRay(u, renderer, camera) {
+    resolution(renderer, u.uResolution.value);
+    const e = camera.matrixWorld.elements;
+    const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
+    const aspect = u.uResolution.value.x / u.uResolution.value.y;
+    u.uRayForward.value.set(-e[8], -e[9], -e[10]).normalize();
+    u.uRayRight.value.set(e[0], e[1], e[2]).normalize().multiplyScalar(tanHalf * aspect);
+    u.uRayUp.value.set(e[4], e[5], e[6]).normalize().multiplyScalar(tanHalf);
+}
+
+/**
+ * The G-buffer of `geometry` seen by `camera` at `width x height` with brdf-preview's coverage:
+ * render::raster snaps vertices to 1/256 pixel, as lavapipe does, where a WebGL implementation
+ * may snap coarser (SwiftShader: 1/16), and a pixel whose centre lies that close to a silhouette
+ * edge would be covered by one renderer only. So the mesh is drawn at `scale` (16) times the size,
+ * shifted by half a pixel of that size so that texel `(S x + S / 2, S y + S / 2)` is centred on
+ * pixel `(x, y)`'s centre: its coverage is that of the pixel centre with vertices on a grid of
+ * 1 / (16 S) pixel. Only those texels are written (position, and normal with w = 1), into two
+ * float textures of `S width x S height` (128 MB for 128 x 128): for tests and stills, not for
+ * frames. `createDeferred` shades from it.
+ */
+export function exactCoverage(renderer, geometry, camera, width, height, scale = 16) {
+    const target = new THREE.WebGLRenderTarget(scale * width, scale * height, {
+        count: 2,
+        type: THREE.FloatType,
+        format: THREE.RGBAFormat,
+        depthBuffer: true,
+        minFilter: THREE.NearestFilter,
+        magFilter: THREE.NearestFilter,
+        generateMipmaps: false,
+    });
+    const material = new THREE.RawShaderMaterial({
+        name: 'brdf-bake g-buffer',
+        glslVersion: THREE.GLSL3,
+        vertexShader: SURFACE_VERTEX,
+        fragmentShader: GBUFFER_FRAGMENT,
+        side: THREE.DoubleSide,
+        uniforms: { uGScale: { value: scale } },
+    });
+    const scene = new THREE.Scene();
+    scene.add(new THREE.Mesh(geometry, material));
+    const shifted = camera.clone();
+    // Half a texel right and up: three's view offset moves the frustum, so the picture moves the
+    // other way (x from the left, y from the top).
+    shifted.setViewOffset(scale * width, scale * height, -0.5, 0.5, scale * width, scale * height);
+    const previous = { target: renderer.getRenderTarget(), color: renderer.getClearColor(new THREE.Color()), alpha: renderer.getClearAlpha() };
+    renderer.setRenderTarget(target);
+    renderer.setClearColor(0x000000, 0);
+    renderer.clear();
+    renderer.render(scene, shifted);
+    renderer.setRenderTarget(previous.target);
+    renderer.setClearColor(previous.color, previous.alpha);
+    material.dispose();
+    return { target, scale };
+}
+
+function resolution(renderer, target) {
+    const rt = renderer.getRenderTarget();
+    if (rt) {
+        target.set(rt.width, rt.height);
+    } else {
+        renderer.getDrawingBufferSize(target);
+    }
+}
+
+/**
+ * The sphere brdf-preview draws by default (render::Mesh::sphere(1, 128, 64)): a UV sphere around
+ * the z axis, one vertex at each pole, normals exactly radial, the same vertices and triangles in
+ * the same order.
+ */
+export function previewSphere(radius = 1, segments = 128, rings = 64) {
+    const positions = [];
+    const normals = [];
+    const push = (n) => {
+        normals.push(...n);
+        positions.push(...n.map((c) => c * radius));
+    };
+    push([0, 0, 1]);
+    for (let i = 1; i < rings; i++) {
+        const theta = (Math.PI * i) / rings;
+        for (let j = 0; j < segments; j++) {
+            const phi = (2 * Math.PI * j) / segments;
+            push([Math.sin(theta) * Math.cos(phi), Math.sin(theta) * Math.sin(phi), Math.cos(theta)]);
+        }
+    }
+    push([0, 0, -1]);
+    const south = positions.length / 3 - 1;
+    const ring = (i, j) => 1 + (i - 1) * segments + (j % segments);
+    const indices = [];
+    for (let j = 0; j < segments; j++) indices.push(0, ring(1, j), ring(1, j + 1));
+    for (let i = 1; i < rings - 1; i++) {
+        for (let j = 0; j < segments; j++) {
+            const [a, b, c, d] = [ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)];
+            indices.push(a, b, c, a, c, d);
+        }
+    }
+    for (let j = 0; j < segments; j++) indices.push(ring(rings - 1, j), south, ring(rings - 1, j + 1));
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+    geometry.setAttribute('normal', new THREE.Float32BufferAttribute(normals, 3));
+    geometry.setIndex(indices);
+    return geometry;
+}
+
+/**
+ * brdf-preview's camera (render::Camera::orbit with the default target, distance and field of
+ * view): at `azimuthDeg`, `elevationDeg` (brdf-preview --camera AZ,EL) around the origin, +z up,
+ * 45 degrees vertical field of view, near and far planes at 1% and 100 times the distance.
+ */
+export function orbitCamera(aspect, azimuthDeg = 0, elevationDeg = 0, distance = 3.2) {
+    const camera = new THREE.PerspectiveCamera(45, aspect, distance * 0.01, distance * 100);
+    setOrbit(camera, azimuthDeg, elevationDeg, distance);
+    return camera;
+}
+
+/** Moves `camera` to azimuth and elevation (degrees) at `distance` from the origin, +z up. */
+export function setOrbit(camera, azimuthDeg, elevationDeg, distance = 3.2) {
+    const max = Math.PI / 2 - 1e-3;
+    const el = Math.min(Math.max((elevationDeg * Math.PI) / 180, -max), max);
+    const az = (azimuthDeg * Math.PI) / 180;
+    camera.up.set(0, 0, 1);
+    camera.position.set(
+        distance * Math.cos(el) * Math.cos(az),
+        distance * Math.cos(el) * Math.sin(az),
+        distance * Math.sin(el),
+    );
+    camera.lookAt(0, 0, 0);
+    camera.updateMatrixWorld();
+}

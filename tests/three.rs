@@ -1,0 +1,499 @@
+//! A bake in three.js (`engines/three`), in a real browser: `brdf-bake --engine-textures` writes
+//! the textures the estimators read (every one valid to Khronos' `ktx2check` and to `ktx-parse`,
+//! the parser three.js uses, and holding the bake's numbers), and the three.js material renders
+//! brdf-preview's sphere in headless Chromium (WebGL 2 on SwiftShader, driven by puppeteer-core:
+//! `engines/three/test/render.mjs`) as brdf-preview renders it on the GPU: the same estimator
+//! with the same samples, so the two pictures differ by the port alone.
+//!
+//! Two ways to draw. `exact`: the mesh rasterized at brdf-preview's sub-pixel precision
+//! (`exactCoverage` in `engines/three/src/index.js`: a G-buffer at 16 times the size, then the
+//! material's estimators as a full-screen pass), so that every pixel covers what it covers in
+//! brdf-preview; `forward`: the material on the mesh, as a scene draws it, where SwiftShader's
+//! coarser sub-pixel grid (1/16 pixel, against lavapipe's and `render::raster`'s 1/256) covers
+//! about a dozen rim pixels of a 128 x 128 sphere differently.
+//!
+//! Needs Chromium (`/usr/bin/chromium`, Debian's `chromium`, or `CHROMIUM`), node and
+//! `npm ci` in engines/three (`make setup`); fails saying so when one is missing.
+//!
+//! `make three-cases` runs the issue's six cases at brdf-preview's default samples
+//! ([`three_js_equals_brdf_preview_on_the_six_cases`], ignored in `make test`: about 10 minutes
+//! on 2 cores, most of it SwiftShader's reference renders).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::support::{nbrdf_table, root, run, shared, tool};
+
+/// The PSNR both modes must reach against brdf-preview drawn exactly: the issue asks 40 dB; the
+/// same estimator with the same samples and the same coverage leaves f32 rounding alone, one
+/// 8-bit step at a few hundred pixels, above 60 dB (measured on the six cases: 62.1 to 73.8 dB).
+const MIN_EXACT_PSNR_DB: f64 = 60.0;
+
+/// Drawn forward, the pictures differ by the rim on top: pixels whose centre lies within 1/32
+/// pixel of a silhouette edge, which SwiftShader's 1/16-pixel vertex grid covers otherwise than
+/// brdf-preview's 1/256 (measured: 12 to 15 pixels per case, 37.6 to 45.9 dB over all pixels).
+/// So a forward drawing is held to this: every pixel beyond [`FAR_STEPS`] lies within
+/// [`RIM_PX`] of the sphere's silhouette circle, and the others reach this PSNR (measured 56.5 to
+/// 67.2 dB).
+const MIN_FORWARD_OFF_RIM_PSNR_DB: f64 = 50.0;
+
+/// A difference of more than this many 8-bit steps is not rounding.
+const FAR_STEPS: u8 = 8;
+
+/// How close to the silhouette circle a rim pixel's centre lies (measured: 0.07 pixel at most).
+const RIM_PX: f64 = 0.5;
+
+/// The test bakes: brdf-bake's defaults but the smallest analysis (the atlas enters neither mode).
+fn bake(material: &str, environment: &str) -> PathBuf {
+    let dir = root().join("target/test-tmp/three-bakes").join(format!("{material}-{environment}"));
+    std::fs::create_dir_all(dir.parent().unwrap()).expect("creating target/test-tmp/three-bakes");
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(nbrdf_table(material))
+        .arg("--env")
+        .arg(shared().join("data/env").join(format!("{environment}.hdr")))
+        .arg("--out-dir")
+        .arg(&dir)
+        .args(["--engine-textures", "--analysis-size", "64", "--quiet"]);
+    // At 64 x 64 most lobes reach the analysis grid's limit, a validation problem (exit 1).
+    let r = run(cmd, "");
+    assert!(matches!(r.code, Some(0 | 1)), "the bake failed\n{r}");
+    dir
+}
+
+/// The figures of the bake's engine-textures stage.
+fn figures(dir: &Path) -> serde_json::Value {
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let stage = manifest["stages"].as_array().unwrap().iter().find(|s| s["name"] == "engine-textures");
+    stage.expect("an engine-textures stage").clone()
+}
+
+const ENGINE_TEXTURES: [&str; 6] = [
+    "engine-merl.ktx2",
+    "engine-brdf-tables.ktx2",
+    "engine-view-layers.ktx2",
+    "engine-environment.ktx2",
+    "engine-light-tables.ktx2",
+    "engine-layers.ktx2",
+];
+
+fn read_data(path: &Path) -> prefilter::ktx::DecodedData {
+    prefilter::ktx::decode_data(&std::fs::read(path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Every engine texture is listed in the manifest with its role, passes `ktx2check
+/// --warn-as-error` and `ktx-parse`, has the shape `data-schema/engine-textures.md` gives it, and
+/// holds the bake's numbers: the MERL table's values exactly, level 0 as the bake's `mips.ktx2`
+/// holds it, peaks that are a share of level 0, CDF rows that rise from 0 to 1, layer coordinates
+/// among the layers.
+#[test]
+fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
+    let dir = bake("white-paint", "potsdamer_platz_1k");
+    // A valid manifest (data-schema's JSON schema) listing every file of the folder.
+    crate::brdf_bake::check_complete(&dir);
+    let stage = figures(&dir);
+    let roles: Vec<(&str, &str)> = stage["outputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| (o["path"].as_str().unwrap(), o["role"].as_str().unwrap()))
+        .collect();
+    let expected_roles: Vec<(&str, String)> =
+        ENGINE_TEXTURES.iter().map(|n| (*n, n.trim_end_matches(".ktx2").to_string())).collect();
+    assert_eq!(roles, expected_roles.iter().map(|(n, r)| (*n, r.as_str())).collect::<Vec<_>>());
+    let paths: Vec<PathBuf> = ENGINE_TEXTURES.iter().map(|n| dir.join(n)).collect();
+
+    // Deterministic: the same bytes baked on one thread.
+    let tmp = crate::support::temp_dir();
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(nbrdf_table("white-paint"))
+        .arg("--env")
+        .arg(shared().join("data/env/potsdamer_platz_1k.hdr"))
+        .arg("--out-dir")
+        .arg(tmp.path().join("bake"))
+        .args(["--engine-textures", "--analysis-size", "64", "--quiet"])
+        .env("RAYON_NUM_THREADS", "1");
+    let r = run(cmd, "");
+    assert!(matches!(r.code, Some(0 | 1)), "the bake failed\n{r}");
+    for (name, path) in ENGINE_TEXTURES.iter().zip(&paths) {
+        let again = std::fs::read(tmp.path().join("bake").join(name)).unwrap();
+        assert!(std::fs::read(path).unwrap() == again, "{name} differs when baked on one thread");
+    }
+
+    let ktx2check = root().join("target/ktx2check/ktx2check");
+    assert!(
+        ktx2check.is_file(),
+        "ktx2check is not built: run `make setup` (make setup-ktx; needs cmake and a C++ compiler)"
+    );
+    let mut check = Command::new(&ktx2check);
+    check.arg("--warn-as-error").args(&paths);
+    let r = run(check, "");
+    assert_eq!(r.code, Some(0), "ktx2check found problems\n{r}");
+
+    let modules = root().join("tests/ktx-parse/node_modules/ktx-parse");
+    assert!(
+        modules.is_dir(),
+        "ktx-parse is not installed: run `make setup` (npm ci in tests/ktx-parse; needs node and npm)"
+    );
+    let mut node = Command::new("node");
+    node.arg(root().join("tests/ktx-parse/check.mjs")).args(&paths);
+    let r = run(node, "").expect_code(0);
+    let parsed: Vec<serde_json::Value> = r.stdout.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+
+    let f = &stage["figures"];
+    let n = |v: &serde_json::Value| v.as_u64().unwrap() as usize;
+    let (rows, sectors, slices) = (n(&f["rows"]), n(&f["sectors"]), n(&f["slices"]));
+    let (w, h) = (n(&f["environment_size"][0]), n(&f["environment_size"][1]));
+    let layers = f["exponents"].as_array().unwrap().len();
+    // (vkFormat, width, height, depth, layers) of each file, from the figures.
+    let shapes = [
+        (109, n(&f["merl_size"][0]), n(&f["merl_size"][1]), n(&f["merl_size"][2]), 0),
+        (100, rows.max(sectors) + 1, rows + 2, 0, slices),
+        (100, n(&f["view_rows"]), 1, 0, 0),
+        (109, w, h, 0, 2),
+        (100, w.max(h) + 1, h + 1, 0, 2),
+        (109, n(&f["layers_size"][0]), n(&f["layers_size"][1]), 0, layers),
+    ];
+    for ((json, path), shape) in parsed.iter().zip(&paths).zip(shapes) {
+        let found = (
+            n(&json["vkFormat"]),
+            n(&json["pixelWidth"]),
+            n(&json["pixelHeight"]),
+            n(&json["pixelDepth"]),
+            n(&json["layerCount"]),
+        );
+        assert_eq!(found, shape, "{}\n{r}", path.display());
+        assert_eq!((n(&json["levelCount"]), n(&json["faceCount"])), (1, 1), "{}", path.display());
+        let decoded = read_data(path);
+        let ds = decoded.shape;
+        assert_eq!((ds.width, ds.height, ds.depth, ds.layers), (shape.1, shape.2, shape.3, shape.4));
+    }
+
+    // The MERL table, cell for cell: (phi_d, theta_d, theta_h), RGB in 1/sr, 0 without data.
+    let table = merl::MerlTable::parse(&std::fs::read(nbrdf_table("white-paint")).unwrap()).unwrap();
+    let merl_texels = read_data(&paths[0]).values;
+    for cell in 0..table.dims().cells() {
+        let expected = match table.cell_value(cell) {
+            Some(rgb) => [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 1.0],
+            None => [0.0; 4],
+        };
+        assert_eq!(merl_texels[4 * cell..4 * cell + 4], expected, "cell {cell}");
+    }
+
+    // Each slice: the row edges rise from 0 to at most 2 (t = 1 - cos theta_h), every CDF row from
+    // 0 to 1.
+    let tables = read_data(&paths[1]).values;
+    let width = rows.max(sectors) + 1;
+    let rising = |values: &[f32], what: &str| {
+        assert_eq!(values[0], 0.0, "{what} starts at 0");
+        assert!(values.windows(2).all(|p| p[0] <= p[1]), "{what} does not rise");
+    };
+    for (k, layer) in tables.chunks_exact(width * (rows + 2)).enumerate() {
+        rising(&layer[..=rows], &format!("slice {k}'s row edges"));
+        assert!(layer[rows] <= 2.0);
+        for row in 1..rows + 2 {
+            let len = if row == 1 { rows + 1 } else { sectors + 1 };
+            let cdf = &layer[row * width..row * width + len];
+            rising(cdf, &format!("slice {k}, row {row}"));
+            assert!((cdf[len - 1] - 1.0).abs() < 1e-6, "slice {k}, row {row} ends at {}", cdf[len - 1]);
+        }
+    }
+
+    let view_layers = read_data(&paths[2]).values;
+    assert!(view_layers.iter().all(|&x| (0.0..=(layers - 1) as f32).contains(&x)), "{view_layers:?}");
+
+    // Level 0 is the bake's mips.ktx2 level 0; the peaks take a share of each texel.
+    let mips = prefilter::ktx::decode(&std::fs::read(dir.join("mips.ktx2")).unwrap()).unwrap();
+    let environment = read_data(&paths[3]).values;
+    let (level0, peaks) = environment.split_at(4 * w * h);
+    for (i, (rgb, stored)) in mips.levels[0][0].chunks_exact(3).zip(level0.chunks_exact(4)).enumerate() {
+        assert_eq!(rgb, &stored[..3], "texel {i}");
+        let peak = &peaks[4 * i..4 * i + 3];
+        assert!(peak.iter().zip(rgb).all(|(p, l)| *p >= 0.0 && *p <= *l), "texel {i}: peak {peak:?} of {rgb:?}");
+    }
+    assert_eq!(f["peaks"], peaks.iter().any(|&v| v > 0.0));
+
+    let light = read_data(&paths[4]).values;
+    let light_width = w.max(h) + 1;
+    for (d, layer) in light.chunks_exact(light_width * (h + 1)).enumerate() {
+        for row in 0..=h {
+            let len = if row == 0 { h + 1 } else { w + 1 };
+            let cdf = &layer[row * light_width..row * light_width + len];
+            rising(cdf, &format!("distribution {d}, row {row}"));
+            assert!((cdf[len - 1] - 1.0).abs() < 1e-6, "distribution {d}, row {row} ends at {}", cdf[len - 1]);
+        }
+    }
+}
+
+/// The engine textures hold the lighting: without an environment the bake refuses to start.
+#[test]
+fn engine_textures_need_an_environment() {
+    let tmp = crate::support::temp_dir();
+    let mut cmd = tool("brdf-bake");
+    cmd.arg(crate::support::ggx_copper()).arg("--engine-textures").arg("--out-dir").arg(tmp.path().join("bake"));
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("--env"), "{r}");
+    assert!(!tmp.path().join("bake").exists(), "{r}");
+}
+
+/// The loader refuses every manifest path that would leave the bake folder (`node --test` on
+/// `engines/three/test/loader.test.mjs`).
+#[test]
+fn the_loader_keeps_manifest_paths_inside_the_bake() {
+    assert!(
+        root().join("engines/three/node_modules/three").is_dir(),
+        "three is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"
+    );
+    let mut node = Command::new("node");
+    node.arg("--test").arg(root().join("engines/three/test/loader.test.mjs"));
+    run(node, "").expect_code(0);
+}
+
+/// An 8-bit RGB picture: the first `height` rows of a PNG (brdf-preview's has a caption below).
+fn picture(path: &Path, width: usize, height: usize) -> Vec<u8> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes)).read_info().unwrap();
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buffer).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
+    assert!(info.width as usize == width && info.height as usize >= height, "{}", path.display());
+    buffer.truncate(3 * width * height);
+    buffer
+}
+
+/// `10 log10(255^2 / MSE)` over every pixel and channel (`render::metrics::psnr_db`).
+fn psnr_db(a: &[u8], b: &[u8]) -> f64 {
+    let squared: u64 = a.iter().zip(b).map(|(&x, &y)| u64::from(x.abs_diff(y)).pow(2)).sum();
+    10.0 * (255.0f64 * 255.0 / (squared as f64 / a.len() as f64)).log10()
+}
+
+/// Writes an 8-bit RGB PNG.
+fn write_png(path: &Path, rgb: &[u8], width: usize, height: usize) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width as u32, height as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.write_header().unwrap().write_image_data(rgb).unwrap();
+}
+
+/// One comparison: brdf-preview and three.js on the same bake, mode, samples and size.
+struct Case {
+    psnr_db: f64,
+    /// Pixels with a channel more than [`FAR_STEPS`] apart.
+    far_pixels: usize,
+    /// Of those, the ones farther than [`RIM_PX`] from the silhouette circle.
+    off_rim: usize,
+    /// The PSNR over the other pixels.
+    psnr_without_far_db: f64,
+    three_ms: f64,
+    preview: serde_json::Value,
+}
+
+/// The radius in pixels of the unit sphere's silhouette at brdf-preview's default camera (3.2 from
+/// the centre, 45 degrees vertical field of view) in an image `height` pixels high, centred.
+fn silhouette_radius(height: usize) -> f64 {
+    (1.0f64 / 3.2).asin().tan() / 22.5f64.to_radians().tan() * height as f64 / 2.0
+}
+
+/// Renders `dir` with `mode` (and `extra` brdf-preview arguments: `--converged`; `frames` for
+/// both) by brdf-preview and by three.js in Chromium (drawn `coverage`: exact or forward) at
+/// 128 x 128 into `out`, and compares them; writes
+/// `NAME-actual.png` (three.js), `NAME-expected.png` and `NAME-difference.png` (|a - b| times 4)
+/// there when the comparison fails ([`problem`]).
+fn compare(
+    dir: &Path,
+    out: &Path,
+    name: &str,
+    (mode, coverage): (&str, &str),
+    frames: Option<u32>,
+    extra: &[&str],
+) -> Case {
+    let (width, height) = (128, 128);
+    std::fs::create_dir_all(out).unwrap();
+    let preview_png = out.join(format!("{name}-preview.png"));
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(dir).arg("--out").arg(&preview_png).args(["--mode", mode, "--size", "128x128", "--json"]).args(extra);
+    if let Some(frames) = frames {
+        cmd.args(["--frames", &frames.to_string()]);
+    }
+    let r = run(cmd, "").expect_code(0);
+    let preview = r.json();
+    let spp = preview["spp"].as_u64().unwrap().to_string();
+    let frames = preview["frames"].as_u64().unwrap().to_string();
+
+    let three_png = out.join(format!("{name}-three.png"));
+    let script = root().join("engines/three/test/render.mjs");
+    assert!(
+        root().join("engines/three/node_modules/puppeteer-core").is_dir(),
+        "puppeteer-core is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"
+    );
+    let mut node = Command::new("node");
+    node.arg(&script).arg("--bake").arg(dir).arg("--out").arg(&three_png);
+    node.args(["--mode", mode, "--size", "128x128", "--spp", &spp, "--frames", &frames, "--coverage", coverage]);
+    let r = run(node, "");
+    assert_eq!(
+        r.code,
+        Some(0),
+        "the three.js render failed (Chromium: apt-get install chromium, or set CHROMIUM)\n{r}"
+    );
+    let three: serde_json::Value = serde_json::from_str(r.stdout.trim()).unwrap();
+
+    let a = picture(&three_png, width, height);
+    let b = picture(&preview_png, width, height);
+    let psnr = psnr_db(&a, &b);
+    let (mut far_pixels, mut off_rim) = (0, 0);
+    let (mut near_a, mut near_b) = (Vec::new(), Vec::new());
+    for (i, (p, q)) in a.chunks_exact(3).zip(b.chunks_exact(3)).enumerate() {
+        if p.iter().zip(q).any(|(x, y)| x.abs_diff(*y) > FAR_STEPS) {
+            far_pixels += 1;
+            let (x, y) = ((i % width) as f64 + 0.5, (i / width) as f64 + 0.5);
+            let r = (x - width as f64 / 2.0).hypot(y - height as f64 / 2.0);
+            if (r - silhouette_radius(height)).abs() > RIM_PX {
+                off_rim += 1;
+            }
+        } else {
+            near_a.extend_from_slice(p);
+            near_b.extend_from_slice(q);
+        }
+    }
+    let psnr_without_far_db = psnr_db(&near_a, &near_b);
+    let case = Case {
+        psnr_db: psnr,
+        far_pixels,
+        off_rim,
+        psnr_without_far_db,
+        three_ms: three["render_ms"].as_f64().unwrap(),
+        preview,
+    };
+    if problem(&case, coverage).is_some() {
+        let difference: Vec<u8> =
+            a.iter().zip(&b).map(|(x, y)| (u32::from(x.abs_diff(*y)) * 4).min(255) as u8).collect();
+        write_png(&out.join(format!("{name}-actual.png")), &a, width, height);
+        write_png(&out.join(format!("{name}-expected.png")), &b, width, height);
+        write_png(&out.join(format!("{name}-difference.png")), &difference, width, height);
+    }
+    case
+}
+
+/// What is wrong with a comparison drawn `coverage`, if anything (see [`MIN_EXACT_PSNR_DB`] and
+/// [`MIN_FORWARD_OFF_RIM_PSNR_DB`]).
+fn problem(case: &Case, coverage: &str) -> Option<String> {
+    match coverage {
+        "exact" if case.psnr_db < MIN_EXACT_PSNR_DB => {
+            Some(format!("{:.2} dB, below {MIN_EXACT_PSNR_DB} dB", case.psnr_db))
+        }
+        "forward" if case.off_rim > 0 => Some(format!(
+            "{} of {} pixels beyond {FAR_STEPS} steps lie off the silhouette",
+            case.off_rim, case.far_pixels
+        )),
+        "forward" if case.psnr_without_far_db < MIN_FORWARD_OFF_RIM_PSNR_DB => {
+            Some(format!("{:.2} dB off the rim, below {MIN_FORWARD_OFF_RIM_PSNR_DB} dB", case.psnr_without_far_db))
+        }
+        _ => None,
+    }
+}
+
+/// The CI case: gold-paint under quarry_01 (a sun: the peaks and their sampling tables in use) in
+/// both modes drawn exactly, the prefiltered mode at brdf-preview's defaults (8 frames of 16
+/// samples), the reference mode at 4 of its 32 frames of 64 samples (the same samples as
+/// brdf-preview's first 4 frames, to keep make test short); and the prefiltered mode
+/// drawn forward, as a scene draws the material.
+#[test]
+fn three_js_renders_a_bake_as_brdf_preview_does() {
+    let dir = bake("gold-paint", "quarry_01_1k");
+    let out = root().join("target/test-tmp/three");
+    for (mode, coverage, frames) in
+        [("prefiltered", "exact", None), ("reference", "exact", Some(4)), ("prefiltered", "forward", None)]
+    {
+        let name = format!("gold-paint-quarry-{mode}-{coverage}");
+        let case = compare(&dir, &out, &name, (mode, coverage), frames, &[]);
+        println!(
+            "gold-paint under quarry_01, {mode} drawn {coverage}: {:.2} dB, {} pixels beyond {FAR_STEPS} steps ({} \
+             off the rim), {:.2} dB without them",
+            case.psnr_db, case.far_pixels, case.off_rim, case.psnr_without_far_db
+        );
+        if let Some(problem) = problem(&case, coverage) {
+            panic!("{mode} drawn {coverage}: three.js against brdf-preview: {problem}; pictures in {}", out.display());
+        }
+    }
+}
+
+/// The issue's six cases (white-paint, gold-paint and chrome under quarry_01 and
+/// potsdamer_platz, 128 x 128) at brdf-preview's default samples in both modes drawn exactly,
+/// each at [`MIN_EXACT_PSNR_DB`] or more, and the prefiltered mode drawn forward, different only
+/// on the rim; and against the converged estimate, three.js's exact prefiltered picture within
+/// 1 dB of brdf-preview's. Prints the table. `make three-cases`.
+#[test]
+#[ignore = "about 10 minutes on 2 cores: make three-cases"]
+fn three_js_equals_brdf_preview_on_the_six_cases() {
+    let out = root().join("target/three-cases");
+    let mut rows = Vec::new();
+    let mut failures = Vec::new();
+    for material in ["white-paint", "gold-paint", "chrome"] {
+        for environment in ["quarry_01_1k", "potsdamer_platz_1k"] {
+            let dir = bake(material, environment);
+            let name = format!("{material}-{}", environment.trim_end_matches("_1k"));
+            let reference = compare(&dir, &out, &format!("{name}-reference"), ("reference", "exact"), None, &[]);
+            let prefiltered = compare(
+                &dir,
+                &out,
+                &format!("{name}-prefiltered"),
+                ("prefiltered", "exact"),
+                None,
+                &["--converged", "1024"],
+            );
+            let forward = compare(&dir, &out, &format!("{name}-forward"), ("prefiltered", "forward"), None, &[]);
+            // Both pictures against brdf-preview's converged estimate.
+            let converged = picture(&out.join(format!("{name}-prefiltered-preview-converged.png")), 128, 128);
+            let three = picture(&out.join(format!("{name}-prefiltered-three.png")), 128, 128);
+            let three_converged = psnr_db(&three, &converged);
+            let preview_converged = prefiltered.preview["converged"]["psnr_db"].as_f64().unwrap();
+            rows.push(format!(
+                "| {material} | {} | {:.2} | {:.2} | {:.2} ({} rim px; {:.2} without) | {:.2} | {:.2} | {:+.2} | {:.0} \
+                 | {:.0} |",
+                environment.trim_end_matches("_1k"),
+                reference.psnr_db,
+                prefiltered.psnr_db,
+                forward.psnr_db,
+                forward.far_pixels,
+                forward.psnr_without_far_db,
+                preview_converged,
+                three_converged,
+                three_converged - preview_converged,
+                reference.three_ms,
+                prefiltered.three_ms,
+            ));
+            let cases = [
+                ("reference", &reference, "exact"),
+                ("prefiltered", &prefiltered, "exact"),
+                ("prefiltered", &forward, "forward"),
+            ];
+            for (mode, case, coverage) in cases {
+                if let Some(problem) = problem(case, coverage) {
+                    failures.push(format!("{name} {mode} drawn {coverage}: {problem}"));
+                }
+            }
+            if (three_converged - preview_converged).abs() > 1.0 {
+                failures.push(format!(
+                    "{name}: against the converged estimate three.js {three_converged:.2} dB, brdf-preview \
+                     {preview_converged:.2} dB"
+                ));
+            }
+        }
+    }
+    println!(
+        "three.js in Chromium (SwiftShader) against brdf-preview (same bake, mode and samples, 128 x 128; PSNR in \
+         dB over all pixels; drawn exactly, and the prefiltered mode drawn forward with its pixels beyond 8 steps), \
+         and the exact prefiltered pictures against brdf-preview's converged estimate (1024 samples per strategy); \
+         the render's milliseconds in Chromium"
+    );
+    println!(
+        "| material | environment | reference dB | prefiltered dB | prefiltered forward dB | preview vs converged | \
+         three.js vs converged | difference | reference ms | prefiltered ms |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for row in &rows {
+        println!("{row}");
+    }
+    assert!(failures.is_empty(), "{failures:?}; pictures in {}", out.display());
+}
