@@ -49,7 +49,7 @@ mod wavelet;
 pub use error::Error;
 pub use image::Image;
 pub use transform1::{Decomposition, dwt, idwt, wavedec, waverec};
-pub use transform2::{Decomposition2, Orientation, dwt2, idwt2, wavedec2, waverec2};
+pub use transform2::{Decomposition2, Orientation, Workspace2, dwt2, idwt2, wavedec2, waverec2};
 pub use wavelet::Wavelet;
 
 /// The most levels a signal of length `len` allows: the number of times it can be halved into
