@@ -195,7 +195,9 @@ mod latlong;
 
 pub use compare::{Comparison, PERCENTILES, compare_maps, spearman, wavelet_at_windows};
 pub use error::Error;
-pub use estimate::{BandwidthMap, Config, DEFAULT_C, Reading, local_bandwidth, local_bandwidth_zero_padded};
+pub use estimate::{
+    BandwidthMap, Config, DEFAULT_C, Reading, Workspace, level_frequency, local_bandwidth, local_bandwidth_zero_padded,
+};
 pub use fft::{WindowedFftConfig, WindowedFftMap, window_spread, windowed_fft_bandwidth};
 pub use hdr::{log1p_luminance, luminance};
 pub use latlong::{
