@@ -341,9 +341,15 @@ pub fn build_atlas(
         .enumerate()
         .map_init(Scratch::default, |scratch, (j, tile)| {
             let filled = analyser.render(&luminance, grid.theta_i(j), scratch);
-            let band_energy = crate::view::band_energy(&scratch.image, config.analysis_size, config.relative_noise_floor);
+            let band_energy = crate::view::band_energy_in(
+                &scratch.image,
+                config.analysis_size,
+                config.relative_noise_floor,
+                &mut scratch.extended,
+                scratch.estimator.transform(),
+            );
             analyser.analyse_scratch(scratch);
-            let nyquist_texels = analyser.reduction().reduce(&scratch.cycles_per_radian, &scratch.level, tile);
+            let nyquist_texels = analyser.reduction().reduce(scratch.cycles_per_radian(), &scratch.level, tile);
             progress(config.lobes);
             (analyser.nyquist_pixels(scratch) as u32, nyquist_texels, filled, band_energy)
         })
