@@ -28,7 +28,7 @@ pub struct Config {
     /// in one row (theta_i 21.6 degrees, where the peak falls on the finest wavelets' grid so
     /// that they see more than `eps` of the largest coefficient), a table of it in three rows
     /// (192 of 4096 lobes); at 256 every lobe of n = 1000 reaches the limit.
-    /// It costs about 12 s for a material in a release build on two cores (3 s at 512).
+    /// The cost grows with `size^2` (crate docs, "Performance").
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).
     pub eps: f64,

@@ -81,7 +81,7 @@ impl ViewReduction {
 }
 
 /// The energy of each detail level of a lobe image's wavelet decomposition: the periodic
-/// image's mirror tiling ([`mirror_tiling`]: four copies of the image, so the shares are the
+/// image's mirror tiling ([`crate::mirror_tiling`]: four copies of the image, so the shares are the
 /// image's own), D4, [`analysis_levels`] levels;
 /// finest first, the three orientations of a level summed. A coefficient of level `j` counts only
 /// from `relative_noise_floor` times the image's largest magnitude times `2^j` (the noise floor
