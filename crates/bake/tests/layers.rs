@@ -77,8 +77,7 @@ fn the_maximum_cannot_tell_all_layers_apart() {
 #[test]
 fn a_lambertian_table_selects_the_broadest_layer_at_every_view() {
     let table = Analytic::Lambertian { albedo: [0.8, 0.5, 0.2] }.table(merl::Dims::MERL);
-    let selection =
-        select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layers::DEFAULT_REDUCTION).unwrap();
+    let selection = select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layers::DEFAULT_REDUCTION).unwrap();
     println!("lambertian: view bandwidths {:.3?}", selection.view_bandwidth);
     assert!(selection.view_bandwidth.iter().all(|&b| b == 0.0), "{:?}", selection.view_bandwidth);
     assert!(selection.view_layer.iter().all(|&l| l == 0), "{:?}", selection.view_layer);
