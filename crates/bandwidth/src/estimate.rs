@@ -3,7 +3,7 @@
 //! of eq. 7 per pixel.
 
 use rayon::prelude::*;
-use wavelet::{Image, Wavelet, max_levels2, wavedec2};
+use wavelet::{Image, Wavelet, max_levels2};
 
 use crate::Error;
 
@@ -178,10 +178,57 @@ impl BandwidthMap {
 /// periodization): its right edge meets its left edge and its bottom its top. Both sides must
 /// divide by `2^J` (crate docs, "Sizes").
 pub fn local_bandwidth(image: &Image, config: &Config) -> Result<BandwidthMap, Error> {
-    config.check()?;
-    let (w, h) = (image.width(), image.height());
-    let levels = periodic_levels("image", w, h, config)?;
-    estimate(image, levels, w, h, config)
+    let mut workspace = Workspace::default();
+    workspace.local_bandwidth(image, config)?;
+    Ok(workspace.map.take().expect("just estimated"))
+}
+
+/// Buffers for repeated estimates of images of one size (the lobe images of a BRDF's atlas, one
+/// per row): the transform's ([`wavelet::Workspace2`]), each level's maxima and the map stay
+/// allocated between calls, so that an estimate allocates (and touches fresh memory for) almost
+/// nothing. The results are [`local_bandwidth`]'s, bit for bit.
+#[derive(Debug, Default)]
+pub struct Workspace {
+    transform: wavelet::Workspace2,
+    levels: Vec<LevelRows>,
+    map: Option<BandwidthMap>,
+}
+
+impl Workspace {
+    /// [`local_bandwidth`] in this workspace; the map is borrowed until the next call.
+    pub fn local_bandwidth(&mut self, image: &Image, config: &Config) -> Result<&BandwidthMap, Error> {
+        config.check()?;
+        let (w, h) = (image.width(), image.height());
+        let levels = periodic_levels("image", w, h, config)?;
+        self.run(image, levels, w, h, config, true)
+    }
+
+    /// The finest significant level `j*` ([`BandwidthMap::level`]) of the top-left `width x height`
+    /// pixels only, row-major, `width` per row: each reads what it reads in the whole map, bit
+    /// for bit, at a fraction of the cost when the image is an extension of the part the caller
+    /// needs (a lobe image continued into a periodic one). The frequency of level `j` is
+    /// [`level_frequency`]; it is not stored.
+    pub fn levels_top_left(
+        &mut self,
+        image: &Image,
+        config: &Config,
+        width: usize,
+        height: usize,
+    ) -> Result<&[u8], Error> {
+        config.check()?;
+        let (w, h) = (image.width(), image.height());
+        if width > w || height > h {
+            return Err(Error::Size(format!("a {width}x{height} corner of a {w}x{h} image")));
+        }
+        let levels = periodic_levels("image", w, h, config)?;
+        Ok(&self.run(image, levels, width, height, config, false)?.level)
+    }
+
+    /// The transform's buffers, for a caller that runs other transforms of the same size between
+    /// estimates (they are overwritten by the next estimate).
+    pub fn transform(&mut self) -> &mut wavelet::Workspace2 {
+        &mut self.transform
+    }
 }
 
 /// The local bandwidth of an image of finite extent, zero outside (001 section 2.3, an area light
@@ -272,13 +319,32 @@ impl Cover {
     }
 }
 
-/// One level ready for the per-row pass: for every coefficient row `ky`, the maximum over the
-/// coefficients covering each output column (`rows[ky * out_w + x]`), and the row cover.
-#[derive(Debug)]
+/// One level ready for the per-row pass: the largest magnitude of each coefficient of one row
+/// (`grid`, scratch), for every coefficient row `ky` that covers an output row the maximum over
+/// the coefficients covering each output column (`rows[slot[ky] * out_w + x]`), and the row
+/// cover.
+#[derive(Debug, Default)]
 struct LevelRows {
+    grid: Vec<f64>,
     rows: Vec<f64>,
+    /// Per coefficient row: its place in `rows`, `u32::MAX` when it covers no output row.
+    slot: Vec<u32>,
     m_y: usize,
-    cover_y: Cover,
+    cover_y: Option<Cover>,
+}
+
+/// The larger of two values that are neither NaN nor `-0.0` (coefficient magnitudes): `f64::max`
+/// without its NaN handling, so that the loops vectorize.
+#[inline]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
+/// A buffer of `len` values whose contents the caller overwrites: only growth is filled.
+fn sized(buffer: &mut Vec<f64>, len: usize) -> &mut [f64] {
+    buffer.truncate(len);
+    buffer.resize(len, 0.0);
+    buffer
 }
 
 /// The estimate for the top-left `out_w` x `out_h` pixels of a (padded or extended) image.
@@ -289,13 +355,34 @@ pub(crate) fn estimate(
     out_h: usize,
     config: &Config,
 ) -> Result<BandwidthMap, Error> {
-    let (w, h) = (image.width(), image.height());
-    let decomposition = wavedec2(image, config.wavelet, levels)?;
-    let prepared: Vec<LevelRows> = decomposition
-        .details
-        .par_iter()
-        .enumerate()
-        .map(|(i, details)| {
+    let mut workspace = Workspace::default();
+    workspace.run(image, levels, out_w, out_h, config, true)?;
+    Ok(workspace.map.take().expect("just estimated"))
+}
+
+/// The frequency the estimator reads for level `j*` (1 = finest), in cycles per pixel: `c 2^-j*`,
+/// 0 for no significant level (`j* = 0`).
+pub fn level_frequency(c: f64, level: u8) -> f64 {
+    if level == 0 { 0.0 } else { c * 0.5f64.powi(i32::from(level)) }
+}
+
+impl Workspace {
+    /// [`estimate`] in this workspace's buffers; the frequencies only `with_frequency` (else the
+    /// map's are left empty).
+    fn run(
+        &mut self,
+        image: &Image,
+        levels: usize,
+        out_w: usize,
+        out_h: usize,
+        config: &Config,
+        with_frequency: bool,
+    ) -> Result<&BandwidthMap, Error> {
+        let (w, h) = (image.width(), image.height());
+        let decomposition = self.transform.wavedec2(image, config.wavelet, levels)?;
+        self.levels.resize_with(levels, LevelRows::default);
+        self.levels.truncate(levels);
+        self.levels.par_iter_mut().zip(&decomposition.details).enumerate().for_each(|(i, (prepared, details))| {
             let level = i + 1;
             let (m_x, m_y) = (w >> level, h >> level);
             let floor = config.noise_floor * (1u64 << level) as f64;
@@ -304,76 +391,112 @@ pub(crate) fn estimate(
                 Reading::LevelNormalized => 0.5f64.powi(level as i32),
             };
             let [ch, cv, cd] = details;
-            // The largest magnitude of the three orientations, zero below the noise floor, in the
-            // reading's units.
-            let grid: Vec<f64> = ch
-                .data()
-                .iter()
-                .zip(cv.data())
-                .zip(cd.data())
-                .map(|((a, b), c)| {
-                    let v = a.abs().max(b.abs()).max(c.abs());
-                    if v < floor { 0.0 } else { v * gain }
-                })
-                .collect();
             let cover_x = Cover::new(config.wavelet, level, w, out_w);
-            let mut rows = vec![0.0; m_y * out_w];
-            for (row, src) in rows.chunks_exact_mut(out_w).zip(grid.chunks_exact(m_x)) {
+            let cover_y = Cover::new(config.wavelet, level, h, out_h);
+            // Only the coefficient rows that cover an output row are needed (about half of them
+            // when the output is the top half of an extended image).
+            prepared.slot.clear();
+            prepared.slot.resize(m_y, u32::MAX);
+            for (&first, &count) in cover_y.first.iter().zip(&cover_y.count) {
+                for t in 0..count as usize {
+                    prepared.slot[(first as usize + t) % m_y] = 0;
+                }
+            }
+            let mut needed = 0;
+            for slot in prepared.slot.iter_mut().filter(|s| **s == 0) {
+                *slot = needed;
+                needed += 1;
+            }
+            let rows = sized(&mut prepared.rows, needed as usize * out_w);
+            // One coefficient row at a time: the largest magnitude of the three orientations, zero
+            // below the noise floor, in the reading's units; then its maximum over the coefficients
+            // covering each output column.
+            let grid = sized(&mut prepared.grid, m_x);
+            let used = prepared.slot.iter().enumerate().filter(|(_, s)| **s != u32::MAX).map(|(ky, _)| ky);
+            for (ky, row) in used.zip(rows.chunks_exact_mut(out_w)) {
+                let span = ky * m_x..(ky + 1) * m_x;
+                let (a, b, c) = (&ch.data()[span.clone()], &cv.data()[span.clone()], &cd.data()[span]);
+                for (((g, a), b), c) in grid.iter_mut().zip(a).zip(b).zip(c) {
+                    let v = larger(larger(a.abs(), b.abs()), c.abs());
+                    *g = if v < floor { 0.0 } else { v * gain };
+                }
                 for ((out, &first), &count) in row.iter_mut().zip(&cover_x.first).zip(&cover_x.count) {
                     let mut best = 0.0f64;
                     let mut k = first as usize;
                     for _ in 0..count {
-                        best = best.max(src[k]);
+                        best = larger(best, grid[k]);
                         k = if k + 1 == m_x { 0 } else { k + 1 };
                     }
                     *out = best;
                 }
             }
-            LevelRows { rows, m_y, cover_y: Cover::new(config.wavelet, level, h, out_h) }
-        })
-        .collect();
+            prepared.m_y = m_y;
+            prepared.cover_y = Some(cover_y);
+        });
 
-    let mut level = vec![0u8; out_w * out_h];
-    let mut frequency = vec![0.0; out_w * out_h];
-    let eps = config.eps;
-    level.par_chunks_mut(out_w).zip(frequency.par_chunks_mut(out_w)).enumerate().with_min_len(4).for_each_init(
-        || vec![0.0f64; (levels + 2) * out_w],
-        |scratch, (y, (level_row, frequency_row))| {
-            let (lambdas, rest) = scratch.split_at_mut(levels * out_w);
-            let (max, sum) = rest.split_at_mut(out_w);
-            max.fill(0.0);
-            for (lambda, prepared) in lambdas.chunks_exact_mut(out_w).zip(&prepared) {
-                // lambda_j of this row: the maximum over the covering coefficient rows.
-                let (first, count) = (prepared.cover_y.first[y] as usize, prepared.cover_y.count[y]);
-                lambda.fill(0.0);
-                let mut ky = first;
-                for _ in 0..count {
-                    let src = &prepared.rows[ky * out_w..(ky + 1) * out_w];
-                    for (l, s) in lambda.iter_mut().zip(src) {
-                        *l = l.max(*s);
+        let map = self.map.get_or_insert_with(|| BandwidthMap {
+            width: 0,
+            height: 0,
+            levels: 0,
+            c: 0.0,
+            level: Vec::new(),
+            frequency: Vec::new(),
+        });
+        (map.width, map.height, map.levels, map.c) = (out_w, out_h, levels, config.c);
+        map.level.truncate(out_w * out_h);
+        map.level.resize(out_w * out_h, 0);
+        sized(&mut map.frequency, if with_frequency { out_w * out_h } else { 0 });
+        let prepared = &self.levels;
+        let eps = config.eps;
+        map.level.par_chunks_mut(out_w).enumerate().with_min_len(4).for_each_init(
+            || vec![0.0f64; (levels + 1) * out_w],
+            |scratch, (y, level_row)| {
+                let (lambdas, max) = scratch.split_at_mut(levels * out_w);
+                for (j, (lambda, prepared)) in lambdas.chunks_exact_mut(out_w).zip(prepared).enumerate() {
+                    // lambda_j of this row: the maximum over the covering coefficient rows.
+                    let cover_y = prepared.cover_y.as_ref().expect("prepared above");
+                    let (first, count) = (cover_y.first[y] as usize, cover_y.count[y]);
+                    let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
+                    lambda.fill(0.0);
+                    let mut ky = first;
+                    for _ in 0..count {
+                        for (l, s) in lambda.iter_mut().zip(row(ky)) {
+                            *l = larger(*l, *s);
+                        }
+                        ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
                     }
-                    ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
-                }
-                for (m, l) in max.iter_mut().zip(lambda.iter()) {
-                    *m = m.max(*l);
-                }
-            }
-            // Eq. 7, finest level first: j* is the first level at which the sum of the finer or
-            // equal levels reaches eps times the pixel's largest lambda.
-            sum.fill(0.0);
-            level_row.fill(0);
-            for (j, lambda) in lambdas.chunks_exact(out_w).enumerate() {
-                for (((s, l), m), out) in sum.iter_mut().zip(lambda).zip(max.iter()).zip(level_row.iter_mut()) {
-                    *s += l;
-                    if *out == 0 && *m > 0.0 && *s >= eps * m {
-                        *out = (j + 1) as u8;
+                    if j == 0 {
+                        max.copy_from_slice(lambda);
+                    } else {
+                        for (m, l) in max.iter_mut().zip(lambda.iter()) {
+                            *m = larger(*m, *l);
+                        }
                     }
                 }
+                // Eq. 7, finest level first: j* is the first level at which the sum of the finer
+                // or equal levels reaches eps times the pixel's largest lambda.
+                for (x, (out, &m)) in level_row.iter_mut().zip(max.iter()).enumerate() {
+                    *out = 0;
+                    if m > 0.0 {
+                        let mut sum = 0.0;
+                        for j in 0..levels {
+                            sum += lambdas[j * out_w + x];
+                            if sum >= eps * m {
+                                *out = (j + 1) as u8;
+                                break;
+                            }
+                        }
+                    }
+                }
+            },
+        );
+        if with_frequency {
+            // c 2^-j per level j (index 0: no significant level).
+            let frequency_of: Vec<f64> = (0..=levels as u8).map(|j| level_frequency(config.c, j)).collect();
+            for (f, &j) in map.frequency.iter_mut().zip(&map.level) {
+                *f = frequency_of[j as usize];
             }
-            for (f, &j) in frequency_row.iter_mut().zip(level_row.iter()) {
-                *f = if j == 0 { 0.0 } else { config.c * 0.5f64.powi(j as i32) };
-            }
-        },
-    );
-    Ok(BandwidthMap { width: out_w, height: out_h, levels, c: config.c, level, frequency })
+        }
+        Ok(map)
+    }
 }

@@ -179,9 +179,13 @@
 //! # Performance
 //!
 //! The transform is `wavelet`'s (parallel over rows). Per level, the maximum over orientations
-//! and the sliding maximum along `x` run on the coefficient rows (parallel over levels); the
-//! sliding maximum along `y` and eq. 7 run per output row (parallel over rows) in one scratch
-//! buffer of `(J + 2) x width` values per thread. Nothing is allocated per pixel. A 1024 x 512
+//! and the sliding maximum along `x` run on the coefficient rows that cover an output row, one
+//! row at a time (parallel over levels); the sliding maximum along `y` and eq. 7 (stopping at a
+//! pixel's first significant level) run per output row (parallel over rows) in one scratch
+//! buffer of `(J + 1) x width` values per thread. Nothing is allocated per pixel. [`Workspace`]
+//! keeps every buffer between estimates of images of one size, and
+//! [`Workspace::levels_top_left`] estimates only a corner of an image (what the BRDF atlas keeps
+//! of its continued lobe images), each pixel as in the whole map. A 1024 x 512
 //! map, release build, on two cores shared with other work: 10 ms periodic (up to 27 ms under
 //! load), 19 ms as a lat-long map (the extended image is 1024 x 1024; up to 48 ms), 25 ms zero
 //! padded (2048 x 1024; up to 61 ms). The windowed FFT takes 80 to 300 ms.
@@ -195,7 +199,9 @@ mod latlong;
 
 pub use compare::{Comparison, PERCENTILES, compare_maps, spearman, wavelet_at_windows};
 pub use error::Error;
-pub use estimate::{BandwidthMap, Config, DEFAULT_C, Reading, local_bandwidth, local_bandwidth_zero_padded};
+pub use estimate::{
+    BandwidthMap, Config, DEFAULT_C, Reading, Workspace, level_frequency, local_bandwidth, local_bandwidth_zero_padded,
+};
 pub use fft::{WindowedFftConfig, WindowedFftMap, window_spread, windowed_fft_bandwidth};
 pub use hdr::{log1p_luminance, luminance};
 pub use latlong::{

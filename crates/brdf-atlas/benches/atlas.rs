@@ -1,6 +1,6 @@
 //! Benchmark: `brdf-bandwidth`'s work on a real-derived material (the default 64 x 64 lobes,
-//! 64 x 64 analysis, 16 x 16 tiles), against a baseline measured in the same run (reading and
-//! validating the same MERL file). Goal (issue 3): at most 1 s. Needs
+//! 1024 x 1024 analysis, 16 x 16 tiles), against a baseline measured in the same run (reading and
+//! validating the same MERL file). Goal (issue 33): at most 1.5 s on 2 cores. Needs
 //! `target/merl/gold-paint.binary` (made by the tests, or
 //! `python3 ../shared/tools/nbrdf2merl.py --out target/merl gold-paint`).
 
@@ -39,14 +39,14 @@ fn main() {
     println!("{:<48} {:>8.1}ms {:>12.2}", "baseline: read and validate the MERL file", read.as_secs_f64() * 1e3, 1.0);
     println!(
         "{:<48} {:>8.1}ms {:>12.2}",
-        "bandwidth atlas (64 x 64 lobes, 16 x 16 tiles)",
+        "bandwidth atlas (64 x 64 lobes, 1024 x 1024 analysis)",
         build.as_secs_f64() * 1e3,
         build.as_secs_f64() / read.as_secs_f64()
     );
     let total = read + build;
     println!(
-        "goal: brdf-bandwidth <= 1 s (read + atlas {:.0} ms): {}",
+        "goal: brdf-bandwidth <= 1.5 s (read + atlas {:.0} ms): {}",
         total.as_secs_f64() * 1e3,
-        if total.as_secs_f64() <= 1.0 { "met" } else { "NOT met" }
+        if total.as_secs_f64() <= 1.5 { "met" } else { "NOT met" }
     );
 }

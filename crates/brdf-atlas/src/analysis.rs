@@ -2,9 +2,11 @@
 //! crate's wavelet estimate on it, the conversion to cycles per radian through the lobe map's
 //! Jacobian, and the conservative reduction to a tile.
 
+use rayon::prelude::*;
+
 use crate::atlas::Config;
-use crate::lobe::{LuminanceTable, fill_holes, render};
-use crate::param::{LobeMap, Sample};
+use crate::lobe::{LuminanceTable, Pixels, fill_holes, render, render_fn};
+use crate::param::LobeMap;
 
 /// The per-pixel bandwidth of one lobe at the analysis resolution.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,10 +123,20 @@ impl TileReduction {
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     pub image: Vec<f64>,
-    extended: Vec<f64>,
+    /// The mirror tiling of the band energies, then the periodic continuation, then (its first
+    /// `n^2` values, [`Scratch::cycles_per_radian`]) the analysis's bandwidths: one buffer.
+    pub extended: Vec<f64>,
     holes: Vec<(usize, f64)>,
-    pub cycles_per_radian: Vec<f64>,
+    /// The estimator's buffers (and the transform's, which the band energies borrow).
+    pub estimator: bandwidth::Workspace,
     pub level: Vec<u8>,
+}
+
+impl Scratch {
+    /// The bandwidth of each pixel of the last analysed lobe image, cycles per radian, row-major.
+    pub fn cycles_per_radian(&self) -> &[f64] {
+        &self.extended[..self.level.len()]
+    }
 }
 
 /// Everything about the analysis grid that does not depend on the lobe: what its pixels hold,
@@ -133,7 +145,7 @@ pub(crate) struct Scratch {
 pub struct Analyser {
     config: Config,
     map: LobeMap,
-    samples: Vec<Sample>,
+    pixels: Pixels,
     pixels_per_radian: Vec<f64>,
     inside: Vec<bool>,
     reduction: TileReduction,
@@ -145,11 +157,11 @@ impl Analyser {
     pub fn new(config: &Config) -> Self {
         let n = config.analysis_size;
         let map = LobeMap::new(n);
-        let pixels = || (0..n * n).map(move |k| (k % n, k / n));
-        let samples = pixels().map(|(x, y)| map.sample(x, y)).collect();
-        let pixels_per_radian = pixels().map(|(x, y)| map.pixels_per_radian(x, y)).collect();
-        let inside = pixels().map(|(x, y)| map.inside(x, y)).collect();
-        Self { config: *config, map, samples, pixels_per_radian, inside, reduction: TileReduction::new(n, config.tile) }
+        let at = |k: usize| (k % n, k / n);
+        let pixels_per_radian = (0..n * n).into_par_iter().map(|k| map.pixels_per_radian(at(k).0, at(k).1)).collect();
+        let inside = (0..n * n).into_par_iter().map(|k| map.inside(at(k).0, at(k).1)).collect();
+        let reduction = TileReduction::new(n, config.tile);
+        Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, inside, reduction }
     }
 
     pub fn map(&self) -> LobeMap {
@@ -185,30 +197,35 @@ impl Analyser {
     /// The bandwidth of a lobe image given directly (`size^2` finite luminances, row-major), e.g.
     /// of an analytic BRDF from [`crate::lobe_image_from_fn`].
     pub fn analyse_image(&self, image: Vec<f64>) -> LobeBandwidth {
-        assert_eq!(image.len(), self.samples.len(), "a lobe image has size^2 pixels");
+        assert_eq!(image.len(), self.pixels.len(), "a lobe image has size^2 pixels");
         let mut scratch = Scratch { image, ..Scratch::default() };
         self.analyse_scratch(&mut scratch);
         self.finish(scratch)
     }
 
     fn finish(&self, scratch: Scratch) -> LobeBandwidth {
-        LobeBandwidth {
-            size: self.map.size,
-            image: scratch.image,
-            cycles_per_radian: scratch.cycles_per_radian,
-            level: scratch.level,
-        }
+        let cycles_per_radian = scratch.cycles_per_radian().to_vec();
+        LobeBandwidth { size: self.map.size, image: scratch.image, cycles_per_radian, level: scratch.level }
+    }
+
+    /// The lobe image of any BRDF slice `f(wo)` on this analyser's grid, holes filled: what
+    /// [`crate::lobe_image_from_fn`] returns, from the pixels' samples computed once.
+    pub fn lobe_image(&self, f: impl Fn(glam::DVec3) -> Option<f64>) -> Vec<f64> {
+        let mut image = vec![0.0; self.pixels.len()];
+        render_fn(&self.pixels, f, &mut image);
+        fill_holes(self.map.size, &mut image, &mut Vec::new());
+        image
     }
 
     /// Renders the lobe of incidence `theta_i` (in the frame of the plane of incidence: `wi` at
     /// azimuth 0) into `scratch.image` and fills its holes; returns how many pixels were filled.
     pub(crate) fn render(&self, table: &LuminanceTable, theta_i: f64, scratch: &mut Scratch) -> usize {
-        scratch.image.resize(self.samples.len(), 0.0);
-        render(table, merl::spherical_dir(theta_i, 0.0), &self.samples, &mut scratch.image);
+        scratch.image.resize(self.pixels.len(), 0.0);
+        render(table, merl::spherical_dir(theta_i, 0.0), &self.pixels, &mut scratch.image);
         fill_holes(self.map.size, &mut scratch.image, &mut scratch.holes)
     }
 
-    /// Analyses `scratch.image` into `scratch.cycles_per_radian` and `scratch.level`: the
+    /// Analyses `scratch.image` into [`Scratch::cycles_per_radian`] and `scratch.level`: the
     /// periodic continuation
     /// ([`extend_periodic`]), the estimate with [`analysis_levels`] levels and the noise floor
     /// scaled to the lobe's peak, the estimate of the image's own pixels converted to cycles per
@@ -216,10 +233,9 @@ impl Analyser {
     pub(crate) fn analyse_scratch(&self, scratch: &mut Scratch) {
         let n = self.map.size;
         let e = 2 * n;
-        let image = &scratch.image;
+        let Scratch { image, extended: ext, estimator, level, .. } = scratch;
         let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
 
-        let ext = &mut scratch.extended;
         extend_into(image, n, ext);
 
         let config = bandwidth::Config {
@@ -230,20 +246,17 @@ impl Analyser {
             ..bandwidth::Config::default()
         };
         let extended = wavelet::Image::new(e, e, std::mem::take(ext)).expect("sizes match");
-        let map = bandwidth::local_bandwidth(&extended, &config).expect("the configuration was checked");
+        // Only the image's own pixels are kept: the estimate of the top-left quarter alone.
+        let levels = estimator.levels_top_left(&extended, &config, n, n).expect("the configuration was checked");
         *ext = extended.into_data();
 
-        scratch.cycles_per_radian.resize(n * n, 0.0);
-        scratch.level.resize(n * n, 0);
-        for y in 0..n {
-            let frequency = &map.frequency()[e * y..][..n];
-            let level = &map.level()[e * y..][..n];
-            let factors = &self.pixels_per_radian[n * y..][..n];
-            let out = &mut scratch.cycles_per_radian[n * y..][..n];
-            for ((out, f), s) in out.iter_mut().zip(frequency).zip(factors) {
-                *out = f * s;
-            }
-            scratch.level[n * y..][..n].copy_from_slice(level);
+        // The continuation is no longer needed: its buffer takes the bandwidths.
+        level.clear();
+        level.extend_from_slice(levels);
+        let frequency_of: Vec<f64> =
+            (0..=analysis_levels(n) as u8).map(|j| bandwidth::level_frequency(self.config.c, j)).collect();
+        for ((out, &j), s) in ext[..n * n].iter_mut().zip(level.iter()).zip(&self.pixels_per_radian) {
+            *out = frequency_of[j as usize] * s;
         }
     }
 
@@ -277,30 +290,133 @@ pub fn extend_periodic(image: &[f64], n: usize) -> wavelet::Image {
 /// continuation adds ramps of its own that carry the slope across the borders and would count
 /// as lobe energy (at grazing incidence it moves Phong n = 64 and 256 up a layer).
 pub fn mirror_tiling(image: &[f64], n: usize) -> wavelet::Image {
-    let e = 2 * n;
-    wavelet::Image::from_fn(e, e, |x, y| {
-        let (sx, sy) = (if x < n { x } else { e - 1 - x }, if y < n { y } else { e - 1 - y });
-        image[sy * n + sx]
-    })
+    let mut tiling = Vec::new();
+    mirror_into(image, n, &mut tiling);
+    wavelet::Image::new(2 * n, 2 * n, tiling).expect("sizes match")
 }
 
-/// [`extend_periodic`] into a reused buffer: `ext` becomes `4 n^2` values, row-major.
+/// [`mirror_tiling`] into a reused buffer: `out` becomes `4 n^2` values, row-major.
+pub(crate) fn mirror_into(image: &[f64], n: usize, out: &mut Vec<f64>) {
+    let e = 2 * n;
+    out.clear();
+    out.reserve(e * e);
+    for y in 0..e {
+        let line = &image[(if y < n { y } else { e - 1 - y }) * n..][..n];
+        out.extend_from_slice(line);
+        out.extend(line.iter().rev());
+    }
+}
+
+/// [`extend_periodic`] into a reused buffer: `ext` becomes `4 n^2` values, row-major. Each row
+/// is continued by [`extend_line`]; then the rows below the image are continued the same way,
+/// all columns of an output row at once (the same arithmetic per column as [`extend_line`] on
+/// that column, on contiguous rows, so that it vectorizes).
 fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
     let e = 2 * n;
+    let plan = Continuation::new(n);
     ext.clear();
     ext.resize(e * e, 0.0);
     for (row, line) in ext.chunks_exact_mut(e).zip(image.chunks_exact(n)) {
         row[..n].copy_from_slice(line);
-        extend_line(&mut row[..]);
+        plan.extend_line(row);
     }
-    let mut column = vec![0.0; e];
-    for x in 0..e {
-        for (y, v) in column[..n].iter_mut().enumerate() {
-            *v = ext[y * e + x];
+    let (top, bottom) = ext.split_at_mut(n * e);
+    let row = |i: usize| &top[i * e..(i + 1) * e];
+    for (j, out) in bottom.chunks_exact_mut(e).enumerate() {
+        let mirror = row(n - 1 - j);
+        match plan.steps[j] {
+            Step::Mirror => out.copy_from_slice(mirror),
+            Step::Continue { end, inward, k, blend, share } => {
+                let at = |i: usize| row((end as isize + inward * i as isize) as usize);
+                let (a0, ak) = (at(0), at(k));
+                match share {
+                    None => {
+                        for (((o, &m), &v0), &vk) in out.iter_mut().zip(mirror).zip(a0).zip(ak) {
+                            let odd = 2.0 * v0 - vk;
+                            *o = m + blend * (odd - m);
+                        }
+                    }
+                    Some(share) => {
+                        let [c1, c2, c3] = crate::param::CONTINUATION_WEIGHTS;
+                        let (a2k, a3k) = (at(2 * k), at(3 * k));
+                        for (x, o) in out.iter_mut().enumerate() {
+                            let (m, v0, vk) = (mirror[x], a0[x], ak[x]);
+                            let odd = 2.0 * v0 - vk;
+                            let value = m + blend * (odd - m);
+                            let three_point = c1 * vk + c2 * a2k[x] + c3 * a3k[x];
+                            *o = value + share * (three_point - odd);
+                        }
+                    }
+                }
+            }
         }
-        extend_line(&mut column);
-        for (y, v) in column.iter().enumerate().skip(n) {
-            ext[y * e + x] = *v;
+    }
+}
+
+/// How sample `n + j` of a line of `2 n` is continued ([`extend_line`]).
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    /// The plain mirror image, `v(n - 1 - j)`.
+    Mirror,
+    /// From the end at `end`, `k` samples out, `inward` stepping towards the data: the odd
+    /// reflection blended into the mirror image by `blend` (`cos^2(pi k / n)`), plus, within the
+    /// continuation's reach, the three-point rule's `share`.
+    Continue { end: usize, inward: isize, k: usize, blend: f64, share: Option<f64> },
+}
+
+/// The steps of [`extend_line`] for lines of `2 n` samples, with their weights computed once.
+struct Continuation {
+    steps: Vec<Step>,
+}
+
+impl Continuation {
+    fn new(n: usize) -> Self {
+        let reach = crate::param::CONTINUATION_REACH;
+        let step = |end: usize, inward: isize, k: usize| Step::Continue {
+            end,
+            inward,
+            k,
+            blend: (std::f64::consts::PI * k as f64 / n as f64).cos().powi(2),
+            share: (k <= reach).then(|| crate::param::three_point_share(k as f64 / reach as f64)),
+        };
+        let steps = (0..n)
+            .map(|j| {
+                // Samples past the last value, and before the first (the period wraps).
+                let (right, left) = (j + 1, n - j);
+                if right < n / 2 {
+                    step(n - 1, -1, right)
+                } else if left < n / 2 {
+                    step(0, 1, left)
+                } else {
+                    Step::Mirror
+                }
+            })
+            .collect();
+        Self { steps }
+    }
+
+    /// [`extend_line`] with this plan's weights.
+    fn extend_line(&self, line: &mut [f64]) {
+        let n = line.len() / 2;
+        let (data, rest) = line.split_at_mut(n);
+        let [c1, c2, c3] = crate::param::CONTINUATION_WEIGHTS;
+        for (j, (out, step)) in rest.iter_mut().zip(&self.steps).enumerate() {
+            let mirror = data[n - 1 - j];
+            *out = match *step {
+                Step::Mirror => mirror,
+                Step::Continue { end, inward, k, blend, share } => {
+                    let at = |i: usize| data[(end as isize + inward * i as isize) as usize];
+                    let odd = 2.0 * at(0) - at(k);
+                    let value = mirror + blend * (odd - mirror);
+                    match share {
+                        None => value,
+                        Some(share) => {
+                            let three_point = c1 * at(k) + c2 * at(2 * k) + c3 * at(3 * k);
+                            value + share * (three_point - odd)
+                        }
+                    }
+                }
+            };
         }
     }
 }
@@ -316,34 +432,9 @@ fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
 /// `s = k / `[`crate::param::CONTINUATION_REACH`]), which keeps the slope, and that blends into the plain mirror image by
 /// the middle of the extension (weight `cos^2(pi k / n)`, zero from `k = n / 2`), where the two
 /// ends' continuations would disagree.
+#[cfg(test)]
 fn extend_line(line: &mut [f64]) {
-    let n = line.len() / 2;
-    let (data, rest) = line.split_at_mut(n);
-    let reach = crate::param::CONTINUATION_REACH;
-    let [c1, c2, c3] = crate::param::CONTINUATION_WEIGHTS;
-    // From the end at `end`, `k` samples out, `inward` stepping towards the data.
-    let continue_from = |end: usize, inward: isize, k: usize, mirror: f64| {
-        let at = |i: usize| data[(end as isize + inward * i as isize) as usize];
-        let odd = 2.0 * at(0) - at(k);
-        let mut value = mirror + (std::f64::consts::PI * k as f64 / n as f64).cos().powi(2) * (odd - mirror);
-        if k <= reach {
-            let three_point = c1 * at(k) + c2 * at(2 * k) + c3 * at(3 * k);
-            value += crate::param::three_point_share(k as f64 / reach as f64) * (three_point - odd);
-        }
-        value
-    };
-    for (j, out) in rest.iter_mut().enumerate() {
-        let mirror = data[n - 1 - j];
-        // Samples past the last value, and before the first (the period wraps).
-        let (right, left) = (j + 1, n - j);
-        *out = if right < n / 2 {
-            continue_from(n - 1, -1, right, mirror)
-        } else if left < n / 2 {
-            continue_from(0, 1, left, mirror)
-        } else {
-            mirror
-        };
-    }
+    Continuation::new(line.len() / 2).extend_line(line);
 }
 
 #[cfg(test)]
@@ -371,6 +462,44 @@ mod tests {
         }
         let ext = extend_periodic(&image, 16);
         assert!((0..16).all(|y| (0..16).all(|x| ext.get(x, y) == image[y * 16 + x])));
+    }
+
+    #[test]
+    fn the_analysers_pixels_render_what_the_map_samples() {
+        // The compact pixels (runs of directions, the continued pixels' weighted terms) give
+        // lobe_image_from_fn's image bit for bit, holes (None, then filled) included.
+        let config = Config { analysis_size: 64, tile: 8, ..Config::default() };
+        let analyser = Analyser::new(&config);
+        let f = |w: glam::DVec3| (w.x > -0.9).then(|| (3.0 * w.x).sin() + w.z.max(0.0).powi(7) + 2.0);
+        let compact = analyser.lobe_image(f);
+        let direct = crate::lobe_image_from_fn(analyser.map(), f);
+        assert!(compact.iter().zip(&direct).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn the_continuation_of_all_columns_at_once_is_extend_line_on_each_column() {
+        // extend_into continues the rows below the image a whole row at a time; that must be,
+        // bit for bit, extend_line on every column after every row (the definition).
+        let n = 64;
+        let image: Vec<f64> = (0..n * n).map(|k| ((k * 37 % 101) as f64).sin() * (k as f64 * 1e-3).exp()).collect();
+        let e = 2 * n;
+        let mut expect = vec![0.0; e * e];
+        for (row, line) in expect.chunks_exact_mut(e).zip(image.chunks_exact(n)) {
+            row[..n].copy_from_slice(line);
+            extend_line(row);
+        }
+        let mut column = vec![0.0; e];
+        for x in 0..e {
+            for (y, v) in column[..n].iter_mut().enumerate() {
+                *v = expect[y * e + x];
+            }
+            extend_line(&mut column);
+            for (y, v) in column.iter().enumerate().skip(n) {
+                expect[y * e + x] = *v;
+            }
+        }
+        let got = extend_periodic(&image, n).into_data();
+        assert!(got.iter().zip(&expect).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     /// The largest finest-level D4 detail of a periodic line: of all its coefficients, and of

@@ -28,7 +28,7 @@ pub struct Config {
     /// in one row (theta_i 21.6 degrees, where the peak falls on the finest wavelets' grid so
     /// that they see more than `eps` of the largest coefficient), a table of it in three rows
     /// (192 of 4096 lobes); at 256 every lobe of n = 1000 reaches the limit.
-    /// It costs about 12 s for a material in a release build on two cores (3 s at 512).
+    /// The cost grows with `size^2` (crate docs, "Performance").
     pub analysis_size: usize,
     /// The relative threshold of eq. 7 (`bandwidth::Config::eps`).
     pub eps: f64,
@@ -341,10 +341,15 @@ pub fn build_atlas(
         .enumerate()
         .map_init(Scratch::default, |scratch, (j, tile)| {
             let filled = analyser.render(&luminance, grid.theta_i(j), scratch);
-            let band_energy =
-                crate::view::band_energy(&scratch.image, config.analysis_size, config.relative_noise_floor);
+            let band_energy = crate::view::band_energy_in(
+                &scratch.image,
+                config.analysis_size,
+                config.relative_noise_floor,
+                &mut scratch.extended,
+                scratch.estimator.transform(),
+            );
             analyser.analyse_scratch(scratch);
-            let nyquist_texels = analyser.reduction().reduce(&scratch.cycles_per_radian, &scratch.level, tile);
+            let nyquist_texels = analyser.reduction().reduce(scratch.cycles_per_radian(), &scratch.level, tile);
             progress(config.lobes);
             (analyser.nyquist_pixels(scratch) as u32, nyquist_texels, filled, band_energy)
         })

@@ -177,10 +177,21 @@
 //!
 //! # Performance
 //!
-//! One analysis per row: 64 lobe images of `n^2` trilinear lookups (three per pixel below the
-//! horizon) and 64 estimates of `2n x 2n` images, in parallel over rows, each thread with its
-//! own buffers (only the `bandwidth` crate allocates per lobe). At the default `n = 1024` the
-//! atlas of a material takes about 12 s in a release build on two cores (3 s at 512).
+//! One analysis per row: 64 lobe images of `n^2` pixels (one trilinear lookup each on the
+//! hemisphere, two to four below the horizon) and 64 estimates of the `2n x 2n` continuation,
+//! in parallel over rows. The lobe map's samples are computed once, in parallel, and kept
+//! compactly; each thread keeps its buffers from row to row (the lobe image, the continuation,
+//! the transform's and the estimator's workspaces, [`bandwidth::Workspace`]), and only the
+//! continuation's top-left `n x n` pixels, the image's own, are estimated
+//! ([`bandwidth::Workspace::levels_top_left`]). Every step computes what the straightforward
+//! version computes, bit for bit (the tests compare them; `cargo bench -p bake --bench stages`
+//! times the atlas, row `bandwidth atlas`).
+//!
+//! The lookups are most of the work: about two thirds of the CPU time at the default size
+//! (`perf record target/release/brdf-bandwidth gold-paint.binary --out-dir DIR`, gold-paint),
+//! half of it in the three `atan2` of the half and difference angles (the system's libm; a
+//! faster approximation would move the lookups' fractions and so the atlas's bytes). The D4
+//! transforms (the continuation's and the band energies' mirror tiling) take about a tenth.
 
 mod analysis;
 mod atlas;

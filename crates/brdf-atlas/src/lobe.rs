@@ -141,12 +141,80 @@ fn continue_below_horizon(dims: Dims, luminance: &mut [f64]) {
     }
 }
 
+/// What every pixel of a [`LobeMap`] holds ([`LobeMap::sample`]), kept compactly for the lobe
+/// images of many incident directions: the directions of the pixels on the hemisphere, in runs
+/// of consecutive pixels, and for each continued pixel below it the points of nonzero weight
+/// (the terms [`Sample::eval`] sums, in its order).
+#[derive(Clone, Debug)]
+pub(crate) struct Pixels {
+    len: usize,
+    /// `(first pixel, count)` of each run of direct pixels; their directions in `direct`.
+    runs: Vec<(u32, u32)>,
+    direct: Vec<DVec3>,
+    /// `(pixel, end of its terms in `terms`)` of each continued pixel.
+    continued: Vec<(u32, u32)>,
+    terms: Vec<(DVec3, f64)>,
+}
+
+impl Pixels {
+    /// The samples of `map`'s pixels, computed in parallel over rows.
+    pub(crate) fn new(map: LobeMap) -> Self {
+        use rayon::prelude::*;
+        let n = map.size;
+        let rows: Vec<Vec<Sample>> =
+            (0..n).into_par_iter().map(|y| (0..n).map(|x| map.sample(x, y)).collect()).collect();
+        let mut pixels =
+            Pixels { len: n * n, runs: Vec::new(), direct: Vec::new(), continued: Vec::new(), terms: Vec::new() };
+        for (k, sample) in rows.into_iter().flatten().enumerate() {
+            let k = k as u32;
+            match sample {
+                Sample::Direct(wo) => {
+                    match pixels.runs.last_mut() {
+                        Some((first, count)) if *first + *count == k => *count += 1,
+                        _ => pixels.runs.push((k, 1)),
+                    }
+                    pixels.direct.push(wo);
+                }
+                Sample::Continued { points, weights } => {
+                    pixels.terms.extend(points.into_iter().zip(weights).filter(|&(_, c)| c != 0.0));
+                    pixels.continued.push((k, pixels.terms.len() as u32));
+                }
+            }
+        }
+        pixels
+    }
+
+    /// The number of pixels.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+}
+
 /// Fills `out` (row-major, `map.size^2` values) with the luminance of the BRDF at `wi` for the
-/// map's pixels (`samples`, from [`LobeMap::sample`]); NaN where the table holds no data
+/// map's pixels (`pixels`, from [`LobeMap::sample`]); NaN where the table holds no data
 /// around a pair the pixel needs.
-pub(crate) fn render(table: &LuminanceTable, wi: DVec3, samples: &[Sample], out: &mut [f64]) {
-    for (value, sample) in out.iter_mut().zip(samples) {
-        *value = sample.eval(|wo| table.lookup(wi, wo)).unwrap_or(f64::NAN);
+pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
+    render_fn(pixels, |wo| table.lookup(wi, wo), out);
+}
+
+/// [`render`] of any BRDF slice `f(wo)`: each pixel is [`Sample::eval`] of its sample.
+pub(crate) fn render_fn(pixels: &Pixels, f: impl Fn(DVec3) -> Option<f64>, out: &mut [f64]) {
+    assert_eq!(out.len(), pixels.len, "one value per pixel");
+    let mut directions = pixels.direct.iter();
+    for &(first, count) in &pixels.runs {
+        for (value, wo) in out[first as usize..][..count as usize].iter_mut().zip(directions.by_ref()) {
+            *value = f(*wo).unwrap_or(f64::NAN);
+        }
+    }
+    let mut start = 0;
+    for &(k, end) in &pixels.continued {
+        // Sample::eval: the sum of the weighted terms in order, None if any term has no value.
+        let mut sum = Some(0.0);
+        for &(wo, c) in &pixels.terms[start..end as usize] {
+            sum = sum.and_then(|s| f(wo).map(|v| s + c * v));
+        }
+        out[k as usize] = sum.unwrap_or(f64::NAN);
+        start = end as usize;
     }
 }
 

@@ -33,10 +33,11 @@
 
 use merl::MerlTable;
 
-use crate::analysis::{Analyser, analysis_levels, mirror_tiling};
+use rayon::prelude::*;
+
+use crate::analysis::{Analyser, analysis_levels, mirror_into};
 use crate::atlas::{AtlasBuild, Config};
 use crate::error::Error;
-use crate::lobe::lobe_image_from_fn;
 
 /// How a lobe becomes one number.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,7 +81,7 @@ impl ViewReduction {
 }
 
 /// The energy of each detail level of a lobe image's wavelet decomposition: the periodic
-/// image's mirror tiling ([`mirror_tiling`]: four copies of the image, so the shares are the
+/// image's mirror tiling ([`crate::mirror_tiling`]: four copies of the image, so the shares are the
 /// image's own), D4, [`analysis_levels`] levels;
 /// finest first, the three orientations of a level summed. A coefficient of level `j` counts only
 /// from `relative_noise_floor` times the image's largest magnitude times `2^j` (the noise floor
@@ -88,8 +89,24 @@ impl ViewReduction {
 /// a Lambertian's constant, has none, rather than its lookups' rounding noise, which would read
 /// as the finest frequencies (27 cycles per radian at the default size: the sharpest layer).
 pub fn band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
-    let decomposition = wavelet::wavedec2(&mirror_tiling(image, n), wavelet::Wavelet::D4, analysis_levels(n))
+    band_energy_in(image, n, relative_noise_floor, &mut Vec::new(), &mut wavelet::Workspace2::default())
+}
+
+/// [`band_energy`] with reused buffers: `tiling` for the mirror tiling, `transform` for its
+/// decomposition.
+pub(crate) fn band_energy_in(
+    image: &[f64],
+    n: usize,
+    relative_noise_floor: f64,
+    tiling: &mut Vec<f64>,
+    transform: &mut wavelet::Workspace2,
+) -> Vec<f64> {
+    mirror_into(image, n, tiling);
+    let tiled = wavelet::Image::new(2 * n, 2 * n, std::mem::take(tiling)).expect("sizes match");
+    let decomposition = transform
+        .wavedec2(&tiled, wavelet::Wavelet::D4, analysis_levels(n))
         .expect("lobe images have a power-of-two size of at least 16");
+    *tiling = tiled.into_data();
     let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     decomposition
         .details
@@ -128,8 +145,12 @@ pub fn band_quantile(energy: &[f64], q: f64, c: f64) -> f64 {
 /// the normal, reduced like a view: the layer of exponent `n`'s place on the atlas's scale. The
 /// lobe's normalization does not matter (the estimator is relative to each lobe's peak).
 pub fn layer_bandwidth(config: &Config, n: u32, reduction: ViewReduction) -> f64 {
-    let analyser = Analyser::new(config);
-    let image = lobe_image_from_fn(analyser.map(), |w| Some(w.z.max(0.0).powi(n as i32)));
+    layer_bandwidth_with(&Analyser::new(config), config, n, reduction)
+}
+
+/// [`layer_bandwidth`] with the analyser of `config` made once for all layers.
+fn layer_bandwidth_with(analyser: &Analyser, config: &Config, n: u32, reduction: ViewReduction) -> f64 {
+    let image = analyser.lobe_image(|w| Some(w.z.max(0.0).powi(n as i32)));
     let energy = band_energy(&image, config.analysis_size, config.relative_noise_floor);
     let tile = analyser.analyse_image(image).tile(config.tile);
     reduction.reduce(&tile, &energy, config)
@@ -221,7 +242,9 @@ pub fn select_layers(
             atlas.lobes_y, atlas.tile, atlas.analysis_size, config.lobes, config.tile, config.analysis_size
         )));
     }
-    let layer_bandwidth: Vec<f64> = exponents.iter().map(|&n| layer_bandwidth(config, n, reduction)).collect();
+    let analyser = Analyser::new(config);
+    let layer_bandwidth: Vec<f64> =
+        exponents.par_iter().map(|&n| layer_bandwidth_with(&analyser, config, n, reduction)).collect();
     let view_bandwidth: Vec<f64> = (0..config.lobes)
         .map(|j| reduction.reduce(&atlas.tile_of(atlas.lobe_index(0, j)), &build.band_energy[j], config))
         .collect();

@@ -27,6 +27,15 @@
 //! / size` (rows, row 0 the smoothest): the layout of Filament's and glTF-IBL-Sampler's tables up
 //! to their row order. In `dfg.ktx2` (RGBA16F, half floats are plenty for values in `[0, 1]`)
 //! red is `A`, green `B`, blue 0, alpha 1.
+//!
+//! # Embedded table
+//!
+//! The table depends on nothing a bake reads (neither the map nor the material), so the
+//! default size is computed once per version of this crate and embedded in the build
+//! (`src/dfg-128.bin`): [`table`] at [`DFG_SIZE`] costs a copy instead of the samples. After a
+//! change to the computation, `cargo run --release -p prefilter --example dfg-table >
+//! crates/prefilter/src/dfg-128.bin` writes it again; a test holds the embedded table to
+//! [`compute_table`] on a spread of texels.
 
 use std::f64::consts::PI;
 
@@ -82,8 +91,22 @@ fn visible_normal(v: DVec3, alpha: f64, u1: f64, u2: f64) -> DVec3 {
     DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
 }
 
+/// The table at [`DFG_SIZE`], as [`compute_table`] made it, embedded in the build (module docs,
+/// "Embedded table"): `DFG_SIZE^2` pairs of little-endian `f32`, `A` then `B`, row-major.
+const EMBEDDED: &[u8] = include_bytes!("dfg-128.bin");
+
 /// The table (module docs): `size^2` texels `(A, B)`, row-major, row 0 at the smallest roughness.
+/// At [`DFG_SIZE`] the embedded table, else [`compute_table`].
 pub fn table(size: usize) -> Vec<[f32; 2]> {
+    if size == DFG_SIZE && EMBEDDED.len() == size * size * 8 {
+        let value = |bytes: &[u8]| f32::from_le_bytes(bytes.try_into().expect("4 bytes"));
+        return EMBEDDED.chunks_exact(8).map(|t| [value(&t[..4]), value(&t[4..])]).collect();
+    }
+    compute_table(size)
+}
+
+/// The table computed: [`dfg`] at every texel (about 34 million samples at [`DFG_SIZE`]).
+pub fn compute_table(size: usize) -> Vec<[f32; 2]> {
     (0..size * size)
         .into_par_iter()
         .map(|k| {

@@ -129,3 +129,21 @@ fn a_mirror_reflects_everything_with_schlicks_fresnel() {
         assert!((a + b - 1.0).abs() < 1e-3 && (b - (1.0 - mu).powi(5)).abs() < 1e-3, "mu {mu}: {a} {b}");
     }
 }
+
+#[test]
+fn the_embedded_table_is_the_computed_one() {
+    // The default size is embedded (module docs): held to the computation on a spread of texels
+    // (every 61st, all rows and columns reached). Exact on the machine that wrote it; another
+    // libm may round a sample's last bit differently, which moves an f32 by at most an ulp.
+    let size = prefilter::dfg::DFG_SIZE;
+    let embedded = table(size);
+    assert_eq!(embedded.len(), size * size);
+    for k in (0..size * size).step_by(61) {
+        let mu = ((k % size) as f64 + 0.5) / size as f64;
+        let alpha = alpha(((k / size) as f64 + 0.5) / size as f64).max(prefilter::ggx::MIN_ALPHA);
+        let computed = dfg(mu, alpha).map(|x| x as f32);
+        for (e, c) in embedded[k].iter().zip(computed) {
+            assert!((e - c).abs() <= 2.0 * f32::EPSILON * c.abs().max(1e-3), "texel {k}: embedded {e}, computed {c}");
+        }
+    }
+}

@@ -33,8 +33,11 @@
 //!   warns but computes them) and match it too.
 //!
 //! The 2D transform filters the columns of the rows an output row depends on (contiguous
-//! memory), then that row, one output row at a time and in parallel over rows with rayon; it
-//! allocates nothing but its outputs.
+//! memory), writing the result's even and odd columns apart, then that row, whose taps are then
+//! contiguous too: every inner loop runs over a row and vectorizes, and every coefficient is the
+//! same sum in the same order as the plain filters' (bit for bit). One output row at a time, in
+//! parallel over rows with rayon; it allocates nothing but its outputs, and [`Workspace2`] keeps
+//! those between transforms of one size.
 //!
 //! The tests compare every function with golden vectors produced by PyWavelets
 //! (`tests/golden/make_golden.py`) to 1e-12.
@@ -49,7 +52,7 @@ mod wavelet;
 pub use error::Error;
 pub use image::Image;
 pub use transform1::{Decomposition, dwt, idwt, wavedec, waverec};
-pub use transform2::{Decomposition2, Orientation, dwt2, idwt2, wavedec2, waverec2};
+pub use transform2::{Decomposition2, Orientation, Workspace2, dwt2, idwt2, wavedec2, waverec2};
 pub use wavelet::Wavelet;
 
 /// The most levels a signal of length `len` allows: the number of times it can be halved into

@@ -1,6 +1,6 @@
 use rayon::prelude::*;
 
-use crate::kernels::{analysis_rows, analyze, analyze_across, synthesize, synthesize_across};
+use crate::kernels::{analysis_rows, analyze_across_split, analyze_split, synthesize, synthesize_across};
 use crate::wavelet::{Bank, D4, HAAR};
 use crate::{Error, Image, Wavelet, check_finite, check_levels, with_bank};
 
@@ -97,16 +97,73 @@ pub fn idwt2(approx: &Image, details: &[Image; 3], wavelet: Wavelet) -> Result<I
 /// level=levels)`. Width and height must both be divisible by `2^levels`
 /// ([`crate::max_levels2`]).
 pub fn wavedec2(image: &Image, wavelet: Wavelet, levels: usize) -> Result<Decomposition2, Error> {
-    check_image(image, levels)?;
-    let mut details = Vec::with_capacity(levels);
-    let (mut approx, first) = with_bank!(wavelet, bank => forward_level(bank, image));
-    details.push(first);
-    for _ in 1..levels {
-        let (a, d) = with_bank!(wavelet, bank => forward_level(bank, &approx));
-        approx = a;
-        details.push(d);
+    let mut workspace = Workspace2::default();
+    workspace.wavedec2(image, wavelet, levels)?;
+    Ok(workspace.decomposition.take().expect("just computed"))
+}
+
+/// Buffers for repeated [`wavedec2`] calls on images of one size (a lobe image per row of an
+/// atlas, say): the decomposition and the approximation between two levels stay allocated
+/// between calls, so a call allocates nothing and touches no fresh memory. The coefficients are
+/// [`wavedec2`]'s, bit for bit.
+#[derive(Debug, Default)]
+pub struct Workspace2 {
+    decomposition: Option<Decomposition2>,
+    between: Vec<f64>,
+}
+
+impl Workspace2 {
+    /// [`wavedec2`] into this workspace's buffers; the result is borrowed until the next call.
+    pub fn wavedec2(&mut self, image: &Image, wavelet: Wavelet, levels: usize) -> Result<&Decomposition2, Error> {
+        check_image(image, levels)?;
+        let decomposition = self.decomposition.get_or_insert_with(|| Decomposition2 {
+            wavelet,
+            approx: Image::zeros(0, 0),
+            details: Vec::new(),
+        });
+        decomposition.wavelet = wavelet;
+        let blank = || std::array::from_fn(|_| Image::zeros(0, 0));
+        decomposition.details.resize_with(levels, blank);
+        let (mut w, mut h) = (image.width(), image.height());
+        // Level j reads the approximation of level j - 1 (the image for j = 1) and writes its own:
+        // the two alternate between `between` and the decomposition's `approx`, ending in `approx`.
+        let mut approx = std::mem::replace(&mut decomposition.approx, Image::zeros(0, 0)).into_data();
+        let mut between = std::mem::take(&mut self.between);
+        for level in 0..levels {
+            let (w2, h2) = (w / 2, h / 2);
+            // The last level writes into `approx`; counting back, levels alternate.
+            let into_approx = (levels - 1 - level).is_multiple_of(2);
+            let (mut dst, previous) = if into_approx {
+                (std::mem::take(&mut approx), &between)
+            } else {
+                (std::mem::take(&mut between), &approx)
+            };
+            let src: &[f64] = if level == 0 { image.data() } else { &previous[..w * h] };
+            // Every value is written: only a buffer that grows is filled first.
+            dst.truncate(w2 * h2);
+            dst.resize(w2 * h2, 0.0);
+            let details = &mut decomposition.details[level];
+            let [ch, cv, cd] = details.each_mut().map(|image| {
+                let mut data = std::mem::replace(image, Image::zeros(0, 0)).into_data();
+                data.truncate(w2 * h2);
+                data.resize(w2 * h2, 0.0);
+                data
+            });
+            let mut out = [dst, ch, cv, cd];
+            with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut out));
+            let [a, ch, cv, cd] = out;
+            *details = [ch, cv, cd].map(|data| Image::new(w2, h2, data).expect("sizes match"));
+            if into_approx {
+                approx = a;
+            } else {
+                between = a;
+            }
+            (w, h) = (w2, h2);
+        }
+        decomposition.approx = Image::new(w, h, approx).expect("sizes match");
+        self.between = between;
+        Ok(decomposition)
     }
-    Ok(Decomposition2 { wavelet, approx, details })
 }
 
 /// The inverse of [`wavedec2`]: `pywt.waverec2(coeffs, w, mode="periodization")` with `coeffs` in
@@ -172,7 +229,16 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> (Image, [Imag
     let (w, h) = (image.width(), image.height());
     let (w2, h2) = (w / 2, h / 2);
     let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
-    let [ca, ch, cv, cd] = &mut out;
+    forward_level_into(bank, image.data(), w, h, &mut out);
+    let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
+    (ca, [ch, cv, cd])
+}
+
+/// [`forward_level`] of the `w x h` row-major `src` into `out` (`[cA, cH, cV, cD]`, each
+/// `w / 2 x h / 2` values).
+fn forward_level_into<const F: usize>(bank: &Bank<F>, src: &[f64], w: usize, h: usize, out: &mut [Vec<f64>; 4]) {
+    let w2 = w / 2;
+    let [ca, ch, cv, cd] = out;
     ca.par_chunks_mut(w2)
         .zip(ch.par_chunks_mut(w2))
         .zip(cv.par_chunks_mut(w2))
@@ -182,16 +248,16 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> (Image, [Imag
         .for_each_init(
             || vec![0.0; 2 * w],
             |scratch, (k, (((a, hh), v), dd))| {
-                let src = analysis_rows::<F>(k, h).map(|r| image.row(r));
+                let rows = analysis_rows::<F>(k, h).map(|r| &src[r * w..(r + 1) * w]);
+                // The two column-filtered rows, each deinterleaved into its even and odd columns.
                 let (lo, hi) = scratch.split_at_mut(w);
-                analyze_across(bank, &src, lo, hi);
+                let ((lo_even, lo_odd), (hi_even, hi_odd)) = (lo.split_at_mut(w2), hi.split_at_mut(w2));
+                analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], [&mut *hi_even, &mut *hi_odd]);
                 // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
-                analyze(bank, lo, a, v);
-                analyze(bank, hi, hh, dd);
+                analyze_split(bank, lo_even, lo_odd, a, v);
+                analyze_split(bank, hi_even, hi_odd, hh, dd);
             },
         );
-    let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
-    (ca, [ch, cv, cd])
 }
 
 /// One inverse level of checked coefficients: the transpose of [`forward_level`], one output
