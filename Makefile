@@ -172,6 +172,7 @@ BAKES := $(patsubst $(IN)/%.binary,$(OUT)/%/manifest.json,$(wildcard $(IN)/*.bin
 endif
 bake: build
 	@test -n "$(IN)" -a -n "$(OUT)" || { echo "usage: make bake IN=DIR OUT=DIR [ENV=map.hdr] [-j N]"; exit 2; }
+	@mkdir -p $(OUT)
 	@$(MAKE) --no-print-directory $(BAKES)
 
 # Exit 1 (a stage's validation found a problem; the bake is written and its manifest says what)
