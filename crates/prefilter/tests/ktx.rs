@@ -26,6 +26,19 @@ fn values(data: &[u8], format: TexelFormat) -> Vec<f32> {
     }
 }
 
+/// The data format descriptor `ktx2` builds for `format` as linear BT.709 RGBA (every texture
+/// this writer makes), and its type size.
+fn linear_descriptor(format: Format) -> (Basic, u32) {
+    Basic::from_format_with(
+        format,
+        false,
+        Some(TransferFunction::Linear),
+        Some(ColorPrimaries::BT709),
+        Some(ColorModel::RGBSDA),
+    )
+    .unwrap()
+}
+
 /// The parts every file of ours shares: format, descriptor, key/value data (only standard keys:
 /// no hidden scale), alignment.
 fn check_common(reader: &Reader<&[u8]>, encoded: &Encoded) {
@@ -37,14 +50,7 @@ fn check_common(reader: &Reader<&[u8]>, encoded: &Encoded) {
     assert_eq!(header.format, Some(format));
     assert_eq!(header.type_size as usize, encoded.format.type_size());
     assert_eq!((header.pixel_depth, header.supercompression_scheme), (0, None));
-    let (expected_dfd, type_size) = Basic::from_format_with(
-        format,
-        false,
-        Some(TransferFunction::Linear),
-        Some(ColorPrimaries::BT709),
-        Some(ColorModel::RGBSDA),
-    )
-    .unwrap();
+    let (expected_dfd, type_size) = linear_descriptor(format);
     assert_eq!(type_size as usize, encoded.format.type_size());
     assert_eq!(reader.dfd_blocks().len(), 1);
     assert_eq!(reader.basic_dfd(), Some(&expected_dfd), "the descriptor ktx2 builds for {format:?}");
@@ -259,14 +265,7 @@ fn check_data(shape: ktx::DataShape, orientation: &[u8]) {
     let expected = (shape.width as u32, shape.height as u32, shape.depth as u32, shape.layers as u32, 1);
     assert_eq!(dims, expected);
     assert_eq!((header.level_count, header.supercompression_scheme), (1, None));
-    let (expected_dfd, _) = Basic::from_format_with(
-        format,
-        false,
-        Some(TransferFunction::Linear),
-        Some(ColorPrimaries::BT709),
-        Some(ColorModel::RGBSDA),
-    )
-    .unwrap();
+    let (expected_dfd, _) = linear_descriptor(format);
     assert_eq!(reader.basic_dfd(), Some(&expected_dfd), "the descriptor ktx2 builds for {format:?}");
     let pairs: Vec<(&str, &[u8])> = reader.key_value_data().collect();
     assert_eq!(pairs, vec![("KTXorientation", orientation), ("KTXwriter", b"prefilter tests\0")]);
