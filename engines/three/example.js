@@ -56,8 +56,8 @@ function draw() {
     const ms = performance.now() - start;
     const names = `${bake.manifest.material.name} under ${bake.manifest.environment?.name}`;
     status.textContent =
-        `${names} | ${m} | ${defaults.spp} spp x ${frames} frames | ${canvas.width}x${canvas.height} | ` +
-        `exposure ${bake.figures.exposure_ev.toFixed(2)} EV\n` +
+        `${names} | ${m} | ${defaults.spp} spp x ${frames} frames\n` +
+        `${canvas.width}x${canvas.height} | exposure ${bake.figures.exposure_ev.toFixed(2)} EV\n` +
         `${(ms / frames).toFixed(1)} ms per frame (${ms.toFixed(0)} ms for the picture) | camera ${view.azimuth.toFixed(0)},${view.elevation.toFixed(0)}`;
 }
 
