@@ -72,3 +72,13 @@ fn a_lambertian_table_selects_the_broadest_layer_at_every_view() {
     assert!(selection.view_bandwidth.iter().all(|&b| b == 0.0), "{:?}", selection.view_bandwidth);
     assert!(selection.view_layer.iter().all(|&l| l == 0), "{:?}", selection.view_layer);
 }
+
+/// A default bake reads its layers' bandwidths from `brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS`:
+/// they were measured for the bake's default reduction and Phong exponents (otherwise every bake
+/// would measure them again: right, but slower).
+#[test]
+fn the_known_layer_bandwidths_serve_the_default_bake() {
+    assert_eq!(bake::stage::layers::DEFAULT_REDUCTION, brdf_atlas::view::KNOWN_LAYER_REDUCTION);
+    let known: Vec<u32> = brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS.iter().map(|(n, _)| *n).collect();
+    assert_eq!(known, prefilter::DEFAULT_EXPONENTS.to_vec());
+}

@@ -148,6 +148,33 @@ pub fn layer_bandwidth(config: &Config, n: u32, reduction: ViewReduction) -> f64
     layer_bandwidth_with(&Analyser::new(config), config, n, reduction)
 }
 
+/// The reduction [`KNOWN_LAYER_BANDWIDTHS`] were measured with: the bake's default.
+pub const KNOWN_LAYER_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.99);
+
+/// [`layer_bandwidth`] of the default configuration under [`KNOWN_LAYER_REDUCTION`] for the
+/// default Phong exponents, `(n, bits of the f64)`: they depend on neither the material nor the
+/// map, so a bake reads them rather than measuring the seven lobes again (0.6 s of a bake on 2
+/// cores). Printed by `cargo run --release -p brdf-atlas --example layer-bandwidths`; a test holds
+/// them to the measurement.
+pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 7] = [
+    (1, 0x3fd3609ce95d278a),
+    (4, 0x3fd42cf4b97e1f98),
+    (16, 0x3fdcac9cf3d5b749),
+    (64, 0x3fec08daaa61e260),
+    (256, 0x3ffbb761706661ec),
+    (1024, 0x400b86b514048a06),
+    (4096, 0x401b4b4672efc04f),
+];
+
+/// The layer bandwidth of `n` from [`KNOWN_LAYER_BANDWIDTHS`] where `config` and `reduction` are
+/// the ones they were measured with.
+fn known_layer_bandwidth(config: &Config, n: u32, reduction: ViewReduction) -> Option<f64> {
+    if *config != Config::default() || reduction != KNOWN_LAYER_REDUCTION {
+        return None;
+    }
+    KNOWN_LAYER_BANDWIDTHS.iter().find(|(m, _)| *m == n).map(|(_, bits)| f64::from_bits(*bits))
+}
+
 /// [`layer_bandwidth`] with the analyser of `config` made once for all layers.
 fn layer_bandwidth_with(analyser: &Analyser, config: &Config, n: u32, reduction: ViewReduction) -> f64 {
     let image = analyser.lobe_image(|w| Some(w.z.max(0.0).powi(n as i32)));
@@ -242,9 +269,14 @@ pub fn select_layers(
             atlas.lobes_y, atlas.tile, atlas.analysis_size, config.lobes, config.tile, config.analysis_size
         )));
     }
-    let analyser = Analyser::new(config);
-    let layer_bandwidth: Vec<f64> =
-        exponents.par_iter().map(|&n| layer_bandwidth_with(&analyser, config, n, reduction)).collect();
+    let known: Vec<Option<f64>> = exponents.iter().map(|&n| known_layer_bandwidth(config, n, reduction)).collect();
+    let layer_bandwidth: Vec<f64> = match known.iter().all(Option::is_some) {
+        true => known.into_iter().flatten().collect(),
+        false => {
+            let analyser = Analyser::new(config);
+            exponents.par_iter().map(|&n| layer_bandwidth_with(&analyser, config, n, reduction)).collect()
+        }
+    };
     let view_bandwidth: Vec<f64> = (0..config.lobes)
         .map(|j| reduction.reduce(&atlas.tile_of(atlas.lobe_index(0, j)), &build.band_energy[j], config))
         .collect();

@@ -44,3 +44,14 @@ fn layers_that_do_not_increase_blend_nothing() {
         assert_eq!(layer_coordinate(nu, &damaged), nearest_layer(nu, &damaged) as f64, "nu {nu}");
     }
 }
+
+/// The layer bandwidths a bake reads instead of measuring are the measurement, bit for bit
+/// (`cargo run --release -p brdf-atlas --example layer-bandwidths` prints them again).
+#[test]
+fn the_known_layer_bandwidths_are_the_measured_ones() {
+    let config = brdf_atlas::Config::default();
+    for (n, bits) in brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS {
+        let measured = brdf_atlas::view::layer_bandwidth(&config, n, brdf_atlas::view::KNOWN_LAYER_REDUCTION);
+        assert_eq!(measured.to_bits(), bits, "n = {n}: measured {measured}, known {}", f64::from_bits(bits));
+    }
+}
