@@ -78,12 +78,14 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<ExitCode> {
-    let table = merl::read_file(&args.file).with_context(|| format!("reading {}", args.file.display()))?;
+    // The table's bytes are read once: what is hashed is what is parsed.
+    let bytes = merl::read_bytes(&args.file).and_then(|b| MerlTable::parse(&b).map(|t| (b, t)));
+    let (bytes, table) = bytes.with_context(|| format!("reading {}", args.file.display()))?;
     if args.eval {
         evaluate(&table, &args)?;
         return Ok(ExitCode::SUCCESS);
     }
-    let source = bake::Source::hash(&args.file)?;
+    let source = bake::Source::of_bytes(&args.file, &bytes);
     let program = bake::Program { name: env!("CARGO_PKG_NAME"), version: env!("CARGO_PKG_VERSION") };
     let staged = bake::stage::material_info::run(&table, &source, &program, args.albedo_interp.into())?;
     // The asset is written before anything is printed, so that the JSON can list it.
