@@ -223,7 +223,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             if request.window {
                 bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
             }
-            let out = request.out.as_ref().expect("clap requires --out without --window");
+            let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
             let step = adaptive::render(request, &loaded, lighting, out, host)?;
             files.extend(step.files);
             report.extend(step.report);
@@ -252,7 +252,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                 return Ok(Outcome::Window(shown));
             }
             let gpu = host.open_gpu()?;
-            let out = request.out.as_ref().expect("clap requires --out without --window");
+            let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
             let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
             host.step(format!("{} on the GPU", mode.name()));
             let start = Instant::now();

@@ -59,10 +59,9 @@ pub fn converged_with_progress(
     }
     let gbuffer = visibility(scene)?;
     let width = scene.width;
-    let rgb = shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
+    Ok(shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
         estimate(frame, material, lighting, samples_per_strategy, seed, (y * width + x) as u64)
-    });
-    Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
+    }))
 }
 
 /// The cosine strategy, in the shading frame (density [`pdf_cosine`]).

@@ -44,22 +44,21 @@ pub fn render_with_progress(
     check_settings(settings, material.samples.n_samples, lighting.layers.len(), &material.view_layers)?;
     let gbuffer = visibility(scene)?;
     let width = scene.width;
-    let rgb = shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
+    Ok(shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
         shade(frame, (y * width + x) as u32, material, lighting, settings, 0)
-    });
-    Ok(Image { width, height: scene.height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() })
+    }))
 }
 
-/// Every pixel of `scene`: `pixel(frame, x, y)` where a triangle covers it and has a shading
-/// frame, black where the frame is degenerate, the environment (`level0`) where none covers it.
-/// In parallel over rows, calling `progress(rows done, rows)` as they finish.
+/// The image of `scene`: `pixel(frame, x, y)` where a triangle of `gbuffer` covers the pixel and
+/// has a shading frame, black where the frame is degenerate, the environment (`level0`) where
+/// none covers it. In parallel over rows, calling `progress(rows done, rows)` as they finish.
 pub(crate) fn shade_rows(
     scene: &Scene,
     gbuffer: &GBuffer,
     level0: &EnvMap,
     progress: &(dyn Fn(u64, u64) + Sync),
     pixel: impl Fn(&ShadingFrame, usize, usize) -> [f64; 3] + Sync,
-) -> Vec<f32> {
+) -> Image {
     let eye = scene.camera.eye().as_dvec3();
     let rays = scene.camera.rays(scene.width, scene.height);
     let (width, height) = (scene.width, scene.height);
@@ -78,7 +77,7 @@ pub(crate) fn shade_rows(
         }
         progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, height as u64);
     });
-    rgb
+    Image { width, height, rgb, covered: gbuffer.hits.iter().map(Option::is_some).collect() }
 }
 
 /// The G-buffer of a scene, after checking it.
