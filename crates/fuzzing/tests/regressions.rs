@@ -8,16 +8,24 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, Once};
+use std::sync::{Mutex, MutexGuard, Once};
 
 use fuzzing::CountingAllocator;
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator;
 
-/// The tests of this binary run on parallel threads, and the allocator counts every thread:
-/// one measurement at a time.
+/// The tests of this binary run on parallel threads, and the allocator counts every thread: a
+/// test holds this from its first allocation to its last, so that no other test's inputs (a MERL
+/// table of full size is 35 MB) land in its measurements.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Proof that the calling test holds [`ONE_AT_A_TIME`]; [`run`] measures only under it.
+type Alone = MutexGuard<'static, ()>;
+
+fn alone() -> Alone {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
 
 /// The workspace root: file names are shown relative to it (`fuzz/regressions/asset/...`).
 fn root() -> PathBuf {
@@ -57,12 +65,11 @@ const SHARED_INPUTS: [(&str, &str); 2] = [
 
 /// Runs `harness` on `bytes` under the allocator: `Err` when it panics or holds more than the
 /// bound allows, with the peak either way.
-fn run(harness: fuzzing::Harness, bytes: &[u8]) -> (Result<(), String>, usize) {
+fn run(_alone: &Alone, harness: fuzzing::Harness, bytes: &[u8]) -> (Result<(), String>, usize) {
     // The default hook symbolizes a backtrace (with RUST_BACKTRACE set) on the first panic, tens
     // of megabytes that are not the reader's; print the message only, as the fuzz targets do.
     static QUIET_PANICS: Once = Once::new();
     QUIET_PANICS.call_once(|| std::panic::set_hook(Box::new(|info| eprintln!("{info}"))));
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let (outcome, peak) = fuzzing::measure(|| catch_unwind(AssertUnwindSafe(|| harness(bytes))));
     let outcome = match outcome {
         Ok(()) => fuzzing::check_memory(bytes.len(), peak),
@@ -81,6 +88,7 @@ fn run(harness: fuzzing::Harness, bytes: &[u8]) -> (Result<(), String>, usize) {
 /// Replays every file of `regressions/<target>/` and `corpus/<target>/`, then fails listing
 /// every input that misbehaved.
 fn replay(target: &str) {
+    let alone = alone();
     let harness = fuzzing::HARNESSES.iter().find(|(name, _)| *name == target).expect("a harness of that name").1;
     let dir = root().join("fuzz");
     // A target's own folders exist once it has inputs of its own.
@@ -97,7 +105,7 @@ fn replay(target: &str) {
     let mut largest = (0, String::new());
     for file in &files {
         let bytes = std::fs::read(file).unwrap_or_else(|e| panic!("reading {}: {e}", shown(file)));
-        let (outcome, peak) = run(harness, &bytes);
+        let (outcome, peak) = run(&alone, harness, &bytes);
         if let Err(problem) = outcome {
             failures.push(format!("{}: {problem}", shown(file)));
         }
@@ -149,6 +157,7 @@ fn obj() {
 /// limits, the size they are) and a MERL table of full size (no fuzzer input is that large).
 #[test]
 fn legitimate_inputs_keep_the_bound() {
+    let alone = alone();
     let env = root().join("../shared/data/env");
     assert!(
         env.join("README.md").is_file(),
@@ -167,7 +176,7 @@ fn legitimate_inputs_keep_the_bound() {
     for path in &maps {
         let bytes = std::fs::read(path).expect("reading a shared map");
         let harness = if bytes.starts_with(b"#?") { fuzzing::envmap_hdr } else { fuzzing::envmap_exr };
-        let (outcome, peak) = run(harness, &bytes);
+        let (outcome, peak) = run(&alone, harness, &bytes);
         eprintln!("{}: {} bytes, peak {peak} bytes", shown(path), bytes.len());
         if let Err(problem) = outcome {
             failures.push(format!("{}: {problem}", shown(path)));
@@ -176,7 +185,7 @@ fn legitimate_inputs_keep_the_bound() {
 
     for dims in [merl::Dims::MERL, merl::Dims::MERL_FULL_PHI] {
         let bytes = merl::MerlTable::from_raw(dims, vec![0.5; 3 * dims.cells()]).expect("a valid table").to_bytes();
-        let (outcome, peak) = run(fuzzing::merl, &bytes);
+        let (outcome, peak) = run(&alone, fuzzing::merl, &bytes);
         eprintln!(
             "merl table {} x {} x {}: {} bytes, peak {peak} bytes",
             dims.n_theta_h,
@@ -191,7 +200,7 @@ fn legitimate_inputs_keep_the_bound() {
     for (name, bytes) in full_size_atlases() {
         let payload = asset::decode(&bytes).expect("a valid asset").payload;
         assert!(bake::stage::atlas::from_payload(payload).is_ok(), "{name}: the tools read it back");
-        let (outcome, peak) = run(fuzzing::asset, &bytes);
+        let (outcome, peak) = run(&alone, fuzzing::asset, &bytes);
         eprintln!("{name}: {} bytes, peak {peak} bytes", bytes.len());
         if let Err(problem) = outcome {
             failures.push(format!("{name}: {problem}"));
@@ -223,6 +232,7 @@ fn full_size_atlases() -> [(&'static str, Vec<u8>); 2] {
 /// checksum damaged decodes again to the same asset; a consistent file needs no fix-up.
 #[test]
 fn fix_up_repairs_the_header_only() {
+    let _alone = alone();
     let golden = root().join("fixtures/assets/golden-v1-bandwidth-pca.asset");
     let bytes = std::fs::read(&golden).expect("reading a golden asset");
     assert_eq!(fuzzing::fix_up_asset(&bytes), None, "a golden asset is already consistent");
@@ -242,6 +252,7 @@ fn fix_up_repairs_the_header_only() {
 
 #[test]
 fn the_bound_is_floor_plus_multiple() {
+    let _alone = alone();
     use fuzzing::{FLOOR, MULTIPLE, check_memory};
     assert!(check_memory(0, FLOOR).is_ok());
     assert!(check_memory(1000, FLOOR + MULTIPLE * 1000).is_ok());
