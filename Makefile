@@ -141,7 +141,7 @@ bench: setup-gpu setup-mitsuba
 	$(CARGO) bench -p prefilter --bench prefilter
 	$(CARGO) bench -p brdf-atlas --bench atlas
 	$(CARGO) bench -p bake --bench stages
-	$(CARGO) bench -p haar-brdf --bench table1
+	$(CARGO) bench -p wavelet-brdf --bench table1
 	$(CARGO) bench -p brdf-preview --bench adaptive -- --gpu
 	$(CARGO) bench -p brdf-preview --bench mitsuba
 

@@ -246,7 +246,7 @@ fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
     }
 }
 
-/// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-ratio` would, through
+/// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.
 /// Another material is refused; so is a single-stage tool that cannot update a manifest.
@@ -262,11 +262,11 @@ fn brdf_wavelet_adds_its_stage_to_a_bake_and_other_tools_refuse_one() {
     let names: Vec<&str> = manifest["stages"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
     let at = |n: &str| names.iter().position(|s| *s == n).unwrap_or_else(|| panic!("{n} in {names:?}"));
     assert!(at("bandwidth-atlas") < at("wavelet-brdf") && at("wavelet-brdf") < at("environment-bandwidth"));
-    assert_eq!(manifest["parameters"]["wavelet"]["side"], 8, "{manifest:#}");
+    assert_eq!(manifest["parameters"]["wavelet_brdf"]["side"], 8, "{manifest:#}");
 
     let out = tmp.path().join("w.png");
     let mut cmd = preview_command(&dir, &out);
-    cmd.args(["--brdf", "wavelet"]);
+    cmd.args(["--brdf", "wavelet-brdf"]);
     run(cmd, "").expect_code(0);
 
     // The bake's own command line does not ask for the wavelet: it rebakes without it.
@@ -331,7 +331,7 @@ fn path_options_refuse_fifos_and_devices_without_blocking() {
         for cmd in [
             bake_env_cmd,
             preview(&["--material".as_ref(), bad.as_os_str()]),
-            preview(&["--brdf".as_ref(), "wavelet".as_ref(), "--wavelet".as_ref(), bad.as_os_str()]),
+            preview(&["--brdf".as_ref(), "wavelet-brdf".as_ref(), "--wavelet-brdf".as_ref(), bad.as_os_str()]),
             preview(&["--mesh".as_ref(), bad.as_os_str()]),
         ] {
             run_within(cmd, NO_HANG).0.expect_one_error_line(what);

@@ -1,6 +1,6 @@
 //! `brdf-wavelet` end to end (issue 12): the paper's Lewis-like material through `merl-synth`
 //! and the tool meets Table 1, the asset reads back in `asset-info`, bad settings and damaged
-//! assets are refused with the file and the problem, and `brdf-preview --brdf wavelet` renders
+//! assets are refused with the file and the problem, and `brdf-preview --brdf wavelet-brdf` renders
 //! from it and measures it against the table.
 
 use std::path::Path;
@@ -97,11 +97,11 @@ fn the_previewer_renders_from_the_wavelet_and_measures_it_against_the_table() {
     encode(material, &bake, &["--side", "16", "--ratio", "4"]).expect_code(0);
     let picture = tmp.path().join("preview.png");
     let mut cmd = tool("brdf-preview");
-    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet"]);
+    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet-brdf"]);
     cmd.args(["--size", "48x48", "--frames", "2", "--spp", "16", "--validate", "--json"]);
     let r = run(cmd, "").expect_code(0);
     let json = r.json();
-    assert_eq!(json["brdf"], "wavelet", "{r}");
+    assert_eq!(json["brdf"], "wavelet-brdf", "{r}");
     // The GPU decoder agrees with the CPU's (the gpu crate's tests hold it to rounding).
     assert!(reported_psnr(&json, "psnr_db") > 45.0, "{r}");
     // The table render differs by the encoding's error: finite, well below the CPU agreement.
@@ -113,7 +113,7 @@ fn the_previewer_renders_from_the_wavelet_and_measures_it_against_the_table() {
     let other = tmp.path().join("other");
     encode(&lewis(tmp.path()), &other, &["--side", "4"]).expect_code(0);
     let mut cmd = tool("brdf-preview");
-    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet", "--wavelet"]);
+    cmd.arg(&bake).arg("--out").arg(&picture).args(["--brdf", "wavelet-brdf", "--wavelet-brdf"]);
     cmd.arg(other.join("wavelet-brdf.asset")).args(["--size", "16x16"]);
     let r = run(cmd, "").expect_code(2);
     assert!(r.stderr.contains("not from the bake's material") && r.stderr.contains("wavelet-brdf.asset"), "{r}");
@@ -125,7 +125,7 @@ fn brdf_bake_encodes_the_wavelet_with_the_other_material_stages() {
     let out = tmp.path().join("bake");
     let mut cmd = tool("brdf-bake");
     cmd.arg(crate::support::ggx_copper()).arg("--out-dir").arg(&out);
-    cmd.args(["--analysis-size", "64", "--wavelet-ratio", "16", "--wavelet-quantize", "--json", "--quiet"]);
+    cmd.args(["--analysis-size", "64", "--wavelet-brdf-ratio", "16", "--wavelet-brdf-quantize", "--json", "--quiet"]);
     let r = run(cmd, "");
     assert!(r.code == Some(0) || r.code == Some(1), "{r}");
     let json = r.json();
@@ -140,7 +140,7 @@ fn brdf_bake_encodes_the_wavelet_with_the_other_material_stages() {
     // A ratio that does not divide the grid is refused before anything is written.
     let refused = tmp.path().join("refused");
     let mut cmd = tool("brdf-bake");
-    cmd.arg(crate::support::ggx_copper()).arg("--out-dir").arg(&refused).args(["--wavelet-ratio", "3"]);
+    cmd.arg(crate::support::ggx_copper()).arg("--out-dir").arg(&refused).args(["--wavelet-brdf-ratio", "3"]);
     let r = run(cmd, "").expect_code(2);
     assert!(r.stderr.contains("does not divide") && !refused.exists(), "{r}");
 }

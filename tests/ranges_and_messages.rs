@@ -49,7 +49,7 @@ fn numeric_options_are_refused_outside_their_range() {
         (preview(&["--out", png, "--exposure", "inf"]), "--exposure"),
         (preview(&["--out", png, "--min-psnr", "nan"]), "'--min-psnr <DB>': expected a finite number of dB"),
         (preview(&["--out", png, "--camera", "nan,0"]), "not a finite angle"),
-        (preview(&["--out", png, "--wavelet-lod", "nan"]), "--wavelet-lod"),
+        (preview(&["--out", png, "--wavelet-brdf-lod", "nan"]), "--wavelet-brdf-lod"),
         (preview(&["--out", png, "--max-samples", "0"]), "--max-samples"),
         // A budget the layers alone exceed said "a budget of 0 bytes".
         (
@@ -138,7 +138,11 @@ fn absurd_wavelet_assets_are_refused_and_a_render_that_overflows_is_an_error() {
         let r = run(cmd, "").expect_code(2);
         assert!(r.stderr.contains("invalid payload: wavelet brdf"), "{r}");
         let mut cmd = tool("brdf-preview");
-        cmd.arg(&bake).arg("--out").arg(&png).args(["--size", "16x16", "--brdf", "wavelet", "--wavelet"]).arg(path);
+        cmd.arg(&bake)
+            .arg("--out")
+            .arg(&png)
+            .args(["--size", "16x16", "--brdf", "wavelet-brdf", "--wavelet-brdf"])
+            .arg(path);
         run(cmd, "").expect_one_error_line("invalid payload: wavelet brdf");
     }
 
@@ -154,7 +158,7 @@ fn absurd_wavelet_assets_are_refused_and_a_render_that_overflows_is_an_error() {
     run(cmd, "").expect_code(0);
     let mut cmd = tool("brdf-preview");
     cmd.arg(&bake).arg("--out").arg(&png).args(["--size", "16x16", "--spp", "16", "--frames", "1"]);
-    cmd.args(["--brdf", "wavelet", "--wavelet"]).arg(&overflow);
+    cmd.args(["--brdf", "wavelet-brdf", "--wavelet-brdf"]).arg(&overflow);
     run(cmd, "").expect_one_error_line(&format!("rendering {}: the GPU render has", overflow.display()));
     assert!(!png.exists(), "a failed render wrote its picture");
 }

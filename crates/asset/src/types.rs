@@ -558,7 +558,7 @@ pub const MAX_WAVELET_CHANNEL_MEAN: f64 = 1e6;
 pub const WAVELET_LOG_BOUND: f64 = 64.0;
 
 /// A BRDF encoded in Haar wavelets (payload of [`AssetKind::WaveletBrdf`], written by
-/// `brdf-wavelet`; Claustres, Barthe and Paulin 2007, sections 4-5). Crate `haar-brdf`
+/// `brdf-wavelet`; Claustres, Barthe and Paulin 2007, sections 4-5). Crate `wavelet-brdf`
 /// documents the parameterization, the transform and the reconstruction;
 /// `data-schema/README.md` the bytes.
 ///

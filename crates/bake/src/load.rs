@@ -139,7 +139,7 @@ pub(crate) fn assemble(
     } else {
         None
     };
-    Ok((render::Material { table, samples, view_layers, wavelet: None }, lighting))
+    Ok((render::Material { table, samples, view_layers, wavelet_brdf: None }, lighting))
 }
 
 /// What adaptive shading predicts from: the environment's bandwidth and the material's atlas.
@@ -159,21 +159,21 @@ fn bandwidths(file: &Outputs) -> Result<render::adaptive::Bandwidths, Error> {
 /// Reads a `wavelet-brdf` asset (`brdf-wavelet`) for the material of a loaded bake: it must have
 /// been made from the same MERL table (same SHA-256). `path` is the caller's (a regular file only,
 /// [`asset::read_file`]).
-pub fn wavelet(path: &Path, loaded: &Loaded) -> Result<haar_brdf::WaveletBrdf, Error> {
+pub fn load_wavelet_brdf(path: &Path, loaded: &Loaded) -> Result<wavelet_brdf::Decoded, Error> {
     let asset = asset::read_file(path).map_err(|e| Error::read(path, e))?;
-    wavelet_of_asset(path, &asset, loaded)
+    wavelet_brdf_of_asset(path, &asset, loaded)
 }
 
 /// The bake's own `wavelet-brdf` output (`brdf-wavelet MATERIAL --out-dir BAKE` and `brdf-bake
-/// --wavelet-ratio R` list it in the manifest), read as [`load`] reads every output, with the path
+/// --wavelet-brdf-ratio R` list it in the manifest), read as [`load`] reads every output, with the path
 /// it was read from.
-pub fn bake_wavelet(loaded: &Loaded) -> Result<(PathBuf, haar_brdf::WaveletBrdf), Error> {
+pub fn bake_wavelet_brdf(loaded: &Loaded) -> Result<(PathBuf, wavelet_brdf::Decoded), Error> {
     let Some(output) = loaded.manifest.output("wavelet-brdf") else {
         return Err(Error::read(
             &loaded.dir.join(MANIFEST),
             format!(
                 "the bake has no wavelet-brdf output: add one with brdf-wavelet MATERIAL.binary --out-dir {} (or \
-                 brdf-bake --wavelet-ratio R), or name an asset with --wavelet FILE",
+                 brdf-bake --wavelet-brdf-ratio R), or name an asset with --wavelet-brdf FILE",
                 loaded.dir.display()
             ),
         ));
@@ -182,11 +182,11 @@ pub fn bake_wavelet(loaded: &Loaded) -> Result<(PathBuf, haar_brdf::WaveletBrdf)
     let folder = fsguard::Folder::open(&loaded.dir).map_err(|e| Error::read(&loaded.dir, e))?;
     let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
     let asset = asset::decode(&bytes).map_err(|e| Error::read(&path, e))?;
-    let brdf = wavelet_of_asset(&path, &asset, loaded)?;
+    let brdf = wavelet_brdf_of_asset(&path, &asset, loaded)?;
     Ok((path, brdf))
 }
 
-fn wavelet_of_asset(path: &Path, asset: &asset::Asset, loaded: &Loaded) -> Result<haar_brdf::WaveletBrdf, Error> {
+fn wavelet_brdf_of_asset(path: &Path, asset: &asset::Asset, loaded: &Loaded) -> Result<wavelet_brdf::Decoded, Error> {
     let Payload::WaveletBrdf(payload) = &asset.payload else {
         return Err(Error::read(path, format!("expected a wavelet-brdf asset, found {}", asset.kind())));
     };
@@ -201,7 +201,7 @@ fn wavelet_of_asset(path: &Path, asset: &asset::Asset, loaded: &Loaded) -> Resul
             ),
         ));
     }
-    haar_brdf::WaveletBrdf::from_payload(payload).map_err(|e| Error::read(path, e.to_string()))
+    wavelet_brdf::Decoded::from_payload(payload).map_err(|e| Error::read(path, e.to_string()))
 }
 
 /// A path as the bake was given it: absolute, relative to the working folder, or relative to the

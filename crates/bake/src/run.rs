@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use asset::{BakeManifest, SourceFile, Tool};
 use serde_json::json;
 
-use crate::stage::{atlas, engine, env_bandwidth, importance, layers, pca, prefilter, wavelet};
+use crate::stage::{atlas, engine, env_bandwidth, importance, layers, pca, prefilter, wavelet_brdf};
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
@@ -26,7 +26,7 @@ pub struct BakeConfig {
     /// Fit a PCA model of the atlas with the fewest components within this relative RMSE.
     pub pca_max_error: Option<f64>,
     /// Encode the material in Haar wavelets (`brdf-wavelet`) with these settings.
-    pub wavelet: Option<wavelet::Settings>,
+    pub wavelet_brdf: Option<wavelet_brdf::Settings>,
     pub env_bandwidth: env_bandwidth::Settings,
     pub prefilter: ::prefilter::Config,
     /// How a view's lobe and a layer's lobe become the numbers the layer selection compares.
@@ -48,7 +48,7 @@ impl BakeConfig {
             importance: ::importance::Config::default(),
             atlas: brdf_atlas::Config::default(),
             pca_max_error: None,
-            wavelet: None,
+            wavelet_brdf: None,
             env_bandwidth: env_bandwidth::Settings::default(),
             prefilter: ::prefilter::Config::default(),
             layer_reduction: layers::DEFAULT_REDUCTION,
@@ -80,7 +80,7 @@ impl BakeConfig {
             return Err(Error::Invalid(format!("the pca's largest relative rmse {e} is not in (0, 1)")));
         }
         self.prefilter.check().map_err(|e| Error::stage("prefilter", e))?;
-        if let Some(w) = &self.wavelet {
+        if let Some(w) = &self.wavelet_brdf {
             w.check()?;
         }
         Ok(())
@@ -110,8 +110,10 @@ impl BakeConfig {
             ),
             ("pca_max_error", json!(self.pca_max_error)),
             (
-                "wavelet",
-                self.wavelet.as_ref().map_or(serde_json::Value::Null, |w| serde_json::Value::Object(w.parameters())),
+                "wavelet_brdf",
+                self.wavelet_brdf
+                    .as_ref()
+                    .map_or(serde_json::Value::Null, |w| serde_json::Value::Object(w.parameters())),
             ),
             (
                 "environment_bandwidth",
@@ -268,9 +270,9 @@ pub fn run_bake(
         let components = brdf_atlas::Components::MaxRelativeRmse(max_error);
         record(pca::run(&atlas_build.atlas, &source, program, components)?, &mut manifest)?;
     }
-    if let Some(settings) = config.wavelet {
+    if let Some(settings) = config.wavelet_brdf {
         begin("wavelet encoding");
-        record(wavelet::run(&table, &material_source, program, settings)?, &mut manifest)?;
+        record(wavelet_brdf::run(&table, &material_source, program, settings)?, &mut manifest)?;
     }
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
@@ -469,7 +471,7 @@ fn stage_names(config: &BakeConfig) -> Vec<&'static str> {
     if config.pca_max_error.is_some() {
         names.push("bandwidth pca");
     }
-    if config.wavelet.is_some() {
+    if config.wavelet_brdf.is_some() {
         names.push("wavelet encoding");
     }
     if config.environment.is_some() {

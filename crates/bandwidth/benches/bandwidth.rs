@@ -112,9 +112,9 @@ fn main() {
     let mut rng = StdRng::seed_from_u64(1);
     let n = 1024;
     let array = Image::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
-    let (median, min) = time(|| wavelet::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap());
+    let (median, min) = time(|| dwt::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap());
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a one-thread pool");
-    let (median1, min1) = one_thread.install(|| time(|| wavelet::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap()));
+    let (median1, min1) = one_thread.install(|| time(|| dwt::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap()));
     let case = format!("wavedec2 db2 {n}x{n}, {PYWT_LEVELS} levels");
     match time_pywt(&array) {
         Ok(pywt) => {
@@ -128,7 +128,7 @@ fn main() {
             };
             row(&format!("{case}, {threads} thread(s)"), median, min, &baseline, &faster(median, min), "");
             row(&format!("{case}, 1 thread"), median1, min1, &baseline, &faster(median1, min1), ">= 10x faster");
-            let energy = wavelet::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap().energy();
+            let energy = dwt::wavedec2(&array, Wavelet::D4, PYWT_LEVELS).unwrap().energy();
             let agree = ((energy - pywt.energy) / pywt.energy).abs() <= 1e-9;
             println!(
                 "  pywt check: the energy of all coefficients {} ({energy:.9e} here, {:.9e} pywt)",
@@ -148,8 +148,8 @@ fn main() {
     let map = envmap::load(&path).unwrap_or_else(|e| panic!("error: reading {}: {e}", path.display()));
     let (w, h) = (map.width(), map.height());
     let same_size = Image::from_fn(w, h, |_, _| rng.random_range(-1.0..1.0));
-    let levels = wavelet::max_levels2(w, h);
-    let (transform, _) = time(|| wavelet::wavedec2(&same_size, Wavelet::D4, levels).unwrap());
+    let levels = dwt::max_levels2(w, h);
+    let (transform, _) = time(|| dwt::wavedec2(&same_size, Wavelet::D4, levels).unwrap());
     let baseline = format!("wavedec2 {w}x{h} {levels} lv {:.2} ms", ms(transform));
     let config = Config::default();
     let core = |map: &envmap::EnvMap| {

@@ -4,7 +4,7 @@ pub enum Error {
     /// The wavelet transform refused the (possibly padded) image: NaN or infinite values, or a
     /// size that does not divide by `2^levels`.
     #[error(transparent)]
-    Wavelet(#[from] wavelet::Error),
+    Wavelet(#[from] dwt::Error),
     /// The image is too small or has a side that does not allow enough levels (see the crate
     /// documentation, "Sizes").
     #[error("{0}")]

@@ -2,8 +2,8 @@
 //! (a separable sliding maximum over the coefficient grid), then the finest significant level
 //! of eq. 7 per pixel.
 
+use dwt::{Image, Wavelet, max_levels2};
 use rayon::prelude::*;
-use wavelet::{Image, Wavelet, max_levels2};
 
 use crate::Error;
 
@@ -184,12 +184,12 @@ pub fn local_bandwidth(image: &Image, config: &Config) -> Result<BandwidthMap, E
 }
 
 /// Buffers for repeated estimates of images of one size (the lobe images of a BRDF's atlas, one
-/// per row): the transform's ([`wavelet::Workspace2`]), each level's maxima and the map stay
+/// per row): the transform's ([`dwt::Workspace2`]), each level's maxima and the map stay
 /// allocated between calls, so that an estimate allocates (and touches fresh memory for) almost
 /// nothing. The results are [`local_bandwidth`]'s, bit for bit.
 #[derive(Debug, Default)]
 pub struct Workspace {
-    transform: wavelet::Workspace2,
+    transform: dwt::Workspace2,
     levels: Vec<LevelRows>,
     map: Option<BandwidthMap>,
 }
@@ -226,7 +226,7 @@ impl Workspace {
 
     /// The transform's buffers, for a caller that runs other transforms of the same size between
     /// estimates (they are overwritten by the next estimate).
-    pub fn transform(&mut self) -> &mut wavelet::Workspace2 {
+    pub fn transform(&mut self) -> &mut dwt::Workspace2 {
         &mut self.transform
     }
 }

@@ -5,10 +5,10 @@
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
+use dwt::Image;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
-use wavelet::Image;
 
 use crate::Error;
 use crate::estimate::check_finite;

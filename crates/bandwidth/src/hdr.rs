@@ -1,6 +1,6 @@
 //! What the estimator reads of an HDR image.
 
-use wavelet::Image;
+use dwt::Image;
 
 use crate::Error;
 

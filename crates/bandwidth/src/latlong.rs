@@ -4,8 +4,8 @@
 
 use std::f64::consts::{PI, TAU};
 
+use dwt::Image;
 use rayon::prelude::*;
-use wavelet::Image;
 
 use crate::Error;
 use crate::estimate::{BandwidthMap, Config, estimate, periodic_levels};

@@ -7,7 +7,7 @@
 //!
 //! # The estimator
 //!
-//! The image is decomposed with [`wavelet::wavedec2`] (D4, PyWavelets' `db2`, periodization)
+//! The image is decomposed with [`dwt::wavedec2`] (D4, PyWavelets' `db2`, periodization)
 //! into levels `j = 1` (finest, half the image size) to `J` (coarsest), each holding the
 //! orientations `cH`, `cV`, `cD`. The coefficients are the transform's orthonormal ones, not
 //! rescaled per level.
@@ -61,7 +61,7 @@
 //!
 //! - [`local_bandwidth`]: the image is one period of a periodic image (the transform's own
 //!   boundary), so its right edge meets its left edge. Both sides must divide by `2^J`. By
-//!   default `J` is the most the size allows ([`wavelet::max_levels2`]), and the size is refused
+//!   default `J` is the most the size allows ([`dwt::max_levels2`]), and the size is refused
 //!   when that leaves more than 3 coefficients on the shorter side: then the coarsest support
 //!   (`3 2^J - 2` pixels) still does not span the image and frequencies down to the image size
 //!   would be invisible (1000 x 500 allows only 2 levels). Callers pad or resample such images,
@@ -178,7 +178,7 @@
 //!
 //! # Performance
 //!
-//! The transform is `wavelet`'s (parallel over rows). Per level, the maximum over orientations
+//! The transform is `dwt`'s (parallel over rows). Per level, the maximum over orientations
 //! and the sliding maximum along `x` run on the coefficient rows that cover an output row, one
 //! row at a time (parallel over levels); the sliding maximum along `y` and eq. 7 (stopping at a
 //! pixel's first significant level) run per output row (parallel over rows) in one scratch
@@ -198,6 +198,7 @@ mod hdr;
 mod latlong;
 
 pub use compare::{Comparison, PERCENTILES, compare_maps, spearman, wavelet_at_windows};
+pub use dwt::{Image, Wavelet};
 pub use error::Error;
 pub use estimate::{
     BandwidthMap, Config, DEFAULT_C, Reading, Workspace, level_frequency, local_bandwidth, local_bandwidth_zero_padded,
@@ -208,4 +209,3 @@ pub use latlong::{
     AngularBandwidthMap, latlong_angles, latlong_bandwidth, latlong_direction, latlong_pixels_per_radian,
     latlong_radians_per_pixel,
 };
-pub use wavelet::{Image, Wavelet};

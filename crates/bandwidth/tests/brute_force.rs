@@ -6,8 +6,8 @@
 use bandwidth::{
     BandwidthMap, Config, Image, Wavelet, latlong_bandwidth, local_bandwidth, local_bandwidth_zero_padded,
 };
+use dwt::wavedec2;
 use rand::Rng;
-use wavelet::wavedec2;
 
 use crate::rng;
 

@@ -28,7 +28,7 @@ fn sizes_that_leave_too_few_levels_are_refused() {
     assert_eq!(local_bandwidth_zero_padded(&Image::zeros(100, 20), &deepest).unwrap().levels(), 8);
     // Levels set by hand must divide the size: the transform says so.
     let e = local_bandwidth(&Image::zeros(24, 24), &Config { levels: Some(4), ..Config::default() }).unwrap_err();
-    assert!(matches!(e, Error::Wavelet(wavelet::Error::TooManyLevels { .. })), "{e:?}");
+    assert!(matches!(e, Error::Wavelet(dwt::Error::TooManyLevels { .. })), "{e:?}");
     // 24 allows 3 levels, leaving 3 coefficients: accepted.
     assert_eq!(local_bandwidth(&Image::zeros(24, 24), &Config::default()).unwrap().levels(), 3);
 }

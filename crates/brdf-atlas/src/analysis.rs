@@ -245,7 +245,7 @@ impl Analyser {
             levels: Some(analysis_levels(n)),
             ..bandwidth::Config::default()
         };
-        let extended = wavelet::Image::new(e, e, std::mem::take(ext)).expect("sizes match");
+        let extended = dwt::Image::new(e, e, std::mem::take(ext)).expect("sizes match");
         // Only the image's own pixels are kept: the estimate of the top-left quarter alone.
         let levels = estimator.levels_top_left(&extended, &config, n, n).expect("the configuration was checked");
         *ext = extended.into_data();
@@ -277,10 +277,10 @@ pub fn analysis_levels(n: usize) -> usize {
 /// `2n x 2n` image, the lobe image in its top-left quarter, periodic, and continuous with its
 /// slope across every border of the lobe image (crate docs, "Boundaries"): each row, then
 /// each column of the result, is continued by `extend_line`.
-pub fn extend_periodic(image: &[f64], n: usize) -> wavelet::Image {
+pub fn extend_periodic(image: &[f64], n: usize) -> dwt::Image {
     let mut ext = Vec::new();
     extend_into(image, n, &mut ext);
-    wavelet::Image::new(2 * n, 2 * n, ext).expect("sizes match")
+    dwt::Image::new(2 * n, 2 * n, ext).expect("sizes match")
 }
 
 /// The `2n x 2n` tiling of an `n x n` image by its mirror images (to the right, below, and
@@ -289,10 +289,10 @@ pub fn extend_periodic(image: &[f64], n: usize) -> wavelet::Image {
 /// energy per level is that of four copies of the image, where [`extend_periodic`]'s
 /// continuation adds ramps of its own that carry the slope across the borders and would count
 /// as lobe energy (at grazing incidence it moves Phong n = 64 and 256 up a layer).
-pub fn mirror_tiling(image: &[f64], n: usize) -> wavelet::Image {
+pub fn mirror_tiling(image: &[f64], n: usize) -> dwt::Image {
     let mut tiling = Vec::new();
     mirror_into(image, n, &mut tiling);
-    wavelet::Image::new(2 * n, 2 * n, tiling).expect("sizes match")
+    dwt::Image::new(2 * n, 2 * n, tiling).expect("sizes match")
 }
 
 /// [`mirror_tiling`] into a reused buffer: `out` becomes `4 n^2` values, row-major.
@@ -505,7 +505,7 @@ mod tests {
     /// The largest finest-level D4 detail of a periodic line: of all its coefficients, and of
     /// those whose support (samples `2k` to `2k + 3`) lies within the first `inside` samples.
     fn finest_details(line: &[f64], inside: usize) -> (f64, f64) {
-        let (_, detail) = wavelet::dwt(line, wavelet::Wavelet::D4).unwrap();
+        let (_, detail) = dwt::dwt(line, dwt::Wavelet::D4).unwrap();
         let all = detail.iter().fold(0.0f64, |m, d| m.max(d.abs()));
         let own =
             detail.iter().enumerate().filter(|(k, _)| 2 * k + 3 < inside).fold(0.0f64, |m, (_, d)| m.max(d.abs()));

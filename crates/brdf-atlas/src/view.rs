@@ -89,7 +89,7 @@ impl ViewReduction {
 /// a Lambertian's constant, has none, rather than its lookups' rounding noise, which would read
 /// as the finest frequencies (27 cycles per radian at the default size: the sharpest layer).
 pub fn band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
-    band_energy_in(image, n, relative_noise_floor, &mut Vec::new(), &mut wavelet::Workspace2::default())
+    band_energy_in(image, n, relative_noise_floor, &mut Vec::new(), &mut dwt::Workspace2::default())
 }
 
 /// [`band_energy`] with reused buffers: `tiling` for the mirror tiling, `transform` for its
@@ -99,12 +99,12 @@ pub(crate) fn band_energy_in(
     n: usize,
     relative_noise_floor: f64,
     tiling: &mut Vec<f64>,
-    transform: &mut wavelet::Workspace2,
+    transform: &mut dwt::Workspace2,
 ) -> Vec<f64> {
     mirror_into(image, n, tiling);
-    let tiled = wavelet::Image::new(2 * n, 2 * n, std::mem::take(tiling)).expect("sizes match");
+    let tiled = dwt::Image::new(2 * n, 2 * n, std::mem::take(tiling)).expect("sizes match");
     let decomposition = transform
-        .wavedec2(&tiled, wavelet::Wavelet::D4, analysis_levels(n))
+        .wavedec2(&tiled, dwt::Wavelet::D4, analysis_levels(n))
         .expect("lobe images have a power-of-two size of at least 16");
     *tiling = tiled.into_data();
     let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -114,7 +114,7 @@ pub(crate) fn band_energy_in(
         .enumerate()
         .map(|(i, level)| {
             let floor = relative_noise_floor * peak * (1u64 << (i + 1)) as f64;
-            level.iter().flat_map(wavelet::Image::data).filter(|c| c.abs() >= floor).map(|c| c * c).sum()
+            level.iter().flat_map(dwt::Image::data).filter(|c| c.abs() >= floor).map(|c| c * c).sum()
         })
         .collect()
 }

@@ -1,6 +1,6 @@
 //! Each documented error, with its message.
 
-use wavelet::{
+use dwt::{
     Decomposition, Decomposition2, Error, Image, Wavelet, dwt, dwt2, idwt, idwt2, wavedec, wavedec2, waverec, waverec2,
 };
 
@@ -81,7 +81,7 @@ fn non_finite_values() {
         "signal holds a non-finite value at index 3001",
     );
     let mut dec = wavedec2(&Image::zeros(8, 8), W, 2).unwrap();
-    dec.detail_mut(1, wavelet::Orientation::Diagonal).data_mut()[2] = f64::NAN;
+    dec.detail_mut(1, dwt::Orientation::Diagonal).data_mut()[2] = f64::NAN;
     check(
         waverec2(&dec),
         Error::NonFinite { what: "level 1 diagonal detail".into(), index: 2 },

@@ -5,10 +5,10 @@
 //! 2^(levels/2) per axis for the approximation) and the two implementations differ only in the
 //! order of a handful of additions per level, i.e. by a few ulps.
 
-use serde_json::Value;
-use wavelet::{
+use dwt::{
     Decomposition, Decomposition2, Image, Wavelet, dwt, dwt2, idwt, idwt2, wavedec, wavedec2, waverec, waverec2,
 };
+use serde_json::Value;
 
 use crate::max_abs_diff;
 
@@ -64,7 +64,7 @@ fn one_dimensional_transforms_match_pywavelets() {
         let w = wavelet(case);
         let n = usize_of(&case["shape"][0]);
         let levels = usize_of(&case["max_level"]);
-        assert_eq!(levels, wavelet::max_levels(n));
+        assert_eq!(levels, dwt::max_levels(n));
         let name = format!("{} n={n}", w.pywt_name());
         let x = floats(&case["input"]);
         let (approx, details) = (list(&case["approx"]), list(&case["details"]));
@@ -120,7 +120,7 @@ fn two_dimensional_transforms_match_pywavelets() {
         let w = wavelet(case);
         let (h, wd) = (usize_of(&case["shape"][0]), usize_of(&case["shape"][1]));
         let levels = usize_of(&case["max_level"]);
-        assert_eq!(levels, wavelet::max_levels2(wd, h));
+        assert_eq!(levels, dwt::max_levels2(wd, h));
         let name = format!("{} {h}x{wd} (numpy shape)", w.pywt_name());
         let x = image(case, floats(&case["input"]), 0);
         let (approx, details) = (list(&case["approx"]), levels2(case, "details"));
@@ -136,7 +136,7 @@ fn two_dimensional_transforms_match_pywavelets() {
             assert_eq!((dec.approx.width(), dec.approx.height()), (wd >> l, h >> l));
             worst.check(&format!("{name} wavedec2 level={l} approx"), dec.approx.data(), &approx[l - 1]);
             for j in 1..=l {
-                for (o, want) in wavelet::Orientation::ALL.into_iter().zip(&details[j - 1]) {
+                for (o, want) in dwt::Orientation::ALL.into_iter().zip(&details[j - 1]) {
                     let got = dec.detail(j, o);
                     let context = format!("{name} wavedec2 level={l} detail {j} {}", o.name());
                     worst.check(&context, got.data(), want);

@@ -1,7 +1,7 @@
 //! Analytic cases: constants under Haar, polynomials of degree 1 under D4 (two vanishing
 //! moments), stripes in one orientation only, and the support of every coefficient.
 
-use wavelet::{Image, Orientation, Wavelet, coefficient_center, dwt2, wavedec, wavedec2};
+use dwt::{Image, Orientation, Wavelet, coefficient_center, dwt2, wavedec, wavedec2};
 
 /// Constant `c`: no detail anywhere, approximation `c 2^(levels / 2)` per axis (each Haar
 /// low-pass sums two samples and divides by sqrt 2). Exact up to rounding of O(1) values.

@@ -3,7 +3,7 @@
 //! Tolerance 1e-12 absolute for the round trip (each level adds a few ulps of O(1) values), and
 //! 1e-12 relative for the energy (a sum of n squares, each off by a few ulps).
 
-use wavelet::{Wavelet, dwt, dwt2, idwt, idwt2, max_levels, max_levels2, wavedec, wavedec2, waverec, waverec2};
+use dwt::{Wavelet, dwt, dwt2, idwt, idwt2, max_levels, max_levels2, wavedec, wavedec2, waverec, waverec2};
 
 use crate::{max_abs_diff, random_image, random_signal, rng};
 

@@ -1,12 +1,12 @@
-//! Integration tests of the `wavelet` crate, one binary with a module per topic.
+//! Integration tests of the `dwt` crate, one binary with a module per topic.
 
 mod errors;
 mod golden;
 mod known_answers;
 mod roundtrip;
 
+use dwt::Image;
 use rand::{Rng, SeedableRng, rngs::StdRng};
-use wavelet::Image;
 
 /// Uniform values in [-1, 1): the magnitude the absolute tolerances are stated for.
 pub fn random_signal(rng: &mut StdRng, n: usize) -> Vec<f64> {

@@ -144,7 +144,7 @@ fn read_asset(bytes: &[u8]) {
         }
         asset::Payload::WaveletBrdf(payload) => {
             // Decode it as the previewer does, and evaluate it at a few direction pairs.
-            if let Ok(brdf) = haar_brdf::WaveletBrdf::from_payload(&payload) {
+            if let Ok(brdf) = wavelet_brdf::Decoded::from_payload(&payload) {
                 let dirs =
                     [glam::DVec3::Z, glam::DVec3::new(0.6, 0.0, 0.8), glam::DVec3::new(-0.3, 0.9, 0.3).normalize()];
                 for (wi, wo) in dirs.iter().zip(dirs.iter().rev()) {

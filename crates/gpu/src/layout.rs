@@ -12,7 +12,7 @@ use crate::preview::adaptive::AdaptivePass;
 use crate::preview::present::PresentUniform;
 use crate::preview::uniforms::{PredictUniform, ShadeUniform, WaveletUniform};
 use crate::wgsl::{
-    BRDF_WAVELET, MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_ADAPTIVE, PREVIEW_BINDINGS, PREVIEW_PREDICT, PREVIEW_PRESENT,
+    MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_ADAPTIVE, PREVIEW_BINDINGS, PREVIEW_PREDICT, PREVIEW_PRESENT, WAVELET_BRDF,
 };
 
 /// A host struct: the WGSL source and struct it mirrors, its size, and its members' WGSL names
@@ -72,7 +72,7 @@ fn shared_structs() -> Vec<Shared> {
         }),
         shared!(MERL_LOOKUP_BATCH.source, "MerlDirPair", DirPair { "wi" => wi, "wo" => wo }),
         shared!(MERL_LOOKUP_BATCH.source, "MerlSample", GpuSample { "rgb" => rgb, "cell" => cell }),
-        shared!(BRDF_WAVELET.source, "WaveletParams", WaveletUniform {
+        shared!(WAVELET_BRDF.source, "WaveletParams", WaveletUniform {
             "side" => side, "levels" => levels, "enabled" => enabled, "lod" => lod, "mean" => mean,
             "epsilon" => epsilon,
         }),

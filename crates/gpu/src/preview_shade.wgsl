@@ -2,7 +2,7 @@
 //! documentation is the specification), per pixel of the triangle-index G-buffer that
 //! `preview_raster.wgsl` drew, added into an accumulation buffer (entry points `shade_backdrop`,
 //! `shade_frame`, and `shade_blocks` for an adaptive frame). `material_brdf` of
-//! `brdf_wavelet.wgsl` (group 0: the MERL table's nearest lookup, or the wavelet reconstruction)
+//! `wavelet_brdf.wgsl` (group 0: the MERL table's nearest lookup, or the wavelet reconstruction)
 //! is the BRDF; `gpu::wgsl` lists the files this one needs.
 //!
 //! Every step is a function named after the CPU's (`render::raster`, `render::shade`, `envmap`),

@@ -1,4 +1,4 @@
-//! WGSL port of `haar_brdf::WaveletBrdf::eval` (Claustres et al. 2007, sections 5.3-5.4): the
+//! WGSL port of `wavelet_brdf::Decoded::eval` (Claustres et al. 2007, sections 5.3-5.4): the
 //! BRDF reconstructed from its Haar coefficients at a level of detail, step for step in f32.
 //! Compiled after `merl_lookup.wgsl` (for `merl_atan2`); group 0 bindings 2-4 hold the asset.
 //! `material_brdf` is what the previewer's estimators call: the wavelet when one is bound
@@ -28,7 +28,7 @@ struct WaveletBilinear {
     weights: vec4<f32>,
 }
 
-// `haar_brdf::Grid::bilinear` for a direction with z >= 0.
+// `wavelet_brdf::Grid::bilinear` for a direction with z >= 0.
 fn wavelet_bilinear(w: vec3<f32>) -> WaveletBilinear {
     let theta = merl_atan2(w.z, w.x);
     let phi = merl_atan2(sqrt(w.x * w.x + w.z * w.z), w.y);
@@ -47,14 +47,14 @@ fn wavelet_bilinear(w: vec3<f32>) -> WaveletBilinear {
     );
 }
 
-// Coefficient position `p` of outgoing cell `o` (`haar_brdf::WaveletBrdf::coefficient`).
+// Coefficient position `p` of outgoing cell `o` (`wavelet_brdf::Decoded::coefficient`).
 fn wavelet_coefficient(p: u32, o: u32) -> vec3<f32> {
     let at = (wavelet_map[p] * wavelet.side * wavelet.side + o) * 3u;
     return vec3<f32>(wavelet_slices[at], wavelet_slices[at + 1u], wavelet_slices[at + 2u]);
 }
 
-// `haar_brdf::WaveletBrdf::log_value`: Haar synthesis of incoming cell `i` of outgoing cell `o`
-// at the integer level of detail `lod` (`haar_brdf::transform::synthesis`).
+// `wavelet_brdf::Decoded::log_value`: Haar synthesis of incoming cell `i` of outgoing cell `o`
+// at the integer level of detail `lod` (`wavelet_brdf::transform::synthesis`).
 fn wavelet_log_value(o: u32, i: u32, lod: u32) -> vec3<f32> {
     let n = wavelet.side;
     let r = i / n;
@@ -75,7 +75,7 @@ fn wavelet_log_value(o: u32, i: u32, lod: u32) -> vec3<f32> {
     return sum;
 }
 
-// `haar_brdf::WaveletBrdf::eval`.
+// `wavelet_brdf::Decoded::eval`.
 fn wavelet_eval(wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (!(wi.z >= 0.0 && wo.z >= 0.0)) {
         return vec3<f32>(0.0);

@@ -23,7 +23,7 @@ pub static MERL_LOOKUP: Wgsl = wgsl!("merl_lookup.wgsl", []);
 /// The lookup's batch entry point for the tests (`MerlLookup`).
 pub static MERL_LOOKUP_BATCH: Wgsl = wgsl!("merl_lookup_batch.wgsl", [MERL_LOOKUP]);
 /// The wavelet BRDF decoder and `material_brdf`, the BRDF the estimators read.
-pub static BRDF_WAVELET: Wgsl = wgsl!("brdf_wavelet.wgsl", [MERL_LOOKUP]);
+pub static WAVELET_BRDF: Wgsl = wgsl!("wavelet_brdf.wgsl", [MERL_LOOKUP]);
 /// The raster pass, a module of its own.
 pub static PREVIEW_RASTER: Wgsl = wgsl!("preview_raster.wgsl", []);
 /// The shading module's constants, groups 1 and 2 and its dispatch order.
@@ -38,12 +38,12 @@ pub static PREVIEW_ENVIRONMENT: Wgsl =
 /// The shading pass's entry points.
 pub static PREVIEW_SHADE: Wgsl = wgsl!(
     "preview_shade.wgsl",
-    [BRDF_WAVELET, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
+    [WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
 /// The prediction of an adaptive frame.
 pub static PREVIEW_PREDICT: Wgsl = wgsl!(
     "preview_predict.wgsl",
-    [MERL_LOOKUP, BRDF_WAVELET, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
+    [MERL_LOOKUP, WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
 /// An adaptive frame after its prediction.
 pub static PREVIEW_ADAPTIVE: Wgsl = wgsl!("preview_adaptive.wgsl", [PREVIEW_BINDINGS, PREVIEW_GEOMETRY]);
@@ -58,7 +58,7 @@ pub static SEPARATE: [&Wgsl; 2] = [&PREVIEW_RASTER, &PREVIEW_PRESENT];
 pub static ALL: [&Wgsl; 12] = [
     &MERL_LOOKUP,
     &MERL_LOOKUP_BATCH,
-    &BRDF_WAVELET,
+    &WAVELET_BRDF,
     &PREVIEW_RASTER,
     &PREVIEW_BINDINGS,
     &PREVIEW_SAMPLING,
@@ -326,7 +326,7 @@ mod tests {
     #[test]
     fn every_wgsl_function_names_its_rust_twin_or_says_why_not() {
         let crates = workspace_declarations();
-        assert!(crates.contains_key("render") && crates.contains_key("haar_brdf"), "crates: {:?}", crates.keys());
+        assert!(crates.contains_key("render") && crates.contains_key("wavelet_brdf"), "crates: {:?}", crates.keys());
         let mut wrong = Vec::new();
         let mut functions = 0;
         for w in ALL {

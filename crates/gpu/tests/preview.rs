@@ -54,7 +54,7 @@ fn material(brdf: Analytic) -> Material {
         samples: SampleSet::new(&tables),
         table,
         view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0],
-        wavelet: None,
+        wavelet_brdf: None,
     }
 }
 
@@ -235,17 +235,17 @@ fn ggx_prefiltered_matches_the_cpu() {
 
 /// The GGX material with its BRDF read from a Haar wavelet encoding of its table (16 x 16 grid,
 /// 4:1, 8-bit codes) at a fractional level of detail, so that the WGSL decoder's every step
-/// (bilinear cells, synthesis, level blend, dequantized codes) is held to `haar_brdf`.
+/// (bilinear cells, synthesis, level blend, dequantized codes) is held to `wavelet_brdf`.
 fn ggx_wavelet() -> &'static Material {
     static MATERIAL: OnceLock<Material> = OnceLock::new();
     MATERIAL.get_or_init(|| {
         let material = ggx();
-        let grid = haar_brdf::Grid::new(16).expect("a power of two");
-        let resampled = haar_brdf::resample_table(grid, &material.table);
-        let config = haar_brdf::Config { keep: haar_brdf::Keep::Ratio(4), quantize: true, ..Default::default() };
-        let encoded = haar_brdf::encode(&resampled, config).expect("a valid config");
-        let brdf = haar_brdf::WaveletBrdf::from_payload(&encoded.payload).expect("a valid payload");
-        Material { wavelet: Some(render::Wavelet { brdf, lod: 0.5 }), ..material.clone() }
+        let grid = wavelet_brdf::Grid::new(16).expect("a power of two");
+        let resampled = wavelet_brdf::resample_table(grid, &material.table);
+        let config = wavelet_brdf::Config { keep: wavelet_brdf::Keep::Ratio(4), quantize: true, ..Default::default() };
+        let encoded = wavelet_brdf::encode(&resampled, config).expect("a valid config");
+        let brdf = wavelet_brdf::Decoded::from_payload(&encoded.payload).expect("a valid payload");
+        Material { wavelet_brdf: Some(render::WaveletBrdf { brdf, lod: 0.5 }), ..material.clone() }
     })
 }
 

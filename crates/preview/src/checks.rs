@@ -82,9 +82,9 @@ pub(crate) fn check_finite(request: &Request, rgb: &[f32], what: &str) -> Result
     if bad == 0 {
         return Ok(());
     }
-    let source = match (request.brdf, &request.wavelet) {
-        (Brdf::Wavelet, Some(path)) => path.display().to_string(),
-        (Brdf::Wavelet, None) => format!("the wavelet-brdf asset of {}", request.bake.display()),
+    let source = match (request.brdf, &request.wavelet_brdf) {
+        (Brdf::WaveletBrdf, Some(path)) => path.display().to_string(),
+        (Brdf::WaveletBrdf, None) => format!("the wavelet-brdf asset of {}", request.bake.display()),
         (Brdf::Table, _) => format!("the bake in {}", request.bake.display()),
     };
     bail!(

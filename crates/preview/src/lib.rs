@@ -95,7 +95,7 @@ pub enum Brdf {
     /// The MERL table (nearest lookup).
     Table,
     /// Its Haar wavelet encoding (Claustres et al. 2007), decoded on the GPU.
-    Wavelet,
+    WaveletBrdf,
 }
 
 /// A preview, as `brdf-preview`'s options ask for it (its `--help` says what each does).
@@ -106,8 +106,8 @@ pub struct Request {
     pub out: Option<PathBuf>,
     pub material: Option<PathBuf>,
     pub brdf: Brdf,
-    pub wavelet: Option<PathBuf>,
-    pub wavelet_lod: f64,
+    pub wavelet_brdf: Option<PathBuf>,
+    pub wavelet_brdf_lod: f64,
     /// `sphere`, `torus` or the path of a Wavefront OBJ file.
     pub mesh: String,
     pub mode: Mode,
@@ -186,18 +186,22 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
         checks::check_output_folder(path)?;
     }
     let mut loaded = bake::load(&request.bake, request.material.as_deref())?;
-    if request.brdf == Brdf::Wavelet {
-        let (path, brdf) = match &request.wavelet {
-            Some(path) => (path.clone(), bake::load_wavelet(path, &loaded)?),
-            None => bake::bake_wavelet(&loaded)?,
+    if request.brdf == Brdf::WaveletBrdf {
+        let (path, brdf) = match &request.wavelet_brdf {
+            Some(path) => (path.clone(), bake::load_wavelet_brdf(path, &loaded)?),
+            None => bake::bake_wavelet_brdf(&loaded)?,
         };
         let levels = brdf.grid().levels() as f64;
-        if !(0.0..=levels).contains(&request.wavelet_lod) {
-            bail!("--wavelet-lod {} is outside 0 to {levels} (the levels of {})", request.wavelet_lod, path.display());
+        if !(0.0..=levels).contains(&request.wavelet_brdf_lod) {
+            bail!(
+                "--wavelet-brdf-lod {} is outside 0 to {levels} (the levels of {})",
+                request.wavelet_brdf_lod,
+                path.display()
+            );
         }
-        loaded.material.wavelet = Some(render::Wavelet { brdf, lod: request.wavelet_lod });
-    } else if request.wavelet.is_some() {
-        bail!("--wavelet names the asset for --brdf wavelet; add --brdf wavelet to render with it");
+        loaded.material.wavelet_brdf = Some(render::WaveletBrdf { brdf, lod: request.wavelet_brdf_lod });
+    } else if request.wavelet_brdf.is_some() {
+        bail!("--wavelet-brdf names the asset for --brdf wavelet-brdf; add --brdf wavelet-brdf to render with it");
     }
     // Every output is encoded before any is written.
     let mut files: Vec<Output> = Vec::new();
@@ -236,7 +240,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             let scene = scene(request)?;
             let pixels = (scene.width * scene.height) as u128;
             let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
-            let renders = if loaded.material.wavelet.is_some() { 2 } else { 1 };
+            let renders = if loaded.material.wavelet_brdf.is_some() { 2 } else { 1 };
             check_work(
                 request,
                 &[
@@ -261,8 +265,8 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
             let picture = metrics::tonemap(&image, &tone_mapping);
             let names = names(&loaded.manifest);
-            let brdf = match &loaded.material.wavelet {
-                Some(w) => format!("wavelet {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
+            let brdf = match &loaded.material.wavelet_brdf {
+                Some(w) => format!("wavelet-brdf {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
                 None => "table".to_string(),
             };
             let caption = format!(
@@ -292,7 +296,7 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             value = json!({
                 "bake": request.bake.display().to_string(),
                 "mode": mode.name(),
-                "brdf": match request.brdf { Brdf::Table => "table", Brdf::Wavelet => "wavelet" },
+                "brdf": match request.brdf { Brdf::Table => "table", Brdf::WaveletBrdf => "wavelet-brdf" },
                 "spp": settings.spp,
                 "frames": settings.frames,
                 "width": scene.width,
@@ -303,9 +307,9 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
                 "mean_luminance": metrics::mean_luminance(&image),
             });
 
-            if loaded.material.wavelet.is_some() {
+            if loaded.material.wavelet_brdf.is_some() {
                 // What the compression costs: the same render from the table itself.
-                let table_material = render::Material { wavelet: None, ..loaded.material.clone() };
+                let table_material = render::Material { wavelet_brdf: None, ..loaded.material.clone() };
                 host.step(format!("{} from the table on the GPU", mode.name()));
                 let table =
                     gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;

@@ -107,10 +107,10 @@
 //! weights sum to 1 wherever either density is positive. The table's density is positive over
 //! the whole upper hemisphere (its defensive share), so `M` is integrated without bias. The BRDF
 //! is the table's nearest lookup (`merl::MerlTable::lookup` with `Interp::Nearest`, the lookup
-//! the WGSL ports), 0 where the table holds no data; or, when the material carries a [`Wavelet`],
-//! its reconstruction at the wavelet's level of detail (`haar_brdf::WaveletBrdf::eval`: bilinear
+//! the WGSL ports), 0 where the table holds no data; or, when the material carries a [`WaveletBrdf`],
+//! its reconstruction at the wavelet's level of detail (`wavelet_brdf::Decoded::eval`: bilinear
 //! over the 4 x 4 surrounding cell pairs of the sphere grid, Haar synthesis of each, in the log
-//! domain; the WGSL `brdf_wavelet.wgsl` ports it). The modes differ in `F` and `M`:
+//! domain; the WGSL `wavelet_brdf.wgsl` ports it). The modes differ in `F` and `M`:
 //!
 //! - [`Mode::Reference`]: `F = 0`, `M` the environment's level 0, bilinear
 //!   (`envmap::EnvMap::lookup`), `p_l` its importance sampling ([`Lighting::environment`]: texels
@@ -272,16 +272,16 @@ pub struct Material {
     /// ([`view_layer`]).
     pub view_layers: Vec<f32>,
     /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
-    /// the table (`brdf-preview --brdf wavelet`): see "The BRDF" in the crate docs.
-    pub wavelet: Option<Wavelet>,
+    /// the table (`brdf-preview --brdf wavelet-brdf`): see "The BRDF" in the crate docs.
+    pub wavelet_brdf: Option<WaveletBrdf>,
 }
 
-/// A wavelet encoding of the material (asset kind `wavelet-brdf`, crate `haar_brdf`) and the
+/// A wavelet encoding of the material (asset kind `wavelet-brdf`, crate `wavelet_brdf`) and the
 /// level of detail it is read at.
 #[derive(Clone, Debug)]
-pub struct Wavelet {
-    pub brdf: haar_brdf::WaveletBrdf,
-    /// In `[0, log2 n]`: 0 is full resolution (`haar_brdf::WaveletBrdf::eval`).
+pub struct WaveletBrdf {
+    pub brdf: wavelet_brdf::Decoded,
+    /// In `[0, log2 n]`: 0 is full resolution (`wavelet_brdf::Decoded::eval`).
     pub lod: f64,
 }
 

@@ -161,7 +161,7 @@ pub(crate) fn slice_of(theta_o: f64, n_slices: usize) -> usize {
 /// `f(wi, wo)`: the wavelet reconstruction when the material has one, else the table's nearest
 /// lookup, 0 where it holds no data.
 pub(crate) fn brdf(material: &Material, wi_local: DVec3, wo_local: DVec3) -> [f64; 3] {
-    match &material.wavelet {
+    match &material.wavelet_brdf {
         Some(w) => w.brdf.eval(wi_local, wo_local, w.lod),
         None => material.table.lookup(wi_local, wo_local, Interp::Nearest).unwrap_or([0.0; 3]),
     }

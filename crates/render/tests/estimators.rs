@@ -47,7 +47,7 @@ fn the_reference_modes_error_carries_no_structure() {
     let table = merl::analytic::Analytic::Lambertian { albedo: [0.5; 3] }.table(merl::Dims::MERL);
     let config = importance::Config { n_vectors: 2, n_samples: 64, ..importance::Config::default() };
     let samples = render::SampleSet::new(&importance::build(&table, &config).expect("a valid config"));
-    let material = &Material { table, samples, view_layers: vec![0.0], wavelet: None };
+    let material = &Material { table, samples, view_layers: vec![0.0], wavelet_brdf: None };
     let settings = Settings { mode: Mode::Reference, spp: 64, frames: render::frames_to_exhaust(2, 64, 64), seed: 1 };
     let image = render::render(&scene, material, &lighting, &settings).expect("valid inputs");
     let truth = converged(&scene, material, &lighting, 256, 9).expect("valid inputs");

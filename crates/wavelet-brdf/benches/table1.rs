@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use haar_brdf::{Config, Grid, Keep, WaveletBrdf, encode, errors, resample_table};
+use wavelet_brdf::{Config, Decoded, Grid, Keep, encode, errors, resample_table};
 
 fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/merl");
@@ -22,7 +22,7 @@ fn main() {
         println!("skipped: no tables in {} (make test-data makes them)", dir.display());
         return;
     }
-    let grid = Grid::new(haar_brdf::DEFAULT_SIDE).expect("the default side");
+    let grid = Grid::new(wavelet_brdf::DEFAULT_SIDE).expect("the default side");
     println!(
         "{} threads; (32 x 32)^2 samples; rms in 1/sr; rel: mean |f - f'| / f in % over f > 0; rel>=floor: the same \
          over f >= eps mu (1% of the channel mean)",
@@ -46,7 +46,7 @@ fn main() {
                     .expect("a valid config");
                 encode_s += start.elapsed().as_secs_f64();
                 let start = Instant::now();
-                let brdf = WaveletBrdf::from_payload(&encoded.payload).expect("a valid payload");
+                let brdf = Decoded::from_payload(&encoded.payload).expect("a valid payload");
                 let decoded = brdf.decode(0);
                 decode_s += start.elapsed().as_secs_f64();
                 let e = errors(&resampled.values, &decoded, brdf.floor());

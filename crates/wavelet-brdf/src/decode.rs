@@ -1,5 +1,5 @@
 //! Reading a `wavelet-brdf` payload back: the value of any direction pair at any level of detail
-//! (sections 5.3-5.4), by the same steps the WGSL decoder (`gpu`, `haar_brdf.wgsl`) takes.
+//! (sections 5.3-5.4), by the same steps the WGSL decoder (`gpu`, `wavelet_brdf.wgsl`) takes.
 
 use glam::DVec3;
 
@@ -9,7 +9,7 @@ use crate::transform;
 
 /// A decoded `wavelet-brdf` asset, ready to evaluate.
 #[derive(Clone, Debug, PartialEq)]
-pub struct WaveletBrdf {
+pub struct Decoded {
     grid: Grid,
     epsilon: f64,
     channel_mean: [f64; 3],
@@ -20,9 +20,9 @@ pub struct WaveletBrdf {
     slices: Vec<f32>,
 }
 
-impl WaveletBrdf {
+impl Decoded {
     /// Checks the payload (as the asset reader does) and lays its slices out behind a zero slice.
-    pub fn from_payload(payload: &asset::WaveletBrdf) -> Result<WaveletBrdf, Error> {
+    pub fn from_payload(payload: &asset::WaveletBrdf) -> Result<Decoded, Error> {
         payload.check().map_err(Error::Invalid)?;
         let grid = Grid::new(payload.side as usize)?;
         let slice_len = grid.cells() * 3;
@@ -36,7 +36,7 @@ impl WaveletBrdf {
                 }));
             }
         }
-        Ok(WaveletBrdf {
+        Ok(Decoded {
             grid,
             epsilon: payload.epsilon,
             channel_mean: payload.channel_mean,
@@ -62,7 +62,7 @@ impl WaveletBrdf {
         self.map.len() as f64 / self.map.iter().filter(|&&m| m != 0).count().max(1) as f64
     }
 
-    /// Per coefficient position, its slice in [`WaveletBrdf::slices`] (0: the zero slice).
+    /// Per coefficient position, its slice in [`Decoded::slices`] (0: the zero slice).
     pub fn map(&self) -> &[u32] {
         &self.map
     }
@@ -116,7 +116,7 @@ impl WaveletBrdf {
     ///    directions);
     /// 2. the log-encoded value of each of the 16 cell pairs at the integer levels `floor(lod)`
     ///    and `floor(lod) + 1` (up to `J`), blended by the fraction of `lod` (section 5.4.1);
-    /// 3. the bilinear sum of those values, in the log domain, and [`WaveletBrdf::from_log`].
+    /// 3. the bilinear sum of those values, in the log domain, and [`Decoded::from_log`].
     pub fn eval(&self, wi: DVec3, wo: DVec3, lod: f64) -> [f64; 3] {
         let (Some(outgoing), Some(incoming)) = (self.grid.bilinear(wo), self.grid.bilinear(wi)) else {
             return [0.0; 3];
@@ -142,7 +142,7 @@ impl WaveletBrdf {
     }
 
     /// Every log-encoded value at the integer level of detail `lod`, by the inverse transform of
-    /// whole slices (`wavelet::waverec2`: independent of [`WaveletBrdf::log_value`]'s point
+    /// whole slices (`dwt::waverec2`: independent of [`Decoded::log_value`]'s point
     /// synthesis), in the layout of `Resampled::log_encoded`.
     pub fn decode_log(&self, lod: usize) -> Vec<f64> {
         let cells = self.grid.cells();

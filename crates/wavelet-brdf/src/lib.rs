@@ -1,6 +1,6 @@
 //! Haar wavelet encoding of measured BRDFs for real-time rendering (Claustres, Barthe and Paulin,
 //! *Wavelet encoding of BRDFs for real-time rendering*, Graphics Interface 2007, sections 4-5):
-//! the tool `brdf-wavelet` and the previewer's `--brdf wavelet`.
+//! the tool `brdf-wavelet` and the previewer's `--brdf wavelet-brdf`.
 //!
 //! # The steps, and the choices the paper leaves open
 //!
@@ -31,7 +31,7 @@
 //! 5. **Quantisation** (section 5.1, optional). Each stored slice and channel keeps its range
 //!    (`offset`, `step`, as `f32`) and 8-bit codes `round((c - offset) / step)`, `step = range /
 //!    255`: the error of a coefficient is at most `step / 2`.
-//! 6. **Reconstruction** ([`WaveletBrdf::eval`], sections 5.3-5.4). Level of detail `lod` in
+//! 6. **Reconstruction** ([`Decoded::eval`], sections 5.3-5.4). Level of detail `lod` in
 //!    `[0, log2 n]` leaves out the finest `floor(lod)` levels and blends linearly to the next
 //!    (section 5.4.1; `0` is full resolution). Magnification (section 5.4.2) is bilinear between
 //!    cell centres over `wi` and over `wo`, on the log-encoded values: by linearity this is the
@@ -62,7 +62,7 @@ pub mod transform;
 mod decode;
 mod encode;
 
-pub use decode::WaveletBrdf;
+pub use decode::Decoded;
 pub use encode::{
     Coefficients, DEFAULT_EPSILON, DEFAULT_SIDE, Keep, Resampled, coefficients, resample, resample_table,
 };
@@ -164,7 +164,7 @@ pub struct Errors {
 }
 
 /// The errors of `decoded` against `original` (same layout); `floor` per channel is usually
-/// `eps mu` ([`WaveletBrdf::floor`]).
+/// `eps mu` ([`Decoded::floor`]).
 pub fn errors(original: &[[f64; 3]], decoded: &[[f64; 3]], floor: [f64; 3]) -> Errors {
     assert_eq!(original.len(), decoded.len(), "two tables of one grid");
     let (mut squares, mut sum, mut relative, mut max_relative, mut positive) = (0.0, 0.0, 0.0, 0.0f64, 0usize);

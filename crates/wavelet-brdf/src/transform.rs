@@ -1,7 +1,7 @@
 //! The 2D non-standard Haar transform of one slice (section 4.2) in its in-place ("Mallat")
 //! layout, and the synthesis of one value from it (section 5.3).
 //!
-//! The transform is `wavelet::wavedec2` with the Haar wavelet over all `J = log2 n` levels (rows
+//! The transform is `dwt::wavedec2` with the Haar wavelet over all `J = log2 n` levels (rows
 //! and columns transformed once per level, then the approximation again: the non-standard
 //! decomposition). Its coefficients are laid out in one `n x n` array, row-major, index
 //! `p = row n + col`: the approximation at `(0, 0)`, and level `j` (`1` finest .. `J`), whose
@@ -25,8 +25,8 @@
 //! ([`synthesis`]). Reconstruction at level of detail `L` leaves out the levels `j <= L`: the
 //! value is then the mean of the `2^L x 2^L` block around the cell (Haar's approximation).
 
+use dwt::{Decomposition2, Image, Orientation, Wavelet};
 use rayon::prelude::*;
-use wavelet::{Decomposition2, Image, Orientation, Wavelet};
 
 use crate::grid::Grid;
 
@@ -46,7 +46,7 @@ fn position(side: usize, level: usize, band: Orientation, ky: usize, kx: usize) 
 pub fn forward(grid: Grid, slice: &[f64]) -> Vec<f64> {
     let n = grid.side();
     let image = Image::new(n, n, slice.to_vec()).expect("a slice holds n^2 values");
-    let d = wavelet::wavedec2(&image, Wavelet::Haar, grid.levels()).expect("n is a power of two and values finite");
+    let d = dwt::wavedec2(&image, Wavelet::Haar, grid.levels()).expect("n is a power of two and values finite");
     let mut layout = vec![0.0; grid.cells()];
     layout[0] = d.approx.get(0, 0);
     for (j, bands) in d.details.iter().enumerate() {
@@ -63,7 +63,7 @@ pub fn forward(grid: Grid, slice: &[f64]) -> Vec<f64> {
 }
 
 /// The slice of a coefficient layout, reconstructed at level of detail `lod` (`0` is full
-/// resolution; the levels `1..=lod` are left out) by `wavelet::waverec2`.
+/// resolution; the levels `1..=lod` are left out) by `dwt::waverec2`.
 pub fn inverse(grid: Grid, layout: &[f64], lod: usize) -> Vec<f64> {
     let n = grid.side();
     let band_image = |level: usize, band: Orientation| {
@@ -74,7 +74,7 @@ pub fn inverse(grid: Grid, layout: &[f64], lod: usize) -> Vec<f64> {
     let details = (1..=grid.levels()).map(|j| Orientation::ALL.map(|band| band_image(j, band))).collect();
     let approx = Image::new(1, 1, vec![layout[0]]).expect("one value");
     let d = Decomposition2 { wavelet: Wavelet::Haar, approx, details };
-    wavelet::waverec2(&d).expect("a whole decomposition of finite values").into_data()
+    dwt::waverec2(&d).expect("a whole decomposition of finite values").into_data()
 }
 
 /// The terms `(position, weight)` whose sum `sum weight * layout[position]` is the value of cell

@@ -5,9 +5,9 @@
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use haar_brdf::{Config, Grid, Keep, Resampled, WaveletBrdf, encode, errors, grid, resample, transform};
 use merl::analytic::Analytic;
 use rand::{Rng, SeedableRng};
+use wavelet_brdf::{Config, Decoded, Grid, Keep, Resampled, encode, errors, grid, resample, transform};
 
 /// The paper's Lewis-like material: `kd 0.8, ks 0.2, n 10` (Table 1's Lewis row).
 const LEWIS: Analytic = Analytic::Phong { n: 10.0, ks: [0.2; 3], kd: [0.8; 3] };
@@ -22,9 +22,9 @@ fn lewis() -> &'static Resampled {
     LEWIS32.get_or_init(|| resampled(32, LEWIS))
 }
 
-fn decoded(resampled: &Resampled, config: Config) -> (haar_brdf::Encoded, WaveletBrdf) {
+fn decoded(resampled: &Resampled, config: Config) -> (wavelet_brdf::Encoded, Decoded) {
     let encoded = encode(resampled, config).unwrap();
-    let brdf = WaveletBrdf::from_payload(&encoded.payload).unwrap();
+    let brdf = Decoded::from_payload(&encoded.payload).unwrap();
     (encoded, brdf)
 }
 
@@ -35,7 +35,7 @@ fn random_slice(side: usize, seed: u64) -> Vec<f64> {
 
 #[test]
 fn point_synthesis_equals_the_inverse_transform_at_every_level() {
-    // Two independent reconstructions: `wavelet::waverec2` of whole slices (held to PyWavelets)
+    // Two independent reconstructions: `dwt::waverec2` of whole slices (held to PyWavelets)
     // and the closed-form synthesis the decoders use. 1e-12: both are a few dozen f64 operations.
     for side in [2, 8, 32] {
         let grid = Grid::new(side).unwrap();
@@ -118,7 +118,7 @@ fn the_log_domain_error_is_the_energy_of_the_dropped_coefficients() {
     // Parseval. 1e-5 relative: the kept coefficients are stored as f32, which adds about 1e-7 of
     // their size per value; the dropped energy is a share of a percent of the total or more.
     let table = lewis();
-    let log = table.log_encoded(haar_brdf::DEFAULT_EPSILON);
+    let log = table.log_encoded(wavelet_brdf::DEFAULT_EPSILON);
     for ratio in [4, 16, 32] {
         let (encoded, brdf) = decoded(table, Config { keep: Keep::Ratio(ratio), ..Config::default() });
         let error: f64 = log.iter().zip(brdf.decode_log(0)).map(|(a, b)| (a - b) * (a - b)).sum();
@@ -141,7 +141,7 @@ fn a_ratio_keeps_exactly_its_share_of_the_coefficients() {
         assert_eq!(encoded.kept_coefficients * ratio as usize, encoded.total_coefficients);
         assert_eq!(encoded.total_coefficients, 3 * 16usize.pow(4));
         // The kept positions are those of largest energy.
-        let energy = haar_brdf::coefficients(&table, haar_brdf::DEFAULT_EPSILON).unwrap().position_energy();
+        let energy = wavelet_brdf::coefficients(&table, wavelet_brdf::DEFAULT_EPSILON).unwrap().position_energy();
         let kept = |keep: bool| energy.iter().zip(&encoded.payload.map).filter(move |(_, m)| (**m != 0) == keep);
         let least_kept = kept(true).map(|(e, _)| *e).fold(f64::INFINITY, f64::min);
         assert!(kept(false).all(|(e, _)| *e <= least_kept), "{ratio}:1");
@@ -161,7 +161,7 @@ fn a_ratio_keeps_exactly_its_share_of_the_coefficients() {
 /// (every coefficient of the `(1 - 1/ratio)` outgoing cells of least energy). A dropped slice
 /// reconstructs to log value 0 everywhere, `f' = mu (1 - eps)`.
 fn dropping_outgoing_slices(table: &Resampled, ratio: usize) -> f64 {
-    let coefficients = haar_brdf::coefficients(table, haar_brdf::DEFAULT_EPSILON).unwrap();
+    let coefficients = wavelet_brdf::coefficients(table, wavelet_brdf::DEFAULT_EPSILON).unwrap();
     let cells = table.grid.cells();
     let mut energy = vec![0.0; cells];
     for (k, v) in coefficients.values.iter().enumerate() {
@@ -172,7 +172,7 @@ fn dropping_outgoing_slices(table: &Resampled, ratio: usize) -> f64 {
     let mut kept = vec![false; cells];
     order[..cells / ratio].iter().for_each(|&o| kept[o] = true);
     let mean = table.channel_mean();
-    let dropped = mean.map(|m| m * (1.0 - haar_brdf::DEFAULT_EPSILON));
+    let dropped = mean.map(|m| m * (1.0 - wavelet_brdf::DEFAULT_EPSILON));
     let decoded: Vec<[f64; 3]> =
         table.values.iter().enumerate().map(|(k, f)| if kept[k / cells] { *f } else { dropped }).collect();
     errors(&table.values, &decoded, [0.0; 3]).mean_relative_error
@@ -211,8 +211,8 @@ fn quantisation_rounds_each_coefficient_to_its_slice_range() {
     let asset::WaveletCoefficients::Quantized { step, .. } = &encoded.payload.coefficients else {
         panic!("not quantized")
     };
-    let exact = haar_brdf::coefficients(&table, config.epsilon).unwrap();
-    let brdf = WaveletBrdf::from_payload(&encoded.payload).unwrap();
+    let exact = wavelet_brdf::coefficients(&table, config.epsilon).unwrap();
+    let brdf = Decoded::from_payload(&encoded.payload).unwrap();
     let slice_len = table.grid.cells() * 3;
     for (p, &m) in encoded.payload.map.iter().enumerate() {
         if m == 0 {
@@ -226,7 +226,7 @@ fn quantisation_rounds_each_coefficient_to_its_slice_range() {
         }
     }
     let unquantized =
-        WaveletBrdf::from_payload(&encode(&table, Config { quantize: false, ..config }).unwrap().payload).unwrap();
+        Decoded::from_payload(&encode(&table, Config { quantize: false, ..config }).unwrap().payload).unwrap();
     let (eq, ef) = (
         errors(&table.values, &brdf.decode(0), brdf.floor()),
         errors(&table.values, &unquantized.decode(0), unquantized.floor()),
@@ -285,13 +285,13 @@ fn a_lambertian_material_evaluates_exactly_between_cells() {
 fn absurd_coefficients_are_refused() {
     let table = resampled(4, LEWIS);
     let good = encode(&table, Config { keep: Keep::Ratio(4), ..Config::default() }).unwrap().payload;
-    assert!(WaveletBrdf::from_payload(&good).is_ok());
+    assert!(Decoded::from_payload(&good).is_ok());
     let bound = (asset::WAVELET_LOG_BOUND * f64::from(good.side)) as f32;
     for (value, accepted) in [(bound, true), (-bound, true), (1.001 * bound, false), (1e30, false), (f32::NAN, false)] {
         let mut payload = good.clone();
         let asset::WaveletCoefficients::Float(values) = &mut payload.coefficients else { panic!("not floats") };
         values[0] = value;
-        let result = WaveletBrdf::from_payload(&payload);
+        let result = Decoded::from_payload(&payload);
         assert_eq!(result.is_ok(), accepted, "{value}: {:?}", result.err().map(|e| e.to_string()));
     }
 }
@@ -300,7 +300,7 @@ fn absurd_coefficients_are_refused() {
 fn damaged_payloads_are_refused_with_their_problem() {
     let table = resampled(4, LEWIS);
     let good = encode(&table, Config { keep: Keep::Ratio(4), quantize: true, ..Config::default() }).unwrap().payload;
-    assert!(WaveletBrdf::from_payload(&good).is_ok());
+    assert!(Decoded::from_payload(&good).is_ok());
     type Damage = Box<dyn Fn(&mut asset::WaveletBrdf)>;
     let cases: Vec<(&str, Damage)> = vec![
         ("side", Box::new(|p| p.side = 6)),
@@ -363,7 +363,7 @@ fn damaged_payloads_are_refused_with_their_problem() {
     for (problem, damage) in cases {
         let mut bad = good.clone();
         damage(&mut bad);
-        let err = WaveletBrdf::from_payload(&bad).unwrap_err().to_string();
+        let err = Decoded::from_payload(&bad).unwrap_err().to_string();
         assert!(err.contains(problem), "expected '{problem}' in: {err}");
     }
 }

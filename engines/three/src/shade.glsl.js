@@ -228,7 +228,7 @@ int merl_axis_index(float x, int n) {
     return int(clamp(floor(x), 0.0, float(n - 1)));
 }
 
-// merl_lookup_nearest and brdf_wavelet.wgsl's material_brdf for a table: the nearest cell.
+// merl_lookup_nearest and wavelet_brdf.wgsl's material_brdf for a table: the nearest cell.
 vec3 material_brdf(vec3 wi, vec3 wo) {
     ivec3 dims = textureSize(uMerl, 0);
     vec4 hd = merl_half_diff(wi, wo);

@@ -10,16 +10,16 @@ use bake::{BakeConfig, Program, Progress};
 use clap::Parser;
 use serde_json::json;
 
-/// Bake a MERL material (and, with --env, an environment map) for real-time rendering. Writes,
-/// in DIR: the importance samples (importance.asset, importance.png), the bandwidth atlas
-/// (bandwidth-atlas.asset: once per row for an isotropic table, kind bandwidth-rows; .exr: the
-/// full 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset,
-/// .png), with --wavelet-ratio its Haar wavelet encoding (wavelet-brdf.asset, .png; what
-/// brdf-preview --brdf wavelet reads), and with --env the environment's bandwidth (env-bandwidth.exr/.png), its Phong-lobe
-/// layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2, layers.png),
-/// the layer selection (layer-selection.asset) and with --engine-textures the engine textures
-/// (engine-*.ktx2); then manifest.json (data-schema/README.md: every file with its sha256, the parameters, the tool
-/// version and each stage's validation figures), written last.
+/// Bake a MERL material (and, with --env, an environment map) for real-time rendering. Writes, in
+/// DIR: the importance samples (importance.asset, importance.png), the bandwidth atlas
+/// (bandwidth-atlas.asset: once per row for an isotropic table, kind bandwidth-rows; .exr: the full
+/// 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset, .png), with
+/// --wavelet-brdf-ratio its Haar wavelet encoding (wavelet-brdf.asset, .png; what brdf-preview
+/// --brdf wavelet-brdf reads), and with --env the environment's bandwidth (env-bandwidth.exr/.png),
+/// its Phong-lobe layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2,
+/// layers.png), the layer selection (layer-selection.asset) and with --engine-textures the engine
+/// textures (engine-*.ktx2); then manifest.json (data-schema/README.md: every file with its sha256,
+/// the parameters, the tool version and each stage's validation figures), written last.
 ///
 /// A rerun with the same inputs (by sha256), parameters and tool version finds the manifest up to
 /// date and writes nothing (--force bakes anyway). Outputs are deterministic: reruns and thread
@@ -53,11 +53,11 @@ struct Args {
     /// grid), keeping 1/R of the coefficients: a power of two up to 1024 (4, 16 and 32 are the
     /// paper's Table 1).
     #[arg(long, value_name = "R", value_parser = cli::parse_count)]
-    wavelet_ratio: Option<usize>,
+    wavelet_brdf_ratio: Option<usize>,
 
-    /// With --wavelet-ratio, store the kept coefficients as 8-bit codes.
-    #[arg(long, requires = "wavelet_ratio")]
-    wavelet_quantize: bool,
+    /// With --wavelet-brdf-ratio, store the kept coefficients as 8-bit codes.
+    #[arg(long, requires = "wavelet_brdf_ratio")]
+    wavelet_brdf_quantize: bool,
 
     /// Vectors of importance samples per view elevation (each of --samples samples): the
     /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
@@ -144,14 +144,14 @@ fn run(args: Args) -> Result<ExitCode> {
     }
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;
-    if let Some(ratio) = args.wavelet_ratio {
-        let ratio = u32::try_from(ratio).map_err(|_| anyhow::anyhow!("--wavelet-ratio {ratio} is too large"))?;
-        let config_w = haar_brdf::Config {
-            keep: haar_brdf::Keep::Ratio(ratio),
-            quantize: args.wavelet_quantize,
+    if let Some(ratio) = args.wavelet_brdf_ratio {
+        let ratio = u32::try_from(ratio).map_err(|_| anyhow::anyhow!("--wavelet-brdf-ratio {ratio} is too large"))?;
+        let config_w = wavelet_brdf::Config {
+            keep: wavelet_brdf::Keep::Ratio(ratio),
+            quantize: args.wavelet_brdf_quantize,
             ..Default::default()
         };
-        config.wavelet = Some(bake::stage::wavelet::Settings { config: config_w, ..Default::default() });
+        config.wavelet_brdf = Some(bake::stage::wavelet_brdf::Settings { config: config_w, ..Default::default() });
     }
     config.importance.n_vectors = args.vectors;
     config.importance.n_samples = args.samples;

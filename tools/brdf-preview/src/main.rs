@@ -59,7 +59,7 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///                environment, the cosine and the MERL grid's half vectors, N samples per
 ///                strategy, no baked table) and reports PSNR and the ratio of mean luminances
 ///
-///   --brdf wavelet
+///   --brdf wavelet-brdf
 ///                evaluates the BRDF from its Haar wavelet encoding (brdf-wavelet), decoded per
 ///                sample on the GPU, renders the same image from the table, reports the PSNR and
 ///                relative error of the wavelet image against it and writes OUT-table.png
@@ -82,20 +82,20 @@ struct Args {
     material: Option<PathBuf>,
 
     /// Which BRDF the estimators evaluate: the MERL table (nearest lookup), or its Haar wavelet
-    /// encoding (brdf-wavelet; Claustres et al. 2007), decoded on the GPU at --wavelet-lod.
+    /// encoding (brdf-wavelet; Claustres et al. 2007), decoded on the GPU at --wavelet-brdf-lod.
     #[arg(long, value_enum, default_value_t = BrdfArg::Table)]
     brdf: BrdfArg,
 
-    /// The wavelet-brdf asset for --brdf wavelet, made from the bake's material. Default: the
+    /// The wavelet-brdf asset for --brdf wavelet-brdf, made from the bake's material. Default: the
     /// bake's own (its manifest's wavelet-brdf output, which brdf-wavelet MATERIAL --out-dir BAKE
-    /// and brdf-bake --wavelet-ratio R add).
+    /// and brdf-bake --wavelet-brdf-ratio R add).
     #[arg(long, value_name = "FILE")]
-    wavelet: Option<PathBuf>,
+    wavelet_brdf: Option<PathBuf>,
 
     /// Level of detail of the wavelet reconstruction, from 0 (full resolution) to log2 of the
     /// grid side (the hemisphere's mean, at most 8); fractions blend two levels.
     #[arg(long, value_name = "L", default_value_t = 0.0, value_parser = parse_lod)]
-    wavelet_lod: f64,
+    wavelet_brdf_lod: f64,
 
     /// The mesh: sphere, torus, or a Wavefront OBJ file (scaled to the unit sphere).
     #[arg(long, default_value = "sphere", value_name = "sphere|torus|FILE.obj")]
@@ -201,7 +201,7 @@ struct Args {
     min_psnr: Option<f64>,
 
     /// The most samples this run may take, a ceiling against runaway work (a mistyped --frames or
-    /// --converged): pixels x spp x frames on the GPU (twice with --brdf wavelet), the same again
+    /// --converged): pixels x spp x frames on the GPU (twice with --brdf wavelet-brdf), the same again
     /// on the CPU with --validate, and pixels x 3 x N for the converged estimate (--converged N;
     /// --validate in the adaptive modes takes 256). From 1; the default, 2^32, is about a minute
     /// of a GPU or an hour of CPU: raise it for a deliberate long run.
@@ -237,7 +237,7 @@ struct Args {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum BrdfArg {
     Table,
-    Wavelet,
+    WaveletBrdf,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -313,10 +313,10 @@ fn run(args: Args) -> Result<ExitCode> {
         material: args.material,
         brdf: match args.brdf {
             BrdfArg::Table => Brdf::Table,
-            BrdfArg::Wavelet => Brdf::Wavelet,
+            BrdfArg::WaveletBrdf => Brdf::WaveletBrdf,
         },
-        wavelet: args.wavelet,
-        wavelet_lod: args.wavelet_lod,
+        wavelet_brdf: args.wavelet_brdf,
+        wavelet_brdf_lod: args.wavelet_brdf_lod,
         mesh: args.mesh,
         mode: match args.mode {
             ModeArg::Reference => Mode::Reference,

@@ -1,15 +1,15 @@
 //! `brdf-wavelet`: a MERL BRDF encoded in Haar wavelets for real-time rendering (Claustres,
 //! Barthe and Paulin 2007), as one asset, with the errors of its Table 1 and a picture of a few
-//! slices. Argument parsing and printing around `bake::stage::wavelet`.
+//! slices. Argument parsing and printing around `bake::stage::wavelet_brdf`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
-use bake::stage::wavelet::Settings;
+use bake::stage::wavelet_brdf::Settings;
 use bake::{Program, Source};
 use clap::Parser;
-use haar_brdf::{Config, DEFAULT_EPSILON, DEFAULT_SIDE, Keep};
+use wavelet_brdf::{Config, DEFAULT_EPSILON, DEFAULT_SIDE, Keep};
 
 /// Encode a MERL BRDF table in Haar wavelets (Claustres, Barthe and Paulin 2007, sections 4-5):
 /// resample it on the sphere parameterization ((32 x 32)^2 direction pairs by default), log-encode
@@ -18,12 +18,12 @@ use haar_brdf::{Config, DEFAULT_EPSILON, DEFAULT_SIDE, Keep};
 /// quantize to 8 bits. Writes, in DIR: wavelet-brdf.asset (kind wavelet-brdf; layout in
 /// data-schema/README.md) and wavelet-brdf.png (three slices before and after, and their relative
 /// error). Reports the paper's Table 1 figures: RMS error and mean relative error against the
-/// resampled table. brdf-preview --brdf wavelet renders from the asset.
+/// resampled table. brdf-preview --brdf wavelet-brdf renders from the asset.
 ///
 /// Into a bake folder (one with a manifest.json, made by brdf-bake from the same table), the
-/// files are added to the bake as brdf-bake --wavelet-ratio would add them: the manifest lists
+/// files are added to the bake as brdf-bake --wavelet-brdf-ratio would add them: the manifest lists
 /// them and records these settings, through the bake's own protocol (the folder locked, the new
-/// files and manifest switched in together). A later brdf-bake without --wavelet-ratio rebakes the
+/// files and manifest switched in together). A later brdf-bake without --wavelet-brdf-ratio rebakes the
 /// folder without them.
 ///
 /// Example: brdf-wavelet lewis.binary --out-dir lewis --ratio 16 --quantize 8
@@ -101,11 +101,11 @@ fn run(args: Args) -> Result<ExitCode> {
     let source = Source::of_bytes(&args.material, &bytes);
     let table = merl::MerlTable::parse(&bytes).with_context(|| format!("reading {}", args.material.display()))?;
     drop(bytes);
-    let staged = bake::stage::wavelet::run(&table, &source, &PROGRAM, settings)?;
+    let staged = bake::stage::wavelet_brdf::run(&table, &source, &PROGRAM, settings)?;
     let dir = &args.out_dir;
     let mut report = staged.report.clone();
     let parameters = serde_json::Value::Object(settings.parameters());
-    if bake::write_stage(dir, &staged, &source, ("wavelet", parameters))? {
+    if bake::write_stage(dir, &staged, &source, ("wavelet_brdf", parameters))? {
         report.push(format!(
             "added to the bake in {}: its {} lists the files and these settings",
             dir.display(),

@@ -9,7 +9,7 @@ pub mod layers;
 pub mod material_info;
 pub mod pca;
 pub mod prefilter;
-pub mod wavelet;
+pub mod wavelet_brdf;
 
 /// Whether `name` is the name of a file some stage writes (`importance.asset`, `layer-n16.exr`,
 /// ...; `data-schema/README.md` lists them by role): a rebake removes a file of the previous
@@ -23,8 +23,8 @@ pub fn is_output_name(name: &str) -> bool {
         atlas::PICTURE,
         pca::ASSET,
         pca::PICTURE,
-        wavelet::ASSET,
-        wavelet::PICTURE,
+        wavelet_brdf::ASSET,
+        wavelet_brdf::PICTURE,
         env_bandwidth::EXR,
         env_bandwidth::PICTURE,
         prefilter::ASSET,

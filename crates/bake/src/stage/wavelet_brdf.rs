@@ -1,16 +1,16 @@
 //! Haar wavelet encoding of a material (`brdf-wavelet`; `004` sections 4-5, crate
-//! `haar-brdf`): the asset of kind `wavelet-brdf`, Table 1's errors of the reconstruction
+//! `wavelet-brdf`): the asset of kind `wavelet-brdf`, Table 1's errors of the reconstruction
 //! against the resampled table, and a picture of a few slices before and after.
 
 use std::f64::consts::FRAC_PI_2;
 
-use haar_brdf::{Config, Grid, Keep, Resampled, WaveletBrdf};
 use merl::MerlTable;
 use picture::colormap::{Scale, inferno, viridis};
 use picture::layout::{Axis, Grid as Panels, caption, heat_map, stack};
 use picture::legend::Legend;
 use picture::{Canvas, format_number};
 use serde_json::json;
+use wavelet_brdf::{Config, Decoded, Grid, Keep, Resampled};
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
@@ -26,7 +26,7 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Settings {
-        Settings { side: haar_brdf::DEFAULT_SIDE, config: Config::default() }
+        Settings { side: wavelet_brdf::DEFAULT_SIDE, config: Config::default() }
     }
 }
 
@@ -71,11 +71,11 @@ pub const MAX_SIDE: usize = 64;
 pub fn run(table: &MerlTable, source: &Source, program: &Program, settings: Settings) -> Result<Staged, Error> {
     settings.check()?;
     let grid = Grid::new(settings.side).map_err(|e| Error::Invalid(e.to_string()))?;
-    let resampled = haar_brdf::resample_table(grid, table);
-    let encoded = haar_brdf::encode(&resampled, settings.config).map_err(|e| Error::Invalid(e.to_string()))?;
-    let brdf = WaveletBrdf::from_payload(&encoded.payload).map_err(|e| Error::Internal(e.to_string()))?;
+    let resampled = wavelet_brdf::resample_table(grid, table);
+    let encoded = wavelet_brdf::encode(&resampled, settings.config).map_err(|e| Error::Invalid(e.to_string()))?;
+    let brdf = Decoded::from_payload(&encoded.payload).map_err(|e| Error::Internal(e.to_string()))?;
     let decoded = brdf.decode(0);
-    let errors = haar_brdf::errors(&resampled.values, &decoded, brdf.floor());
+    let errors = wavelet_brdf::errors(&resampled.values, &decoded, brdf.floor());
 
     let config = settings.config;
     let keep = keep_name(config.keep);

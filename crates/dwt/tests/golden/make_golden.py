@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Golden vectors for the `wavelet` crate, produced by PyWavelets.
+"""Golden vectors for the `dwt` crate, produced by PyWavelets.
 
 Generated with PyWavelets 1.9.0 and numpy 2.4.6 (Python 3.11). To regenerate, from the
 repository root:
 
     python3 -m pip install PyWavelets==1.9.0 numpy==2.4.6
-    python3 crates/wavelet/tests/golden/make_golden.py
+    python3 crates/dwt/tests/golden/make_golden.py
 
 The output is deterministic (fixed seeds) and is written next to this script as
 `golden_1d.json` and `golden_2d.json`. Floats are written with Python's `repr` (shortest string

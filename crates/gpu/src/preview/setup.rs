@@ -33,7 +33,7 @@ impl Renderer {
 
         let table = &material.table;
         check_buffer_fits(&limits, info, table_bytes(table.dims()), "the MERL table")?;
-        if let Some(w) = &material.wavelet {
+        if let Some(w) = &material.wavelet_brdf {
             check_buffer_fits(&limits, info, 4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
         }
         let samples = &material.samples;
@@ -196,14 +196,14 @@ impl Renderer {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             let table_buffer = storage("merl table", bytemuck::cast_slice(&gpu_table_values(table)));
-            let wavelet = WaveletUniform::new(material.wavelet.as_ref());
+            let wavelet = WaveletUniform::new(material.wavelet_brdf.as_ref());
             let wavelet_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("wavelet params"),
                 contents: bytemuck::bytes_of(&wavelet),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             // Without a wavelet the shader never reads these; a binding cannot be empty.
-            let (map, slices) = match &material.wavelet {
+            let (map, slices) = match &material.wavelet_brdf {
                 Some(w) => (w.brdf.map(), w.brdf.slices()),
                 None => (&[0u32][..], &[0f32][..]),
             };

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use render::Mode;
 
-/// `WaveletParams` of `brdf_wavelet.wgsl`.
+/// `WaveletParams` of `wavelet_brdf.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct WaveletUniform {
@@ -17,7 +17,7 @@ pub(crate) struct WaveletUniform {
 }
 
 impl WaveletUniform {
-    pub(crate) fn new(wavelet: Option<&render::Wavelet>) -> WaveletUniform {
+    pub(crate) fn new(wavelet: Option<&render::WaveletBrdf>) -> WaveletUniform {
         match wavelet {
             Some(w) => {
                 let grid = w.brdf.grid();
