@@ -127,23 +127,15 @@ target/merl/%.binary: | setup-python
 	@echo "making $@ (nbrdf2merl.py)"
 	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
 
-## bench: timings against baselines measured in the same run (benchmarks, not tests). Then issue
-## 11's equal-quality benchmark of the adaptive modes against the brute force, on the GPU
-## (lavapipe without one) at 512 x 512: about 50 minutes the first time on 2 cores (its bakes and
-## converged images are kept under target/bench-adaptive/), 12 after. Last, issue 31's outside
-## referee: the CPU renderer against Mitsuba 3 (setup-mitsuba) on twelve cases at 128 x 128, about
-## 30 minutes the first time on 2 cores (its bakes and Mitsuba's renders are kept under
-## target/bench-mitsuba/), 6 after.
-bench: setup-gpu setup-mitsuba
-	$(CARGO) bench -p importance --bench build
-	$(CARGO) bench -p envmap --bench load
-	$(CARGO) bench -p bandwidth --bench bandwidth
-	$(CARGO) bench -p prefilter --bench prefilter
-	$(CARGO) bench -p brdf-atlas --bench atlas
-	$(CARGO) bench -p bake --bench stages
-	$(CARGO) bench -p wavelet-brdf --bench table1
-	$(CARGO) bench -p brdf-preview --bench adaptive -- --gpu
-	$(CARGO) bench -p brdf-preview --bench mitsuba
+## bench: every benchmark (scripts/benchmarks.py lists them: timings against baselines measured in
+## the same run, issue 11's equal-quality benchmark of the adaptive modes on the GPU, lavapipe
+## without one, and issue 31's outside referee, the CPU renderer against Mitsuba 3), each report
+## written into docs/benchmarks.md stamped with the commit and the machine; BENCH="stages atlas"
+## runs some and keeps the other sections. About 90 minutes the first time on 2 cores (the
+## adaptive and Mitsuba benchmarks keep their bakes, converged images and renders under
+## target/bench-adaptive/ and target/bench-mitsuba/), 30 after.
+bench: setup-gpu setup-mitsuba test-data
+	python3 scripts/benchmarks.py $(BENCH)
 
 ## three-cases: the three.js material in headless Chromium against brdf-preview on the issue's six
 ## cases (white-paint, gold-paint, chrome under quarry_01 and potsdamer_platz, 128 x 128, both

@@ -185,10 +185,9 @@
 //! buffer of `(J + 1) x width` values per thread. Nothing is allocated per pixel. [`Workspace`]
 //! keeps every buffer between estimates of images of one size, and
 //! [`Workspace::levels_top_left`] estimates only a corner of an image (what the BRDF atlas keeps
-//! of its continued lobe images), each pixel as in the whole map. A 1024 x 512
-//! map, release build, on two cores shared with other work: 10 ms periodic (up to 27 ms under
-//! load), 19 ms as a lat-long map (the extended image is 1024 x 1024; up to 48 ms), 25 ms zero
-//! padded (2048 x 1024; up to 61 ms). The windowed FFT takes 80 to 300 ms.
+//! of its continued lobe images), each pixel as in the whole map. `cargo bench -p bandwidth
+//! --bench bandwidth` times a real 1024 x 512 map against one D4 decomposition of it (its last
+//! report is in `docs/benchmarks.md`).
 
 mod compare;
 mod error;

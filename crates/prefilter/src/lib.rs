@@ -77,10 +77,10 @@
 //!
 //! # Cost
 //!
-//! A 1024 x 512 map, the 7 default exponents, 256 x 128 layers: about 0.1 s on 2 cores in release
-//! (0.18 s with the cores shared), several hundred times faster than the brute-force reference
-//! (`benches/prefilter.rs` prints the table). Memory: the row spectra and coefficients, a few tens
-//! of megabytes at `L = 411`.
+//! Time: `cargo bench -p prefilter --bench prefilter` times real 1024 x 512 maps, the 7 default
+//! exponents and 256 x 128 layers, against the brute-force reference (its last report is in
+//! `docs/benchmarks.md`). Memory: the row spectra and coefficients, a few tens of megabytes at
+//! `L = 411`.
 
 pub mod cube;
 pub mod dfg;

@@ -35,9 +35,8 @@
 //! than [`PLATEAU_DB`]), an equal-quality speed-up is the luck of the samples, and the report
 //! marks the row `~` and summarizes the rows off the plateau apart. A brute force that finds a
 //! small bright source only by chance flattens so: the reference mode before it sampled the
-//! environment did under quarry's sun. With multiple importance sampling of the environment it
-//! converges there like anywhere (gold-paint / quarry / sphere: 26.2 dB at 1 spp to 50.2 at 64,
-//! 4 dB per doubling).
+//! environment did under quarry's sun; with multiple importance sampling of the environment it
+//! converges there like anywhere.
 //!
 //! # On the GPU
 //!
@@ -49,19 +48,7 @@
 //! rasterize in every frame. On lavapipe the "GPU" is the machine's own cores: a frame's time is
 //! its work, not its waits.
 //!
-//! # Measured
-//!
-//! `cargo bench -p brdf-preview --bench adaptive -- --gpu` on lavapipe (2 cores, idle; the
-//! report's first lines give the commit; seed 0), paper reading: `adaptive` median speed-up 3.7x
-//! (0.4x to 15.1x; 11 of 24 rows at the 4x), `adaptive-prefiltered` 6.9x (0.9x to 22.7x;
-//! 7 of 24 at 10x); no row on a plateau. By material: gold-paint 6.8x and 10.1x, white-paint 6.1x
-//! and 9.4x, chrome 1.1x and 2.2x (its frames stop at their ceiling, which the brute force
-//! reaches in a few samples). The other readings: level-normalized 2.9x and 2.8x, the FFT oracle
-//! 2.8x and 3.7x, paper with the lobe weight 4.0x and 6.6x. The brute force's frame takes 76 to
-//! 96 ms at 1 spp (two directions a sample: the material's and the environment's), the adaptive
-//! frames 112 to 752 ms and 64 to 330 ms; 16x anti-aliasing costs 1.5x to 2.1x the time of none.
-//! A first run takes about 30 minutes on 2 cores (the twelve converged estimates on the CPU,
-//! kept for later runs). Not measured on a GPU with these estimators.
+//! # Running it
 //!
 //! `cargo bench -p brdf-preview --bench adaptive [-- --quick] [-- --gpu] [-- --seed S]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). Bakes and
