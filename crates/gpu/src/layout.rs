@@ -12,7 +12,7 @@ use crate::preview::adaptive::AdaptivePass;
 use crate::preview::present::PresentUniform;
 use crate::preview::uniforms::{PredictUniform, ShadeUniform, WaveletUniform};
 use crate::wgsl::{
-    MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_ADAPTIVE, PREVIEW_BINDINGS, PREVIEW_PREDICT, PREVIEW_PRESENT, WAVELET_BRDF,
+    ADAPTIVE_PREDICT, ADAPTIVE_STATE, MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_BINDINGS, PREVIEW_PRESENT, WAVELET_BRDF,
 };
 
 /// A host struct: the WGSL source and struct it mirrors, its size, and its members' WGSL names
@@ -88,11 +88,11 @@ fn shared_structs() -> Vec<Shared> {
             "peak_marginal" => tables.peak_marginal, "peak_conditional" => tables.peak_conditional,
             "items" => items, "_pad0" => _pad0, "_pad1" => _pad1, "_pad2" => _pad2,
         }),
-        shared!(PREVIEW_PREDICT.source, "Predict", PredictUniform {
+        shared!(ADAPTIVE_PREDICT.source, "Predict", PredictUniform {
             "n_b" => n_b, "env_width" => env_width, "env_height" => env_height, "lobes_x" => lobes_x,
             "lobes_y" => lobes_y, "tile" => tile, "radians_per_pixel" => radians_per_pixel, "_pad" => _pad,
         }),
-        shared!(PREVIEW_ADAPTIVE.source, "AdaptivePass", AdaptivePass {
+        shared!(ADAPTIVE_STATE.source, "AdaptivePass", AdaptivePass {
             "level" => level, "top" => top, "width" => width, "height" => height, "out_width" => out_width,
             "out_height" => out_height, "ss" => ss, "count" => count, "level_table" => level_table,
             "sharpness" => sharpness, "n_rows" => n_rows, "oracle" => oracle, "depth_sigma" => depth_sigma,

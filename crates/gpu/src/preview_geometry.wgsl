@@ -44,7 +44,7 @@ fn inside_clip_volume(c: vec4<f32>) -> bool {
 // coordinates relative to the pixel centre stay below 2^25 in magnitude (within the guard band of
 // an image of up to 16384 pixels), so the products need 51 bits: f32 would round them, and a
 // sliver's small edge function is the difference of two large products. (Also the adaptive
-// frame's allocation's sums: `preview_adaptive.wgsl`.)
+// frame's allocation's sums: `preview/adaptive/samples.wgsl`.)
 struct Wide {
     hi: u32,
     lo: u32,

@@ -3,7 +3,8 @@
 //! A test holds each file's list to what it uses: every name it uses that another file declares
 //! comes from a file it lists, and it lists no file it does not use.
 
-/// A WGSL file: its name in `crates/gpu/src`, its source and the files whose declarations it uses.
+/// A WGSL file: its path under `crates/gpu/src`, its source and the files whose declarations it
+/// uses.
 #[derive(Debug)]
 pub struct Wgsl {
     pub file: &'static str,
@@ -40,13 +41,21 @@ pub static PREVIEW_SHADE: Wgsl = wgsl!(
     "preview_shade.wgsl",
     [WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
-/// The prediction of an adaptive frame.
-pub static PREVIEW_PREDICT: Wgsl = wgsl!(
-    "preview_predict.wgsl",
+/// An adaptive frame, a file per stage of `render::adaptive` named as its Rust twin there
+/// (`predict.rs`: `predict.wgsl`), beside the host side in `preview/adaptive/`. The prediction.
+pub static ADAPTIVE_PREDICT: Wgsl = wgsl!(
+    "preview/adaptive/predict.wgsl",
     [MERL_LOOKUP, WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
-/// An adaptive frame after its prediction.
-pub static PREVIEW_ADAPTIVE: Wgsl = wgsl!("preview_adaptive.wgsl", [PREVIEW_BINDINGS, PREVIEW_GEOMETRY]);
+/// The frame's state after its prediction, which the stages below share.
+pub static ADAPTIVE_STATE: Wgsl = wgsl!("preview/adaptive/state.wgsl", []);
+/// The pyramids and the plan.
+pub static ADAPTIVE_PLAN: Wgsl = wgsl!("preview/adaptive/plan.wgsl", [PREVIEW_BINDINGS, ADAPTIVE_STATE]);
+/// The samples and the list of shaded blocks.
+pub static ADAPTIVE_SAMPLES: Wgsl =
+    wgsl!("preview/adaptive/samples.wgsl", [PREVIEW_BINDINGS, PREVIEW_GEOMETRY, ADAPTIVE_STATE]);
+/// The shaded blocks in place, the up-sampling and the output.
+pub static ADAPTIVE_FRAME: Wgsl = wgsl!("preview/adaptive/frame.wgsl", [PREVIEW_BINDINGS, ADAPTIVE_STATE]);
 /// The present pass, a module of its own.
 pub static PREVIEW_PRESENT: Wgsl = wgsl!("preview_present.wgsl", []);
 
@@ -55,7 +64,7 @@ pub static PREVIEW_PRESENT: Wgsl = wgsl!("preview_present.wgsl", []);
 pub static SEPARATE: [&Wgsl; 2] = [&PREVIEW_RASTER, &PREVIEW_PRESENT];
 
 /// Every file, for the tests.
-pub static ALL: [&Wgsl; 12] = [
+pub static ALL: [&Wgsl; 15] = [
     &MERL_LOOKUP,
     &MERL_LOOKUP_BATCH,
     &WAVELET_BRDF,
@@ -65,8 +74,11 @@ pub static ALL: [&Wgsl; 12] = [
     &PREVIEW_GEOMETRY,
     &PREVIEW_ENVIRONMENT,
     &PREVIEW_SHADE,
-    &PREVIEW_PREDICT,
-    &PREVIEW_ADAPTIVE,
+    &ADAPTIVE_PREDICT,
+    &ADAPTIVE_STATE,
+    &ADAPTIVE_PLAN,
+    &ADAPTIVE_SAMPLES,
+    &ADAPTIVE_FRAME,
     &PREVIEW_PRESENT,
 ];
 
@@ -357,7 +369,13 @@ mod tests {
     /// A module holds each file once, after the files it needs.
     #[test]
     fn a_module_composes_its_files_once_in_dependency_order() {
-        let roots = [&super::PREVIEW_SHADE, &super::PREVIEW_PREDICT, &super::PREVIEW_ADAPTIVE];
+        let roots = [
+            &super::PREVIEW_SHADE,
+            &super::ADAPTIVE_PREDICT,
+            &super::ADAPTIVE_PLAN,
+            &super::ADAPTIVE_SAMPLES,
+            &super::ADAPTIVE_FRAME,
+        ];
         let source = super::module(&roots);
         let at = |w: &Wgsl| {
             assert_eq!(source.matches(w.source).count(), 1, "{} once", w.file);
@@ -368,7 +386,7 @@ mod tests {
                 assert!(at(need) < at(w), "{} after {}", w.file, need.file);
             }
         }
-        assert!(source.ends_with(super::PREVIEW_ADAPTIVE.source));
+        assert!(source.ends_with(super::ADAPTIVE_FRAME.source));
         assert!(
             ALL.iter()
                 .filter(|w| !SEPARATE.iter().any(|s| s.file == w.file))

@@ -156,8 +156,10 @@ impl Renderer {
                 source: wgpu::ShaderSource::Wgsl(
                     crate::wgsl::module(&[
                         &crate::wgsl::PREVIEW_SHADE,
-                        &crate::wgsl::PREVIEW_PREDICT,
-                        &crate::wgsl::PREVIEW_ADAPTIVE,
+                        &crate::wgsl::ADAPTIVE_PREDICT,
+                        &crate::wgsl::ADAPTIVE_PLAN,
+                        &crate::wgsl::ADAPTIVE_SAMPLES,
+                        &crate::wgsl::ADAPTIVE_FRAME,
                     ])
                     .into(),
                 ),

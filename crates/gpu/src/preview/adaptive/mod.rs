@@ -3,7 +3,7 @@
 //! from the same surfaces), and each frame then runs as one submission, one wait:
 //!
 //! 1. the prediction at the prediction pixels (`predict_blocks`), the levels of the bandwidth
-//!    buffer, the min and max pyramids and the plan of every block (`preview_adaptive.wgsl`),
+//!    buffer, the min and max pyramids and the plan of every block (`predict.wgsl`, `plan.wgsl`),
 //!    which counts the shaded blocks per level and per chunk of [`CHUNK`] candidates;
 //! 2. their samples (`adaptive_allocate`, one invocation: `render::adaptive::area_allocation`
 //!    from the counts per level, in integers, so the CPU's samples exactly), and the list of
@@ -42,7 +42,7 @@ use crate::merl_lookup::capture_errors;
 use state::*;
 pub(super) use state::{Pipelines, State, layout};
 
-/// `AdaptivePass` of `preview_adaptive.wgsl`.
+/// `AdaptivePass` of `state.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct AdaptivePass {
@@ -71,7 +71,7 @@ pub(crate) struct AdaptivePass {
 /// `NONE` of the WGSL: a render pixel without a prediction (not shadeable).
 const NONE: u32 = u32::MAX;
 
-/// The WGSL's control words (`preview_adaptive.wgsl`): shaded blocks in all, the status, the
+/// The WGSL's control words (`state.wgsl`): shaded blocks in all, the status, the
 /// samples given, `shade_blocks`' items, the indirect dispatches' workgroups, shaded blocks
 /// per level, the allocation's per level, then from `CONTROL_CHUNKS` one per chunk of [`CHUNK`]
 /// candidates (the plan's counts); all are cleared each frame, the first `CONTROL_CHUNKS` read
@@ -514,15 +514,15 @@ mod tests {
         CHUNK, CONTROL_ARGS, CONTROL_CHUNKS, CONTROL_COUNTS, CONTROL_PARTS, CONTROL_SAMPLES, CONTROL_SHADED,
         CONTROL_STATUS, MAX_LEVELS, PART, parts,
     };
-    use crate::wgsl::PREVIEW_ADAPTIVE;
+    use crate::wgsl::ADAPTIVE_STATE;
 
     #[test]
     fn the_constants_match_the_wgsl() {
         let weight = format!("const MIN_WEIGHT: f32 = {:e};", render::adaptive::MIN_WEIGHT);
-        let declared = PREVIEW_ADAPTIVE.source.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
+        let declared = ADAPTIVE_STATE.source.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
         let value: f64 = declared.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
         assert_eq!(value, render::adaptive::MIN_WEIGHT, "{declared} against {weight}");
-        assert!(PREVIEW_ADAPTIVE.source.contains("const NONE: u32 = 0xffffffffu;"));
+        assert!(ADAPTIVE_STATE.source.contains("const NONE: u32 = 0xffffffffu;"));
         for (name, value) in [
             ("CONTROL_SHADED", CONTROL_SHADED),
             ("CONTROL_STATUS", CONTROL_STATUS),
@@ -536,10 +536,10 @@ mod tests {
             ("RUN", CHUNK / 64),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
-            assert!(PREVIEW_ADAPTIVE.source.contains(&line), "the WGSL lacks {line}");
+            assert!(ADAPTIVE_STATE.source.contains(&line), "the WGSL lacks {line}");
         }
         // Per level 4 words from CONTROL_LEVELS, for every level, before the chunks.
-        assert!(PREVIEW_ADAPTIVE.source.contains("const CONTROL_LEVELS: u32 = 32u;"));
+        assert!(ADAPTIVE_STATE.source.contains("const CONTROL_LEVELS: u32 = 32u;"));
         assert!(32 + 4 * MAX_LEVELS as u32 <= CONTROL_CHUNKS && CONTROL_COUNTS as usize + MAX_LEVELS <= 32);
     }
 

@@ -1,6 +1,7 @@
 //! An adaptive frame's state on the GPU, made once per geometry (camera and supersampling),
 //! prediction level and pyramid top: the records, levels and candidates uploaded, one buffer per
-//! kind; the pipelines of `preview_adaptive.wgsl` and their bind group layout.
+//! kind; the pipelines of the passes of `plan.wgsl`, `samples.wgsl` and `frame.wgsl` (on
+//! `state.wgsl`) and their bind group layout.
 
 use std::sync::Arc;
 
@@ -14,7 +15,7 @@ use crate::merl_lookup::capture_errors;
 use crate::preview::Renderer;
 
 /// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
-/// and pyramid top: `preview_adaptive.wgsl`'s state.
+/// and pyramid top: `state.wgsl`'s state.
 #[derive(Debug)]
 pub(crate) struct State {
     pub(super) geometry: Arc<Geometry>,
@@ -23,7 +24,7 @@ pub(crate) struct State {
     /// `(width, height, first block)` per level.
     pub(super) levels: Vec<(u32, u32, u32)>,
     pub(super) blocks: u32,
-    /// Blocks that hold a shadeable pixel, per level (`preview_adaptive.wgsl`'s candidates).
+    /// Blocks that hold a shadeable pixel, per level (`state.wgsl`'s candidates).
     pub(super) candidates_per_level: Vec<u32>,
     /// The pass uniform with the tables' offsets (the per-pass fields zero).
     pub(super) base: AdaptivePass,
@@ -59,7 +60,7 @@ pub(super) struct Clock {
 /// Bytes of [`Clock`]'s timestamps.
 pub(super) const CLOCK_BYTES: u64 = 4 * 8;
 
-/// The buffers of `preview_adaptive.wgsl`'s state, in its binding order (3 to 12).
+/// The buffers of `state.wgsl`'s state, in its binding order (3 to 12).
 #[derive(Debug)]
 pub(super) struct Buffers {
     pub(super) records_surface: wgpu::Buffer,
@@ -320,7 +321,7 @@ impl Renderer {
     }
 }
 
-/// The adaptive frame's pipelines (`preview_adaptive.wgsl`), group 3 from
+/// The adaptive frame's pipelines (`plan.wgsl`, `samples.wgsl`, `frame.wgsl`), group 3 from
 /// [`Renderer`]'s `adaptive_layout`.
 #[derive(Debug)]
 pub(crate) struct Pipelines {
