@@ -174,7 +174,7 @@ pub fn chain(
     let (mut lobes, mut sizes) = (Vec::new(), Vec::new());
     let roughness = chain_lobes(width, levels, &mut lobes, &mut sizes)?;
     let convolved = crate::convolve_lobes(map, &lobes, &sizes, method, progress)?;
-    Ok(assemble(map, width, roughness, convolved))
+    Ok(assemble(map, &envmap::MipChain::new(map), width, roughness, convolved))
 }
 
 /// Appends the lobes and sizes of a chain's levels 1 and up ([`chain`]); returns every level's
@@ -200,23 +200,24 @@ pub(crate) fn chain_lobes(
     Ok(roughness)
 }
 
-/// The chain from its levels 1 and up, convolved, and the mirror level made here.
+/// The chain from its levels 1 and up, convolved, and the mirror level, from `mips` (`map`'s mip
+/// chain) or `map`.
 pub(crate) fn assemble(
     map: &envmap::EnvMap,
+    mips: &envmap::MipChain,
     width: usize,
     roughness: Vec<f64>,
     convolved: Vec<crate::Convolved>,
 ) -> Chain {
-    let mirror = mirror_level(map, width);
+    let mirror = mirror_level(map, mips, width);
     let methods = convolved.iter().map(|c| c.method).collect();
     let levels = std::iter::once(mirror).chain(convolved.into_iter().map(|c| c.map)).collect();
     Chain { roughness, levels, methods }
 }
 
 /// The map at `width x width / 2` (see [`Chain`]).
-fn mirror_level(map: &envmap::EnvMap, width: usize) -> envmap::EnvMap {
-    let chain = envmap::MipChain::new(map);
-    if let Some(level) = chain.levels().iter().find(|l| l.width() == width) {
+fn mirror_level(map: &envmap::EnvMap, mips: &envmap::MipChain, width: usize) -> envmap::EnvMap {
+    if let Some(level) = mips.levels().iter().find(|l| l.width() == width) {
         return level.clone();
     }
     let height = width / 2;

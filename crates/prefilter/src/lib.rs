@@ -275,7 +275,7 @@ pub fn prefilter_with_progress(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Prefiltered, Error> {
     let array_only = Config { chain: false, ggx_levels: 0, ..config.clone() };
-    Ok(prefilter_all(map, &array_only, progress)?.prefiltered)
+    Ok(convolve_all(map, &array_only, progress)?.0)
 }
 
 /// Everything a [`Config`] asks for: the layers, and the chains of [`Config::chain`] and
@@ -290,8 +290,29 @@ pub struct All {
 
 /// [`prefilter_with_progress`], [`phong_chain`] and [`ggx::chain`] as `config` asks, in one
 /// [`convolve_lobes`]: the map's harmonics are analysed once for all of them, and a chain level
-/// that is an array layer (the sharpest exponent at the layers' size) is computed once.
-pub fn prefilter_all(map: &EnvMap, config: &Config, progress: &(dyn Fn(Progress) + Sync)) -> Result<All, Error> {
+/// that is an array layer (the sharpest exponent at the layers' size) is computed once. `mips` is
+/// the map's mip chain (`envmap::MipChain::new(map)`), which the GGX chain's level 0 is taken
+/// from: a caller that needs the chain itself (a bake writes it) makes it once for both.
+pub fn prefilter_all(
+    map: &EnvMap,
+    mips: &envmap::MipChain,
+    config: &Config,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<All, Error> {
+    let (prefiltered, phong_chain, ggx) = convolve_all(map, config, progress)?;
+    let ggx = ggx.map(|(roughness, convolved)| ggx::assemble(map, mips, config.width, roughness, convolved));
+    Ok(All { prefiltered, phong_chain, ggx })
+}
+
+/// The GGX chain's roughness and convolved levels 1 and up, before its level 0 joins them.
+type GgxLevels = (Vec<f64>, Vec<Convolved>);
+
+/// [`prefilter_all`]'s convolutions: the layers, the Phong chain and the GGX chain's levels.
+fn convolve_all(
+    map: &EnvMap,
+    config: &Config,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(Prefiltered, Option<Vec<(u32, EnvMap)>>, Option<GgxLevels>), Error> {
     config.check()?;
     let mut lobes: Vec<Lobe> = config.exponents.iter().map(|&n| Lobe::Phong(n)).collect();
     let mut sizes = vec![(config.width, config.height); lobes.len()];
@@ -311,8 +332,8 @@ pub fn prefilter_all(map: &EnvMap, config: &Config, progress: &(dyn Fn(Progress)
         let levels: Vec<EnvMap> = convolved.by_ref().take(exponents.len()).map(|c| c.map).collect();
         exponents.into_iter().zip(levels).collect()
     });
-    let ggx = ggx_roughness.map(|roughness| ggx::assemble(map, config.width, roughness, convolved.collect()));
-    Ok(All { prefiltered, phong_chain, ggx })
+    let ggx = ggx_roughness.map(|roughness| (roughness, convolved.collect()));
+    Ok((prefiltered, phong_chain, ggx))
 }
 
 /// The exponents as one mip chain, the layout engines read (cmft's): level `m` holds the `m`-th

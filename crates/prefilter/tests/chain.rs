@@ -48,7 +48,7 @@ fn prefilter_all_gives_the_same_layers_and_chains_in_one_pass() {
     let map = real_map("potsdamer_platz_1k.hdr");
     let config =
         Config { exponents: vec![1, 16, 256], width: 64, height: 32, chain: true, ggx_levels: 4, ..Config::default() };
-    let all = prefilter::prefilter_all(&map, &config, &|_| {}).unwrap();
+    let all = prefilter::prefilter_all(&map, &envmap::MipChain::new(&map), &config, &|_| {}).unwrap();
     assert_eq!(all.prefiltered, prefilter::prefilter(&map, &config).unwrap());
     let chain = all.phong_chain.unwrap();
     assert_eq!(chain, phong_chain(&map, &config, &|_| {}).unwrap());

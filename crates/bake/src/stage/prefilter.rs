@@ -71,11 +71,13 @@ pub fn run(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Staged, Prefiltered), Error> {
     config.check().map_err(|e| Error::stage("prefilter", e))?;
-    // The layers and the chains in one pass over the map's harmonics.
-    let all = prefilter::prefilter_all(map, config, &|p| progress(p.done, p.total))
+    // The layers and the chains in one pass over the map's harmonics; the mip chain once, for the
+    // GGX chain's level 0 and the bake's mips.
+    let mips = MipChain::new(map);
+    let all = prefilter::prefilter_all(map, &mips, config, &|p| progress(p.done, p.total))
         .map_err(|e| Error::stage("prefilter", e))?;
     let prefiltered = all.prefiltered;
-    let mut staged = outputs(map, source, program, config, &prefiltered)?;
+    let mut staged = outputs(map, &mips, source, program, config, &prefiltered)?;
     if all.phong_chain.is_some() || all.ggx.is_some() {
         let writer = format!("{} {}", program.name, program.version);
         let engine = engine::outputs(all.phong_chain, all.ggx, config, &writer)?;
@@ -91,8 +93,10 @@ pub fn run(
     Ok((staged, prefiltered))
 }
 
+/// The stage's files: the layers, `chain` (the map's mip chain) and what `config` adds.
 fn outputs(
     map: &EnvMap,
+    chain: &MipChain,
     source: &Source,
     program: &Program,
     config: &Config,
@@ -101,7 +105,6 @@ fn outputs(
     let writer = format!("{} {}", program.name, program.version);
     let encoding = |what: &str, e: &dyn std::fmt::Display| Error::Internal(format!("encoding {what}: {e}"));
     let layer_maps: Vec<&EnvMap> = prefiltered.layers.iter().map(|layer| &layer.map).collect();
-    let chain = MipChain::new(map);
     // The encoders are serial (the EXR and PNG compressors above all): run them side by side.
     let ktx =
         |result: Result<prefilter::ktx::Encoded, prefilter::Error>, name: &str| result.map_err(|e| encoding(name, &e));
@@ -109,7 +112,7 @@ fn outputs(
         || {
             rayon::join(
                 || ktx(prefilter::ktx::encode_array(&layer_maps, config.storage, &writer), LAYERS_KTX2),
-                || ktx(prefilter::ktx::encode_mip_chain(&chain, config.storage, &writer), MIPS_KTX2),
+                || ktx(prefilter::ktx::encode_mip_chain(chain, config.storage, &writer), MIPS_KTX2),
             )
         },
         || {
@@ -127,7 +130,7 @@ fn outputs(
             let png = || {
                 let exponents_and_maps: Vec<(u32, &EnvMap)> =
                     prefiltered.layers.iter().map(|layer| (layer.exponent, &layer.map)).collect();
-                let sheet = prefilter::contact_sheet(&chain, &exponents_and_maps);
+                let sheet = prefilter::contact_sheet(chain, &exponents_and_maps);
                 envmap::encode_png_rgb8(sheet.width, sheet.height, &sheet.rgb8).map_err(|e| encoding(CONTACT_SHEET, &e))
             };
             // Cube maps for engines (not linked from the asset: the previewer reads the lat-long
@@ -138,7 +141,7 @@ fn outputs(
                 }
                 Ok(Some((
                     ktx(prefilter::cube::encode_layers(&layer_maps, config.storage, &writer), LAYERS_CUBE_KTX2)?,
-                    ktx(prefilter::cube::encode_mip_chain(&chain, config.storage, &writer), MIPS_CUBE_KTX2)?,
+                    ktx(prefilter::cube::encode_mip_chain(chain, config.storage, &writer), MIPS_CUBE_KTX2)?,
                 )))
             };
             rayon::join(exrs, || rayon::join(png, cubes))
