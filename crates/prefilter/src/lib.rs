@@ -275,7 +275,7 @@ pub fn prefilter_with_progress(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Prefiltered, Error> {
     let array_only = Config { chain: false, ggx_levels: 0, ..config.clone() };
-    Ok(convolve_all(map, &array_only, progress)?.0)
+    Ok(convolve_all(map, &array_only, progress)?.prefiltered)
 }
 
 /// Everything a [`Config`] asks for: the layers, and the chains of [`Config::chain`] and
@@ -299,20 +299,20 @@ pub fn prefilter_all(
     config: &Config,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<All, Error> {
-    let (prefiltered, phong_chain, ggx) = convolve_all(map, config, progress)?;
+    let Convolutions { prefiltered, phong_chain, ggx } = convolve_all(map, config, progress)?;
     let ggx = ggx.map(|(roughness, convolved)| ggx::assemble(map, mips, config.width, roughness, convolved));
     Ok(All { prefiltered, phong_chain, ggx })
 }
 
-/// The GGX chain's roughness and convolved levels 1 and up, before its level 0 joins them.
-type GgxLevels = (Vec<f64>, Vec<Convolved>);
+/// [`prefilter_all`]'s convolutions: the GGX chain is its roughness and its levels 1 and up,
+/// before its level 0 joins them.
+struct Convolutions {
+    prefiltered: Prefiltered,
+    phong_chain: Option<Vec<(u32, EnvMap)>>,
+    ggx: Option<(Vec<f64>, Vec<Convolved>)>,
+}
 
-/// [`prefilter_all`]'s convolutions: the layers, the Phong chain and the GGX chain's levels.
-fn convolve_all(
-    map: &EnvMap,
-    config: &Config,
-    progress: &(dyn Fn(Progress) + Sync),
-) -> Result<(Prefiltered, Option<Vec<(u32, EnvMap)>>, Option<GgxLevels>), Error> {
+fn convolve_all(map: &EnvMap, config: &Config, progress: &(dyn Fn(Progress) + Sync)) -> Result<Convolutions, Error> {
     config.check()?;
     let mut lobes: Vec<Lobe> = config.exponents.iter().map(|&n| Lobe::Phong(n)).collect();
     let mut sizes = vec![(config.width, config.height); lobes.len()];
@@ -333,7 +333,7 @@ fn convolve_all(
         exponents.into_iter().zip(levels).collect()
     });
     let ggx = ggx_roughness.map(|roughness| (roughness, convolved.collect()));
-    Ok((prefiltered, phong_chain, ggx))
+    Ok(Convolutions { prefiltered, phong_chain, ggx })
 }
 
 /// The exponents as one mip chain, the layout engines read (cmft's): level `m` holds the `m`-th
