@@ -194,6 +194,7 @@
 //! transforms (the continuation's and the band energies' mirror tiling) take about a tenth.
 
 mod analysis;
+mod atan;
 mod atlas;
 mod error;
 mod lobe;
