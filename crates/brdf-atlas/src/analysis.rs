@@ -127,8 +127,6 @@ pub(crate) struct Scratch {
     /// `n^2` values, [`Scratch::cycles_per_radian`]) the analysis's bandwidths: one buffer.
     pub extended: Vec<f64>,
     holes: Vec<(usize, f64)>,
-    /// The lookups of the continued pixels' terms.
-    terms: Vec<f64>,
     /// The estimator's buffers (and the transform's, which the band energies borrow).
     pub estimator: bandwidth::Workspace,
     pub level: Vec<u8>,
@@ -223,7 +221,7 @@ impl Analyser {
     /// azimuth 0) into `scratch.image` and fills its holes; returns how many pixels were filled.
     pub(crate) fn render(&self, table: &LuminanceTable, theta_i: f64, scratch: &mut Scratch) -> usize {
         scratch.image.resize(self.pixels.len(), 0.0);
-        render(table, merl::spherical_dir(theta_i, 0.0), &self.pixels, &mut scratch.image, &mut scratch.terms);
+        render(table, merl::spherical_dir(theta_i, 0.0), &self.pixels, &mut scratch.image);
         fill_holes(self.map.size, &mut scratch.image, &mut scratch.holes)
     }
 

@@ -85,8 +85,15 @@ impl LuminanceTable {
             let end = (start + BLOCK).min(out.len());
             self.grid_coords_many(wi, wo.slice(start..end), &mut coords);
             let [x_h, x_d, x_p] = &coords;
-            for (k, value) in out[start..end].iter_mut().enumerate() {
-                *value = self.trilinear(x_h[k], x_d[k], x_p[k]).unwrap_or(f64::NAN);
+            let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
+            if self.complete {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = self.trilinear_complete(x_h, x_d, x_p);
+                }
+            } else {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = self.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
+                }
             }
             start = end;
         }
@@ -171,28 +178,49 @@ impl LuminanceTable {
         let rows = [(h0, d0), (h0, d1), (h1, d0), (h1, d1)];
         let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
         let (mut sum, mut weight) = (0.0, 0.0);
-        if self.complete {
-            // No NaN, every value >= 0: a zero weight's product is a zero, as below, bit for bit.
-            for ((ih, id), wr) in rows.into_iter().zip(row_weights) {
-                let row = &self.luminance[(ih * d.n_theta_d + id) * n_p..][..n_p];
-                for (v, wp) in [(row[p0], 1.0 - tp), (row[p1], tp)] {
-                    let w = wr * wp;
-                    sum += w * v;
-                    weight += w;
-                }
-            }
-        } else {
-            for ((ih, id), wr) in rows.into_iter().zip(row_weights) {
-                let row = &self.luminance[(ih * d.n_theta_d + id) * n_p..][..n_p];
-                for (v, wp) in [(row[p0], 1.0 - tp), (row[p1], tp)] {
-                    // A NaN (no data) corner contributes nothing; nor does a zero weight.
-                    let w = if v.is_nan() { 0.0 } else { wr * wp };
-                    sum += if w == 0.0 { 0.0 } else { w * v };
-                    weight += w;
-                }
+        for ((ih, id), wr) in rows.into_iter().zip(row_weights) {
+            let row = &self.luminance[(ih * d.n_theta_d + id) * n_p..][..n_p];
+            for (v, wp) in [(row[p0], 1.0 - tp), (row[p1], tp)] {
+                // A NaN (no data) corner contributes nothing; nor does a zero weight.
+                let w = if v.is_nan() { 0.0 } else { wr * wp };
+                sum += if w == 0.0 { 0.0 } else { w * v };
+                weight += w;
             }
         }
         (weight > 0.0).then(|| sum / weight)
+    }
+
+    /// [`Self::trilinear`] of a table without holes (`complete`), bit for bit: no value is NaN
+    /// and all are `>= 0`, so a zero weight's product is a zero there too, and the weights sum
+    /// to about 1 (never 0).
+    #[inline(always)]
+    fn trilinear_complete(&self, x_h: f64, x_d: f64, x_p: f64) -> f64 {
+        let d = self.dims;
+        let clamped = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let i0 = (x as usize).min(n - 1);
+            (i0, usize::from(i0 + 1 < n), x - i0 as f64)
+        };
+        let (h0, h_step, th) = clamped(x_h, d.n_theta_h);
+        let (d0, d_step, td) = clamped(x_d, d.n_theta_d);
+        let n_p = d.n_phi_d;
+        let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
+        let p0 = (x_p as usize).min(n_p - 1);
+        let (p1, tp) = (if p0 + 1 == n_p { 0 } else { p0 + 1 }, x_p - p0 as f64);
+        // The four (theta_h, theta_d) rows of phi_d values, in trilinear's order.
+        let base = (h0 * d.n_theta_d + d0) * n_p;
+        let (dh, dd) = (h_step * d.n_theta_d * n_p, d_step * n_p);
+        let rows = [base, base + dd, base + dh, base + dh + dd];
+        let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (row, wr) in rows.into_iter().zip(row_weights) {
+            for (p, wp) in [(p0, 1.0 - tp), (p1, tp)] {
+                let w = wr * wp;
+                sum += w * self.luminance[row + p];
+                weight += w;
+            }
+        }
+        sum / weight
     }
 }
 
@@ -308,6 +336,14 @@ impl Pixels {
                 }
             }
         }
+        for v in [&mut pixels.direct.x, &mut pixels.direct.y, &mut pixels.direct.z, &mut pixels.terms.x] {
+            v.shrink_to_fit();
+        }
+        for v in [&mut pixels.terms.y, &mut pixels.terms.z, &mut pixels.weights] {
+            v.shrink_to_fit();
+        }
+        pixels.runs.shrink_to_fit();
+        pixels.continued.shrink_to_fit();
         pixels
     }
 
@@ -320,8 +356,8 @@ impl Pixels {
 /// Fills `out` (row-major, `map.size^2` values) with the luminance of the BRDF at `wi` for the
 /// map's pixels (`pixels`, from [`LobeMap::sample`]); NaN where the table holds no data
 /// around a pair the pixel needs: [`render_fn`] of [`LuminanceTable::lookup`], bit for bit, by
-/// [`LuminanceTable::lookup_many`]. `terms` is scratch space for the continued pixels' terms.
-pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64], terms: &mut Vec<f64>) {
+/// [`LuminanceTable::lookup_many`].
+pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
     let mut start = 0;
     for &(first, count) in &pixels.runs {
@@ -329,17 +365,30 @@ pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &m
         table.lookup_many(wi, pixels.direct.slice(start..start + count), &mut out[first..first + count]);
         start += count;
     }
-    terms.resize(pixels.weights.len(), 0.0);
-    table.lookup_many(wi, pixels.terms.slice(0..pixels.weights.len()), terms);
-    let mut start = 0;
-    for &(k, end) in &pixels.continued {
-        // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
-        let mut sum = 0.0;
-        for (&v, &c) in terms[start..end as usize].iter().zip(&pixels.weights[start..end as usize]) {
-            sum += c * v;
+    // The continued pixels' terms, a few hundred pixels at a time (at most 4 terms each).
+    const TERMS: usize = 1024;
+    let mut values = [0.0; TERMS];
+    let mut pixel = 0;
+    while pixel < pixels.continued.len() {
+        let first_term = pixel.checked_sub(1).map_or(0, |p| pixels.continued[p].1 as usize);
+        let mut end = pixel + 1;
+        while end < pixels.continued.len() && pixels.continued[end].1 as usize - first_term <= TERMS {
+            end += 1;
         }
-        out[k as usize] = sum;
-        start = end as usize;
+        let last_term = pixels.continued[end - 1].1 as usize;
+        let values = &mut values[..last_term - first_term];
+        table.lookup_many(wi, pixels.terms.slice(first_term..last_term), values);
+        let mut term = first_term;
+        for &(k, term_end) in &pixels.continued[pixel..end] {
+            // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
+            let mut sum = 0.0;
+            for t in term..term_end as usize {
+                sum += pixels.weights[t] * values[t - first_term];
+            }
+            out[k as usize] = sum;
+            term = term_end as usize;
+        }
+        pixel = end;
     }
 }
 
