@@ -611,6 +611,35 @@ mod tests {
         }
     }
 
+    /// The lobe image of the batch lookups is the one of the single lookup, bit for bit: the
+    /// runs of direct pixels and the continued pixels' terms (more than one buffer of them at
+    /// 64 x 64), with and without cells lacking data.
+    #[test]
+    fn render_is_render_fn_of_lookup_bit_for_bit() {
+        let table = Analytic::Ggx { alpha: 0.1, f0: [0.9, 0.9, 0.9] }.table(Dims::MERL);
+        let dims = table.dims();
+        let mut raw = table.raw().to_vec();
+        for cell in 60 * dims.n_theta_d * dims.n_phi_d..dims.cells() {
+            for channel in 0..3 {
+                raw[channel * dims.cells() + cell] = merl::NO_DATA_RAW;
+            }
+        }
+        let holes = MerlTable::from_raw(dims, raw).unwrap();
+        let pixels = Pixels::new(LobeMap::new(64));
+        assert!(pixels.weights.len() > 1024, "{} terms", pixels.weights.len());
+        for table in [table, holes] {
+            let luminance = LuminanceTable::new(&table);
+            for theta_i in [0.1, 0.8, 1.5] {
+                let wi = spherical_dir(theta_i, 0.0);
+                let (mut fast, mut single) = (vec![0.0; pixels.len()], vec![0.0; pixels.len()]);
+                render(&luminance, wi, &pixels, &mut fast);
+                render_fn(&pixels, |wo| luminance.lookup(wi, wo), &mut single);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+                assert_eq!(bits(&fast), bits(&single), "theta_i {theta_i}, complete {}", luminance.complete);
+            }
+        }
+    }
+
     #[test]
     fn cells_without_data_continue_the_last_two_linearly() {
         let dims = Dims::MERL;
