@@ -102,10 +102,23 @@ impl LuminanceTable {
     /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into `coords`.
     #[inline(always)]
     fn grid_coords_many<const N: usize>(&self, wi: DVec3, wo: DirectionsRef<'_>, coords: &mut [[f64; N]; 3]) {
+        // Three loops, each short enough to keep its values in registers: the arguments of the
+        // three angles, the angles (one atan2 per element), their grid coordinates.
+        let n = wo.x.len();
+        assert!(n <= N && wo.y.len() == n && wo.z.len() == n, "a block of directions");
+        let (mut y, mut x) = ([[0.0; N]; 3], [[0.0; N]; 3]);
+        for k in 0..n {
+            let (a, b) = self.angle_arguments(wi, DVec3::new(wo.x[k], wo.y[k], wo.z[k]));
+            for i in 0..3 {
+                (y[i][k], x[i][k]) = (a[i], b[i]);
+            }
+        }
+        for ((angle, &y), &x) in coords.as_flattened_mut().iter_mut().zip(y.as_flattened()).zip(x.as_flattened()) {
+            *angle = atan2(y, x);
+        }
         let [x_h, x_d, x_p] = coords;
-        let block = (x_h.iter_mut().zip(x_d.iter_mut()).zip(x_p.iter_mut())).zip(wo.x.iter().zip(wo.y).zip(wo.z));
-        for (((h, d), p), ((&x, &y), &z)) in block {
-            [*h, *d, *p] = self.grid_coords(wi, DVec3::new(x, y, z));
+        for ((h, d), p) in x_h[..n].iter_mut().zip(&mut x_d[..n]).zip(&mut x_p[..n]) {
+            [*h, *d, *p] = self.scale(*h, *d, *p);
         }
     }
 
@@ -113,18 +126,23 @@ impl LuminanceTable {
     /// [`crate::atan::atan2`] (module docs, "Angles"). Branch-free, for [`Self::lookup_many`].
     #[inline(always)]
     fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
+        let (y, x) = self.angle_arguments(wi, wo);
+        self.scale(atan2(y[0], x[0]), atan2(y[1], x[1]), atan2(y[2], x[2]))
+    }
+
+    /// The `(y, x)` whose `atan2` are `theta_h`, `theta_d` and `phi_d` of `(wi, wo)`.
+    #[inline(always)]
+    fn angle_arguments(&self, wi: DVec3, wo: DVec3) -> ([f64; 3], [f64; 3]) {
         let s = wi + wo;
         let rho2 = s.x * s.x + s.y * s.y;
-        let theta_h = atan2(rho2.sqrt(), s.z);
         // theta_d is the angle between wi and h, i.e. between wi and s.
-        let theta_d = atan2(wi.cross(s).length(), wi.dot(s));
+        let (cross, dot) = (wi.cross(s).length(), wi.dot(s));
         // d's x and y times rho |s| > 0; at rho = 0 (h the normal) the reference's (wi.x, wi.y).
         let length = (rho2 + s.z * s.z).sqrt();
         let normal = rho2 == 0.0;
         let dy = if normal { wi.y } else { (wi.y * s.x - wi.x * s.y) * length };
         let dx = if normal { wi.x } else { (wi.x * s.x + wi.y * s.y) * s.z - wi.z * rho2 };
-        let phi_d = atan2(dy, dx);
-        self.scale(theta_h, theta_d, phi_d)
+        ([rho2.sqrt(), cross, dy], [s.z, dot, dx])
     }
 
     /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, computed without
