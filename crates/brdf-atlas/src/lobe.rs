@@ -4,9 +4,9 @@
 //! [`LuminanceTable`] is the table reduced to one luminance per cell, read by its own copy of
 //! `merl`'s trilinear lookup: the lookup is linear in the cell values, so wherever the eight
 //! corners of a pair hold data it returns exactly the luminance of `merl`'s RGB lookup (to
-//! rounding; the tests hold it to 1e-12) while reading a third of the memory and skipping the
-//! trigonometry the general half/difference conversion needs (`cos phi_h` and `sin phi_h` come
-//! from the half vector itself).
+//! rounding; the tests hold it to 1e-12) while reading a third of the memory and computing the
+//! angles from `wi + wo` by arithmetic and the crate's own `atan2`, many pairs in one vectorized
+//! loop ([`LuminanceTable::lookup_many`], crate docs, "Angles").
 //!
 //! Where corners hold no data (configurations below the horizon, only near it) the two differ on
 //! purpose. `merl` leaves those corners out and renormalizes, which holds the lobe flat across
@@ -58,7 +58,7 @@ impl LuminanceTable {
     /// The luminance of the BRDF for a pair of unit directions, trilinear between cells as in
     /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`], the cells without data
     /// continued (module docs); `None` where all eight corners are in columns without data.
-    /// The angles come from the directions by arithmetic and this crate's `atan2` (module docs,
+    /// The angles come from the directions by arithmetic and this crate's `atan2` (crate docs,
     /// "Angles"); [`Self::lookup_libm`] is the same lookup with libm's.
     pub fn lookup(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
         let [x_h, x_d, x_p] = self.grid_coords(wi, wo);
@@ -67,7 +67,7 @@ impl LuminanceTable {
 
     /// [`Self::lookup`] with the angles of [`merl::half_diff`], by the system's libm `atan2`
     /// after normalizing the half vector and rotating `wi` into its frame: the reference the
-    /// fast angles are held to (module docs, "Angles").
+    /// fast angles are held to (crate docs, "Angles").
     pub fn lookup_libm(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
         let [x_h, x_d, x_p] = self.grid_coords_libm(wi, wo);
         self.trilinear(x_h, x_d, x_p)
@@ -123,7 +123,7 @@ impl LuminanceTable {
     }
 
     /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, to the accuracy of
-    /// [`crate::atan::atan2`] (module docs, "Angles"). Branch-free, for [`Self::lookup_many`].
+    /// [`crate::atan::atan2`] (crate docs, "Angles"). Branch-free, for [`Self::lookup_many`].
     #[inline(always)]
     fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
         let (y, x) = self.angle_arguments(wi, wo);
@@ -544,7 +544,7 @@ mod tests {
         (dir(), dir())
     }
 
-    /// The angles of the fast lookup against libm's (module docs, "Angles"): the grid
+    /// The angles of the fast lookup against libm's (crate docs, "Angles"): the grid
     /// coordinates within `1e-13` (`theta_h`'s near its pole, where the square root spacing
     /// stretches it, and `phi_d`'s, where `theta_d` is near 0 and `phi_d` is undefined, scaled by
     /// the conditioning), and the luminance within `1e-13` of the largest corner.
