@@ -4,9 +4,9 @@
 //! [`LuminanceTable`] is the table reduced to one luminance per cell, read by its own copy of
 //! `merl`'s trilinear lookup: the lookup is linear in the cell values, so wherever the eight
 //! corners of a pair hold data it returns exactly the luminance of `merl`'s RGB lookup (to
-//! rounding; the tests hold it to 1e-12) while reading a third of the memory and skipping the
-//! trigonometry the general half/difference conversion needs (`cos phi_h` and `sin phi_h` come
-//! from the half vector itself).
+//! rounding; the tests hold it to 1e-12) while reading a third of the memory and computing the
+//! angles from `wi + wo` by arithmetic and the crate's own `atan2`, many pairs in one vectorized
+//! loop ([`LuminanceTable::lookup_many`], crate docs, "Angles").
 //!
 //! Where corners hold no data (configurations below the horizon, only near it) the two differ on
 //! purpose. `merl` leaves those corners out and renormalizes, which holds the lobe flat across
@@ -22,6 +22,7 @@ use std::f64::consts::FRAC_2_PI;
 use glam::DVec3;
 use merl::{Dims, MerlTable};
 
+use crate::atan::atan2;
 use crate::param::{LobeMap, Sample};
 
 /// A MERL table reduced to the luminance of each cell, in 1/sr, with the cells that hold no data
@@ -30,6 +31,8 @@ use crate::param::{LobeMap, Sample};
 pub struct LuminanceTable {
     dims: Dims,
     luminance: Vec<f64>,
+    /// Whether every cell holds a value (no NaN); all are `>= 0`.
+    complete: bool,
 }
 
 impl std::fmt::Debug for LuminanceTable {
@@ -44,7 +47,8 @@ impl LuminanceTable {
         let mut luminance =
             (0..dims.cells()).map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance)).collect::<Vec<f64>>();
         continue_below_horizon(dims, &mut luminance);
-        Self { dims, luminance }
+        let complete = !luminance.iter().any(|v| v.is_nan());
+        Self { dims, luminance, complete }
     }
 
     pub fn dims(&self) -> Dims {
@@ -54,15 +58,97 @@ impl LuminanceTable {
     /// The luminance of the BRDF for a pair of unit directions, trilinear between cells as in
     /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`], the cells without data
     /// continued (module docs); `None` where all eight corners are in columns without data.
+    /// The angles come from the directions by arithmetic and this crate's `atan2` (crate docs,
+    /// "Angles"); [`Self::lookup_libm`] is the same lookup with libm's.
     pub fn lookup(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
         let [x_h, x_d, x_p] = self.grid_coords(wi, wo);
         self.trilinear(x_h, x_d, x_p)
     }
 
+    /// [`Self::lookup`] with the angles of [`merl::half_diff`], by the system's libm `atan2`
+    /// after normalizing the half vector and rotating `wi` into its frame: the reference the
+    /// fast angles are held to (crate docs, "Angles").
+    pub fn lookup_libm(&self, wi: DVec3, wo: DVec3) -> Option<f64> {
+        let [x_h, x_d, x_p] = self.grid_coords_libm(wi, wo);
+        self.trilinear(x_h, x_d, x_p)
+    }
+
+    /// [`Self::lookup`] of `wi` and each direction of `wo` into `out` (NaN for `None`): the same
+    /// values, bit for bit, the angles of a block of pairs computed in one loop that the
+    /// compiler vectorizes, then their trilinear reads.
+    pub(crate) fn lookup_many(&self, wi: DVec3, wo: DirectionsRef<'_>, out: &mut [f64]) {
+        const BLOCK: usize = 64;
+        assert_eq!(wo.x.len(), out.len(), "one value per direction");
+        let mut coords = [[0.0; BLOCK]; 3];
+        let mut start = 0;
+        while start < out.len() {
+            let end = (start + BLOCK).min(out.len());
+            self.grid_coords_many(wi, wo.slice(start..end), &mut coords);
+            let [x_h, x_d, x_p] = &coords;
+            let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
+            if self.complete {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = self.trilinear_complete(x_h, x_d, x_p);
+                }
+            } else {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = self.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
+                }
+            }
+            start = end;
+        }
+    }
+
+    /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into `coords`.
+    #[inline(always)]
+    fn grid_coords_many<const N: usize>(&self, wi: DVec3, wo: DirectionsRef<'_>, coords: &mut [[f64; N]; 3]) {
+        // Three loops, each short enough to keep its values in registers: the arguments of the
+        // three angles, the angles (one atan2 per element), their grid coordinates.
+        let n = wo.x.len();
+        assert!(n <= N && wo.y.len() == n && wo.z.len() == n, "a block of directions");
+        let (mut y, mut x) = ([[0.0; N]; 3], [[0.0; N]; 3]);
+        for k in 0..n {
+            let (a, b) = self.angle_arguments(wi, DVec3::new(wo.x[k], wo.y[k], wo.z[k]));
+            for i in 0..3 {
+                (y[i][k], x[i][k]) = (a[i], b[i]);
+            }
+        }
+        for ((angle, &y), &x) in coords.as_flattened_mut().iter_mut().zip(y.as_flattened()).zip(x.as_flattened()) {
+            *angle = atan2(y, x);
+        }
+        let [x_h, x_d, x_p] = coords;
+        for ((h, d), p) in x_h[..n].iter_mut().zip(&mut x_d[..n]).zip(&mut x_p[..n]) {
+            [*h, *d, *p] = self.scale(*h, *d, *p);
+        }
+    }
+
+    /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, to the accuracy of
+    /// [`crate::atan::atan2`] (crate docs, "Angles"). Branch-free, for [`Self::lookup_many`].
+    #[inline(always)]
+    fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
+        let (y, x) = self.angle_arguments(wi, wo);
+        self.scale(atan2(y[0], x[0]), atan2(y[1], x[1]), atan2(y[2], x[2]))
+    }
+
+    /// The `(y, x)` whose `atan2` are `theta_h`, `theta_d` and `phi_d` of `(wi, wo)`.
+    #[inline(always)]
+    fn angle_arguments(&self, wi: DVec3, wo: DVec3) -> ([f64; 3], [f64; 3]) {
+        let s = wi + wo;
+        let rho2 = s.x * s.x + s.y * s.y;
+        // theta_d is the angle between wi and h, i.e. between wi and s.
+        let (cross, dot) = (wi.cross(s).length(), wi.dot(s));
+        // d's x and y times rho |s| > 0; at rho = 0 (h the normal) the reference's (wi.x, wi.y).
+        let length = (rho2 + s.z * s.z).sqrt();
+        let normal = rho2 == 0.0;
+        let dy = if normal { wi.y } else { (wi.y * s.x - wi.x * s.y) * length };
+        let dx = if normal { wi.x } else { (wi.x * s.x + wi.y * s.y) * s.z - wi.z * rho2 };
+        ([rho2.sqrt(), cross, dy], [s.z, dot, dx])
+    }
+
     /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, computed without
     /// trigonometric calls for the rotations: the half vector's own components are the cosines
     /// and sines of `theta_h` and `phi_h`.
-    fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
+    fn grid_coords_libm(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
         let h = (wi + wo).normalize();
         let rho = (h.x * h.x + h.y * h.y).sqrt();
         let theta_h = rho.atan2(h.z);
@@ -75,7 +161,12 @@ impl LuminanceTable {
         let dz = x1 * sin_t + wi.z * cos_t;
         let theta_d = (dx * dx + dy * dy).sqrt().atan2(dz);
         let phi_d = dy.atan2(dx);
+        self.scale(theta_h, theta_d, phi_d)
+    }
 
+    /// The grid coordinates of the angles, as [`merl::Dims::grid_coords`].
+    #[inline(always)]
+    fn scale(&self, theta_h: f64, theta_d: f64, phi_d: f64) -> [f64; 3] {
         let d = self.dims;
         let x_h = (theta_h.max(0.0) * FRAC_2_PI).sqrt() * d.n_theta_h as f64;
         let x_d = theta_d * FRAC_2_PI * d.n_theta_d as f64;
@@ -116,6 +207,39 @@ impl LuminanceTable {
         }
         (weight > 0.0).then(|| sum / weight)
     }
+
+    /// [`Self::trilinear`] of a table without holes (`complete`), bit for bit: no value is NaN
+    /// and all are `>= 0`, so a zero weight's product is a zero there too, and the weights sum
+    /// to about 1 (never 0).
+    #[inline(always)]
+    fn trilinear_complete(&self, x_h: f64, x_d: f64, x_p: f64) -> f64 {
+        let d = self.dims;
+        let clamped = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let i0 = (x as usize).min(n - 1);
+            (i0, usize::from(i0 + 1 < n), x - i0 as f64)
+        };
+        let (h0, h_step, th) = clamped(x_h, d.n_theta_h);
+        let (d0, d_step, td) = clamped(x_d, d.n_theta_d);
+        let n_p = d.n_phi_d;
+        let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
+        let p0 = (x_p as usize).min(n_p - 1);
+        let (p1, tp) = (if p0 + 1 == n_p { 0 } else { p0 + 1 }, x_p - p0 as f64);
+        // The four (theta_h, theta_d) rows of phi_d values, in trilinear's order.
+        let base = (h0 * d.n_theta_d + d0) * n_p;
+        let (dh, dd) = (h_step * d.n_theta_d * n_p, d_step * n_p);
+        let rows = [base, base + dd, base + dh, base + dh + dd];
+        let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (row, wr) in rows.into_iter().zip(row_weights) {
+            for (p, wp) in [(p0, 1.0 - tp), (p1, tp)] {
+                let w = wr * wp;
+                sum += w * self.luminance[row + p];
+                weight += w;
+            }
+        }
+        sum / weight
+    }
 }
 
 /// Continues each `(theta_h, phi_d)` column of `luminance` (NaN where a cell holds no data)
@@ -141,6 +265,44 @@ fn continue_below_horizon(dims: Dims, luminance: &mut [f64]) {
     }
 }
 
+/// Unit vectors as three arrays of components, for loops over many of them that vectorize.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Directions {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+}
+
+/// A run of [`Directions`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DirectionsRef<'a> {
+    x: &'a [f64],
+    y: &'a [f64],
+    z: &'a [f64],
+}
+
+impl<'a> DirectionsRef<'a> {
+    fn slice(self, range: std::ops::Range<usize>) -> DirectionsRef<'a> {
+        DirectionsRef { x: &self.x[range.clone()], y: &self.y[range.clone()], z: &self.z[range] }
+    }
+}
+
+impl Directions {
+    fn push(&mut self, w: DVec3) {
+        self.x.push(w.x);
+        self.y.push(w.y);
+        self.z.push(w.z);
+    }
+
+    fn slice(&self, range: std::ops::Range<usize>) -> DirectionsRef<'_> {
+        DirectionsRef { x: &self.x[range.clone()], y: &self.y[range.clone()], z: &self.z[range] }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = DVec3> + '_ {
+        self.x.iter().zip(&self.y).zip(&self.z).map(|((&x, &y), &z)| DVec3::new(x, y, z))
+    }
+}
+
 /// What every pixel of a [`LobeMap`] holds ([`LobeMap::sample`]), kept compactly for the lobe
 /// images of many incident directions: the directions of the pixels on the hemisphere, in runs
 /// of consecutive pixels, and for each continued pixel below it the points of nonzero weight
@@ -150,10 +312,12 @@ pub(crate) struct Pixels {
     len: usize,
     /// `(first pixel, count)` of each run of direct pixels; their directions in `direct`.
     runs: Vec<(u32, u32)>,
-    direct: Vec<DVec3>,
+    direct: Directions,
     /// `(pixel, end of its terms in `terms`)` of each continued pixel.
     continued: Vec<(u32, u32)>,
-    terms: Vec<(DVec3, f64)>,
+    /// The terms' points and weights.
+    terms: Directions,
+    weights: Vec<f64>,
 }
 
 impl Pixels {
@@ -163,8 +327,14 @@ impl Pixels {
         let n = map.size;
         let rows: Vec<Vec<Sample>> =
             (0..n).into_par_iter().map(|y| (0..n).map(|x| map.sample(x, y)).collect()).collect();
-        let mut pixels =
-            Pixels { len: n * n, runs: Vec::new(), direct: Vec::new(), continued: Vec::new(), terms: Vec::new() };
+        let mut pixels = Pixels {
+            len: n * n,
+            runs: Vec::new(),
+            direct: Directions::default(),
+            continued: Vec::new(),
+            terms: Directions::default(),
+            weights: Vec::new(),
+        };
         for (k, sample) in rows.into_iter().flatten().enumerate() {
             let k = k as u32;
             match sample {
@@ -176,11 +346,22 @@ impl Pixels {
                     pixels.direct.push(wo);
                 }
                 Sample::Continued { points, weights } => {
-                    pixels.terms.extend(points.into_iter().zip(weights).filter(|&(_, c)| c != 0.0));
-                    pixels.continued.push((k, pixels.terms.len() as u32));
+                    for (w, c) in points.into_iter().zip(weights).filter(|&(_, c)| c != 0.0) {
+                        pixels.terms.push(w);
+                        pixels.weights.push(c);
+                    }
+                    pixels.continued.push((k, pixels.weights.len() as u32));
                 }
             }
         }
+        for v in [&mut pixels.direct.x, &mut pixels.direct.y, &mut pixels.direct.z, &mut pixels.terms.x] {
+            v.shrink_to_fit();
+        }
+        for v in [&mut pixels.terms.y, &mut pixels.terms.z, &mut pixels.weights] {
+            v.shrink_to_fit();
+        }
+        pixels.runs.shrink_to_fit();
+        pixels.continued.shrink_to_fit();
         pixels
     }
 
@@ -192,9 +373,41 @@ impl Pixels {
 
 /// Fills `out` (row-major, `map.size^2` values) with the luminance of the BRDF at `wi` for the
 /// map's pixels (`pixels`, from [`LobeMap::sample`]); NaN where the table holds no data
-/// around a pair the pixel needs.
+/// around a pair the pixel needs: [`render_fn`] of [`LuminanceTable::lookup`], bit for bit, by
+/// [`LuminanceTable::lookup_many`].
 pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
-    render_fn(pixels, |wo| table.lookup(wi, wo), out);
+    assert_eq!(out.len(), pixels.len, "one value per pixel");
+    let mut start = 0;
+    for &(first, count) in &pixels.runs {
+        let (first, count) = (first as usize, count as usize);
+        table.lookup_many(wi, pixels.direct.slice(start..start + count), &mut out[first..first + count]);
+        start += count;
+    }
+    // The continued pixels' terms, a few hundred pixels at a time (at most 4 terms each).
+    const TERMS: usize = 1024;
+    let mut values = [0.0; TERMS];
+    let mut pixel = 0;
+    while pixel < pixels.continued.len() {
+        let first_term = pixel.checked_sub(1).map_or(0, |p| pixels.continued[p].1 as usize);
+        let mut end = pixel + 1;
+        while end < pixels.continued.len() && pixels.continued[end].1 as usize - first_term <= TERMS {
+            end += 1;
+        }
+        let last_term = pixels.continued[end - 1].1 as usize;
+        let values = &mut values[..last_term - first_term];
+        table.lookup_many(wi, pixels.terms.slice(first_term..last_term), values);
+        let mut term = first_term;
+        for &(k, term_end) in &pixels.continued[pixel..end] {
+            // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
+            let mut sum = 0.0;
+            for t in term..term_end as usize {
+                sum += pixels.weights[t] * values[t - first_term];
+            }
+            out[k as usize] = sum;
+            term = term_end as usize;
+        }
+        pixel = end;
+    }
 }
 
 /// [`render`] of any BRDF slice `f(wo)`: each pixel is [`Sample::eval`] of its sample.
@@ -203,14 +416,15 @@ pub(crate) fn render_fn(pixels: &Pixels, f: impl Fn(DVec3) -> Option<f64>, out: 
     let mut directions = pixels.direct.iter();
     for &(first, count) in &pixels.runs {
         for (value, wo) in out[first as usize..][..count as usize].iter_mut().zip(directions.by_ref()) {
-            *value = f(*wo).unwrap_or(f64::NAN);
+            *value = f(wo).unwrap_or(f64::NAN);
         }
     }
     let mut start = 0;
+    let mut terms = pixels.terms.iter().zip(&pixels.weights);
     for &(k, end) in &pixels.continued {
         // Sample::eval: the sum of the weighted terms in order, None if any term has no value.
         let mut sum = Some(0.0);
-        for &(wo, c) in &pixels.terms[start..end as usize] {
+        for (wo, &c) in terms.by_ref().take(end as usize - start) {
             sum = sum.and_then(|s| f(wo).map(|v| s + c * v));
         }
         out[k as usize] = sum.unwrap_or(f64::NAN);
@@ -282,7 +496,7 @@ pub fn lobe_image_from_fn(map: LobeMap, mut f: impl FnMut(DVec3) -> Option<f64>)
 mod tests {
     use super::*;
     use merl::analytic::Analytic;
-    use merl::{Interp, spherical_dir};
+    use merl::{Interp, MerlTable, spherical_dir};
     use rand::{Rng, SeedableRng, rngs::StdRng};
 
     /// The eight cells `merl`'s trilinear lookup reads for a pair.
@@ -322,6 +536,126 @@ mod tests {
         }
         println!("{compared} pairs equal merl's lookup, {continued} read continued cells");
         assert!(compared > 150_000, "{compared}");
+    }
+
+    /// A random pair of directions of the upper hemisphere, uniform in solid angle.
+    fn random_pair(rng: &mut StdRng) -> (DVec3, DVec3) {
+        let mut dir = || spherical_dir(rng.random::<f64>().acos(), rng.random::<f64>() * std::f64::consts::TAU);
+        (dir(), dir())
+    }
+
+    /// The angles of the fast lookup against libm's (crate docs, "Angles"): the grid
+    /// coordinates within `1e-13` (`theta_h`'s near its pole, where the square root spacing
+    /// stretches it, and `phi_d`'s, where `theta_d` is near 0 and `phi_d` is undefined, scaled by
+    /// the conditioning), and the luminance within `1e-13` of the largest corner.
+    #[test]
+    fn fast_angles_equal_libms_to_rounding() {
+        let table = Analytic::Ggx { alpha: 0.2, f0: [0.9, 0.5, 0.1] }.table(Dims::MERL);
+        let luminance = LuminanceTable::new(&table);
+        let mut rng = StdRng::seed_from_u64(33);
+        let mut worst = [0.0f64; 4];
+        for _ in 0..1_000_000 {
+            let (wi, wo) = random_pair(&mut rng);
+            let fast = luminance.grid_coords(wi, wo);
+            let libm = luminance.grid_coords_libm(wi, wo);
+            let hd = merl::half_diff(wi, wo);
+            // The angles come from s = wi + wo, rounded to 1e-16, of length 2 cos(theta_d): they
+            // move by 1e-16 / |s|. x_h = 90 sqrt(2 theta_h / pi) moves by 1 / sqrt(theta_h) times
+            // theta_h, phi_d by 1 / sin(theta_d) times the pole's move.
+            let s = 1.0f64.max((2.0 * hd.theta_d.cos()).recip());
+            let scale = [
+                s * 1.0f64.max((2.0 * hd.theta_h / std::f64::consts::PI).sqrt().recip()),
+                s,
+                s * 1.0f64.max(hd.theta_d.sin().recip()),
+            ];
+            for k in 0..3 {
+                let mut difference = (fast[k] - libm[k]).abs();
+                if k == 2 {
+                    // phi_d wraps around.
+                    difference = difference.min(luminance.dims.n_phi_d as f64 - difference);
+                }
+                worst[k] = worst[k].max(difference / scale[k]);
+                assert!(difference <= 1e-13 * scale[k], "{wi} {wo}: coordinate {k}: {fast:?} vs {libm:?}");
+            }
+            let (a, b) = (luminance.lookup(wi, wo).unwrap(), luminance.lookup_libm(wi, wo).unwrap());
+            let largest = corners(table.dims(), wi, wo).map(|c| luminance.luminance[c]).fold(0.0, f64::max);
+            worst[3] = worst[3].max((a - b).abs() / largest);
+            assert!((a - b).abs() <= 1e-13 * largest, "{wi} {wo}: {a} vs {b}");
+        }
+        println!("largest differences (x_h, x_d, x_p scaled; luminance relative to the largest corner): {worst:?}");
+    }
+
+    /// The batch lookup is the single one, bit for bit, with and without cells lacking data.
+    #[test]
+    fn lookup_many_is_lookup_bit_for_bit() {
+        let mut table = Analytic::Ggx { alpha: 0.3, f0: [0.2, 0.5, 0.9] }.table(Dims::MERL);
+        let complete = LuminanceTable::new(&table);
+        assert!(complete.complete);
+        // Columns without data anywhere (theta_h cells 40 to 49): lookups near them renormalize.
+        let dims = table.dims();
+        let mut raw = table.raw().to_vec();
+        for h in 40..50 {
+            for cell in h * dims.n_theta_d * dims.n_phi_d..(h + 1) * dims.n_theta_d * dims.n_phi_d {
+                for channel in 0..3 {
+                    raw[channel * dims.cells() + cell] = merl::NO_DATA_RAW;
+                }
+            }
+        }
+        table = MerlTable::from_raw(dims, raw).unwrap();
+        let holes = LuminanceTable::new(&table);
+        assert!(!holes.complete);
+        let mut rng = StdRng::seed_from_u64(34);
+        for luminance in [complete, holes] {
+            let wi = random_pair(&mut rng).0;
+            let mut directions = Directions::default();
+            for _ in 0..10_000 {
+                directions.push(random_pair(&mut rng).1);
+            }
+            // The mirror direction: h on the normal.
+            directions.push(DVec3::new(-wi.x, -wi.y, wi.z));
+            let n = directions.x.len();
+            let mut out = vec![0.0; n];
+            luminance.lookup_many(wi, directions.slice(0..n), &mut out);
+            let (mut none, mut some) = (0, 0);
+            for (wo, got) in directions.iter().zip(&out) {
+                let expect = luminance.lookup(wi, wo);
+                match expect {
+                    Some(v) => assert_eq!(v.to_bits(), got.to_bits(), "{wi} {wo}"),
+                    None => assert!(got.is_nan(), "{wi} {wo}"),
+                }
+                (none, some) = if expect.is_some() { (none, some + 1) } else { (none + 1, some) };
+            }
+            println!("{some} values, {none} without");
+        }
+    }
+
+    /// The lobe image of the batch lookups is the one of the single lookup, bit for bit: the
+    /// runs of direct pixels and the continued pixels' terms (more than one buffer of them at
+    /// 64 x 64), with and without cells lacking data.
+    #[test]
+    fn render_is_render_fn_of_lookup_bit_for_bit() {
+        let table = Analytic::Ggx { alpha: 0.1, f0: [0.9, 0.9, 0.9] }.table(Dims::MERL);
+        let dims = table.dims();
+        let mut raw = table.raw().to_vec();
+        for cell in 60 * dims.n_theta_d * dims.n_phi_d..dims.cells() {
+            for channel in 0..3 {
+                raw[channel * dims.cells() + cell] = merl::NO_DATA_RAW;
+            }
+        }
+        let holes = MerlTable::from_raw(dims, raw).unwrap();
+        let pixels = Pixels::new(LobeMap::new(64));
+        assert!(pixels.weights.len() > 1024, "{} terms", pixels.weights.len());
+        for table in [table, holes] {
+            let luminance = LuminanceTable::new(&table);
+            for theta_i in [0.1, 0.8, 1.5] {
+                let wi = spherical_dir(theta_i, 0.0);
+                let (mut fast, mut single) = (vec![0.0; pixels.len()], vec![0.0; pixels.len()]);
+                render(&luminance, wi, &pixels, &mut fast);
+                render_fn(&pixels, |wo| luminance.lookup(wi, wo), &mut single);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+                assert_eq!(bits(&fast), bits(&single), "theta_i {theta_i}, complete {}", luminance.complete);
+            }
+        }
     }
 
     #[test]
