@@ -85,7 +85,11 @@ def stamp():
 
 
 def section(name, title, command, kind, report, when):
-    body = report.rstrip() if kind == "markdown" else "```text\n" + report.rstrip() + "\n```"
+    if kind == "markdown":
+        # The report's headings below the section's (its `#` is the section's `##` plus one).
+        body = re.sub(r"^#", "###", report.rstrip(), flags=re.M)
+    else:
+        body = "```text\n" + report.rstrip() + "\n```"
     return f"<!-- benchmark: {name} -->\n## {title}\n\n`{command}`: {when}.\n\n{body}\n<!-- end: {name} -->\n"
 
 
