@@ -123,7 +123,8 @@ impl LuminanceTable {
     }
 
     /// [`merl::Dims::grid_coords`] of [`merl::half_diff`]`(wi, wo)`, to the accuracy of
-    /// [`crate::atan::atan2`] (crate docs, "Angles"). Branch-free, for [`Self::lookup_many`].
+    /// [`crate::atan::atan2`] (crate docs, "Angles"): the steps of [`Self::grid_coords_many`]
+    /// for one pair.
     #[inline(always)]
     fn grid_coords(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
         let (y, x) = self.angle_arguments(wi, wo);
@@ -295,7 +296,7 @@ impl Directions {
     }
 
     fn slice(&self, range: std::ops::Range<usize>) -> DirectionsRef<'_> {
-        DirectionsRef { x: &self.x[range.clone()], y: &self.y[range.clone()], z: &self.z[range] }
+        DirectionsRef { x: &self.x, y: &self.y, z: &self.z }.slice(range)
     }
 
     fn iter(&self) -> impl Iterator<Item = DVec3> + '_ {
@@ -354,10 +355,15 @@ impl Pixels {
                 }
             }
         }
-        for v in [&mut pixels.direct.x, &mut pixels.direct.y, &mut pixels.direct.z, &mut pixels.terms.x] {
-            v.shrink_to_fit();
-        }
-        for v in [&mut pixels.terms.y, &mut pixels.terms.z, &mut pixels.weights] {
+        for v in [
+            &mut pixels.direct.x,
+            &mut pixels.direct.y,
+            &mut pixels.direct.z,
+            &mut pixels.terms.x,
+            &mut pixels.terms.y,
+            &mut pixels.terms.z,
+            &mut pixels.weights,
+        ] {
             v.shrink_to_fit();
         }
         pixels.runs.shrink_to_fit();
