@@ -84,13 +84,18 @@ def stamp():
     return f"commit {commit}, {date}, {os.cpu_count()} logical CPUs ({cpu}{memory}){load}"
 
 
-def section(name, title, command, kind, report, when):
+def section(name, title, command, when, body=None):
+    """A section of the document: its markers, title, command and stamp, then `body`, if any."""
+    body = f"\n{body}" if body is not None else ""
+    return f"<!-- benchmark: {name} -->\n## {title}\n\n`{command}`: {when}.\n{body}\n<!-- end: {name} -->\n"
+
+
+def report_body(kind, report):
+    """A report as a section shows it: text as printed; markdown with its headings below the
+    section's (its `#` is the section's `##` plus one)."""
     if kind == "markdown":
-        # The report's headings below the section's (its `#` is the section's `##` plus one).
-        body = re.sub(r"^#", "###", report.rstrip(), flags=re.M)
-    else:
-        body = "```text\n" + report.rstrip() + "\n```"
-    return f"<!-- benchmark: {name} -->\n## {title}\n\n`{command}`: {when}.\n\n{body}\n<!-- end: {name} -->\n"
+        return re.sub(r"^#", "###", report.rstrip(), flags=re.M)
+    return "```text\n" + report.rstrip() + "\n```"
 
 
 def sections(text):
@@ -105,7 +110,7 @@ def write(found):
     """docs/benchmarks.md: the header, then the sections in the order of BENCHMARKS."""
     parts = [HEADER]
     for name, title, command, _ in BENCHMARKS:
-        parts.append(found.get(name) or f"<!-- benchmark: {name} -->\n## {title}\n\n`{command}`: not run yet.\n<!-- end: {name} -->\n")
+        parts.append(found.get(name) or section(name, title, command, "not run yet"))
     DOC.parent.mkdir(exist_ok=True)
     tmp = DOC.with_suffix(".md.tmp")
     tmp.write_text("\n".join(parts))
@@ -138,7 +143,7 @@ def main(argv):
             failed.append(name)
             continue
         found = sections(DOC.read_text()) if DOC.exists() else {}
-        found[name] = section(name, title, command, kind, "".join(lines), when)
+        found[name] = section(name, title, command, when, report_body(kind, "".join(lines)))
         write(found)
         print(f"==> {name}: its report is in {DOC.relative_to(ROOT)}", file=sys.stderr)
     return 1 if failed else 0
