@@ -340,6 +340,66 @@ fn larger(a: f64, b: f64) -> f64 {
     if b > a { b } else { a }
 }
 
+/// Eq. 7 for one output row `y` ([`Workspace::run`]), as a [`pulp::WithSimd`] so that its loops
+/// are compiled for the best instruction set the processor has (AVX2 where present; the same
+/// operations in the same order, so the same bits).
+struct Eq7Row<'a> {
+    prepared: &'a [LevelRows],
+    y: usize,
+    eps: f64,
+    /// `levels + 2` rows of scratch: each level's lambda, their maximum, the running sum.
+    scratch: &'a mut [f64],
+    level_row: &'a mut [u8],
+}
+
+impl pulp::WithSimd for Eq7Row<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        let Self { prepared, y, eps, scratch, level_row } = self;
+        let out_w = level_row.len();
+        let levels = prepared.len();
+        let (lambdas, rest) = scratch.split_at_mut(levels * out_w);
+        let (max, sum) = rest.split_at_mut(out_w);
+        for (j, (lambda, prepared)) in lambdas.chunks_exact_mut(out_w).zip(prepared).enumerate() {
+            // lambda_j of this row: the maximum over the covering coefficient rows.
+            let cover_y = prepared.cover_y.as_ref().expect("prepared above");
+            let (first, count) = (cover_y.first[y] as usize, cover_y.count[y]);
+            let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
+            lambda.fill(0.0);
+            let mut ky = first;
+            for _ in 0..count {
+                for (l, s) in lambda.iter_mut().zip(row(ky)) {
+                    *l = larger(*l, *s);
+                }
+                ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
+            }
+            if j == 0 {
+                max.copy_from_slice(lambda);
+            } else {
+                for (m, l) in max.iter_mut().zip(lambda.iter()) {
+                    *m = larger(*m, *l);
+                }
+            }
+        }
+        // Eq. 7, finest level first: j* is the first level at which the sum of the finer or
+        // equal levels reaches eps times the pixel's largest lambda (0 where every lambda is 0).
+        // Level by level over the whole row, so that the loop vectorizes; each pixel's sum takes
+        // its terms in the same order as a loop over its levels that stops at j*.
+        level_row.fill(0);
+        sum.fill(0.0);
+        for (j, lambda) in lambdas.chunks_exact(out_w).enumerate() {
+            let j = (j + 1) as u8;
+            for (((out, s), &l), &m) in level_row.iter_mut().zip(sum.iter_mut()).zip(lambda).zip(max.iter()) {
+                *s += l;
+                let reached = *out == 0 && m > 0.0 && *s >= eps * m;
+                *out = if reached { j } else { *out };
+            }
+        }
+    }
+}
+
 /// A buffer of `len` values whose contents the caller overwrites: only growth is filled.
 fn sized(buffer: &mut Vec<f64>, len: usize) -> &mut [f64] {
     buffer.truncate(len);
@@ -447,47 +507,11 @@ impl Workspace {
         map.level.resize(out_w * out_h, 0);
         sized(&mut map.frequency, if with_frequency { out_w * out_h } else { 0 });
         let prepared = &self.levels;
-        let eps = config.eps;
+        let arch = pulp::Arch::new();
         map.level.par_chunks_mut(out_w).enumerate().with_min_len(4).for_each_init(
-            || vec![0.0f64; (levels + 1) * out_w],
+            || vec![0.0f64; (levels + 2) * out_w],
             |scratch, (y, level_row)| {
-                let (lambdas, max) = scratch.split_at_mut(levels * out_w);
-                for (j, (lambda, prepared)) in lambdas.chunks_exact_mut(out_w).zip(prepared).enumerate() {
-                    // lambda_j of this row: the maximum over the covering coefficient rows.
-                    let cover_y = prepared.cover_y.as_ref().expect("prepared above");
-                    let (first, count) = (cover_y.first[y] as usize, cover_y.count[y]);
-                    let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
-                    lambda.fill(0.0);
-                    let mut ky = first;
-                    for _ in 0..count {
-                        for (l, s) in lambda.iter_mut().zip(row(ky)) {
-                            *l = larger(*l, *s);
-                        }
-                        ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
-                    }
-                    if j == 0 {
-                        max.copy_from_slice(lambda);
-                    } else {
-                        for (m, l) in max.iter_mut().zip(lambda.iter()) {
-                            *m = larger(*m, *l);
-                        }
-                    }
-                }
-                // Eq. 7, finest level first: j* is the first level at which the sum of the finer
-                // or equal levels reaches eps times the pixel's largest lambda.
-                for (x, (out, &m)) in level_row.iter_mut().zip(max.iter()).enumerate() {
-                    *out = 0;
-                    if m > 0.0 {
-                        let mut sum = 0.0;
-                        for j in 0..levels {
-                            sum += lambdas[j * out_w + x];
-                            if sum >= eps * m {
-                                *out = (j + 1) as u8;
-                                break;
-                            }
-                        }
-                    }
-                }
+                arch.dispatch(Eq7Row { prepared, y, eps: config.eps, scratch, level_row });
             },
         );
         if with_frequency {

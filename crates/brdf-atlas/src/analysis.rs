@@ -314,7 +314,8 @@ pub(crate) fn mirror_into(image: &[f64], n: usize, out: &mut Vec<f64>) {
 fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
     let e = 2 * n;
     let plan = Continuation::new(n);
-    ext.clear();
+    // Every value is written below: only a buffer that grows is filled first.
+    ext.truncate(e * e);
     ext.resize(e * e, 0.0);
     for (row, line) in ext.chunks_exact_mut(e).zip(image.chunks_exact(n)) {
         row[..n].copy_from_slice(line);

@@ -75,28 +75,11 @@ impl LuminanceTable {
 
     /// [`Self::lookup`] of `wi` and each direction of `wo` into `out` (NaN for `None`): the same
     /// values, bit for bit, the angles of a block of pairs computed in one loop that the
-    /// compiler vectorizes, then their trilinear reads.
+    /// compiler vectorizes, then their trilinear reads; compiled for the best instruction set the
+    /// processor has ([`Lookups`]).
     pub(crate) fn lookup_many(&self, wi: DVec3, wo: DirectionsRef<'_>, out: &mut [f64]) {
-        const BLOCK: usize = 64;
         assert_eq!(wo.x.len(), out.len(), "one value per direction");
-        let mut coords = [[0.0; BLOCK]; 3];
-        let mut start = 0;
-        while start < out.len() {
-            let end = (start + BLOCK).min(out.len());
-            self.grid_coords_many(wi, wo.slice(start..end), &mut coords);
-            let [x_h, x_d, x_p] = &coords;
-            let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
-            if self.complete {
-                for (((value, &x_h), &x_d), &x_p) in values {
-                    *value = self.trilinear_complete(x_h, x_d, x_p);
-                }
-            } else {
-                for (((value, &x_h), &x_d), &x_p) in values {
-                    *value = self.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
-                }
-            }
-            start = end;
-        }
+        pulp::Arch::new().dispatch(Lookups { table: self, wi, wo, out });
     }
 
     /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into `coords`.
@@ -179,6 +162,7 @@ impl LuminanceTable {
     /// The same interpolation as `merl`'s `trilinear`, on one channel: corners that are NaN
     /// (a column without data) or have weight 0 are left out and the other weights renormalized.
     /// Branch-free over the eight corners.
+    #[inline(always)]
     fn trilinear(&self, x_h: f64, x_d: f64, x_p: f64) -> Option<f64> {
         let d = self.dims;
         let clamped = |x: f64, n: usize| {
@@ -240,6 +224,45 @@ impl LuminanceTable {
             }
         }
         sum / weight
+    }
+}
+
+/// [`LuminanceTable::lookup_many`]'s work, as a [`pulp::WithSimd`]: its body, and the angles
+/// and reads inlined into it, are compiled for the instruction set the dispatch chose (AVX2
+/// where present), the same operations in the same order (no fused multiply-add: the compiler
+/// never contracts unasked), so the same bits on every processor.
+struct Lookups<'a> {
+    table: &'a LuminanceTable,
+    wi: DVec3,
+    wo: DirectionsRef<'a>,
+    out: &'a mut [f64],
+}
+
+impl pulp::WithSimd for Lookups<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        const BLOCK: usize = 64;
+        let Self { table, wi, wo, out } = self;
+        let mut coords = [[0.0; BLOCK]; 3];
+        let mut start = 0;
+        while start < out.len() {
+            let end = (start + BLOCK).min(out.len());
+            table.grid_coords_many(wi, wo.slice(start..end), &mut coords);
+            let [x_h, x_d, x_p] = &coords;
+            let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
+            if table.complete {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = table.trilinear_complete(x_h, x_d, x_p);
+                }
+            } else {
+                for (((value, &x_h), &x_d), &x_p) in values {
+                    *value = table.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
+                }
+            }
+            start = end;
+        }
     }
 }
 

@@ -42,6 +42,7 @@ pub(crate) fn analyze<const F: usize>(bank: &Bank<F>, x: &[f64], a: &mut [f64], 
 /// sums in the same order (`a[k] = 0 + lo[0] x[..] + lo[1] x[..] + ...`, bit for bit), but away
 /// from the wrap-around every tap reads a contiguous slice, so the loops run over `k` and
 /// vectorize where [`analyze`]'s stride-2 windows do not.
+#[inline(always)]
 pub(crate) fn analyze_split<const F: usize>(bank: &Bank<F>, even: &[f64], odd: &[f64], a: &mut [f64], d: &mut [f64]) {
     let half = even.len();
     let n = 2 * half;
@@ -65,17 +66,25 @@ pub(crate) fn analyze_split<const F: usize>(bank: &Bank<F>, even: &[f64], odd: &
         return;
     }
     let (a, d) = (&mut a[interior.clone()], &mut d[interior.clone()]);
-    a.fill(0.0);
-    d.fill(0.0);
     for j in 0..F {
         // Tap j of output k reads x[2 k + t], t = j - SHIFT: even[k + t / 2] or odd[k + (t - 1) / 2].
         let t = j as isize - shift as isize;
         let (src, offset) = if t.rem_euclid(2) == 0 { (even, t.div_euclid(2)) } else { (odd, (t - 1).div_euclid(2)) };
         let src = &src[(interior.start as isize + offset) as usize..][..a.len()];
         let (lo, hi) = (bank.lo[j], bank.hi[j]);
-        for ((ak, dk), v) in a.iter_mut().zip(d.iter_mut()).zip(src) {
-            *ak += lo * v;
-            *dk += hi * v;
+        let outputs = a.iter_mut().zip(d.iter_mut()).zip(src);
+        if j == 0 {
+            // The sums start from 0.0, as the boundary coefficients' do (0.0 + x, not x: the
+            // same bits, the sign of a zero included), without a pass to clear them first.
+            for ((ak, dk), v) in outputs {
+                *ak = 0.0 + lo * v;
+                *dk = 0.0 + hi * v;
+            }
+        } else {
+            for ((ak, dk), v) in outputs {
+                *ak += lo * v;
+                *dk += hi * v;
+            }
         }
     }
 }
@@ -146,6 +155,7 @@ pub(crate) fn analyze_across<const F: usize>(bank: &Bank<F>, rows: &[&[f64]; F],
 
 /// [`analyze_across`] with its outputs deinterleaved for [`analyze_split`]: column `2 i` of the
 /// low-pass row goes to `lo[0][i]`, column `2 i + 1` to `lo[1][i]`, likewise the high-pass row.
+#[inline(always)]
 pub(crate) fn analyze_across_split<const F: usize>(
     bank: &Bank<F>,
     rows: &[&[f64]; F],

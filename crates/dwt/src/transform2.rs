@@ -82,8 +82,8 @@ impl Decomposition2 {
 /// One level of the forward transform: `cA, (cH, cV, cD)` of
 /// `pywt.dwt2(x, w, mode="periodization")`. Width and height must be even.
 pub fn dwt2(image: &Image, wavelet: Wavelet) -> Result<(Image, [Image; 3]), Error> {
-    check_image(image, 1)?;
-    Ok(with_bank!(wavelet, bank => forward_level(bank, image)))
+    check_shape(image, 1)?;
+    with_bank!(wavelet, bank => forward_level(bank, image))
 }
 
 /// One level of the inverse transform: `pywt.idwt2((approx, details), w, mode="periodization")`,
@@ -115,7 +115,7 @@ pub struct Workspace2 {
 impl Workspace2 {
     /// [`wavedec2`] into this workspace's buffers; the result is borrowed until the next call.
     pub fn wavedec2(&mut self, image: &Image, wavelet: Wavelet, levels: usize) -> Result<&Decomposition2, Error> {
-        check_image(image, levels)?;
+        check_shape(image, levels)?;
         let decomposition = self.decomposition.get_or_insert_with(|| Decomposition2 {
             wavelet,
             approx: Image::zeros(0, 0),
@@ -150,7 +150,10 @@ impl Workspace2 {
                 data
             });
             let mut out = [dst, ch, cv, cd];
-            with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut out));
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut out));
+            if level == 0 && !finite {
+                return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
+            }
             let [a, ch, cv, cd] = out;
             *details = [ch, cv, cd].map(|data| Image::new(w2, h2, data).expect("sizes match"));
             if into_approx {
@@ -180,13 +183,14 @@ pub fn waverec2(decomposition: &Decomposition2) -> Result<Image, Error> {
     Ok(image)
 }
 
-fn check_image(image: &Image, levels: usize) -> Result<(), Error> {
+/// The checks of an image's shape; its values are checked by the first level's pass
+/// ([`forward_level_into`]), which reads them anyway.
+fn check_shape(image: &Image, levels: usize) -> Result<(), Error> {
     if image.data().is_empty() {
         return Err(Error::Empty { what: "image" });
     }
     check_levels("width", image.width(), levels)?;
-    check_levels("height", image.height(), levels)?;
-    check_finite(|| "image".to_owned(), image.data())
+    check_levels("height", image.height(), levels)
 }
 
 fn check_coefficients(approx: &Image, details: &[[Image; 3]]) -> Result<(), Error> {
@@ -221,43 +225,88 @@ fn min_rows(width: usize) -> usize {
     (1 << 14) / width.max(1) + 1
 }
 
-/// One forward level of a checked image (even width and height), one output row `k` at a time:
-/// the column filters combine the `F` input rows that row `k` depends on (contiguous rows, so
-/// the loops vectorize), then the row filter splits each of the two results. Columns first is
-/// also PyWavelets' order (axis 0, then axis 1), and no intermediate image is ever allocated.
-fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> (Image, [Image; 3]) {
+/// One forward level of an image of checked shape (even width and height), one output row `k`
+/// at a time: the column filters combine the `F` input rows that row `k` depends on (contiguous
+/// rows, so the loops vectorize), then the row filter splits each of the two results. Columns
+/// first is also PyWavelets' order (axis 0, then axis 1), and no intermediate image is ever
+/// allocated. An image with a NaN or an infinity is refused.
+fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image, [Image; 3]), Error> {
     let (w, h) = (image.width(), image.height());
     let (w2, h2) = (w / 2, h / 2);
     let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
-    forward_level_into(bank, image.data(), w, h, &mut out);
+    if !forward_level_into(bank, image.data(), w, h, &mut out) {
+        return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
+    }
     let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
-    (ca, [ch, cv, cd])
+    Ok((ca, [ch, cv, cd]))
 }
 
 /// [`forward_level`] of the `w x h` row-major `src` into `out` (`[cA, cH, cV, cD]`, each
-/// `w / 2 x h / 2` values).
-fn forward_level_into<const F: usize>(bank: &Bank<F>, src: &[f64], w: usize, h: usize, out: &mut [Vec<f64>; 4]) {
+/// `w / 2 x h / 2` values); whether every value of `src` is finite. Each output row checks the
+/// last two of the rows it reads, which covers every row once, while they are in cache (a
+/// separate pass over the image cost as much as a tenth of the transform). The loops are
+/// compiled for the best instruction set the processor has ([`pulp::Arch`]: AVX2 where
+/// present): the same operations in the same order (no fused multiply-add), so the same bits.
+fn forward_level_into<const F: usize>(
+    bank: &Bank<F>,
+    src: &[f64],
+    w: usize,
+    h: usize,
+    out: &mut [Vec<f64>; 4],
+) -> bool {
     let w2 = w / 2;
     let [ca, ch, cv, cd] = out;
+    let arch = pulp::Arch::new();
     ca.par_chunks_mut(w2)
         .zip(ch.par_chunks_mut(w2))
         .zip(cv.par_chunks_mut(w2))
         .zip(cd.par_chunks_mut(w2))
         .enumerate()
         .with_min_len(min_rows(w))
-        .for_each_init(
+        .map_init(
             || vec![0.0; 2 * w],
             |scratch, (k, (((a, hh), v), dd))| {
                 let rows = analysis_rows::<F>(k, h).map(|r| &src[r * w..(r + 1) * w]);
-                // The two column-filtered rows, each deinterleaved into its even and odd columns.
-                let (lo, hi) = scratch.split_at_mut(w);
-                let ((lo_even, lo_odd), (hi_even, hi_odd)) = (lo.split_at_mut(w2), hi.split_at_mut(w2));
-                analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], [&mut *hi_even, &mut *hi_odd]);
-                // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
-                analyze_split(bank, lo_even, lo_odd, a, v);
-                analyze_split(bank, hi_even, hi_odd, hh, dd);
+                arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd] })
             },
-        );
+        )
+        .reduce(|| true, |a, b| a & b)
+}
+
+/// One output row of [`forward_level_into`] from its `F` input rows, as a [`pulp::WithSimd`]:
+/// its body is inlined into the function compiled for the instruction set (a closure would be
+/// called from it, compiled for the baseline).
+struct OutputRow<'a, const F: usize> {
+    bank: &'a Bank<F>,
+    rows: [&'a [f64]; F],
+    scratch: &'a mut [f64],
+    /// `[cA, cH, cV, cD]`'s rows.
+    out: [&'a mut [f64]; 4],
+}
+
+impl<const F: usize> pulp::WithSimd for OutputRow<'_, F> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> bool {
+        let Self { bank, rows, scratch, out: [a, hh, v, dd] } = self;
+        let w2 = a.len();
+        // The two column-filtered rows, each deinterleaved into its even and odd columns.
+        let (lo, hi) = scratch.split_at_mut(2 * w2);
+        let ((lo_even, lo_odd), (hi_even, hi_odd)) = (lo.split_at_mut(w2), hi.split_at_mut(w2));
+        analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], [&mut *hi_even, &mut *hi_odd]);
+        // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
+        analyze_split(bank, lo_even, lo_odd, a, v);
+        analyze_split(bank, hi_even, hi_odd, hh, dd);
+        all_finite(rows[F - 2]) & all_finite(rows[F - 1])
+    }
+}
+
+/// Whether no value is NaN or infinite, by an integer test on the exponent that vectorizes.
+#[inline(always)]
+fn all_finite(values: &[f64]) -> bool {
+    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+    values.iter().fold(0u64, |acc, v| acc | u64::from(v.to_bits() & EXPONENT == EXPONENT)) == 0
 }
 
 /// One inverse level of checked coefficients: the transpose of [`forward_level`], one output

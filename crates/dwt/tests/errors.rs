@@ -72,6 +72,21 @@ fn non_finite_values() {
         Error::NonFinite { what: "image".into(), index: 25 },
         "image holds a non-finite value at index 25",
     );
+    // The first level's pass checks each row as it reads it: a value anywhere, in every row,
+    // with both wavelets, one level or several, and the first of two is the one named.
+    for wavelet in [Wavelet::Haar, W] {
+        for index in (0..256).step_by(7) {
+            let mut image = Image::zeros(16, 16);
+            image.data_mut()[index] = f64::NAN;
+            image.data_mut()[255] = f64::INFINITY;
+            let want = || Error::NonFinite { what: "image".into(), index };
+            assert_eq!(wavedec2(&image, wavelet, 3).unwrap_err(), want(), "{wavelet:?} at {index}");
+            assert_eq!(dwt2(&image, wavelet).unwrap_err(), want(), "{wavelet:?} at {index}");
+        }
+    }
+    // Finite values whose coefficients overflow are not the image's fault: no error.
+    let huge = Image::new(8, 8, vec![f64::MAX; 64]).unwrap();
+    assert!(wavedec2(&huge, W, 2).is_ok());
     // Past the first block of the scan too.
     let mut long = vec![0.0; 4096];
     long[3001] = f64::INFINITY;
