@@ -341,7 +341,7 @@ fn larger(a: f64, b: f64) -> f64 {
 }
 
 /// Eq. 7 for one output row `y` ([`Workspace::run`]), as a [`pulp::WithSimd`] so that its loops
-/// are compiled for the best instruction set the processor has (AVX2 where present; the same
+/// are compiled for the best instruction set the processor has (AVX-512 or AVX2 where present; the same
 /// operations in the same order, so the same bits).
 struct Eq7Row<'a> {
     prepared: &'a [LevelRows],

@@ -228,8 +228,8 @@ impl LuminanceTable {
 }
 
 /// [`LuminanceTable::lookup_many`]'s work, as a [`pulp::WithSimd`]: its body, and the angles
-/// and reads inlined into it, are compiled for the instruction set the dispatch chose (AVX2
-/// where present), the same operations in the same order (no fused multiply-add: the compiler
+/// and reads inlined into it, are compiled for the instruction set the dispatch chose (AVX-512
+/// or AVX2 where present), the same operations in the same order (no fused multiply-add: the compiler
 /// never contracts unasked), so the same bits on every processor.
 struct Lookups<'a> {
     table: &'a LuminanceTable,
@@ -312,6 +312,18 @@ impl<'a> DirectionsRef<'a> {
 }
 
 impl Directions {
+    fn reserve(&mut self, additional: usize) {
+        for v in [&mut self.x, &mut self.y, &mut self.z] {
+            v.reserve_exact(additional);
+        }
+    }
+
+    fn append(&mut self, other: &Directions) {
+        self.x.extend_from_slice(&other.x);
+        self.y.extend_from_slice(&other.y);
+        self.z.extend_from_slice(&other.z);
+    }
+
     fn push(&mut self, w: DVec3) {
         self.x.push(w.x);
         self.y.push(w.y);
@@ -345,53 +357,79 @@ pub(crate) struct Pixels {
 }
 
 impl Pixels {
-    /// The samples of `map`'s pixels, computed in parallel over rows.
+    /// The samples of `map`'s pixels, computed in parallel over rows, each row compacted on its
+    /// own, then the rows joined (a run that crosses a row's end continues into the next).
     pub(crate) fn new(map: LobeMap) -> Self {
         use rayon::prelude::*;
         let n = map.size;
-        let rows: Vec<Vec<Sample>> =
-            (0..n).into_par_iter().map(|y| (0..n).map(|x| map.sample(x, y)).collect()).collect();
-        let mut pixels = Pixels {
-            len: n * n,
+        let rows: Vec<Pixels> = (0..n)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = Pixels::empty();
+                for x in 0..n {
+                    row.push((y * n + x) as u32, map.sample(x, y));
+                }
+                row
+            })
+            .collect();
+        let mut pixels = Pixels::empty();
+        let total = |f: fn(&Pixels) -> usize| rows.iter().map(f).sum::<usize>();
+        let (direct, terms) = (total(|p| p.direct.x.len()), total(|p| p.weights.len()));
+        pixels.direct.reserve(direct);
+        pixels.terms.reserve(terms);
+        pixels.weights.reserve(terms);
+        pixels.continued.reserve(total(|p| p.continued.len()));
+        for row in rows {
+            let mut runs = row.runs.into_iter();
+            if let (Some(&(first, count)), Some((last_first, last_count))) =
+                (runs.as_slice().first(), pixels.runs.last_mut())
+                && *last_first + *last_count == first
+            {
+                *last_count += count;
+                runs.next();
+            }
+            pixels.runs.extend(runs);
+            pixels.direct.append(&row.direct);
+            let offset = pixels.weights.len() as u32;
+            pixels.continued.extend(row.continued.iter().map(|&(k, end)| (k, end + offset)));
+            pixels.terms.append(&row.terms);
+            pixels.weights.extend_from_slice(&row.weights);
+        }
+        pixels.len = n * n;
+        pixels.runs.shrink_to_fit();
+        pixels
+    }
+
+    fn empty() -> Self {
+        Pixels {
+            len: 0,
             runs: Vec::new(),
             direct: Directions::default(),
             continued: Vec::new(),
             terms: Directions::default(),
             weights: Vec::new(),
-        };
-        for (k, sample) in rows.into_iter().flatten().enumerate() {
-            let k = k as u32;
-            match sample {
-                Sample::Direct(wo) => {
-                    match pixels.runs.last_mut() {
-                        Some((first, count)) if *first + *count == k => *count += 1,
-                        _ => pixels.runs.push((k, 1)),
-                    }
-                    pixels.direct.push(wo);
+        }
+    }
+
+    /// Appends pixel `k`, which holds `sample`.
+    fn push(&mut self, k: u32, sample: Sample) {
+        match sample {
+            Sample::Direct(wo) => {
+                match self.runs.last_mut() {
+                    Some((first, count)) if *first + *count == k => *count += 1,
+                    _ => self.runs.push((k, 1)),
                 }
-                Sample::Continued { points, weights } => {
-                    for (w, c) in points.into_iter().zip(weights).filter(|&(_, c)| c != 0.0) {
-                        pixels.terms.push(w);
-                        pixels.weights.push(c);
-                    }
-                    pixels.continued.push((k, pixels.weights.len() as u32));
+                self.direct.push(wo);
+            }
+            Sample::Continued { points, weights } => {
+                for (w, c) in points.into_iter().zip(weights).filter(|&(_, c)| c != 0.0) {
+                    self.terms.push(w);
+                    self.weights.push(c);
                 }
+                self.continued.push((k, self.weights.len() as u32));
             }
         }
-        for v in [
-            &mut pixels.direct.x,
-            &mut pixels.direct.y,
-            &mut pixels.direct.z,
-            &mut pixels.terms.x,
-            &mut pixels.terms.y,
-            &mut pixels.terms.z,
-            &mut pixels.weights,
-        ] {
-            v.shrink_to_fit();
-        }
-        pixels.runs.shrink_to_fit();
-        pixels.continued.shrink_to_fit();
-        pixels
+        self.len += 1;
     }
 
     /// The number of pixels.

@@ -245,8 +245,8 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image
 /// `w / 2 x h / 2` values); whether every value of `src` is finite. Each output row checks the
 /// last two of the rows it reads, which covers every row once, while they are in cache (a
 /// separate pass over the image cost as much as a tenth of the transform). The loops are
-/// compiled for the best instruction set the processor has ([`pulp::Arch`]: AVX2 where
-/// present): the same operations in the same order (no fused multiply-add), so the same bits.
+/// compiled for the best instruction set the processor has ([`pulp::Arch`]: AVX-512 or AVX2
+/// where present): the same operations in the same order (no fused multiply-add), so the same bits.
 fn forward_level_into<const F: usize>(
     bank: &Bank<F>,
     src: &[f64],

@@ -32,8 +32,6 @@ pub fn run(
     config.check().map_err(|e| Error::stage("bandwidth atlas", e))?;
     let build = build_atlas(table, config, tick).map_err(|e| Error::stage("bandwidth atlas", e))?;
     let atlas = &build.atlas;
-    let exr = envmap::encode_exr(atlas.width(), atlas.height(), &[("Y", &atlas.data)], envmap::SampleType::F32)
-        .map_err(|e| Error::Internal(format!("encoding {EXR}: {e}")))?;
     let notes = format!(
         "{} {} of {} lobes reach the analysis grid's limit: their values are lower bounds ({:.2} cycles per \
          radian at a lobe's centre).",
@@ -49,10 +47,17 @@ pub fn run(
         zero: "0: flat, no detail above the noise floor",
         notes: &notes,
     };
-    let (figure, scale) = picture::figure(atlas, &atlas.data, &text);
+    // The texture and the picture are encoded side by side (a tenth of the stage's time each).
+    let (exr, (png, scale)) = rayon::join(
+        || envmap::encode_exr(atlas.width(), atlas.height(), &[("Y", &atlas.data)], envmap::SampleType::F32),
+        || {
+            let (figure, scale) = picture::figure(atlas, &atlas.data, &text);
+            (envmap::encode_png_rgb8(figure.width, figure.height, &figure.rgb), scale)
+        },
+    );
+    let exr = exr.map_err(|e| Error::Internal(format!("encoding {EXR}: {e}")))?;
+    let png = png.map_err(|e| Error::Internal(format!("encoding {PICTURE}: {e}")))?;
     let range = (scale.lo(), scale.hi());
-    let png = envmap::encode_png_rgb8(figure.width, figure.height, &figure.rgb)
-        .map_err(|e| Error::Internal(format!("encoding {PICTURE}: {e}")))?;
     let parameters = [
         ("lobes", config.lobes.to_string()),
         ("tile", config.tile.to_string()),
@@ -125,7 +130,7 @@ fn describe(
     let stored_texels = if rows { atlas.lobes_y * atlas.tile_len() } else { atlas.data.len() };
     let stats = &build.stats;
     let mut sorted: Vec<f32> = atlas.data.clone();
-    sorted.sort_by(f32::total_cmp);
+    sorted.sort_unstable_by(f32::total_cmp);
     let quantile = |q: f64| f64::from(sorted[((sorted.len() - 1) as f64 * q).round() as usize]);
     let n_lobes = atlas.n_lobes();
     let flat = sorted.iter().filter(|v| **v == 0.0).count();
