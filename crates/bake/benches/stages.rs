@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 use bake::stage::{atlas, env_bandwidth, importance, layers, prefilter};
 use bake::{BakeConfig, Program, Source};
+use brdf_atlas::LuminanceTable;
 
 const RUNS: usize = 5;
 const MATERIAL: &str = "gold-paint";
@@ -115,9 +116,12 @@ fn main() {
     );
     print(
         "bandwidth atlas",
-        &measure(|| atlas::run(&table, &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas")),
+        &measure(|| {
+            atlas::run(&LuminanceTable::new(&table), &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas")
+        }),
     );
-    let (_, build) = atlas::run(&table, &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas");
+    let (_, build) =
+        atlas::run(&LuminanceTable::new(&table), &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas");
     print("read the map", &measure(|| envmap::load(&map_path).expect("the map")));
     let map = envmap::load(&map_path).expect("the map");
     print(

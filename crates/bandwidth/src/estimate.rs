@@ -329,6 +329,8 @@ struct LevelRows {
     rows: Vec<f64>,
     /// Per coefficient row: its place in `rows`, `u32::MAX` when it covers no output row.
     slot: Vec<u32>,
+    /// The number of coefficient rows that cover an output row.
+    needed: usize,
     m_y: usize,
     cover_y: Option<Cover>,
 }
@@ -349,6 +351,8 @@ struct Eq7Row<'a> {
     eps: f64,
     /// `levels + 2` rows of scratch: each level's lambda, their maximum, the running sum.
     scratch: &'a mut [f64],
+    /// Per level, the covering coefficient rows `(first, count)` its lambda in `scratch` is of.
+    covered: &'a mut [Option<(u32, u32)>],
     level_row: &'a mut [u8],
 }
 
@@ -357,23 +361,27 @@ impl pulp::WithSimd for Eq7Row<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) {
-        let Self { prepared, y, eps, scratch, level_row } = self;
+        let Self { prepared, y, eps, scratch, covered, level_row } = self;
         let out_w = level_row.len();
         let levels = prepared.len();
         let (lambdas, rest) = scratch.split_at_mut(levels * out_w);
         let (max, sum) = rest.split_at_mut(out_w);
-        for (j, (lambda, prepared)) in lambdas.chunks_exact_mut(out_w).zip(prepared).enumerate() {
+        let lambdas_of = lambdas.chunks_exact_mut(out_w).zip(prepared).zip(covered.iter_mut());
+        for (j, ((lambda, prepared), covered)) in lambdas_of.enumerate() {
             // lambda_j of this row: the maximum over the covering coefficient rows.
             let cover_y = prepared.cover_y.as_ref().expect("prepared above");
-            let (first, count) = (cover_y.first[y] as usize, cover_y.count[y]);
-            let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
-            lambda.fill(0.0);
-            let mut ky = first;
-            for _ in 0..count {
-                for (l, s) in lambda.iter_mut().zip(row(ky)) {
-                    *l = larger(*l, *s);
+            let (first, count) = (cover_y.first[y], cover_y.count[y]);
+            if *covered != Some((first, count)) {
+                let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
+                lambda.fill(0.0);
+                let mut ky = first as usize;
+                for _ in 0..count {
+                    for (l, s) in lambda.iter_mut().zip(row(ky)) {
+                        *l = larger(*l, *s);
+                    }
+                    ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
                 }
-                ky = if ky + 1 == prepared.m_y { 0 } else { ky + 1 };
+                *covered = Some((first, count));
             }
             if j == 0 {
                 max.copy_from_slice(lambda);
@@ -439,22 +447,15 @@ impl Workspace {
         with_frequency: bool,
     ) -> Result<&BandwidthMap, Error> {
         let (w, h) = (image.width(), image.height());
-        let decomposition = self.transform.wavedec2(image, config.wavelet, levels)?;
         self.levels.resize_with(levels, LevelRows::default);
         self.levels.truncate(levels);
-        self.levels.par_iter_mut().zip(&decomposition.details).enumerate().for_each(|(i, (prepared, details))| {
+        // Only the coefficient rows that cover an output row are needed (about half of them when
+        // the output is the top half of an extended image): the transform computes the details
+        // of those rows alone.
+        for (i, prepared) in self.levels.iter_mut().enumerate() {
             let level = i + 1;
-            let (m_x, m_y) = (w >> level, h >> level);
-            let floor = config.noise_floor * (1u64 << level) as f64;
-            let gain = match config.reading {
-                Reading::Paper => 1.0,
-                Reading::LevelNormalized => 0.5f64.powi(level as i32),
-            };
-            let [ch, cv, cd] = details;
-            let cover_x = Cover::new(config.wavelet, level, w, out_w);
+            let m_y = h >> level;
             let cover_y = Cover::new(config.wavelet, level, h, out_h);
-            // Only the coefficient rows that cover an output row are needed (about half of them
-            // when the output is the top half of an extended image).
             prepared.slot.clear();
             prepared.slot.resize(m_y, u32::MAX);
             for (&first, &count) in cover_y.first.iter().zip(&cover_y.count) {
@@ -467,7 +468,26 @@ impl Workspace {
                 *slot = needed;
                 needed += 1;
             }
-            let rows = sized(&mut prepared.rows, needed as usize * out_w);
+            prepared.needed = needed as usize;
+            prepared.m_y = m_y;
+            prepared.cover_y = Some(cover_y);
+        }
+        let levels_rows = &self.levels;
+        let decomposition = self
+            .transform
+            .wavedec2_where(image, config.wavelet, levels, &|level, k| levels_rows[level - 1].slot[k] != u32::MAX)?;
+        self.levels.par_iter_mut().zip(&decomposition.details).enumerate().for_each(|(i, (prepared, details))| {
+            let level = i + 1;
+            let m_x = w >> level;
+            let floor = config.noise_floor * (1u64 << level) as f64;
+            let gain = match config.reading {
+                Reading::Paper => 1.0,
+                Reading::LevelNormalized => 0.5f64.powi(level as i32),
+            };
+            let [ch, cv, cd] = details;
+            let cover_x = Cover::new(config.wavelet, level, w, out_w);
+            let needed = prepared.needed;
+            let rows = sized(&mut prepared.rows, needed * out_w);
             // One coefficient row at a time: the largest magnitude of the three orientations, zero
             // below the noise floor, in the reading's units; then its maximum over the coefficients
             // covering each output column.
@@ -490,8 +510,6 @@ impl Workspace {
                     *out = best;
                 }
             }
-            prepared.m_y = m_y;
-            prepared.cover_y = Some(cover_y);
         });
 
         let map = self.map.get_or_insert_with(|| BandwidthMap {
@@ -508,10 +526,18 @@ impl Workspace {
         sized(&mut map.frequency, if with_frequency { out_w * out_h } else { 0 });
         let prepared = &self.levels;
         let arch = pulp::Arch::new();
-        map.level.par_chunks_mut(out_w).enumerate().with_min_len(4).for_each_init(
-            || vec![0.0f64; (levels + 2) * out_w],
-            |scratch, (y, level_row)| {
-                arch.dispatch(Eq7Row { prepared, y, eps: config.eps, scratch, level_row });
+        // Bands of rows, each row after the other: a level's lambda changes only when the
+        // coefficient rows covering the output row do (every 2^j rows at level j), and is kept
+        // until then.
+        const BAND: usize = 16;
+        map.level.par_chunks_mut(BAND * out_w).enumerate().for_each_init(
+            || (vec![0.0f64; (levels + 2) * out_w], vec![None; levels]),
+            |(scratch, covered), (band, level_rows)| {
+                covered.fill(None);
+                for (r, level_row) in level_rows.chunks_exact_mut(out_w).enumerate() {
+                    let y = band * BAND + r;
+                    arch.dispatch(Eq7Row { prepared, y, eps: config.eps, scratch, covered, level_row });
+                }
             },
         );
         if with_frequency {

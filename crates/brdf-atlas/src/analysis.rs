@@ -93,20 +93,29 @@ impl TileReduction {
         let (n, t) = (self.size, self.tile);
         let m = n / t;
         let mut nyquist_texels = 0;
+        // Row by row through each band of `m` rows, `m` pixels per texel: the values are
+        // finite and >= 0, so the largest of those on the hemisphere is the largest of the
+        // values with the others read as 0, which vectorizes.
+        let (mut best, mut nyquist) = (vec![0.0f64; t], vec![false; t]);
         for ty in 0..t {
-            for tx in 0..t {
-                let (mut best, mut nyquist) = (0.0f64, false);
-                for y in ty * m..(ty + 1) * m {
-                    for x in tx * m..(tx + 1) * m {
-                        let k = y * n + x;
-                        if self.inside[k] {
-                            best = best.max(cycles_per_radian[k]);
-                            nyquist |= level[k] == 1;
-                        }
+            best.fill(0.0);
+            nyquist.fill(false);
+            for y in ty * m..(ty + 1) * m {
+                let row = y * n..(y + 1) * n;
+                let pixels = cycles_per_radian[row.clone()].chunks_exact(m).zip(level[row.clone()].chunks_exact(m));
+                for (((b, q), (v, l)), inside) in
+                    best.iter_mut().zip(&mut nyquist).zip(pixels).zip(self.inside[row].chunks_exact(m))
+                {
+                    for ((&v, &l), &inside) in v.iter().zip(l).zip(inside) {
+                        let v = if inside { v } else { 0.0 };
+                        *b = if v > *b { v } else { *b };
+                        *q |= inside & (l == 1);
                     }
                 }
-                out[ty * t + tx] = best as f32;
-                nyquist_texels += usize::from(nyquist);
+            }
+            for (tx, (&b, &q)) in best.iter().zip(&nyquist).enumerate() {
+                out[ty * t + tx] = b as f32;
+                nyquist_texels += usize::from(q);
             }
         }
         for (k, &s) in self.source.iter().enumerate() {

@@ -41,12 +41,18 @@ pub(crate) fn analyze<const F: usize>(bank: &Bank<F>, x: &[f64], a: &mut [f64], 
 /// [`analyze`] of a signal given deinterleaved: `even[i] = x[2 i]`, `odd[i] = x[2 i + 1]`. The same
 /// sums in the same order (`a[k] = 0 + lo[0] x[..] + lo[1] x[..] + ...`, bit for bit), but away
 /// from the wrap-around every tap reads a contiguous slice, so the loops run over `k` and
-/// vectorize where [`analyze`]'s stride-2 windows do not.
+/// vectorize where [`analyze`]'s stride-2 windows do not. Without `d`, the approximation alone.
 #[inline(always)]
-pub(crate) fn analyze_split<const F: usize>(bank: &Bank<F>, even: &[f64], odd: &[f64], a: &mut [f64], d: &mut [f64]) {
+pub(crate) fn analyze_split<const F: usize>(
+    bank: &Bank<F>,
+    even: &[f64],
+    odd: &[f64],
+    a: &mut [f64],
+    mut d: Option<&mut [f64]>,
+) {
     let half = even.len();
     let n = 2 * half;
-    debug_assert!(half >= 1 && odd.len() == half && a.len() == half && d.len() == half);
+    debug_assert!(half >= 1 && odd.len() == half && a.len() == half && d.as_ref().is_none_or(|d| d.len() == half));
     let shift = Bank::<F>::SHIFT;
     let x = |i: usize| if i.is_multiple_of(2) { even[i / 2] } else { odd[i / 2] };
     let first = shift.div_ceil(2);
@@ -60,30 +66,46 @@ pub(crate) fn analyze_split<const F: usize>(bank: &Bank<F>, even: &[f64], odd: &
             sa += bank.lo[j] * v;
             sd += bank.hi[j] * v;
         }
-        (a[k], d[k]) = (sa, sd);
+        a[k] = sa;
+        if let Some(d) = d.as_deref_mut() {
+            d[k] = sd;
+        }
     }
     if interior.is_empty() {
         return;
     }
-    let (a, d) = (&mut a[interior.clone()], &mut d[interior.clone()]);
+    let a = &mut a[interior.clone()];
+    let mut d = d.map(|d| &mut d[interior.clone()]);
     for j in 0..F {
         // Tap j of output k reads x[2 k + t], t = j - SHIFT: even[k + t / 2] or odd[k + (t - 1) / 2].
         let t = j as isize - shift as isize;
         let (src, offset) = if t.rem_euclid(2) == 0 { (even, t.div_euclid(2)) } else { (odd, (t - 1).div_euclid(2)) };
         let src = &src[(interior.start as isize + offset) as usize..][..a.len()];
         let (lo, hi) = (bank.lo[j], bank.hi[j]);
-        let outputs = a.iter_mut().zip(d.iter_mut()).zip(src);
-        if j == 0 {
-            // The sums start from 0.0, as the boundary coefficients' do (0.0 + x, not x: the
-            // same bits, the sign of a zero included), without a pass to clear them first.
-            for ((ak, dk), v) in outputs {
-                *ak = 0.0 + lo * v;
-                *dk = 0.0 + hi * v;
+        // The sums start from 0.0, as the boundary coefficients' do (0.0 + x, not x: the same
+        // bits, the sign of a zero included), without a pass to clear them first.
+        match (j, d.as_deref_mut()) {
+            (0, Some(d)) => {
+                for ((ak, dk), v) in a.iter_mut().zip(d.iter_mut()).zip(src) {
+                    *ak = 0.0 + lo * v;
+                    *dk = 0.0 + hi * v;
+                }
             }
-        } else {
-            for ((ak, dk), v) in outputs {
-                *ak += lo * v;
-                *dk += hi * v;
+            (_, Some(d)) => {
+                for ((ak, dk), v) in a.iter_mut().zip(d.iter_mut()).zip(src) {
+                    *ak += lo * v;
+                    *dk += hi * v;
+                }
+            }
+            (0, None) => {
+                for (ak, v) in a.iter_mut().zip(src) {
+                    *ak = 0.0 + lo * v;
+                }
+            }
+            (_, None) => {
+                for (ak, v) in a.iter_mut().zip(src) {
+                    *ak += lo * v;
+                }
             }
         }
     }
@@ -155,16 +177,33 @@ pub(crate) fn analyze_across<const F: usize>(bank: &Bank<F>, rows: &[&[f64]; F],
 
 /// [`analyze_across`] with its outputs deinterleaved for [`analyze_split`]: column `2 i` of the
 /// low-pass row goes to `lo[0][i]`, column `2 i + 1` to `lo[1][i]`, likewise the high-pass row.
+/// Without `hi`, the low-pass row alone.
 #[inline(always)]
 pub(crate) fn analyze_across_split<const F: usize>(
     bank: &Bank<F>,
     rows: &[&[f64]; F],
     lo: [&mut [f64]; 2],
-    hi: [&mut [f64]; 2],
+    hi: Option<[&mut [f64]; 2]>,
 ) {
     let [lo_even, lo_odd] = lo;
-    let [hi_even, hi_odd] = hi;
     let half = lo_even.len();
+    let Some([hi_even, hi_odd]) = hi else {
+        for (j, row) in rows.iter().enumerate() {
+            let (l, row) = (bank.lo[j], &row[..2 * half]);
+            let outputs = lo_even.iter_mut().zip(lo_odd.iter_mut()).zip(row.chunks_exact(2));
+            if j == 0 {
+                for ((le, lo), pair) in outputs {
+                    (*le, *lo) = (l * pair[0], l * pair[1]);
+                }
+            } else {
+                for ((le, lo), pair) in outputs {
+                    *le += l * pair[0];
+                    *lo += l * pair[1];
+                }
+            }
+        }
+        return;
+    };
     for (j, row) in rows.iter().enumerate() {
         let (l, h, row) = (bank.lo[j], bank.hi[j], &row[..2 * half]);
         let outputs = lo_even.iter_mut().zip(lo_odd.iter_mut()).zip(hi_even.iter_mut().zip(hi_odd.iter_mut()));
@@ -232,16 +271,23 @@ mod tests {
             let mut split = vec![0.0; 2 * w];
             let (l, h) = split.split_at_mut(w);
             let ((le, lo_), (he, ho)) = (l.split_at_mut(half), h.split_at_mut(half));
-            analyze_across_split(bank, &rows, [&mut *le, &mut *lo_], [&mut *he, &mut *ho]);
+            analyze_across_split(bank, &rows, [&mut *le, &mut *lo_], Some([&mut *he, &mut *ho]));
+            let same = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| u.to_bits() == v.to_bits());
+            // The low-pass alone is the same low-pass.
+            let (mut le_alone, mut lo_alone) = (vec![0.0; half], vec![0.0; half]);
+            analyze_across_split(bank, &rows, [&mut le_alone, &mut lo_alone], None);
+            assert!(same(le, &le_alone) && same(lo_, &lo_alone), "w {w}");
             for (x, (line, (even, odd))) in [(&lo, (&*le, &*lo_)), (&hi, (&*he, &*ho))].into_iter().enumerate() {
                 let interleaved: Vec<f64> = even.iter().zip(odd.iter()).flat_map(|(e, o)| [*e, *o]).collect();
-                assert!(line.iter().zip(&interleaved).all(|(a, b)| a.to_bits() == b.to_bits()), "w {w}, row {x}");
+                assert!(same(line, &interleaved), "w {w}, row {x}");
                 let (mut a, mut d) = (vec![0.0; half], vec![0.0; half]);
                 analyze(bank, line, &mut a, &mut d);
                 let (mut a2, mut d2) = (vec![0.0; half], vec![0.0; half]);
-                analyze_split(bank, even, odd, &mut a2, &mut d2);
-                let same = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| u.to_bits() == v.to_bits());
+                analyze_split(bank, even, odd, &mut a2, Some(&mut d2));
                 assert!(same(&a, &a2) && same(&d, &d2), "w {w}, row {x}");
+                let mut a3 = vec![0.0; half];
+                analyze_split(bank, even, odd, &mut a3, None);
+                assert!(same(&a, &a3), "w {w}, row {x}: the approximation alone");
             }
         }
     }

@@ -109,12 +109,30 @@ pub fn wavedec2(image: &Image, wavelet: Wavelet, levels: usize) -> Result<Decomp
 #[derive(Debug, Default)]
 pub struct Workspace2 {
     decomposition: Option<Decomposition2>,
-    between: Vec<f64>,
+    /// The approximations between levels, alternately.
+    between: [Vec<f64>; 2],
 }
 
 impl Workspace2 {
     /// [`wavedec2`] into this workspace's buffers; the result is borrowed until the next call.
     pub fn wavedec2(&mut self, image: &Image, wavelet: Wavelet, levels: usize) -> Result<&Decomposition2, Error> {
+        self.wavedec2_where(image, wavelet, levels, &|_, _| true)
+    }
+
+    /// [`Self::wavedec2`] with the detail coefficients of level `j` (1 = finest) computed only in
+    /// the rows `k` where `rows_with_details(j, k)` holds: the other rows of that level's three detail
+    /// images hold whatever the workspace held before (unspecified). The approximation is
+    /// computed everywhere, as the coarser levels read it. An estimate that reads the details
+    /// of part of an image ([`wavedec2`]'s work for a row without details: the low-pass across
+    /// rows and along the row, three eighths) uses it; every coefficient it computes is
+    /// [`wavedec2`]'s, bit for bit.
+    pub fn wavedec2_where(
+        &mut self,
+        image: &Image,
+        wavelet: Wavelet,
+        levels: usize,
+        rows_with_details: &(dyn Fn(usize, usize) -> bool + Sync),
+    ) -> Result<&Decomposition2, Error> {
         check_shape(image, levels)?;
         let decomposition = self.decomposition.get_or_insert_with(|| Decomposition2 {
             wavelet,
@@ -126,43 +144,38 @@ impl Workspace2 {
         decomposition.details.resize_with(levels, blank);
         let (mut w, mut h) = (image.width(), image.height());
         // Level j reads the approximation of level j - 1 (the image for j = 1) and writes its own:
-        // the two alternate between `between` and the decomposition's `approx`, ending in `approx`.
-        let mut approx = std::mem::replace(&mut decomposition.approx, Image::zeros(0, 0)).into_data();
+        // the two alternate between the two buffers of `between`, which only grow (a buffer cut
+        // to a coarse level's size and grown again for the next image's first level would be
+        // cleared again), and the last one is copied into the decomposition's `approx`.
         let mut between = std::mem::take(&mut self.between);
         for level in 0..levels {
             let (w2, h2) = (w / 2, h / 2);
-            // The last level writes into `approx`; counting back, levels alternate.
-            let into_approx = (levels - 1 - level).is_multiple_of(2);
-            let (mut dst, previous) = if into_approx {
-                (std::mem::take(&mut approx), &between)
-            } else {
-                (std::mem::take(&mut between), &approx)
-            };
+            let [even, odd] = &mut between;
+            let (dst, previous) = if level % 2 == 0 { (even, &*odd) } else { (odd, &*even) };
             let src: &[f64] = if level == 0 { image.data() } else { &previous[..w * h] };
             // Every value is written: only a buffer that grows is filled first.
-            dst.truncate(w2 * h2);
-            dst.resize(w2 * h2, 0.0);
+            if dst.len() < w2 * h2 {
+                dst.resize(w2 * h2, 0.0);
+            }
             let details = &mut decomposition.details[level];
-            let [ch, cv, cd] = details.each_mut().map(|image| {
+            let [mut ch, mut cv, mut cd] = details.each_mut().map(|image| {
                 let mut data = std::mem::replace(image, Image::zeros(0, 0)).into_data();
                 data.truncate(w2 * h2);
                 data.resize(w2 * h2, 0.0);
                 data
             });
-            let mut out = [dst, ch, cv, cd];
-            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut out));
+            let with_details = |k: usize| rows_with_details(level + 1, k);
+            let out = [&mut dst[..w2 * h2], &mut ch[..], &mut cv[..], &mut cd[..]];
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, out, &with_details));
             if level == 0 && !finite {
                 return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
             }
-            let [a, ch, cv, cd] = out;
             *details = [ch, cv, cd].map(|data| Image::new(w2, h2, data).expect("sizes match"));
-            if into_approx {
-                approx = a;
-            } else {
-                between = a;
-            }
             (w, h) = (w2, h2);
         }
+        let mut approx = std::mem::replace(&mut decomposition.approx, Image::zeros(0, 0)).into_data();
+        approx.clear();
+        approx.extend_from_slice(&between[(levels - 1) % 2][..w * h]);
         decomposition.approx = Image::new(w, h, approx).expect("sizes match");
         self.between = between;
         Ok(decomposition)
@@ -234,7 +247,7 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image
     let (w, h) = (image.width(), image.height());
     let (w2, h2) = (w / 2, h / 2);
     let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
-    if !forward_level_into(bank, image.data(), w, h, &mut out) {
+    if !forward_level_into(bank, image.data(), w, h, out.each_mut().map(|b| &mut b[..]), &|_| true) {
         return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
     }
     let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
@@ -242,7 +255,8 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image
 }
 
 /// [`forward_level`] of the `w x h` row-major `src` into `out` (`[cA, cH, cV, cD]`, each
-/// `w / 2 x h / 2` values); whether every value of `src` is finite. Each output row checks the
+/// `w / 2 x h / 2` values), the details only of the rows `k` where `details(k)` holds; whether
+/// every value of `src` is finite. Each output row checks the
 /// last two of the rows it reads, which covers every row once, while they are in cache (a
 /// separate pass over the image cost as much as a tenth of the transform). The loops are
 /// compiled for the best instruction set the processor has ([`pulp::Arch`]: AVX-512 or AVX2
@@ -252,7 +266,8 @@ fn forward_level_into<const F: usize>(
     src: &[f64],
     w: usize,
     h: usize,
-    out: &mut [Vec<f64>; 4],
+    out: [&mut [f64]; 4],
+    details: &(dyn Fn(usize) -> bool + Sync),
 ) -> bool {
     let w2 = w / 2;
     let [ca, ch, cv, cd] = out;
@@ -267,7 +282,7 @@ fn forward_level_into<const F: usize>(
             || vec![0.0; 2 * w],
             |scratch, (k, (((a, hh), v), dd))| {
                 let rows = analysis_rows::<F>(k, h).map(|r| &src[r * w..(r + 1) * w]);
-                arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd] })
+                arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd], details: details(k) })
             },
         )
         .reduce(|| true, |a, b| a & b)
@@ -282,6 +297,8 @@ struct OutputRow<'a, const F: usize> {
     scratch: &'a mut [f64],
     /// `[cA, cH, cV, cD]`'s rows.
     out: [&'a mut [f64]; 4],
+    /// Whether to compute the details (else `cA` alone).
+    details: bool,
 }
 
 impl<const F: usize> pulp::WithSimd for OutputRow<'_, F> {
@@ -289,15 +306,20 @@ impl<const F: usize> pulp::WithSimd for OutputRow<'_, F> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) -> bool {
-        let Self { bank, rows, scratch, out: [a, hh, v, dd] } = self;
+        let Self { bank, rows, scratch, out: [a, hh, v, dd], details } = self;
         let w2 = a.len();
         // The two column-filtered rows, each deinterleaved into its even and odd columns.
         let (lo, hi) = scratch.split_at_mut(2 * w2);
         let ((lo_even, lo_odd), (hi_even, hi_odd)) = (lo.split_at_mut(w2), hi.split_at_mut(w2));
-        analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], [&mut *hi_even, &mut *hi_odd]);
-        // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
-        analyze_split(bank, lo_even, lo_odd, a, v);
-        analyze_split(bank, hi_even, hi_odd, hh, dd);
+        if details {
+            analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], Some([&mut *hi_even, &mut *hi_odd]));
+            // Low-pass along axis 0 -> (cA, cV) along axis 1; high-pass -> (cH, cD).
+            analyze_split(bank, lo_even, lo_odd, a, Some(v));
+            analyze_split(bank, hi_even, hi_odd, hh, Some(dd));
+        } else {
+            analyze_across_split(bank, &rows, [&mut *lo_even, &mut *lo_odd], None);
+            analyze_split(bank, lo_even, lo_odd, a, None);
+        }
         all_finite(rows[F - 2]) & all_finite(rows[F - 1])
     }
 }

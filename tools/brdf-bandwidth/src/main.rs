@@ -66,6 +66,9 @@ fn run(args: Args) -> Result<ExitCode> {
     let config = Config { lobes: args.lobes, tile: args.tile, analysis_size: args.analysis_size, ..Config::default() };
     config.check()?;
     let table = merl::read_file(&args.material).with_context(|| format!("reading {}", args.material.display()))?;
+    // The atlas reads the luminance alone: the table goes before the analysis's buffers come.
+    let luminance = brdf_atlas::LuminanceTable::new(&table);
+    drop(table);
     let source = Source::hash(&args.material)?;
     let progress = cli::Progress::new(args.quiet);
     progress.step("lobes".to_string());
@@ -73,7 +76,7 @@ fn run(args: Args) -> Result<ExitCode> {
     let done = std::sync::atomic::AtomicU64::new(0);
     let tick =
         |n: usize| progress.work(done.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed) + n as u64, total);
-    let (staged, _) = bake::stage::atlas::run(&table, &source, &PROGRAM, &config, &tick)?;
+    let (staged, _) = bake::stage::atlas::run(&luminance, &source, &PROGRAM, &config, &tick)?;
     progress.finish();
     let dir = &args.out_dir;
     staged.write(dir)?;
