@@ -180,19 +180,23 @@
 //! One analysis per row: 64 lobe images of `n^2` pixels (one trilinear lookup each on the
 //! hemisphere, two to four below the horizon) and 64 estimates of the `2n x 2n` continuation,
 //! in parallel over rows. The lobe map's samples are computed once, in parallel, and kept
-//! compactly; each thread keeps its buffers from row to row (the lobe image, the continuation,
-//! the transform's and the estimator's workspaces, [`bandwidth::Workspace`]), and only the
-//! continuation's top-left `n x n` pixels, the image's own, are estimated
-//! ([`bandwidth::Workspace::levels_top_left`]). Every step computes what the straightforward
-//! version computes, bit for bit (the tests compare them; `cargo bench -p bake --bench stages`
-//! times the atlas, row `bandwidth atlas`).
+//! compactly; a row in progress holds one set of buffers (the lobe image, the continuation, the
+//! transform's and the estimator's workspaces, [`bandwidth::Workspace`]), taken from and given
+//! back to a pool, so that no row faults in fresh memory; only the continuation's top-left
+//! `n x n` pixels, the image's own, are estimated
+//! ([`bandwidth::Workspace::levels_top_left`], whose transform computes the details of the
+//! coefficient rows it reads alone). Every step computes what the straightforward version
+//! computes, bit for bit, except the band energies' order of summation and the lookups' angles
+//! ("Angles": the tests compare them; `cargo bench -p bake --bench stages` times the atlas, row
+//! `bandwidth atlas`).
 //!
-//! The lookups are the largest part: about two fifths of the CPU time at the default size
+//! The loops (the lookups, the transform's rows, eq. 7, the band energies' sums) are compiled
+//! for the best instruction set the processor has, AVX-512 or AVX2 where present, chosen at run
+//! time (`pulp`); the compiler never fuses a multiply and an add unasked, so every processor
+//! computes the same bits. At the default size the lookups take about a third of the CPU time
 //! (`perf record target/release/brdf-bandwidth gold-paint.binary --out-dir DIR`, gold-paint),
-//! half of it the angles (blocks of 64 pairs, vectorized: "Angles") and half the trilinear
-//! reads; a table without holes is read without the checks for cells lacking data. The D4
-//! transforms (the continuation's and the band energies' mirror tiling) take about a fifth, the
-//! estimator's per-pixel levels about a tenth.
+//! the two D4 transforms per row (the continuation's and the band energies' mirror tiling)
+//! about a quarter, memory-bound, the estimator's per-pixel levels about a tenth.
 //!
 //! # Angles
 //!
@@ -211,13 +215,18 @@
 //! conditioning (`1 / |s|`; `1 / sqrt(theta_h)` for `theta_h`'s square-root spacing,
 //! `1 / sin(theta_d)` for `phi_d` near the pole) and the luminance within `1e-13` of the largest
 //! of the eight corners (test `fast_angles_equal_libms_to_rounding`, a million random pairs).
-//! On the 20 shared materials at the default settings, against libm's lookups
-//! (`cargo run --release -p brdf-atlas --example lookup-difference -- target/merl/*.binary`,
-//! after `make test-data`): every pixel of every row's lobe image within 5e-14 of the lobe's
-//! peak, every band energy within 1.5e-13 and every view bandwidth within 5e-14 (relative); **no
-//! texel of any atlas differs** (a pixel's level moves only where a coefficient sits within
-//! such a difference of an eq. 7 threshold: none does) and **no row's layer**. `brdf-bandwidth`
-//! writes the same files, byte for byte, as with libm's lookups on all 20.
+//! The band energies ([`view::band_energy`]) add a level's squares in eight partial sums, which
+//! vectorize, where one sum after another was bound by the addition's latency: the two orders
+//! are each within `m u` of the exact sum of their `m` terms (`u = 2^-53`).
+//!
+//! On the 20 shared materials at the default settings, against libm's lookups and one sum after
+//! another (`cargo run --release -p brdf-atlas --example analysis-difference --
+//! target/merl/*.binary`, after `make test-data`): every pixel of every row's lobe image within
+//! 5e-14 of the lobe's peak, every band energy within 1.5e-13 and every view bandwidth within
+//! 5e-14 (relative); **no texel of any atlas differs** (a pixel's level moves only where a
+//! coefficient sits within such a difference of an eq. 7 threshold: none does) and **no row's
+//! layer**. `brdf-bandwidth` writes the same files, byte for byte, as before either change on all
+//! 20.
 
 mod analysis;
 mod atan;

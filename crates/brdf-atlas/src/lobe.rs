@@ -652,7 +652,9 @@ mod tests {
         println!("largest differences (x_h, x_d, x_p scaled; luminance relative to the largest corner): {worst:?}");
     }
 
-    /// The batch lookup is the single one, bit for bit, with and without cells lacking data.
+    /// The batch lookup is the single one, bit for bit, with and without cells lacking data: the
+    /// batch compiled for the instruction set chosen at run time, the single one for the
+    /// baseline.
     #[test]
     fn lookup_many_is_lookup_bit_for_bit() {
         let mut table = Analytic::Ggx { alpha: 0.3, f0: [0.2, 0.5, 0.9] }.table(Dims::MERL);

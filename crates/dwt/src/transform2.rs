@@ -350,3 +350,35 @@ fn inverse_level<const F: usize>(bank: &Bank<F>, approx: &Image, details: &[Imag
     );
     Image::new(w, h, out).expect("sizes match")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pulp::WithSimd;
+
+    /// An output row computed with the instruction set chosen at run time is the baseline's, bit
+    /// for bit, with and without its details.
+    fn check_dispatch<const F: usize>(bank: &Bank<F>) {
+        let w = 38;
+        let rows: Vec<Vec<f64>> =
+            (0..F).map(|r| (0..w).map(|c| ((r * 131 + c * 71) as f64 * 0.37).sin() * 1e3).collect()).collect();
+        let rows: [&[f64]; F] = std::array::from_fn(|r| &rows[r][..]);
+        for details in [true, false] {
+            let run = |dispatch: bool| {
+                let (mut scratch, mut out) = (vec![0.0; 2 * w], [(); 4].map(|_| vec![0.0; w / 2]));
+                let [a, hh, v, dd] = out.each_mut().map(|b| &mut b[..]);
+                let row = OutputRow { bank, rows, scratch: &mut scratch, out: [a, hh, v, dd], details };
+                let finite =
+                    if dispatch { pulp::Arch::new().dispatch(row) } else { row.with_simd(pulp::Scalar::new()) };
+                (finite, out.map(|b| b.iter().map(|x| x.to_bits()).collect::<Vec<u64>>()))
+            };
+            assert_eq!(run(true), run(false), "details {details}");
+        }
+    }
+
+    #[test]
+    fn dispatched_rows_are_the_baselines_bit_for_bit() {
+        check_dispatch(&D4);
+        check_dispatch(&HAAR);
+    }
+}

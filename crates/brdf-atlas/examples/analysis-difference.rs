@@ -1,11 +1,14 @@
-//! What the lookups' own `atan2` (`LuminanceTable::lookup`) changes against libm's
-//! (`LuminanceTable::lookup_libm`, the lookups before it) in the default analysis of MERL tables:
-//! per table, every row's lobe image drawn both ways, the largest difference of a pixel relative
+//! What the fast analysis changes against the straightforward one in the default analysis of
+//! MERL tables. The fast analysis reads the lobes with the crate's own `atan2`
+//! (`LuminanceTable::lookup`) and sums a level's band energy in eight partial sums
+//! (`view::band_energy`); the reference reads them with libm's (`LuminanceTable::lookup_libm`)
+//! and sums one coefficient after another ([`sequential_band_energy`]), as the crate did before.
+//! Per table, every row's lobe image drawn both ways: the largest difference of a pixel relative
 //! to the lobe's peak, the tiles whose texels differ in any bit, the largest relative difference
 //! of a row's band energy and of its view bandwidth (the bake's default reduction), and the rows
 //! whose Phong layer (the default layers) differs. The crate docs ("Angles") quote it.
 //!
-//! `cargo run --release -p brdf-atlas --example lookup-difference -- TABLE.binary ...`
+//! `cargo run --release -p brdf-atlas --example analysis-difference -- TABLE.binary ...`
 //! Exit status 1 if a tile or a layer differs.
 
 use std::process::ExitCode;
@@ -13,6 +16,25 @@ use std::process::ExitCode;
 use brdf_atlas::view::{KNOWN_LAYER_BANDWIDTHS, KNOWN_LAYER_REDUCTION, band_energy, nearest_layer};
 use brdf_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
 use rayon::prelude::*;
+
+/// `view::band_energy` as the crate computed it before its partial sums: the squares of a
+/// level's coefficients at or above the noise floor, added one after another (the three
+/// orientations in turn, each row-major).
+fn sequential_band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
+    let tiling = brdf_atlas::mirror_tiling(image, n);
+    let decomposition = dwt::wavedec2(&tiling, dwt::Wavelet::D4, brdf_atlas::analysis_levels(n)).expect("a lobe image");
+    let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut energy = Vec::new();
+    for (i, level) in decomposition.details.iter().enumerate() {
+        let floor = relative_noise_floor * peak * (1u64 << (i + 1)) as f64;
+        let mut sum = 0.0;
+        for c in level.iter().flat_map(dwt::Image::data).filter(|c| c.abs() >= floor) {
+            sum += c * c;
+        }
+        energy.push(sum);
+    }
+    energy
+}
 
 /// What one row shows: the image difference, whether the tiles differ, the band energies' and
 /// the view bandwidth's relative differences, whether the layer differs.
@@ -59,7 +81,7 @@ fn main() -> ExitCode {
                 let n = config.analysis_size;
                 let energy = band_energy(&fast, n, config.relative_noise_floor);
                 let (tile_fast, energy_fast, nu_fast, layer_fast) = view(fast, energy);
-                let energy = band_energy(&libm, n, config.relative_noise_floor);
+                let energy = sequential_band_energy(&libm, n, config.relative_noise_floor);
                 let (tile_libm, energy_libm, nu_libm, layer_libm) = view(libm, energy);
                 let bits = |tile: &[f32]| tile.iter().map(|v| v.to_bits()).collect::<Vec<u32>>();
                 let relative = |a: f64, b: f64| if b > 0.0 { (a - b).abs() / b } else { a.abs() };
