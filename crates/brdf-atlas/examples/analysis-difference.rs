@@ -1,7 +1,7 @@
 //! What the fast analysis changes against the straightforward one in the default analysis of
 //! MERL tables. The fast analysis reads the lobes with the crate's own `atan2`
-//! (`LuminanceTable::lookup`) and sums a level's band energy in eight partial sums
-//! (`view::band_energy`); the reference reads them with libm's (`LuminanceTable::lookup_libm`)
+//! (`LuminanceTable::lookup`) and sums a level's band energy in eight partial sums per row of
+//! coefficients (`view::band_energy`); the reference reads them with libm's (`LuminanceTable::lookup_libm`)
 //! and sums one coefficient after another ([`sequential_band_energy`]), as the crate did before.
 //! Per table, every row's lobe image drawn both ways: the largest difference of a pixel relative
 //! to the lobe's peak, the tiles whose texels differ in any bit, the largest relative difference
@@ -100,7 +100,7 @@ fn main() -> ExitCode {
         let view = rows.iter().fold(0.0f64, |m, r| m.max(r.view));
         let layers = rows.iter().filter(|r| r.layer).count();
         let name = std::path::Path::new(&path).file_stem().map_or(path.clone(), |s| s.to_string_lossy().into_owned());
-        println!("{name}  {image:.2e}  {tiles} of {}  {energy:.2e}  {view:.2e}  {layers}", config.lobes);
+        println!("{name}  {image:.3e}  {tiles} of {}  {energy:.3e}  {view:.3e}  {layers}", config.lobes);
         differs |= tiles > 0 || layers > 0;
     }
     if differs { ExitCode::from(1) } else { ExitCode::SUCCESS }

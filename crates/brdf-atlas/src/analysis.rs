@@ -299,20 +299,40 @@ pub fn extend_periodic(image: &[f64], n: usize) -> dwt::Image {
 /// continuation adds ramps of its own that carry the slope across the borders and would count
 /// as lobe energy (at grazing incidence it moves Phong n = 64 and 256 up a layer).
 pub fn mirror_tiling(image: &[f64], n: usize) -> dwt::Image {
-    let mut tiling = Vec::new();
-    mirror_into(image, n, &mut tiling);
-    dwt::Image::new(2 * n, 2 * n, tiling).expect("sizes match")
+    use dwt::Rows;
+    let tiling = MirrorTiling { image, n };
+    let e = 2 * n;
+    let mut data = vec![0.0; e * e];
+    for (r, row) in data.chunks_exact_mut(e).enumerate() {
+        tiling.row(r, row);
+    }
+    dwt::Image::new(e, e, data).expect("sizes match")
 }
 
-/// [`mirror_tiling`] into a reused buffer: `out` becomes `4 n^2` values, row-major.
-pub(crate) fn mirror_into(image: &[f64], n: usize, out: &mut Vec<f64>) {
-    let e = 2 * n;
-    out.clear();
-    out.reserve(e * e);
-    for y in 0..e {
-        let line = &image[(if y < n { y } else { e - 1 - y }) * n..][..n];
-        out.extend_from_slice(line);
-        out.extend(line.iter().rev());
+/// [`mirror_tiling`] given row by row ([`dwt::Rows`]), never stored: row `y` of the `2n x 2n`
+/// tiling is row `y` (or `2n - 1 - y` below the image) followed by its mirror image.
+pub(crate) struct MirrorTiling<'a> {
+    pub image: &'a [f64],
+    pub n: usize,
+}
+
+impl dwt::Rows for MirrorTiling<'_> {
+    fn width(&self) -> usize {
+        2 * self.n
+    }
+
+    fn height(&self) -> usize {
+        2 * self.n
+    }
+
+    fn row(&self, r: usize, out: &mut [f64]) {
+        let n = self.n;
+        let line = &self.image[(if r < n { r } else { 2 * n - 1 - r }) * n..][..n];
+        let (left, right) = out.split_at_mut(n);
+        left.copy_from_slice(line);
+        for (o, &v) in right.iter_mut().zip(line.iter().rev()) {
+            *o = v;
+        }
     }
 }
 

@@ -363,7 +363,6 @@ pub fn build_atlas_of(
                 &scratch.image,
                 config.analysis_size,
                 config.relative_noise_floor,
-                &mut scratch.extended,
                 scratch.estimator.transform(),
             );
             analyser.analyse_scratch(scratch);

@@ -190,10 +190,11 @@
 //! ("Angles": the tests compare them; `cargo bench -p bake --bench stages` times the atlas, row
 //! `bandwidth atlas`).
 //!
-//! The loops (the lookups, the transform's rows, eq. 7, the band energies' sums) are compiled
-//! for the best instruction set the processor has, AVX-512 or AVX2 where present, chosen at run
-//! time (`pulp`); the compiler never fuses a multiply and an add unasked, so every processor
-//! computes the same bits. At the default size the lookups take about a third of the CPU time
+//! The band energies' mirror tiling is never stored (the transform reads it row by row,
+//! [`dwt::Rows`]), nor are its details. The loops (the lookups, the transform's rows, eq. 7, the
+//! band energies' sums) are compiled for the best instruction set the processor has, AVX-512 or
+//! AVX2 where present, chosen at run time (`pulp`); the compiler never fuses a multiply and an
+//! add unasked, so every processor computes the same bits. At the default size the lookups take about a third of the CPU time
 //! (`perf record target/release/brdf-bandwidth gold-paint.binary --out-dir DIR`, gold-paint),
 //! the two D4 transforms per row (the continuation's and the band energies' mirror tiling)
 //! about a quarter, memory-bound, the estimator's per-pixel levels about a tenth.
@@ -215,14 +216,16 @@
 //! conditioning (`1 / |s|`; `1 / sqrt(theta_h)` for `theta_h`'s square-root spacing,
 //! `1 / sin(theta_d)` for `phi_d` near the pole) and the luminance within `1e-13` of the largest
 //! of the eight corners (test `fast_angles_equal_libms_to_rounding`, a million random pairs).
-//! The band energies ([`view::band_energy`]) add a level's squares in eight partial sums, which
-//! vectorize, where one sum after another was bound by the addition's latency: the two orders
-//! are each within `m u` of the exact sum of their `m` terms (`u = 2^-53`).
+//! The band energies ([`view::band_energy`]) are summed as the transform makes each row of
+//! coefficients ([`dwt::Workspace2::detail_energy`]: eight partial sums per row and orientation,
+//! which vectorize, the rows in order), where the stored details were added one after another,
+//! bound by the addition's latency: the two orders are each within `m u` of the exact sum of
+//! their `m` terms (`u = 2^-53`).
 //!
 //! On the 20 shared materials at the default settings, against libm's lookups and one sum after
 //! another (`cargo run --release -p brdf-atlas --example analysis-difference --
 //! target/merl/*.binary`, after `make test-data`): every pixel of every row's lobe image within
-//! 5e-14 of the lobe's peak, every band energy within 1.5e-13 and every view bandwidth within
+//! 5e-14 of the lobe's peak, every band energy within 2e-13 and every view bandwidth within
 //! 5e-14 (relative); **no texel of any atlas differs** (a pixel's level moves only where a
 //! coefficient sits within such a difference of an eq. 7 threshold: none does) and **no row's
 //! layer**. `brdf-bandwidth` writes the same files, byte for byte, as before either change on all

@@ -35,7 +35,7 @@ use merl::MerlTable;
 
 use rayon::prelude::*;
 
-use crate::analysis::{Analyser, analysis_levels, mirror_into};
+use crate::analysis::{Analyser, MirrorTiling, analysis_levels};
 use crate::atlas::{AtlasBuild, Config};
 use crate::error::Error;
 
@@ -89,72 +89,24 @@ impl ViewReduction {
 /// a Lambertian's constant, has none, rather than its lookups' rounding noise, which would read
 /// as the finest frequencies (27 cycles per radian at the default size: the sharpest layer).
 pub fn band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
-    band_energy_in(image, n, relative_noise_floor, &mut Vec::new(), &mut dwt::Workspace2::default())
+    band_energy_in(image, n, relative_noise_floor, &mut dwt::Workspace2::default())
 }
 
-/// [`band_energy`] with reused buffers: `tiling` for the mirror tiling, `transform` for its
-/// decomposition.
+/// [`band_energy`] with the transform's reused buffers. The tiling is given to the transform row
+/// by row and its details summed as they are made ([`dwt::Workspace2::detail_energy`]: eight
+/// partial sums per row and orientation, within `2 m u` of a sum in order, `m` terms), neither
+/// ever stored.
 pub(crate) fn band_energy_in(
     image: &[f64],
     n: usize,
     relative_noise_floor: f64,
-    tiling: &mut Vec<f64>,
     transform: &mut dwt::Workspace2,
 ) -> Vec<f64> {
-    mirror_into(image, n, tiling);
-    let tiled = dwt::Image::new(2 * n, 2 * n, std::mem::take(tiling)).expect("sizes match");
-    let decomposition = transform
-        .wavedec2(&tiled, dwt::Wavelet::D4, analysis_levels(n))
-        .expect("lobe images have a power-of-two size of at least 16");
-    *tiling = tiled.into_data();
     let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let arch = pulp::Arch::new();
-    decomposition
-        .details
-        .iter()
-        .enumerate()
-        .map(|(i, level)| {
-            let floor = relative_noise_floor * peak * (1u64 << (i + 1)) as f64;
-            level.iter().map(|image| arch.dispatch(SquaresFrom { values: image.data(), floor })).sum()
-        })
-        .collect()
-}
-
-/// The sum of the squares of the `values` whose magnitude is at least `floor`, as a
-/// [`pulp::WithSimd`] (compiled for AVX-512 or AVX2 where the processor has them): eight partial
-/// sums of every eighth value, added pairwise at the end, so that the loop vectorizes. A
-/// sequential sum (one addition after another, bound by the addition's latency) took a tenth of
-/// the atlas's time. The two orders differ by rounding alone: the terms are all `>= 0`, and each
-/// order is within `m u` of the exact sum of its `m` terms (`u = 2^-53`), so the two are within
-/// `2 m u` of each other (test `lane_sums_are_the_sequential_sum_to_rounding`); on the 20
-/// shared materials they moved no texel and no row's layer (crate docs, "Angles").
-struct SquaresFrom<'a> {
-    values: &'a [f64],
-    floor: f64,
-}
-
-impl pulp::WithSimd for SquaresFrom<'_> {
-    type Output = f64;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) -> f64 {
-        const LANES: usize = 8;
-        let Self { values, floor } = self;
-        let mut sums = [0.0f64; LANES];
-        let square = |v: f64| if v.abs() >= floor { v * v } else { 0.0 };
-        let blocks = values.chunks_exact(LANES);
-        let rest = blocks.remainder();
-        for block in blocks {
-            for (sum, &v) in sums.iter_mut().zip(block) {
-                *sum += square(v);
-            }
-        }
-        for (sum, &v) in sums.iter_mut().zip(rest) {
-            *sum += square(v);
-        }
-        let [a, b, c, d, e, f, g, h] = sums;
-        ((a + b) + (c + d)) + ((e + f) + (g + h))
-    }
+    let floor = |level: usize| relative_noise_floor * peak * (1u64 << level) as f64;
+    transform
+        .detail_energy(&MirrorTiling { image, n }, dwt::Wavelet::D4, analysis_levels(n), &floor)
+        .expect("lobe images are finite, of a power-of-two size of at least 16")
 }
 
 /// The frequency, in cycles per pixel, below which a share `q` of the detail energy `energy`
@@ -197,10 +149,10 @@ pub const KNOWN_LAYER_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.9
 pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 7] = [
     (1, 0x3fd3609ce95d2754),
     (4, 0x3fd42cf4b97e1f98),
-    (16, 0x3fdcac9cf3d5b749),
+    (16, 0x3fdcac9cf3d5b74d),
     (64, 0x3fec08daaa61e251),
     (256, 0x3ffbb761706661e7),
-    (1024, 0x400b86b5140489fd),
+    (1024, 0x400b86b5140489ea),
     (4096, 0x401b4b4672efc038),
 ];
 
@@ -331,37 +283,4 @@ pub fn select_layers_of_table(
 ) -> Result<LayerSelection, Error> {
     let build = crate::build_atlas(table, config, &|_| {})?;
     select_layers(&build, config, exponents, reduction)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use pulp::WithSimd;
-    use rand::{Rng, SeedableRng, rngs::StdRng};
-
-    #[test]
-    fn lane_sums_are_the_sequential_sum_to_rounding() {
-        let mut rng = StdRng::seed_from_u64(7);
-        for len in [0, 1, 7, 8, 9, 1000, 100_003] {
-            // Magnitudes over ten decades, both signs; the floor drops about three tenths.
-            let values: Vec<f64> = (0..len)
-                .map(|_| {
-                    let magnitude = 10f64.powf(rng.random_range(-5.0..5.0));
-                    if rng.random() { magnitude } else { -magnitude }
-                })
-                .collect();
-            let floor = 0.01;
-            let squares: Vec<f64> = values.iter().filter(|v| v.abs() >= floor).map(|v| v * v).collect();
-            let mut sequential = 0.0;
-            for square in &squares {
-                sequential += square;
-            }
-            let lanes = pulp::Arch::new().dispatch(SquaresFrom { values: &values, floor });
-            let bound = 2.0 * squares.len() as f64 * (f64::EPSILON / 2.0) * sequential;
-            assert!((lanes - sequential).abs() <= bound, "{len} values: {lanes} against {sequential}");
-            // The instruction set chosen at run time computes the baseline's bits.
-            let baseline = SquaresFrom { values: &values, floor }.with_simd(pulp::Scalar::new());
-            assert_eq!(lanes.to_bits(), baseline.to_bits(), "{len} values");
-        }
-    }
 }

@@ -37,7 +37,12 @@
 //! contiguous too: every inner loop runs over a row and vectorizes, and every coefficient is the
 //! same sum in the same order as the plain filters' (bit for bit). One output row at a time, in
 //! parallel over rows with rayon; it allocates nothing but its outputs, and [`Workspace2`] keeps
-//! those between transforms of one size.
+//! those between transforms of one size. The row loops are compiled for the best instruction set
+//! the processor has (AVX-512 or AVX2, chosen at run time by `pulp`), the same operations in the
+//! same order, so the same bits everywhere. Two variants serve analyses of part of an image:
+//! [`Workspace2::wavedec2_where`] computes the details of chosen rows only, and
+//! [`Workspace2::detail_energy`] sums each level's thresholded squares as the rows are made, of
+//! an image given row by row ([`Rows`]), storing neither.
 //!
 //! The tests compare every function with golden vectors produced by PyWavelets
 //! (`tests/golden/make_golden.py`) to 1e-12.
@@ -52,7 +57,7 @@ mod wavelet;
 pub use error::Error;
 pub use image::Image;
 pub use transform1::{Decomposition, dwt, idwt, wavedec, waverec};
-pub use transform2::{Decomposition2, Orientation, Workspace2, dwt2, idwt2, wavedec2, waverec2};
+pub use transform2::{Decomposition2, Orientation, Rows, Workspace2, dwt2, idwt2, wavedec2, waverec2};
 pub use wavelet::Wavelet;
 
 /// The most levels a signal of length `len` allows: the number of times it can be halved into

@@ -165,8 +165,8 @@ impl Workspace2 {
                 data
             });
             let with_details = |k: usize| rows_with_details(level + 1, k);
-            let out = [&mut dst[..w2 * h2], &mut ch[..], &mut cv[..], &mut cd[..]];
-            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, out, &with_details));
+            let sink = Sink::Store([&mut ch[..], &mut cv[..], &mut cd[..]], &with_details);
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, Source::Stored(src), w, h, &mut dst[..w2 * h2], sink));
             if level == 0 && !finite {
                 return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
             }
@@ -179,6 +179,114 @@ impl Workspace2 {
         decomposition.approx = Image::new(w, h, approx).expect("sizes match");
         self.between = between;
         Ok(decomposition)
+    }
+
+    /// The energy of each detail level of [`wavedec2`] of `image` (finest first), counting a
+    /// coefficient of level `j` only where its magnitude is at least `floor(j)`: the sum of the
+    /// squares of the three orientations' coefficients. The details are never stored, only the
+    /// approximations between levels: each output row's are summed while in cache, in eight
+    /// partial sums per orientation ([`SquaresFrom`]), `(cH + cV) + cD` per row, the rows of a
+    /// level added in order (the same bits on any number of threads). The image is given row by
+    /// row ([`Rows`]), so that one made from a smaller one (a mirror tiling) is never stored
+    /// either; it is refused with a NaN or an infinity.
+    pub fn detail_energy(
+        &mut self,
+        image: &dyn Rows,
+        wavelet: Wavelet,
+        levels: usize,
+        floor: &(dyn Fn(usize) -> f64 + Sync),
+    ) -> Result<Vec<f64>, Error> {
+        let (mut w, mut h) = (image.width(), image.height());
+        if w == 0 || h == 0 {
+            return Err(Error::Empty { what: "image" });
+        }
+        check_levels("width", w, levels)?;
+        check_levels("height", h, levels)?;
+        let mut between = std::mem::take(&mut self.between);
+        let mut sums = Vec::new();
+        let mut energy = Vec::with_capacity(levels);
+        for level in 0..levels {
+            let (w2, h2) = (w / 2, h / 2);
+            let [even, odd] = &mut between;
+            let (dst, previous) = if level % 2 == 0 { (even, &*odd) } else { (odd, &*even) };
+            let src = if level == 0 { Source::Rows(image) } else { Source::Stored(&previous[..w * h]) };
+            if dst.len() < w2 * h2 {
+                dst.resize(w2 * h2, 0.0);
+            }
+            sums.resize(h2, 0.0);
+            let sink = Sink::Energy { floor: floor(level + 1), sums: &mut sums[..] };
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut dst[..w2 * h2], sink));
+            if level == 0 && !finite {
+                self.between = between;
+                return Err(first_non_finite(image));
+            }
+            let mut total = 0.0;
+            for sum in &sums {
+                total += sum;
+            }
+            energy.push(total);
+            (w, h) = (w2, h2);
+        }
+        self.between = between;
+        Ok(energy)
+    }
+}
+
+/// An image given row by row ([`Workspace2::detail_energy`]): an image that is a function of a
+/// smaller one need not be stored.
+pub trait Rows: Sync {
+    fn width(&self) -> usize;
+    fn height(&self) -> usize;
+    /// Writes row `r` (`width` values) into `out`.
+    fn row(&self, r: usize, out: &mut [f64]);
+}
+
+/// The error for the first non-finite value of `image`, row-major (one is known to be there).
+fn first_non_finite(image: &dyn Rows) -> Error {
+    let w = image.width();
+    let mut row = vec![0.0; w];
+    (0..image.height())
+        .find_map(|r| {
+            image.row(r, &mut row);
+            check_finite(|| "image".to_owned(), &row).err().map(|e| match e {
+                Error::NonFinite { what, index } => Error::NonFinite { what, index: r * w + index },
+                other => other,
+            })
+        })
+        .expect("a non-finite value")
+}
+
+/// The sum of the squares of the `values` whose magnitude is at least `floor`, as a
+/// [`pulp::WithSimd`] (compiled for AVX-512 or AVX2 where the processor has them): eight partial
+/// sums of every eighth value, added pairwise at the end, so that the loop vectorizes (one sum
+/// after another is bound by the addition's latency). The terms are all `>= 0`: the result is
+/// within `m u` of the exact sum of its `m` terms (`u = 2^-53`), as a sum in order is.
+pub(crate) struct SquaresFrom<'a> {
+    pub values: &'a [f64],
+    pub floor: f64,
+}
+
+impl pulp::WithSimd for SquaresFrom<'_> {
+    type Output = f64;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> f64 {
+        const LANES: usize = 8;
+        let Self { values, floor } = self;
+        let mut sums = [0.0f64; LANES];
+        let square = |v: f64| if v.abs() >= floor { v * v } else { 0.0 };
+        let blocks = values.chunks_exact(LANES);
+        let rest = blocks.remainder();
+        for block in blocks {
+            for (sum, &v) in sums.iter_mut().zip(block) {
+                *sum += square(v);
+            }
+        }
+        for (sum, &v) in sums.iter_mut().zip(rest) {
+            *sum += square(v);
+        }
+        let [a, b, c, d, e, f, g, h] = sums;
+        ((a + b) + (c + d)) + ((e + f) + (g + h))
     }
 }
 
@@ -247,45 +355,100 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image
     let (w, h) = (image.width(), image.height());
     let (w2, h2) = (w / 2, h / 2);
     let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
-    if !forward_level_into(bank, image.data(), w, h, out.each_mut().map(|b| &mut b[..]), &|_| true) {
+    let [ca, ch, cv, cd] = out.each_mut().map(|b| &mut b[..]);
+    if !forward_level_into(bank, Source::Stored(image.data()), w, h, ca, Sink::Store([ch, cv, cd], &|_| true)) {
         return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
     }
     let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
     Ok((ca, [ch, cv, cd]))
 }
 
-/// [`forward_level`] of the `w x h` row-major `src` into `out` (`[cA, cH, cV, cD]`, each
-/// `w / 2 x h / 2` values), the details only of the rows `k` where `details(k)` holds; whether
-/// every value of `src` is finite. Each output row checks the
-/// last two of the rows it reads, which covers every row once, while they are in cache (a
-/// separate pass over the image cost as much as a tenth of the transform). The loops are
-/// compiled for the best instruction set the processor has ([`pulp::Arch`]: AVX-512 or AVX2
-/// where present): the same operations in the same order (no fused multiply-add), so the same bits.
+/// The input of a level: a stored image (`w x h`, row-major) or one given row by row.
+#[derive(Clone, Copy)]
+enum Source<'a> {
+    Stored(&'a [f64]),
+    Rows(&'a dyn Rows),
+}
+
+impl<'a> Source<'a> {
+    /// The `F` input rows of output row `k` of an image of `h` rows of `w`: slices of a stored
+    /// image, or written into `buffer` (`F w` values).
+    fn rows<const F: usize>(self, k: usize, w: usize, h: usize, buffer: &'a mut [f64]) -> [&'a [f64]; F] {
+        let indices = analysis_rows::<F>(k, h);
+        match self {
+            Source::Stored(src) => indices.map(|r| &src[r * w..(r + 1) * w]),
+            Source::Rows(rows) => {
+                for (&r, out) in indices.iter().zip(buffer.chunks_exact_mut(w)) {
+                    rows.row(r, out);
+                }
+                let mut chunks = buffer.chunks_exact(w);
+                std::array::from_fn(|_| chunks.next().expect("F rows"))
+            }
+        }
+    }
+}
+
+/// Where a level's detail rows go.
+enum Sink<'a> {
+    /// Into the level's three images (`[cH, cV, cD]`), in the rows `k` where the predicate holds.
+    Store([&'a mut [f64]; 3], &'a (dyn Fn(usize) -> bool + Sync)),
+    /// Each row's squares of the three orientations' coefficients at least `floor` in magnitude,
+    /// summed ([`SquaresFrom`]: `(cH + cV) + cD`), into `sums[k]`.
+    Energy { floor: f64, sums: &'a mut [f64] },
+}
+
+/// One level of `src` (`w x h`) into `approx` (`w / 2 x h / 2`), its details into `sink`;
+/// whether every value of `src` is finite. Each output row checks the last two of the rows it
+/// reads, which covers every row once, while they are in cache (a separate pass over the image
+/// cost as much as a tenth of the transform). The loops are compiled for the best instruction
+/// set the processor has ([`pulp::Arch`]: AVX-512 or AVX2 where present): the same operations in
+/// the same order (no fused multiply-add), so the same bits.
 fn forward_level_into<const F: usize>(
     bank: &Bank<F>,
-    src: &[f64],
+    src: Source<'_>,
     w: usize,
     h: usize,
-    out: [&mut [f64]; 4],
-    details: &(dyn Fn(usize) -> bool + Sync),
+    approx: &mut [f64],
+    sink: Sink<'_>,
 ) -> bool {
     let w2 = w / 2;
-    let [ca, ch, cv, cd] = out;
     let arch = pulp::Arch::new();
-    ca.par_chunks_mut(w2)
-        .zip(ch.par_chunks_mut(w2))
-        .zip(cv.par_chunks_mut(w2))
-        .zip(cd.par_chunks_mut(w2))
-        .enumerate()
-        .with_min_len(min_rows(w))
-        .map_init(
-            || vec![0.0; 2 * w],
-            |scratch, (k, (((a, hh), v), dd))| {
-                let rows = analysis_rows::<F>(k, h).map(|r| &src[r * w..(r + 1) * w]);
-                arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd], details: details(k) })
-            },
-        )
-        .reduce(|| true, |a, b| a & b)
+    // Per job: the input rows where they are made, the two column-filtered rows, and, for the
+    // energy, the three detail rows.
+    let buffers = || (vec![0.0; F * w], vec![0.0; 2 * w], vec![0.0; 3 * w2]);
+    match sink {
+        Sink::Store([ch, cv, cd], with_details) => approx
+            .par_chunks_mut(w2)
+            .zip(ch.par_chunks_mut(w2))
+            .zip(cv.par_chunks_mut(w2))
+            .zip(cd.par_chunks_mut(w2))
+            .enumerate()
+            .with_min_len(min_rows(w))
+            .map_init(buffers, |(input, scratch, _), (k, (((a, hh), v), dd))| {
+                let rows = src.rows::<F>(k, w, h, input);
+                arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd], details: with_details(k) })
+            })
+            .reduce(|| true, |a, b| a & b),
+        Sink::Energy { floor, sums } => approx
+            .par_chunks_mut(w2)
+            .zip(sums.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_rows(w))
+            .map_init(buffers, |(input, scratch, detail), (k, (a, sum))| {
+                let rows = src.rows::<F>(k, w, h, input);
+                let [hh, v, dd] = {
+                    let mut parts = detail.chunks_exact_mut(w2);
+                    std::array::from_fn(|_| parts.next().expect("three rows"))
+                };
+                let finite = arch.dispatch(OutputRow { bank, rows, scratch, out: [a, hh, v, dd], details: true });
+                let energy = |part: &[f64]| arch.dispatch(SquaresFrom { values: part, floor });
+                let mut parts = detail.chunks_exact(w2);
+                let mut next = || energy(parts.next().expect("three rows"));
+                *sum = (next() + next()) + next();
+                finite
+            })
+            .reduce(|| true, |a, b| a & b),
+    }
 }
 
 /// One output row of [`forward_level_into`] from its `F` input rows, as a [`pulp::WithSimd`]:
@@ -380,5 +543,80 @@ mod tests {
     fn dispatched_rows_are_the_baselines_bit_for_bit() {
         check_dispatch(&D4);
         check_dispatch(&HAAR);
+    }
+
+    #[test]
+    fn lane_sums_are_the_sequential_sum_to_rounding() {
+        use rand::{Rng, SeedableRng, rngs::StdRng};
+        let mut rng = StdRng::seed_from_u64(7);
+        for len in [0, 1, 7, 8, 9, 1000, 100_003] {
+            // Magnitudes over ten decades, both signs; the floor drops about three tenths.
+            let values: Vec<f64> = (0..len)
+                .map(|_| {
+                    let magnitude = 10f64.powf(rng.random_range(-5.0..5.0));
+                    if rng.random() { magnitude } else { -magnitude }
+                })
+                .collect();
+            let floor = 0.01;
+            let squares: Vec<f64> = values.iter().filter(|v| v.abs() >= floor).map(|v| v * v).collect();
+            let mut sequential = 0.0;
+            for square in &squares {
+                sequential += square;
+            }
+            let lanes = pulp::Arch::new().dispatch(SquaresFrom { values: &values, floor });
+            let bound = 2.0 * squares.len() as f64 * (f64::EPSILON / 2.0) * sequential;
+            assert!((lanes - sequential).abs() <= bound, "{len} values: {lanes} against {sequential}");
+            // The instruction set chosen at run time computes the baseline's bits.
+            let baseline = SquaresFrom { values: &values, floor }.with_simd(pulp::Scalar::new());
+            assert_eq!(lanes.to_bits(), baseline.to_bits(), "{len} values");
+        }
+    }
+
+    /// A stored image given row by row.
+    struct Stored<'a>(&'a Image);
+
+    impl Rows for Stored<'_> {
+        fn width(&self) -> usize {
+            self.0.width()
+        }
+        fn height(&self) -> usize {
+            self.0.height()
+        }
+        fn row(&self, r: usize, out: &mut [f64]) {
+            out.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
+        }
+    }
+
+    #[test]
+    fn detail_energy_is_the_stored_decompositions_to_rounding() {
+        // The thresholded energy of every level of the stored decomposition, summed in order,
+        // against the streamed one: within 2 m u of each other (m terms of one sign), on either
+        // wavelet, with a floor that drops part of each level, and the same on one thread.
+        let (w, h, levels) = (256, 256, 4);
+        let data: Vec<f64> =
+            (0..w * h).map(|k| ((k * 37 % 101) as f64 * 0.3).sin() * (1.0 + k as f64 * 1e-2)).collect();
+        let image = Image::new(w, h, data).unwrap();
+        let floor = |level: usize| 0.05 * (1u64 << level) as f64;
+        for wavelet in [Wavelet::Haar, Wavelet::D4] {
+            let stored = wavedec2(&image, wavelet, levels).unwrap();
+            let streamed = Workspace2::default().detail_energy(&Stored(&image), wavelet, levels, &floor).unwrap();
+            for (j, (level, &got)) in stored.details.iter().zip(&streamed).enumerate() {
+                let squares: Vec<f64> =
+                    level.iter().flat_map(Image::data).filter(|c| c.abs() >= floor(j + 1)).map(|c| c * c).collect();
+                assert!(!squares.is_empty() && squares.len() < 3 * level[0].data().len(), "level {}", j + 1);
+                let expect: f64 = squares.iter().sum();
+                let bound = 2.0 * squares.len() as f64 * (f64::EPSILON / 2.0) * expect;
+                assert!((got - expect).abs() <= bound, "{wavelet:?} level {}: {got} against {expect}", j + 1);
+            }
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            let alone = one.install(|| Workspace2::default().detail_energy(&Stored(&image), wavelet, levels, &floor));
+            assert_eq!(alone.unwrap(), streamed, "{wavelet:?} on one thread");
+        }
+        // A non-finite value is named by its index, as the stored transform names it.
+        let mut bad = image.clone();
+        bad.data_mut()[5 * w + 7] = f64::NAN;
+        let err = Workspace2::default().detail_energy(&Stored(&bad), Wavelet::D4, levels, &floor).unwrap_err();
+        assert_eq!(err, wavedec2(&bad, Wavelet::D4, levels).unwrap_err());
+        assert_eq!(err, Error::NonFinite { what: "image".into(), index: 5 * w + 7 });
     }
 }
