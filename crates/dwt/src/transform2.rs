@@ -185,7 +185,7 @@ impl Workspace2 {
     /// coefficient of level `j` only where its magnitude is at least `floor(j)`: the sum of the
     /// squares of the three orientations' coefficients. The details are never stored, only the
     /// approximations between levels: each output row's are summed while in cache, in eight
-    /// partial sums per orientation ([`SquaresFrom`]), `(cH + cV) + cD` per row, the rows of a
+    /// partial sums per orientation (pairwise at the end), `(cH + cV) + cD` per row, the rows of a
     /// level added in order (the same bits on any number of threads). The image is given row by
     /// row ([`Rows`]), so that one made from a smaller one (a mirror tiling) is never stored
     /// either; it is refused with a NaN or an infinity.
@@ -393,7 +393,7 @@ enum Sink<'a> {
     /// Into the level's three images (`[cH, cV, cD]`), in the rows `k` where the predicate holds.
     Store([&'a mut [f64]; 3], &'a (dyn Fn(usize) -> bool + Sync)),
     /// Each row's squares of the three orientations' coefficients at least `floor` in magnitude,
-    /// summed ([`SquaresFrom`]: `(cH + cV) + cD`), into `sums[k]`.
+    /// summed (`SquaresFrom`: `(cH + cV) + cD`), into `sums[k]`.
     Energy { floor: f64, sums: &'a mut [f64] },
 }
 
