@@ -206,11 +206,12 @@ impl Workspace {
     /// The finest significant level `j*` ([`BandwidthMap::level`]) of the top-left `width x height`
     /// pixels only, row-major, `width` per row: each reads what it reads in the whole map, bit
     /// for bit, at a fraction of the cost when the image is an extension of the part the caller
-    /// needs (a lobe image continued into a periodic one). The frequency of level `j` is
+    /// needs (a lobe image continued into a periodic one, whose rows the caller may make as they
+    /// are read: [`dwt::Rows`]; an [`Image`] is one). The frequency of level `j` is
     /// [`level_frequency`]; it is not stored.
     pub fn levels_top_left(
         &mut self,
-        image: &Image,
+        image: &dyn dwt::Rows,
         config: &Config,
         width: usize,
         height: usize,
@@ -439,7 +440,7 @@ impl Workspace {
     /// map's are left empty).
     fn run(
         &mut self,
-        image: &Image,
+        image: &dyn dwt::Rows,
         levels: usize,
         out_w: usize,
         out_h: usize,

@@ -178,16 +178,19 @@
 //!
 //! # Performance
 //!
-//! The transform is `dwt`'s (parallel over rows). Per level, the maximum over orientations
-//! and the sliding maximum along `x` run on the coefficient rows that cover an output row, one
-//! row at a time (parallel over levels); the sliding maximum along `y` and eq. 7 (stopping at a
-//! pixel's first significant level) run per output row (parallel over rows) in one scratch
-//! buffer of `(J + 1) x width` values per thread. Nothing is allocated per pixel. [`Workspace`]
-//! keeps every buffer between estimates of images of one size, and
-//! [`Workspace::levels_top_left`] estimates only a corner of an image (what the BRDF atlas keeps
-//! of its continued lobe images), each pixel as in the whole map. `cargo bench -p bandwidth
-//! --bench bandwidth` times a real 1024 x 512 map against one D4 decomposition of it (its last
-//! report is in `docs/benchmarks.md`).
+//! The transform is `dwt`'s (parallel over rows; the details only of the coefficient rows that
+//! cover an output row). Per level, the maximum over orientations and the sliding maximum along
+//! `x` run on those rows, one row at a time (parallel over levels); the sliding maximum along `y`
+//! and eq. 7 run per output row, in bands of 16 rows (parallel over bands), a level's maximum
+//! kept while the coefficient rows covering the output row stay the same, in one scratch buffer
+//! of `(J + 2) x width` values per band; eq. 7 adds the levels of a whole row at once, each
+//! pixel's sum in its own order. The loops are compiled for AVX-512 or AVX2 where the processor
+//! has them (the same bits). Nothing is allocated per pixel. [`Workspace`] keeps every buffer
+//! between estimates of images of one size, and [`Workspace::levels_top_left`] estimates only a
+//! corner of an image given row by row ([`dwt::Rows`]: the BRDF atlas's continued lobe images,
+//! whose rows below the lobe are made as they are read), each pixel as in the whole map.
+//! `cargo bench -p bandwidth --bench bandwidth` times a real 1024 x 512 map against one D4
+//! decomposition of it (its last report is in `docs/benchmarks.md`).
 
 mod compare;
 mod error;

@@ -158,6 +158,8 @@ pub struct Analyser {
     pixels_per_radian: Vec<f64>,
     inside: Vec<bool>,
     reduction: TileReduction,
+    /// The periodic continuation's steps ([`extend_periodic`]).
+    plan: Continuation,
 }
 
 impl Analyser {
@@ -170,7 +172,8 @@ impl Analyser {
         let pixels_per_radian = (0..n * n).into_par_iter().map(|k| map.pixels_per_radian(at(k).0, at(k).1)).collect();
         let inside = (0..n * n).into_par_iter().map(|k| map.inside(at(k).0, at(k).1)).collect();
         let reduction = TileReduction::new(n, config.tile);
-        Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, inside, reduction }
+        let plan = Continuation::new(n);
+        Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, inside, reduction, plan }
     }
 
     pub fn map(&self) -> LobeMap {
@@ -241,11 +244,12 @@ impl Analyser {
     /// radian.
     pub(crate) fn analyse_scratch(&self, scratch: &mut Scratch) {
         let n = self.map.size;
-        let e = 2 * n;
         let Scratch { image, extended: ext, estimator, level, .. } = scratch;
         let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
 
-        extend_into(image, n, ext);
+        // The rows of the continuation that hold the image, continued; those below are made
+        // from them as the transform reads them, never stored.
+        self.plan.extend_rows_into(image, ext);
 
         let config = bandwidth::Config {
             eps: self.config.eps,
@@ -254,10 +258,9 @@ impl Analyser {
             levels: Some(analysis_levels(n)),
             ..bandwidth::Config::default()
         };
-        let extended = dwt::Image::new(e, e, std::mem::take(ext)).expect("sizes match");
+        let extended = Continued { plan: &self.plan, top: ext };
         // Only the image's own pixels are kept: the estimate of the top-left quarter alone.
         let levels = estimator.levels_top_left(&extended, &config, n, n).expect("the configuration was checked");
-        *ext = extended.into_data();
 
         // The continuation is no longer needed: its buffer takes the bandwidths.
         level.clear();
@@ -303,8 +306,9 @@ pub fn mirror_tiling(image: &[f64], n: usize) -> dwt::Image {
     let tiling = MirrorTiling { image, n };
     let e = 2 * n;
     let mut data = vec![0.0; e * e];
+    let mut buffer = vec![0.0; e];
     for (r, row) in data.chunks_exact_mut(e).enumerate() {
-        tiling.row(r, row);
+        row.copy_from_slice(tiling.row(r, &mut buffer));
     }
     dwt::Image::new(e, e, data).expect("sizes match")
 }
@@ -325,36 +329,129 @@ impl dwt::Rows for MirrorTiling<'_> {
         2 * self.n
     }
 
-    fn row(&self, r: usize, out: &mut [f64]) {
+    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
         let n = self.n;
         let line = &self.image[(if r < n { r } else { 2 * n - 1 - r }) * n..][..n];
-        let (left, right) = out.split_at_mut(n);
+        let (left, right) = buffer.split_at_mut(n);
         left.copy_from_slice(line);
         for (o, &v) in right.iter_mut().zip(line.iter().rev()) {
             *o = v;
         }
+        buffer
     }
 }
 
-/// [`extend_periodic`] into a reused buffer: `ext` becomes `4 n^2` values, row-major. Each row
-/// is continued by [`extend_line`]; then the rows below the image are continued the same way,
-/// all columns of an output row at once (the same arithmetic per column as [`extend_line`] on
-/// that column, on contiguous rows, so that it vectorizes).
+/// [`extend_periodic`] into a reused buffer: `ext` becomes `4 n^2` values, row-major: the rows
+/// of the image continued ([`Continuation::extend_rows_into`]), then the rows below
+/// ([`Continuation::continue_row`]).
 fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
-    let e = 2 * n;
     let plan = Continuation::new(n);
-    // Every value is written below: only a buffer that grows is filled first.
-    ext.truncate(e * e);
+    plan.extend_rows_into(image, ext);
+    let e = 2 * n;
     ext.resize(e * e, 0.0);
-    for (row, line) in ext.chunks_exact_mut(e).zip(image.chunks_exact(n)) {
-        row[..n].copy_from_slice(line);
-        plan.extend_line(row);
-    }
     let (top, bottom) = ext.split_at_mut(n * e);
-    let row = |i: usize| &top[i * e..(i + 1) * e];
     for (j, out) in bottom.chunks_exact_mut(e).enumerate() {
+        plan.continue_row(top, j, out);
+    }
+}
+
+/// The periodic continuation of a lobe image as the transform reads it ([`dwt::Rows`]): the
+/// image's rows continued, stored (`top`, `n` rows of `2 n`), and the rows below made from them
+/// on demand, so that the `2n x 2n` image is never stored.
+struct Continued<'a> {
+    plan: &'a Continuation,
+    top: &'a [f64],
+}
+
+impl dwt::Rows for Continued<'_> {
+    fn width(&self) -> usize {
+        2 * self.plan.n()
+    }
+
+    fn height(&self) -> usize {
+        2 * self.plan.n()
+    }
+
+    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
+        let (n, e) = (self.plan.n(), 2 * self.plan.n());
+        if r < n {
+            &self.top[r * e..(r + 1) * e]
+        } else {
+            self.plan.continue_row(self.top, r - n, buffer);
+            buffer
+        }
+    }
+}
+
+/// How sample `n + j` of a line of `2 n` is continued ([`extend_line`]).
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    /// The plain mirror image, `v(n - 1 - j)`.
+    Mirror,
+    /// From the end at `end`, `k` samples out, `inward` stepping towards the data: the odd
+    /// reflection blended into the mirror image by `blend` (`cos^2(pi k / n)`), plus, within the
+    /// continuation's reach, the three-point rule's `share`.
+    Continue { end: usize, inward: isize, k: usize, blend: f64, share: Option<f64> },
+}
+
+/// The steps of [`extend_line`] for lines of `2 n` samples, with their weights computed once.
+#[derive(Debug)]
+pub(crate) struct Continuation {
+    steps: Vec<Step>,
+}
+
+impl Continuation {
+    pub(crate) fn new(n: usize) -> Self {
+        let reach = crate::param::CONTINUATION_REACH;
+        let step = |end: usize, inward: isize, k: usize| Step::Continue {
+            end,
+            inward,
+            k,
+            blend: (std::f64::consts::PI * k as f64 / n as f64).cos().powi(2),
+            share: (k <= reach).then(|| crate::param::three_point_share(k as f64 / reach as f64)),
+        };
+        let steps = (0..n)
+            .map(|j| {
+                // Samples past the last value, and before the first (the period wraps).
+                let (right, left) = (j + 1, n - j);
+                if right < n / 2 {
+                    step(n - 1, -1, right)
+                } else if left < n / 2 {
+                    step(0, 1, left)
+                } else {
+                    Step::Mirror
+                }
+            })
+            .collect();
+        Self { steps }
+    }
+
+    /// The number of values of the lines it continues (to `2 n`).
+    fn n(&self) -> usize {
+        self.steps.len()
+    }
+
+    /// The `n` rows of `image` (`n x n`, row-major), each continued by [`Self::extend_line`]:
+    /// `out` becomes `n` rows of `2 n` values.
+    fn extend_rows_into(&self, image: &[f64], out: &mut Vec<f64>) {
+        let (n, e) = (self.n(), 2 * self.n());
+        // Every value is written below: only a buffer that grows is filled first.
+        out.truncate(n * e);
+        out.resize(n * e, 0.0);
+        for (row, line) in out.chunks_exact_mut(e).zip(image.chunks_exact(n)) {
+            row[..n].copy_from_slice(line);
+            self.extend_line(row);
+        }
+    }
+
+    /// Row `n + j` of the continuation, from its first `n` rows `top` (each `2 n` values,
+    /// continued): every column continued as [`Self::extend_line`] continues a line, all columns
+    /// of the row at once (contiguous rows, so that it vectorizes).
+    fn continue_row(&self, top: &[f64], j: usize, out: &mut [f64]) {
+        let (n, e) = (self.n(), 2 * self.n());
+        let row = |i: usize| &top[i * e..(i + 1) * e];
         let mirror = row(n - 1 - j);
-        match plan.steps[j] {
+        match self.steps[j] {
             Step::Mirror => out.copy_from_slice(mirror),
             Step::Continue { end, inward, k, blend, share } => {
                 let at = |i: usize| row((end as isize + inward * i as isize) as usize);
@@ -380,49 +477,6 @@ fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
                 }
             }
         }
-    }
-}
-
-/// How sample `n + j` of a line of `2 n` is continued ([`extend_line`]).
-#[derive(Clone, Copy, Debug)]
-enum Step {
-    /// The plain mirror image, `v(n - 1 - j)`.
-    Mirror,
-    /// From the end at `end`, `k` samples out, `inward` stepping towards the data: the odd
-    /// reflection blended into the mirror image by `blend` (`cos^2(pi k / n)`), plus, within the
-    /// continuation's reach, the three-point rule's `share`.
-    Continue { end: usize, inward: isize, k: usize, blend: f64, share: Option<f64> },
-}
-
-/// The steps of [`extend_line`] for lines of `2 n` samples, with their weights computed once.
-struct Continuation {
-    steps: Vec<Step>,
-}
-
-impl Continuation {
-    fn new(n: usize) -> Self {
-        let reach = crate::param::CONTINUATION_REACH;
-        let step = |end: usize, inward: isize, k: usize| Step::Continue {
-            end,
-            inward,
-            k,
-            blend: (std::f64::consts::PI * k as f64 / n as f64).cos().powi(2),
-            share: (k <= reach).then(|| crate::param::three_point_share(k as f64 / reach as f64)),
-        };
-        let steps = (0..n)
-            .map(|j| {
-                // Samples past the last value, and before the first (the period wraps).
-                let (right, left) = (j + 1, n - j);
-                if right < n / 2 {
-                    step(n - 1, -1, right)
-                } else if left < n / 2 {
-                    step(0, 1, left)
-                } else {
-                    Step::Mirror
-                }
-            })
-            .collect();
-        Self { steps }
     }
 
     /// [`extend_line`] with this plan's weights.

@@ -128,12 +128,12 @@ impl Workspace2 {
     /// [`wavedec2`]'s, bit for bit.
     pub fn wavedec2_where(
         &mut self,
-        image: &Image,
+        image: &dyn Rows,
         wavelet: Wavelet,
         levels: usize,
         rows_with_details: &(dyn Fn(usize, usize) -> bool + Sync),
     ) -> Result<&Decomposition2, Error> {
-        check_shape(image, levels)?;
+        check_size(image.width(), image.height(), levels)?;
         let decomposition = self.decomposition.get_or_insert_with(|| Decomposition2 {
             wavelet,
             approx: Image::zeros(0, 0),
@@ -152,7 +152,7 @@ impl Workspace2 {
             let (w2, h2) = (w / 2, h / 2);
             let [even, odd] = &mut between;
             let (dst, previous) = if level % 2 == 0 { (even, &*odd) } else { (odd, &*even) };
-            let src: &[f64] = if level == 0 { image.data() } else { &previous[..w * h] };
+            let src = if level == 0 { Source::Rows(image) } else { Source::Stored(&previous[..w * h]) };
             // Every value is written: only a buffer that grows is filled first.
             if dst.len() < w2 * h2 {
                 dst.resize(w2 * h2, 0.0);
@@ -166,9 +166,9 @@ impl Workspace2 {
             });
             let with_details = |k: usize| rows_with_details(level + 1, k);
             let sink = Sink::Store([&mut ch[..], &mut cv[..], &mut cd[..]], &with_details);
-            let finite = with_bank!(wavelet, bank => forward_level_into(bank, Source::Stored(src), w, h, &mut dst[..w2 * h2], sink));
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut dst[..w2 * h2], sink));
             if level == 0 && !finite {
-                return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
+                return Err(first_non_finite(image));
             }
             *details = [ch, cv, cd].map(|data| Image::new(w2, h2, data).expect("sizes match"));
             (w, h) = (w2, h2);
@@ -197,11 +197,7 @@ impl Workspace2 {
         floor: &(dyn Fn(usize) -> f64 + Sync),
     ) -> Result<Vec<f64>, Error> {
         let (mut w, mut h) = (image.width(), image.height());
-        if w == 0 || h == 0 {
-            return Err(Error::Empty { what: "image" });
-        }
-        check_levels("width", w, levels)?;
-        check_levels("height", h, levels)?;
+        check_size(w, h, levels)?;
         let mut between = std::mem::take(&mut self.between);
         let mut sums = Vec::new();
         let mut energy = Vec::with_capacity(levels);
@@ -232,23 +228,38 @@ impl Workspace2 {
     }
 }
 
-/// An image given row by row ([`Workspace2::detail_energy`]): an image that is a function of a
-/// smaller one need not be stored.
+/// An image given row by row ([`Workspace2::wavedec2_where`], [`Workspace2::detail_energy`]): an
+/// image that is a function of a smaller one need not be stored. An [`Image`] is one.
 pub trait Rows: Sync {
     fn width(&self) -> usize;
     fn height(&self) -> usize;
-    /// Writes row `r` (`width` values) into `out`.
-    fn row(&self, r: usize, out: &mut [f64]);
+    /// Row `r` (`width` values): a row the image stores, or one made in `buffer` (`width`
+    /// values).
+    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64];
+}
+
+impl Rows for Image {
+    fn width(&self) -> usize {
+        Image::width(self)
+    }
+
+    fn height(&self) -> usize {
+        Image::height(self)
+    }
+
+    fn row<'a>(&'a self, r: usize, _: &'a mut [f64]) -> &'a [f64] {
+        let w = Image::width(self);
+        &self.data()[r * w..(r + 1) * w]
+    }
 }
 
 /// The error for the first non-finite value of `image`, row-major (one is known to be there).
 fn first_non_finite(image: &dyn Rows) -> Error {
     let w = image.width();
-    let mut row = vec![0.0; w];
+    let mut buffer = vec![0.0; w];
     (0..image.height())
         .find_map(|r| {
-            image.row(r, &mut row);
-            check_finite(|| "image".to_owned(), &row).err().map(|e| match e {
+            check_finite(|| "image".to_owned(), image.row(r, &mut buffer)).err().map(|e| match e {
                 Error::NonFinite { what, index } => Error::NonFinite { what, index: r * w + index },
                 other => other,
             })
@@ -307,11 +318,16 @@ pub fn waverec2(decomposition: &Decomposition2) -> Result<Image, Error> {
 /// The checks of an image's shape; its values are checked by the first level's pass
 /// ([`forward_level_into`]), which reads them anyway.
 fn check_shape(image: &Image, levels: usize) -> Result<(), Error> {
-    if image.data().is_empty() {
+    check_size(image.width(), image.height(), levels)
+}
+
+/// [`check_shape`] of a `width x height` image.
+fn check_size(width: usize, height: usize, levels: usize) -> Result<(), Error> {
+    if width == 0 || height == 0 {
         return Err(Error::Empty { what: "image" });
     }
-    check_levels("width", image.width(), levels)?;
-    check_levels("height", image.height(), levels)
+    check_levels("width", width, levels)?;
+    check_levels("height", height, levels)
 }
 
 fn check_coefficients(approx: &Image, details: &[[Image; 3]]) -> Result<(), Error> {
@@ -378,11 +394,8 @@ impl<'a> Source<'a> {
         match self {
             Source::Stored(src) => indices.map(|r| &src[r * w..(r + 1) * w]),
             Source::Rows(rows) => {
-                for (&r, out) in indices.iter().zip(buffer.chunks_exact_mut(w)) {
-                    rows.row(r, out);
-                }
-                let mut chunks = buffer.chunks_exact(w);
-                std::array::from_fn(|_| chunks.next().expect("F rows"))
+                let mut buffers = buffer.chunks_exact_mut(w);
+                indices.map(|r| rows.row(r, buffers.next().expect("F rows")))
             }
         }
     }
@@ -572,18 +585,19 @@ mod tests {
         }
     }
 
-    /// A stored image given row by row.
-    struct Stored<'a>(&'a Image);
+    /// An image given row by row, made in the buffer (not the stored rows).
+    struct Copied<'a>(&'a Image);
 
-    impl Rows for Stored<'_> {
+    impl Rows for Copied<'_> {
         fn width(&self) -> usize {
             self.0.width()
         }
         fn height(&self) -> usize {
             self.0.height()
         }
-        fn row(&self, r: usize, out: &mut [f64]) {
-            out.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
+        fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
+            buffer.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
+            buffer
         }
     }
 
@@ -599,7 +613,7 @@ mod tests {
         let floor = |level: usize| 0.05 * (1u64 << level) as f64;
         for wavelet in [Wavelet::Haar, Wavelet::D4] {
             let stored = wavedec2(&image, wavelet, levels).unwrap();
-            let streamed = Workspace2::default().detail_energy(&Stored(&image), wavelet, levels, &floor).unwrap();
+            let streamed = Workspace2::default().detail_energy(&Copied(&image), wavelet, levels, &floor).unwrap();
             for (j, (level, &got)) in stored.details.iter().zip(&streamed).enumerate() {
                 let squares: Vec<f64> =
                     level.iter().flat_map(Image::data).filter(|c| c.abs() >= floor(j + 1)).map(|c| c * c).collect();
@@ -609,13 +623,13 @@ mod tests {
                 assert!((got - expect).abs() <= bound, "{wavelet:?} level {}: {got} against {expect}", j + 1);
             }
             let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-            let alone = one.install(|| Workspace2::default().detail_energy(&Stored(&image), wavelet, levels, &floor));
+            let alone = one.install(|| Workspace2::default().detail_energy(&Copied(&image), wavelet, levels, &floor));
             assert_eq!(alone.unwrap(), streamed, "{wavelet:?} on one thread");
         }
         // A non-finite value is named by its index, as the stored transform names it.
         let mut bad = image.clone();
         bad.data_mut()[5 * w + 7] = f64::NAN;
-        let err = Workspace2::default().detail_energy(&Stored(&bad), Wavelet::D4, levels, &floor).unwrap_err();
+        let err = Workspace2::default().detail_energy(&Copied(&bad), Wavelet::D4, levels, &floor).unwrap_err();
         assert_eq!(err, wavedec2(&bad, Wavelet::D4, levels).unwrap_err());
         assert_eq!(err, Error::NonFinite { what: "image".into(), index: 5 * w + 7 });
     }
