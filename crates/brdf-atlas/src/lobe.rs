@@ -43,9 +43,12 @@ impl std::fmt::Debug for LuminanceTable {
 
 impl LuminanceTable {
     pub fn new(table: &MerlTable) -> Self {
+        use rayon::prelude::*;
         let dims = table.dims();
-        let mut luminance =
-            (0..dims.cells()).map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance)).collect::<Vec<f64>>();
+        let mut luminance = (0..dims.cells())
+            .into_par_iter()
+            .map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance))
+            .collect::<Vec<f64>>();
         continue_below_horizon(dims, &mut luminance);
         let complete = !luminance.iter().any(|v| v.is_nan());
         Self { dims, luminance, complete }
@@ -272,8 +275,9 @@ impl pulp::WithSimd for Lookups<'_> {
 /// below the horizon as `theta_d` grows (both directions' heights are unimodal in `theta_d` and
 /// positive at 0), so the cells after the last one with data are all without.
 fn continue_below_horizon(dims: Dims, luminance: &mut [f64]) {
+    use rayon::prelude::*;
     let (n_d, n_p) = (dims.n_theta_d, dims.n_phi_d);
-    for block in luminance.chunks_exact_mut(n_d * n_p) {
+    luminance.par_chunks_exact_mut(n_d * n_p).for_each(|block| {
         for p in 0..n_p {
             let at = |d: usize| d * n_p + p;
             let Some(last) = (0..n_d).rev().find(|&d| !block[at(d)].is_nan()) else { continue };
@@ -286,7 +290,7 @@ fn continue_below_horizon(dims: Dims, luminance: &mut [f64]) {
                 block[at(d)] = (value + slope * (d - last) as f64).max(0.0);
             }
         }
-    }
+    });
 }
 
 /// Unit vectors as three arrays of components, for loops over many of them that vectorize.

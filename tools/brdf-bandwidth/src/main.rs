@@ -65,11 +65,16 @@ fn main() -> ExitCode {
 fn run(args: Args) -> Result<ExitCode> {
     let config = Config { lobes: args.lobes, tile: args.tile, analysis_size: args.analysis_size, ..Config::default() };
     config.check()?;
-    let table = merl::read_file(&args.material).with_context(|| format!("reading {}", args.material.display()))?;
-    // The atlas reads the luminance alone: the table goes before the analysis's buffers come.
-    let luminance = brdf_atlas::LuminanceTable::new(&table);
-    drop(table);
-    let source = Source::hash(&args.material)?;
+    let read = || format!("reading {}", args.material.display());
+    let bytes = merl::read_bytes(&args.material).with_context(read)?;
+    // The provenance's hash of the bytes read, beside their parsing; the atlas reads the
+    // luminance alone, so the table (and the bytes) go before the analysis's buffers come.
+    let (source, luminance) = rayon::join(
+        || Source::of_bytes(&args.material, &bytes),
+        || merl::MerlTable::parse(&bytes).map(|table| brdf_atlas::LuminanceTable::new(&table)),
+    );
+    let luminance = luminance.with_context(read)?;
+    drop(bytes);
     let progress = cli::Progress::new(args.quiet);
     progress.step("lobes".to_string());
     let total = (config.lobes * config.lobes) as u64;
