@@ -143,20 +143,12 @@ impl Workspace2 {
         let blank = || std::array::from_fn(|_| Image::zeros(0, 0));
         decomposition.details.resize_with(levels, blank);
         let (mut w, mut h) = (image.width(), image.height());
-        // Level j reads the approximation of level j - 1 (the image for j = 1) and writes its own:
-        // the two alternate between the two buffers of `between`, which only grow (a buffer cut
-        // to a coarse level's size and grown again for the next image's first level would be
-        // cleared again), and the last one is copied into the decomposition's `approx`.
+        // Level j reads the approximation of level j - 1 (the image for j = 1) and writes its own
+        // ([`level_buffers`]); the last one is copied into the decomposition's `approx`.
         let mut between = std::mem::take(&mut self.between);
         for level in 0..levels {
             let (w2, h2) = (w / 2, h / 2);
-            let [even, odd] = &mut between;
-            let (dst, previous) = if level % 2 == 0 { (even, &*odd) } else { (odd, &*even) };
-            let src = if level == 0 { Source::Rows(image) } else { Source::Stored(&previous[..w * h]) };
-            // Every value is written: only a buffer that grows is filled first.
-            if dst.len() < w2 * h2 {
-                dst.resize(w2 * h2, 0.0);
-            }
+            let (src, dst) = level_buffers(&mut between, image, level, w, h);
             let details = &mut decomposition.details[level];
             let [mut ch, mut cv, mut cd] = details.each_mut().map(|image| {
                 let mut data = std::mem::replace(image, Image::zeros(0, 0)).into_data();
@@ -166,7 +158,7 @@ impl Workspace2 {
             });
             let with_details = |k: usize| rows_with_details(level + 1, k);
             let sink = Sink::Store([&mut ch[..], &mut cv[..], &mut cd[..]], &with_details);
-            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut dst[..w2 * h2], sink));
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, dst, sink));
             if level == 0 && !finite {
                 return Err(first_non_finite(image));
             }
@@ -203,15 +195,10 @@ impl Workspace2 {
         let mut energy = Vec::with_capacity(levels);
         for level in 0..levels {
             let (w2, h2) = (w / 2, h / 2);
-            let [even, odd] = &mut between;
-            let (dst, previous) = if level % 2 == 0 { (even, &*odd) } else { (odd, &*even) };
-            let src = if level == 0 { Source::Rows(image) } else { Source::Stored(&previous[..w * h]) };
-            if dst.len() < w2 * h2 {
-                dst.resize(w2 * h2, 0.0);
-            }
+            let (src, dst) = level_buffers(&mut between, image, level, w, h);
             sums.resize(h2, 0.0);
             let sink = Sink::Energy { floor: floor(level + 1), sums: &mut sums[..] };
-            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, &mut dst[..w2 * h2], sink));
+            let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, dst, sink));
             if level == 0 && !finite {
                 self.between = between;
                 return Err(first_non_finite(image));
@@ -226,6 +213,28 @@ impl Workspace2 {
         self.between = between;
         Ok(energy)
     }
+}
+
+/// Level `level`'s input, `w x h` (the image, or the approximation of the level before), and its
+/// output, `w / 2 x h / 2`: the two buffers of `between` alternate, and only grow (a buffer cut
+/// to a coarse level's size and grown again for the next image's first level would be cleared
+/// again).
+fn level_buffers<'a>(
+    between: &'a mut [Vec<f64>; 2],
+    image: &'a dyn Rows,
+    level: usize,
+    w: usize,
+    h: usize,
+) -> (Source<'a>, &'a mut [f64]) {
+    let [even, odd] = between;
+    let (dst, previous) = if level.is_multiple_of(2) { (even, &*odd) } else { (odd, &*even) };
+    let src = if level == 0 { Source::Rows(image) } else { Source::Stored(&previous[..w * h]) };
+    let len = (w / 2) * (h / 2);
+    // Every value is written: only a buffer that grows is filled first.
+    if dst.len() < len {
+        dst.resize(len, 0.0);
+    }
+    (src, &mut dst[..len])
 }
 
 /// An image given row by row ([`Workspace2::wavedec2_where`], [`Workspace2::detail_energy`]): an
