@@ -167,40 +167,23 @@ impl LuminanceTable {
     /// Branch-free over the eight corners.
     #[inline(always)]
     fn trilinear(&self, x_h: f64, x_d: f64, x_p: f64) -> Option<f64> {
-        let d = self.dims;
-        let clamped = |x: f64, n: usize| {
-            let x = x.clamp(0.0, (n - 1) as f64);
-            let i0 = (x as usize).min(n - 1);
-            (i0, (i0 + 1).min(n - 1), x - i0 as f64)
-        };
-        let (h0, h1, th) = clamped(x_h, d.n_theta_h);
-        let (d0, d1, td) = clamped(x_d, d.n_theta_d);
-        // `grid_coords` keeps x_p in [0, n_phi_d]; merl's rem_euclid is this subtraction there.
-        let n_p = d.n_phi_d;
-        let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
-        let p0 = (x_p as usize).min(n_p - 1);
-        let (p1, tp) = (if p0 + 1 == n_p { 0 } else { p0 + 1 }, x_p - p0 as f64);
-
-        let rows = [(h0, d0), (h0, d1), (h1, d0), (h1, d1)];
-        let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
+        let (cells, weights) = self.corners(x_h, x_d, x_p);
         let (mut sum, mut weight) = (0.0, 0.0);
-        for ((ih, id), wr) in rows.into_iter().zip(row_weights) {
-            let row = &self.luminance[(ih * d.n_theta_d + id) * n_p..][..n_p];
-            for (v, wp) in [(row[p0], 1.0 - tp), (row[p1], tp)] {
-                // A NaN (no data) corner contributes nothing; nor does a zero weight.
-                let w = if v.is_nan() { 0.0 } else { wr * wp };
-                sum += if w == 0.0 { 0.0 } else { w * v };
-                weight += w;
-            }
+        for (cell, w) in cells.into_iter().zip(weights) {
+            let v = self.luminance[cell];
+            // A NaN (no data) corner contributes nothing; nor does a zero weight.
+            let w = if v.is_nan() { 0.0 } else { w };
+            sum += if w == 0.0 { 0.0 } else { w * v };
+            weight += w;
         }
         (weight > 0.0).then(|| sum / weight)
     }
 
-    /// [`Self::trilinear`] of a table without holes (`complete`), bit for bit: no value is NaN
-    /// and all are `>= 0`, so a zero weight's product is a zero there too, and the weights sum
-    /// to about 1 (never 0).
+    /// The eight cells [`Self::trilinear`] reads and their weights, in its order: the four
+    /// `(theta_h, theta_d)` rows of `phi_d` values, each at `p0` then `p1` (the next cell, `p0`
+    /// again across the period's end; the same row twice at the last `theta_h` or `theta_d`).
     #[inline(always)]
-    fn trilinear_complete(&self, x_h: f64, x_d: f64, x_p: f64) -> f64 {
+    fn corners(&self, x_h: f64, x_d: f64, x_p: f64) -> ([usize; 8], [f64; 8]) {
         let d = self.dims;
         let clamped = |x: f64, n: usize| {
             let x = x.clamp(0.0, (n - 1) as f64);
@@ -213,20 +196,46 @@ impl LuminanceTable {
         let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
         let p0 = (x_p as usize).min(n_p - 1);
         let (p1, tp) = (if p0 + 1 == n_p { 0 } else { p0 + 1 }, x_p - p0 as f64);
-        // The four (theta_h, theta_d) rows of phi_d values, in trilinear's order.
         let base = (h0 * d.n_theta_d + d0) * n_p;
         let (dh, dd) = (h_step * d.n_theta_d * n_p, d_step * n_p);
         let rows = [base, base + dd, base + dh, base + dh + dd];
         let row_weights = [(1.0 - th) * (1.0 - td), (1.0 - th) * td, th * (1.0 - td), th * td];
-        let (mut sum, mut weight) = (0.0, 0.0);
-        for (row, wr) in rows.into_iter().zip(row_weights) {
-            for (p, wp) in [(p0, 1.0 - tp), (p1, tp)] {
-                let w = wr * wp;
-                sum += w * self.luminance[row + p];
-                weight += w;
+        let cells = std::array::from_fn(|c| rows[c / 2] + if c % 2 == 0 { p0 } else { p1 });
+        let weights = std::array::from_fn(|c| row_weights[c / 2] * if c % 2 == 0 { 1.0 - tp } else { tp });
+        (cells, weights)
+    }
+
+    /// [`Self::trilinear`] of a table without holes (`complete`) at a block of grid coordinates
+    /// (the first `out.len()`), into `out`, bit for bit: no value is NaN and all are `>= 0`, so
+    /// a zero weight's product is a zero there too, and the weights sum to about 1 (never 0). The
+    /// cells and weights of every lookup first ([`Self::corners`]), then the reads, then the
+    /// weighted sums corner by corner across the block (each lookup's sum in `trilinear`'s
+    /// order), so that the sums vectorize and their chains of additions overlap.
+    #[inline(always)]
+    fn trilinear_complete_many<const N: usize>(&self, coords: &[[f64; N]; 3], out: &mut [f64]) {
+        let n = out.len();
+        let (mut cells, mut weights, mut values) = ([[0usize; N]; 8], [[0.0; N]; 8], [[0.0; N]; 8]);
+        for k in 0..n {
+            let (c, w) = self.corners(coords[0][k], coords[1][k], coords[2][k]);
+            for corner in 0..8 {
+                (cells[corner][k], weights[corner][k]) = (c[corner], w[corner]);
             }
         }
-        sum / weight
+        for (values, cells) in values.iter_mut().zip(&cells) {
+            for (v, &cell) in values[..n].iter_mut().zip(&cells[..n]) {
+                *v = self.luminance[cell];
+            }
+        }
+        let (mut sum, mut weight) = ([0.0; N], [0.0; N]);
+        for (w, v) in weights.iter().zip(&values) {
+            for (((s, t), &w), &v) in sum[..n].iter_mut().zip(&mut weight[..n]).zip(&w[..n]).zip(&v[..n]) {
+                *s += w * v;
+                *t += w;
+            }
+        }
+        for ((o, &s), &t) in out.iter_mut().zip(&sum).zip(&weight) {
+            *o = s / t;
+        }
     }
 }
 
@@ -256,9 +265,7 @@ impl pulp::WithSimd for Lookups<'_> {
             let [x_h, x_d, x_p] = &coords;
             let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
             if table.complete {
-                for (((value, &x_h), &x_d), &x_p) in values {
-                    *value = table.trilinear_complete(x_h, x_d, x_p);
-                }
+                table.trilinear_complete_many(&coords, &mut out[start..end]);
             } else {
                 for (((value, &x_h), &x_d), &x_p) in values {
                     *value = table.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
