@@ -25,6 +25,16 @@ impl Image {
         Self { width, height, data: vec![0.0; width * height] }
     }
 
+    /// The image given row by row by `rows`, stored.
+    pub fn from_rows(rows: &dyn crate::Rows) -> Self {
+        let (width, height) = (rows.width(), rows.height());
+        let (mut data, mut buffer) = (Vec::with_capacity(width * height), vec![0.0; width]);
+        for r in 0..height {
+            data.extend_from_slice(rows.row(r, &mut buffer));
+        }
+        Self { width, height, data }
+    }
+
     /// An image with `f(x, y)` at column `x`, row `y`.
     pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> f64) -> Self {
         let mut data = Vec::with_capacity(width * height);

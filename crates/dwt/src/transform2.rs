@@ -82,7 +82,7 @@ impl Decomposition2 {
 /// One level of the forward transform: `cA, (cH, cV, cD)` of
 /// `pywt.dwt2(x, w, mode="periodization")`. Width and height must be even.
 pub fn dwt2(image: &Image, wavelet: Wavelet) -> Result<(Image, [Image; 3]), Error> {
-    check_shape(image, 1)?;
+    check_size(image.width(), image.height(), 1)?;
     with_bank!(wavelet, bank => forward_level(bank, image))
 }
 
@@ -145,10 +145,10 @@ impl Workspace2 {
         let (mut w, mut h) = (image.width(), image.height());
         // Level j reads the approximation of level j - 1 (the image for j = 1) and writes its own
         // ([`level_buffers`]); the last one is copied into the decomposition's `approx`.
-        let mut between = std::mem::take(&mut self.between);
+        let between = &mut self.between;
         for level in 0..levels {
             let (w2, h2) = (w / 2, h / 2);
-            let (src, dst) = level_buffers(&mut between, image, level, w, h);
+            let (src, dst) = level_buffers(between, image, level, w, h);
             let details = &mut decomposition.details[level];
             let [mut ch, mut cv, mut cd] = details.each_mut().map(|image| {
                 let mut data = std::mem::replace(image, Image::zeros(0, 0)).into_data();
@@ -169,7 +169,6 @@ impl Workspace2 {
         approx.clear();
         approx.extend_from_slice(&between[(levels - 1) % 2][..w * h]);
         decomposition.approx = Image::new(w, h, approx).expect("sizes match");
-        self.between = between;
         Ok(decomposition)
     }
 
@@ -190,17 +189,16 @@ impl Workspace2 {
     ) -> Result<Vec<f64>, Error> {
         let (mut w, mut h) = (image.width(), image.height());
         check_size(w, h, levels)?;
-        let mut between = std::mem::take(&mut self.between);
+        let between = &mut self.between;
         let mut sums = Vec::new();
         let mut energy = Vec::with_capacity(levels);
         for level in 0..levels {
             let (w2, h2) = (w / 2, h / 2);
-            let (src, dst) = level_buffers(&mut between, image, level, w, h);
+            let (src, dst) = level_buffers(between, image, level, w, h);
             sums.resize(h2, 0.0);
             let sink = Sink::Energy { floor: floor(level + 1), sums: &mut sums[..] };
             let finite = with_bank!(wavelet, bank => forward_level_into(bank, src, w, h, dst, sink));
             if level == 0 && !finite {
-                self.between = between;
                 return Err(first_non_finite(image));
             }
             let mut total = 0.0;
@@ -210,7 +208,6 @@ impl Workspace2 {
             energy.push(total);
             (w, h) = (w2, h2);
         }
-        self.between = between;
         Ok(energy)
     }
 }
@@ -324,13 +321,8 @@ pub fn waverec2(decomposition: &Decomposition2) -> Result<Image, Error> {
     Ok(image)
 }
 
-/// The checks of an image's shape; its values are checked by the first level's pass
-/// ([`forward_level_into`]), which reads them anyway.
-fn check_shape(image: &Image, levels: usize) -> Result<(), Error> {
-    check_size(image.width(), image.height(), levels)
-}
-
-/// [`check_shape`] of a `width x height` image.
+/// The checks of a `width x height` image's shape; its values are checked by the first level's
+/// pass ([`forward_level_into`]), which reads them anyway.
 fn check_size(width: usize, height: usize, levels: usize) -> Result<(), Error> {
     if width == 0 || height == 0 {
         return Err(Error::Empty { what: "image" });
@@ -382,7 +374,7 @@ fn forward_level<const F: usize>(bank: &Bank<F>, image: &Image) -> Result<(Image
     let mut out: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; w2 * h2]);
     let [ca, ch, cv, cd] = out.each_mut().map(|b| &mut b[..]);
     if !forward_level_into(bank, Source::Stored(image.data()), w, h, ca, Sink::Store([ch, cv, cd], &|_| true)) {
-        return Err(check_finite(|| "image".to_owned(), image.data()).expect_err("a non-finite value"));
+        return Err(first_non_finite(image));
     }
     let [ca, ch, cv, cd] = out.map(|data| Image::new(w2, h2, data).expect("sizes match"));
     Ok((ca, [ch, cv, cd]))
