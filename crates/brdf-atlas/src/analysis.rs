@@ -241,11 +241,11 @@ impl Analyser {
     /// periodic continuation
     /// ([`extend_periodic`]), the estimate with [`analysis_levels`] levels and the noise floor
     /// scaled to the lobe's peak, the estimate of the image's own pixels converted to cycles per
-    /// radian.
-    pub(crate) fn analyse_scratch(&self, scratch: &mut Scratch) {
+    /// radian. Returns the peak ([`peak`]), which the band energy's noise floor scales with too.
+    pub(crate) fn analyse_scratch(&self, scratch: &mut Scratch) -> f64 {
         let n = self.map.size;
         let Scratch { image, extended: ext, estimator, level, .. } = scratch;
-        let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let peak = peak(image);
 
         // The rows of the continuation that hold the image, continued; those below are made
         // from them as the transform reads them, never stored.
@@ -270,12 +270,19 @@ impl Analyser {
         for ((out, &j), s) in ext[..n * n].iter_mut().zip(level.iter()).zip(&self.pixels_per_radian) {
             *out = frequency_of[j as usize] * s;
         }
+        peak
     }
 
     /// Pixels of the hemisphere at the grid's limit in `scratch.level`.
     pub(crate) fn nyquist_pixels(&self, scratch: &Scratch) -> usize {
         scratch.level.iter().zip(&self.inside).filter(|&(&l, &inside)| l == 1 && inside).count()
     }
+}
+
+/// The largest magnitude of a lobe image: the scale of its noise floor (the estimate's and the
+/// band energies', [`Config::relative_noise_floor`]).
+pub(crate) fn peak(image: &[f64]) -> f64 {
+    image.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
 /// The number of wavelet levels a lobe image of side `n` is analysed with: `log2(n) - 1`, the
@@ -290,9 +297,10 @@ pub fn analysis_levels(n: usize) -> usize {
 /// slope across every border of the lobe image (crate docs, "Boundaries"): each row, then
 /// each column of the result, is continued by `extend_line`.
 pub fn extend_periodic(image: &[f64], n: usize) -> dwt::Image {
-    let mut ext = Vec::new();
-    extend_into(image, n, &mut ext);
-    dwt::Image::new(2 * n, 2 * n, ext).expect("sizes match")
+    let plan = Continuation::new(n);
+    let mut top = Vec::new();
+    plan.extend_rows_into(image, &mut top);
+    dwt::Image::from_rows(&Continued { plan: &plan, top: &top })
 }
 
 /// The `2n x 2n` tiling of an `n x n` image by its mirror images (to the right, below, and
@@ -302,15 +310,7 @@ pub fn extend_periodic(image: &[f64], n: usize) -> dwt::Image {
 /// continuation adds ramps of its own that carry the slope across the borders and would count
 /// as lobe energy (at grazing incidence it moves Phong n = 64 and 256 up a layer).
 pub fn mirror_tiling(image: &[f64], n: usize) -> dwt::Image {
-    use dwt::Rows;
-    let tiling = MirrorTiling { image, n };
-    let e = 2 * n;
-    let mut data = vec![0.0; e * e];
-    let mut buffer = vec![0.0; e];
-    for (r, row) in data.chunks_exact_mut(e).enumerate() {
-        row.copy_from_slice(tiling.row(r, &mut buffer));
-    }
-    dwt::Image::new(e, e, data).expect("sizes match")
+    dwt::Image::from_rows(&MirrorTiling { image, n })
 }
 
 /// [`mirror_tiling`] given row by row ([`dwt::Rows`]), never stored: row `y` of the `2n x 2n`
@@ -338,20 +338,6 @@ impl dwt::Rows for MirrorTiling<'_> {
             *o = v;
         }
         buffer
-    }
-}
-
-/// [`extend_periodic`] into a reused buffer: `ext` becomes `4 n^2` values, row-major: the rows
-/// of the image continued ([`Continuation::extend_rows_into`]), then the rows below
-/// ([`Continuation::continue_row`]).
-fn extend_into(image: &[f64], n: usize, ext: &mut Vec<f64>) {
-    let plan = Continuation::new(n);
-    plan.extend_rows_into(image, ext);
-    let e = 2 * n;
-    ext.resize(e * e, 0.0);
-    let (top, bottom) = ext.split_at_mut(n * e);
-    for (j, out) in bottom.chunks_exact_mut(e).enumerate() {
-        plan.continue_row(top, j, out);
     }
 }
 
@@ -562,8 +548,9 @@ mod tests {
 
     #[test]
     fn the_continuation_of_all_columns_at_once_is_extend_line_on_each_column() {
-        // extend_into continues the rows below the image a whole row at a time; that must be,
-        // bit for bit, extend_line on every column after every row (the definition).
+        // extend_periodic (Continuation::continue_row) continues the rows below the image a
+        // whole row at a time; that must be, bit for bit, extend_line on every column after
+        // every row (the definition).
         let n = 64;
         let image: Vec<f64> = (0..n * n).map(|k| ((k * 37 % 101) as f64).sin() * (k as f64 * 1e-3).exp()).collect();
         let e = 2 * n;

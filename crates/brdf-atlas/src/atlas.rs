@@ -356,20 +356,20 @@ pub fn build_atlas_of(
         .map(|(j, tile)| {
             // A set nobody uses, or a new one: a thread waiting inside a row's inner parallel
             // loops may start another row, which then needs a set of its own.
-            let mut scratch = scratches.lock().expect("no panic while held").pop().unwrap_or_default();
-            let scratch = &mut scratch;
+            let mut set = scratches.lock().expect("no panic while held").pop().unwrap_or_default();
+            let scratch = &mut set;
             let filled = analyser.render(luminance, grid.theta_i(j), scratch);
+            let peak = analyser.analyse_scratch(scratch);
             let band_energy = crate::view::band_energy_in(
                 &scratch.image,
                 config.analysis_size,
-                config.relative_noise_floor,
+                config.relative_noise_floor * peak,
                 scratch.estimator.transform(),
             );
-            analyser.analyse_scratch(scratch);
             let nyquist_texels = analyser.reduction().reduce(scratch.cycles_per_radian(), &scratch.level, tile);
             progress(config.lobes);
             let nyquist_pixels = analyser.nyquist_pixels(scratch) as u32;
-            scratches.lock().expect("no panic while held").push(std::mem::take(scratch));
+            scratches.lock().expect("no panic while held").push(set);
             (nyquist_pixels, nyquist_texels, filled, band_energy)
         })
         .collect();

@@ -35,7 +35,7 @@ use merl::MerlTable;
 
 use rayon::prelude::*;
 
-use crate::analysis::{Analyser, MirrorTiling, analysis_levels};
+use crate::analysis::{Analyser, MirrorTiling, analysis_levels, peak};
 use crate::atlas::{AtlasBuild, Config};
 use crate::error::Error;
 
@@ -89,21 +89,15 @@ impl ViewReduction {
 /// a Lambertian's constant, has none, rather than its lookups' rounding noise, which would read
 /// as the finest frequencies (27 cycles per radian at the default size: the sharpest layer).
 pub fn band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
-    band_energy_in(image, n, relative_noise_floor, &mut dwt::Workspace2::default())
+    band_energy_in(image, n, relative_noise_floor * peak(image), &mut dwt::Workspace2::default())
 }
 
-/// [`band_energy`] with the transform's reused buffers. The tiling is given to the transform row
-/// by row and its details summed as they are made ([`dwt::Workspace2::detail_energy`]: eight
-/// partial sums per row and orientation, within `2 m u` of a sum in order, `m` terms), neither
-/// ever stored.
-pub(crate) fn band_energy_in(
-    image: &[f64],
-    n: usize,
-    relative_noise_floor: f64,
-    transform: &mut dwt::Workspace2,
-) -> Vec<f64> {
-    let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let floor = |level: usize| relative_noise_floor * peak * (1u64 << level) as f64;
+/// [`band_energy`] with the noise floor in the image's units (`relative_noise_floor` times its
+/// peak) and the transform's reused buffers. The tiling is given to the transform row by row and
+/// its details summed as they are made ([`dwt::Workspace2::detail_energy`]: eight partial sums
+/// per row and orientation, within `2 m u` of a sum in order, `m` terms), neither ever stored.
+pub(crate) fn band_energy_in(image: &[f64], n: usize, noise_floor: f64, transform: &mut dwt::Workspace2) -> Vec<f64> {
+    let floor = |level: usize| noise_floor * (1u64 << level) as f64;
     transform
         .detail_energy(&MirrorTiling { image, n }, dwt::Wavelet::D4, analysis_levels(n), &floor)
         .expect("lobe images are finite, of a power-of-two size of at least 16")
