@@ -330,8 +330,6 @@ struct LevelRows {
     rows: Vec<f64>,
     /// Per coefficient row: its place in `rows`, `u32::MAX` when it covers no output row.
     slot: Vec<u32>,
-    /// The number of coefficient rows that cover an output row.
-    needed: usize,
     m_y: usize,
     cover_y: Option<Cover>,
 }
@@ -344,8 +342,8 @@ fn larger(a: f64, b: f64) -> f64 {
 }
 
 /// Eq. 7 for one output row `y` ([`Workspace::run`]), as a [`pulp::WithSimd`] so that its loops
-/// are compiled for the best instruction set the processor has (AVX-512 or AVX2 where present; the same
-/// operations in the same order, so the same bits).
+/// are compiled for the best instruction set the processor has (AVX-512 or AVX2 where present;
+/// the same operations in the same order, so the same bits).
 struct Eq7Row<'a> {
     prepared: &'a [LevelRows],
     y: usize,
@@ -464,12 +462,9 @@ impl Workspace {
                     prepared.slot[(first as usize + t) % m_y] = 0;
                 }
             }
-            let mut needed = 0;
-            for slot in prepared.slot.iter_mut().filter(|s| **s == 0) {
-                *slot = needed;
-                needed += 1;
+            for (place, slot) in prepared.slot.iter_mut().filter(|s| **s == 0).enumerate() {
+                *slot = place as u32;
             }
-            prepared.needed = needed as usize;
             prepared.m_y = m_y;
             prepared.cover_y = Some(cover_y);
         }
@@ -487,7 +482,7 @@ impl Workspace {
             };
             let [ch, cv, cd] = details;
             let cover_x = Cover::new(config.wavelet, level, w, out_w);
-            let needed = prepared.needed;
+            let needed = prepared.slot.iter().filter(|s| **s != u32::MAX).count();
             let rows = sized(&mut prepared.rows, needed * out_w);
             // One coefficient row at a time: the largest magnitude of the three orientations, zero
             // below the noise floor, in the reading's units; then its maximum over the coefficients

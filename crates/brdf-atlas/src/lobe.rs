@@ -192,6 +192,7 @@ impl LuminanceTable {
         };
         let (h0, h_step, th) = clamped(x_h, d.n_theta_h);
         let (d0, d_step, td) = clamped(x_d, d.n_theta_d);
+        // `grid_coords` keeps x_p in [0, n_phi_d]; merl's rem_euclid is this subtraction there.
         let n_p = d.n_phi_d;
         let x_p = if x_p >= n_p as f64 { x_p - n_p as f64 } else { x_p };
         let p0 = (x_p as usize).min(n_p - 1);
