@@ -80,19 +80,21 @@ impl LuminanceTable {
     /// values, bit for bit, the angles of a block of pairs computed in one loop that the
     /// compiler vectorizes, then their trilinear reads; compiled for the best instruction set the
     /// processor has ([`Lookups`]).
-    pub(crate) fn lookup_many(&self, wi: DVec3, wo: DirectionsRef<'_>, out: &mut [f64]) {
+    /// `block` holds the arrays of each block of lookups ([`Block`]), made once by the caller.
+    pub(crate) fn lookup_many(&self, wi: DVec3, wo: DirectionsRef<'_>, out: &mut [f64], block: &mut LookupBlock) {
         assert_eq!(wo.x.len(), out.len(), "one value per direction");
-        pulp::Arch::new().dispatch(Lookups { table: self, wi, wo, out });
+        pulp::Arch::new().dispatch(Lookups { table: self, wi, wo, out, block });
     }
 
-    /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into `coords`.
+    /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into
+    /// `block.coords`.
     #[inline(always)]
-    fn grid_coords_many<const N: usize>(&self, wi: DVec3, wo: DirectionsRef<'_>, coords: &mut [[f64; N]; 3]) {
+    fn grid_coords_many<const N: usize>(&self, wi: DVec3, wo: DirectionsRef<'_>, block: &mut Block<N>) {
         // Three loops, each short enough to keep its values in registers: the arguments of the
         // three angles, the angles (one atan2 per element), their grid coordinates.
         let n = wo.x.len();
         assert!(n <= N && wo.y.len() == n && wo.z.len() == n, "a block of directions");
-        let (mut y, mut x) = ([[0.0; N]; 3], [[0.0; N]; 3]);
+        let Block { y, x, coords, .. } = block;
         for k in 0..n {
             let (a, b) = self.angle_arguments(wi, DVec3::new(wo.x[k], wo.y[k], wo.z[k]));
             for i in 0..3 {
@@ -213,22 +215,25 @@ impl LuminanceTable {
     /// weighted sums corner by corner across the block (each lookup's sum in `trilinear`'s
     /// order), so that the sums vectorize and their chains of additions overlap.
     #[inline(always)]
-    fn trilinear_complete_many<const N: usize>(&self, coords: &[[f64; N]; 3], out: &mut [f64]) {
+    fn trilinear_complete_many<const N: usize>(&self, block: &mut Block<N>, out: &mut [f64]) {
         let n = out.len();
-        let (mut cells, mut weights, mut values) = ([[0usize; N]; 8], [[0.0; N]; 8], [[0.0; N]; 8]);
+        let Block { coords, cells, weights, values, .. } = block;
         for k in 0..n {
             let (c, w) = self.corners(coords[0][k], coords[1][k], coords[2][k]);
             for corner in 0..8 {
                 (cells[corner][k], weights[corner][k]) = (c[corner], w[corner]);
             }
         }
-        for (values, cells) in values.iter_mut().zip(&cells) {
+        // Every cell is in the table; the `min` says so to the compiler, which then reads a
+        // vector of cells at once (a gather) instead of one checked read after another.
+        let (table, last) = (&self.luminance[..], self.luminance.len() - 1);
+        for (values, cells) in values.iter_mut().zip(&*cells) {
             for (v, &cell) in values[..n].iter_mut().zip(&cells[..n]) {
-                *v = self.luminance[cell];
+                *v = table[cell.min(last)];
             }
         }
         let (mut sum, mut weight) = ([0.0; N], [0.0; N]);
-        for (w, v) in weights.iter().zip(&values) {
+        for (w, v) in weights.iter().zip(&*values) {
             for (((s, t), &w), &v) in sum[..n].iter_mut().zip(&mut weight[..n]).zip(&w[..n]).zip(&v[..n]) {
                 *s += w * v;
                 *t += w;
@@ -236,6 +241,37 @@ impl LuminanceTable {
         }
         for ((o, &s), &t) in out.iter_mut().zip(&sum).zip(&weight) {
             *o = s / t;
+        }
+    }
+}
+
+/// The arrays of one block of [`LuminanceTable::lookup_many`]'s lookups, made once per lobe image
+/// and overwritten block after block: each step writes the first `n` entries of an array before
+/// the next reads them (made per block, their clearing took a tenth of the lookups' time).
+pub(crate) struct Block<const N: usize> {
+    /// The `(y, x)` of each lookup's three angles ([`LuminanceTable::angle_arguments`]).
+    y: [[f64; N]; 3],
+    x: [[f64; N]; 3],
+    /// The angles, then their grid coordinates.
+    coords: [[f64; N]; 3],
+    /// Each corner's cell, weight and value ([`LuminanceTable::corners`]).
+    cells: [[usize; N]; 8],
+    weights: [[f64; N]; 8],
+    values: [[f64; N]; 8],
+}
+
+/// The lookups' block: [`Block`] of 64, which fits the first-level cache.
+pub(crate) type LookupBlock = Block<64>;
+
+impl<const N: usize> Block<N> {
+    pub(crate) fn new() -> Self {
+        Block {
+            y: [[0.0; N]; 3],
+            x: [[0.0; N]; 3],
+            coords: [[0.0; N]; 3],
+            cells: [[0; N]; 8],
+            weights: [[0.0; N]; 8],
+            values: [[0.0; N]; 8],
         }
     }
 }
@@ -249,6 +285,7 @@ struct Lookups<'a> {
     wi: DVec3,
     wo: DirectionsRef<'a>,
     out: &'a mut [f64],
+    block: &'a mut LookupBlock,
 }
 
 impl pulp::WithSimd for Lookups<'_> {
@@ -256,19 +293,16 @@ impl pulp::WithSimd for Lookups<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) {
-        const BLOCK: usize = 64;
-        let Self { table, wi, wo, out } = self;
-        let mut coords = [[0.0; BLOCK]; 3];
+        let Self { table, wi, wo, out, block } = self;
         let mut start = 0;
         while start < out.len() {
-            let end = (start + BLOCK).min(out.len());
-            table.grid_coords_many(wi, wo.slice(start..end), &mut coords);
-            let [x_h, x_d, x_p] = &coords;
-            let values = out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p);
+            let end = (start + block.cells[0].len()).min(out.len());
+            table.grid_coords_many(wi, wo.slice(start..end), block);
             if table.complete {
-                table.trilinear_complete_many(&coords, &mut out[start..end]);
+                table.trilinear_complete_many(block, &mut out[start..end]);
             } else {
-                for (((value, &x_h), &x_d), &x_p) in values {
+                let [x_h, x_d, x_p] = &block.coords;
+                for (((value, &x_h), &x_d), &x_p) in out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p) {
                     *value = table.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
                 }
             }
@@ -456,10 +490,11 @@ impl Pixels {
 /// [`LuminanceTable::lookup_many`].
 pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
+    let block = &mut LookupBlock::new();
     let mut start = 0;
     for &(first, count) in &pixels.runs {
         let (first, count) = (first as usize, count as usize);
-        table.lookup_many(wi, pixels.direct.slice(start..start + count), &mut out[first..first + count]);
+        table.lookup_many(wi, pixels.direct.slice(start..start + count), &mut out[first..first + count], block);
         start += count;
     }
     // The continued pixels' terms, a few hundred pixels at a time (at most 4 terms each).
@@ -474,7 +509,7 @@ pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &m
         }
         let last_term = pixels.continued[end - 1].1 as usize;
         let values = &mut values[..last_term - first_term];
-        table.lookup_many(wi, pixels.terms.slice(first_term..last_term), values);
+        table.lookup_many(wi, pixels.terms.slice(first_term..last_term), values, block);
         let mut term = first_term;
         for &(k, term_end) in &pixels.continued[pixel..end] {
             // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
@@ -696,7 +731,7 @@ mod tests {
             directions.push(DVec3::new(-wi.x, -wi.y, wi.z));
             let n = directions.x.len();
             let mut out = vec![0.0; n];
-            luminance.lookup_many(wi, directions.slice(0..n), &mut out);
+            luminance.lookup_many(wi, directions.slice(0..n), &mut out, &mut LookupBlock::new());
             let (mut none, mut some) = (0, 0);
             for (wo, got) in directions.iter().zip(&out) {
                 let expect = luminance.lookup(wi, wo);
