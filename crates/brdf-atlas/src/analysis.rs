@@ -329,7 +329,11 @@ impl dwt::Rows for MirrorTiling<'_> {
         2 * self.n
     }
 
-    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
+    fn stored_row(&self, _: usize) -> Option<&[f64]> {
+        None
+    }
+
+    fn make_row(&self, r: usize, buffer: &mut [f64]) {
         let n = self.n;
         let line = &self.image[(if r < n { r } else { 2 * n - 1 - r }) * n..][..n];
         let (left, right) = buffer.split_at_mut(n);
@@ -337,7 +341,6 @@ impl dwt::Rows for MirrorTiling<'_> {
         for (o, &v) in right.iter_mut().zip(line.iter().rev()) {
             *o = v;
         }
-        buffer
     }
 }
 
@@ -358,14 +361,13 @@ impl dwt::Rows for Continued<'_> {
         2 * self.plan.n()
     }
 
-    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
+    fn stored_row(&self, r: usize) -> Option<&[f64]> {
         let (n, e) = (self.plan.n(), 2 * self.plan.n());
-        if r < n {
-            &self.top[r * e..(r + 1) * e]
-        } else {
-            self.plan.continue_row(self.top, r - n, buffer);
-            buffer
-        }
+        (r < n).then(|| &self.top[r * e..(r + 1) * e])
+    }
+
+    fn make_row(&self, r: usize, buffer: &mut [f64]) {
+        self.plan.continue_row(self.top, r - self.plan.n(), buffer);
     }
 }
 

@@ -235,13 +235,26 @@ fn level_buffers<'a>(
 }
 
 /// An image given row by row ([`Workspace2::wavedec2_where`], [`Workspace2::detail_energy`]): an
-/// image that is a function of a smaller one need not be stored. An [`Image`] is one.
+/// image that is a function of a smaller one need not be stored. Each row is either stored
+/// ([`Self::stored_row`]) or made on demand ([`Self::make_row`]); the transform makes each row
+/// it reads once, though two output rows read it. An [`Image`] stores all of its rows.
 pub trait Rows: Sync {
     fn width(&self) -> usize;
     fn height(&self) -> usize;
-    /// Row `r` (`width` values): a row the image stores, or one made in `buffer` (`width`
-    /// values).
-    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64];
+    /// Row `r` (`width` values) where the image stores it; `None` where it is made.
+    fn stored_row(&self, r: usize) -> Option<&[f64]>;
+    /// Writes row `r`, which the image does not store, into `buffer` (`width` values).
+    fn make_row(&self, r: usize, buffer: &mut [f64]);
+    /// Row `r`: the stored one, or the one made in `buffer` (`width` values).
+    fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
+        match self.stored_row(r) {
+            Some(row) => row,
+            None => {
+                self.make_row(r, buffer);
+                buffer
+            }
+        }
+    }
 }
 
 impl Rows for Image {
@@ -253,9 +266,13 @@ impl Rows for Image {
         Image::height(self)
     }
 
-    fn row<'a>(&'a self, r: usize, _: &'a mut [f64]) -> &'a [f64] {
+    fn stored_row(&self, r: usize) -> Option<&[f64]> {
         let w = Image::width(self);
-        &self.data()[r * w..(r + 1) * w]
+        Some(&self.data()[r * w..(r + 1) * w])
+    }
+
+    fn make_row(&self, _: usize, _: &mut [f64]) {
+        unreachable!("an image stores every row")
     }
 }
 
@@ -389,16 +406,52 @@ enum Source<'a> {
 
 impl<'a> Source<'a> {
     /// The `F` input rows of output row `k` of an image of `h` rows of `w`: slices of a stored
-    /// image, or written into `buffer` (`F w` values).
-    fn rows<const F: usize>(self, k: usize, w: usize, h: usize, buffer: &'a mut [f64]) -> [&'a [f64]; F] {
+    /// image, or made in `made`.
+    fn rows<const F: usize>(self, k: usize, w: usize, h: usize, made: &'a mut MadeRows<F>) -> [&'a [f64]; F] {
         let indices = analysis_rows::<F>(k, h);
         match self {
             Source::Stored(src) => indices.map(|r| &src[r * w..(r + 1) * w]),
-            Source::Rows(rows) => {
-                let mut buffers = buffer.chunks_exact_mut(w);
-                indices.map(|r| rows.row(r, buffers.next().expect("F rows")))
-            }
+            Source::Rows(rows) => made.rows(rows, indices),
         }
+    }
+}
+
+/// The rows a job of [`forward_level_into`] made of a [`Rows`] image, `F` slots of `w` values:
+/// output row `k + 1` reads two of the rows `k` read (the filter steps by 2), which are taken
+/// from their slots instead of made again.
+struct MadeRows<const F: usize> {
+    buffer: Vec<f64>,
+    /// The row each slot holds (`usize::MAX`: none).
+    held: [usize; F],
+}
+
+impl<const F: usize> MadeRows<F> {
+    fn new(w: usize) -> Self {
+        MadeRows { buffer: vec![0.0; F * w], held: [usize::MAX; F] }
+    }
+
+    /// The rows `indices` of `rows`: the stored ones, and the others from the slots, made where
+    /// no slot holds them (in a slot that holds none of `indices`: there is always one, since a
+    /// row is made only when no slot holds it).
+    fn rows<'a>(&'a mut self, rows: &'a dyn Rows, indices: [usize; F]) -> [&'a [f64]; F] {
+        let w = self.buffer.len() / F;
+        let mut slot_of = [0; F];
+        for (slot_of, &r) in slot_of.iter_mut().zip(&indices) {
+            if rows.stored_row(r).is_some() {
+                continue;
+            }
+            *slot_of = match self.held.iter().position(|&held| held == r) {
+                Some(slot) => slot,
+                None => {
+                    let slot = (0..F).find(|&s| !indices.contains(&self.held[s])).expect("a free slot");
+                    rows.make_row(r, &mut self.buffer[slot * w..(slot + 1) * w]);
+                    self.held[slot] = r;
+                    slot
+                }
+            };
+        }
+        let buffer = &self.buffer;
+        std::array::from_fn(|j| rows.stored_row(indices[j]).unwrap_or(&buffer[slot_of[j] * w..(slot_of[j] + 1) * w]))
     }
 }
 
@@ -429,7 +482,7 @@ fn forward_level_into<const F: usize>(
     let arch = pulp::Arch::new();
     // Per job: the input rows where they are made, the two column-filtered rows, and, for the
     // energy, the three detail rows.
-    let buffers = || (vec![0.0; F * w], vec![0.0; 2 * w], vec![0.0; 3 * w2]);
+    let buffers = || (MadeRows::<F>::new(w), vec![0.0; 2 * w], vec![0.0; 3 * w2]);
     match sink {
         Sink::Store([ch, cv, cd], with_details) => approx
             .par_chunks_mut(w2)
@@ -596,10 +649,61 @@ mod tests {
         fn height(&self) -> usize {
             self.0.height()
         }
-        fn row<'a>(&'a self, r: usize, buffer: &'a mut [f64]) -> &'a [f64] {
-            buffer.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
-            buffer
+        fn stored_row(&self, _: usize) -> Option<&[f64]> {
+            None
         }
+        fn make_row(&self, r: usize, buffer: &mut [f64]) {
+            buffer.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
+        }
+    }
+
+    /// [`Copied`], counting the rows it makes.
+    struct Counted<'a>(Copied<'a>, std::sync::atomic::AtomicUsize);
+
+    impl Rows for Counted<'_> {
+        fn width(&self) -> usize {
+            self.0.width()
+        }
+        fn height(&self) -> usize {
+            self.0.height()
+        }
+        fn stored_row(&self, _: usize) -> Option<&[f64]> {
+            None
+        }
+        fn make_row(&self, r: usize, buffer: &mut [f64]) {
+            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.0.make_row(r, buffer);
+        }
+    }
+
+    #[test]
+    fn rows_made_on_demand_give_the_stored_images_coefficients() {
+        // Bit for bit, on both wavelets, heights where an output row's input rows wrap onto
+        // each other (2: rows 0 1 0 1) or across the image's end, one level and several.
+        for wavelet in [Wavelet::Haar, Wavelet::D4] {
+            for (w, h, levels) in [(4, 2, 1), (8, 6, 1), (16, 10, 1), (64, 48, 3)] {
+                let data: Vec<f64> = (0..w * h).map(|k| ((k * 29 % 83) as f64 * 0.7).cos() * (k % 7) as f64).collect();
+                let image = Image::new(w, h, data).unwrap();
+                let stored = wavedec2(&image, wavelet, levels).unwrap();
+                let mut workspace = Workspace2::default();
+                let made = workspace.wavedec2_where(&Copied(&image), wavelet, levels, &|_, _| true).unwrap();
+                let bits = |d: &Decomposition2| {
+                    let images = std::iter::once(&d.approx).chain(d.details.iter().flatten());
+                    images.flat_map(|i| i.data().iter().map(|v| v.to_bits())).collect::<Vec<u64>>()
+                };
+                assert_eq!(bits(made), bits(&stored), "{wavelet:?} {w} x {h}, {levels} levels");
+            }
+        }
+        // Each output row reads four rows, two of them read by the row before: on one thread
+        // (a few jobs, each starting with empty slots) a row is made about once, not twice.
+        let (w, h) = (256, 256);
+        let image = Image::new(w, h, (0..w * h).map(|k| k as f64).collect()).unwrap();
+        let counted = Counted(Copied(&image), std::sync::atomic::AtomicUsize::new(0));
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        one.install(|| Workspace2::default().wavedec2_where(&counted, Wavelet::D4, 1, &|_, _| true).map(|_| ()))
+            .unwrap();
+        let made = counted.1.into_inner();
+        assert!((h..h + h / 4).contains(&made), "{made} rows made for {h}");
     }
 
     #[test]
