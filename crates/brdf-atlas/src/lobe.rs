@@ -358,18 +358,6 @@ impl<'a> DirectionsRef<'a> {
 }
 
 impl Directions {
-    fn reserve(&mut self, additional: usize) {
-        for v in [&mut self.x, &mut self.y, &mut self.z] {
-            v.reserve_exact(additional);
-        }
-    }
-
-    fn append(&mut self, other: &Directions) {
-        self.x.extend_from_slice(&other.x);
-        self.y.extend_from_slice(&other.y);
-        self.z.extend_from_slice(&other.z);
-    }
-
     fn push(&mut self, w: DVec3) {
         self.x.push(w.x);
         self.y.push(w.y);
@@ -386,12 +374,42 @@ impl Directions {
 }
 
 /// What every pixel of a [`LobeMap`] holds ([`LobeMap::sample`]), kept compactly for the lobe
-/// images of many incident directions: the directions of the pixels on the hemisphere, in runs
-/// of consecutive pixels, and for each continued pixel below it the points of nonzero weight
-/// (the terms [`Sample::eval`] sums, in its order).
+/// images of many incident directions, row by row ([`PixelRow`]).
 #[derive(Clone, Debug)]
 pub(crate) struct Pixels {
     len: usize,
+    rows: Vec<PixelRow>,
+}
+
+impl Pixels {
+    /// The samples of `map`'s pixels, computed in parallel over rows.
+    pub(crate) fn new(map: LobeMap) -> Self {
+        use rayon::prelude::*;
+        let n = map.size;
+        let rows = (0..n)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = PixelRow::default();
+                for x in 0..n {
+                    row.push((y * n + x) as u32, map.sample(x, y));
+                }
+                row
+            })
+            .collect();
+        Pixels { len: n * n, rows }
+    }
+
+    /// The number of pixels.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+}
+
+/// The pixels of one row of a [`Pixels`]: the directions of the pixels on the hemisphere, in
+/// runs of consecutive pixels, and for each continued pixel below it the points of nonzero
+/// weight (the terms [`Sample::eval`] sums, in its order).
+#[derive(Clone, Debug, Default)]
+struct PixelRow {
     /// `(first pixel, count)` of each run of direct pixels; their directions in `direct`.
     runs: Vec<(u32, u32)>,
     direct: Directions,
@@ -402,61 +420,7 @@ pub(crate) struct Pixels {
     weights: Vec<f64>,
 }
 
-impl Pixels {
-    /// The samples of `map`'s pixels, computed in parallel over rows, each row compacted on its
-    /// own, then the rows joined (a run that crosses a row's end continues into the next).
-    pub(crate) fn new(map: LobeMap) -> Self {
-        use rayon::prelude::*;
-        let n = map.size;
-        let rows: Vec<Pixels> = (0..n)
-            .into_par_iter()
-            .map(|y| {
-                let mut row = Pixels::empty();
-                for x in 0..n {
-                    row.push((y * n + x) as u32, map.sample(x, y));
-                }
-                row
-            })
-            .collect();
-        let mut pixels = Pixels::empty();
-        let total = |f: fn(&Pixels) -> usize| rows.iter().map(f).sum::<usize>();
-        let (direct, terms) = (total(|p| p.direct.x.len()), total(|p| p.weights.len()));
-        pixels.direct.reserve(direct);
-        pixels.terms.reserve(terms);
-        pixels.weights.reserve(terms);
-        pixels.continued.reserve(total(|p| p.continued.len()));
-        for row in rows {
-            let mut runs = row.runs.into_iter();
-            if let (Some(&(first, count)), Some((last_first, last_count))) =
-                (runs.as_slice().first(), pixels.runs.last_mut())
-                && *last_first + *last_count == first
-            {
-                *last_count += count;
-                runs.next();
-            }
-            pixels.runs.extend(runs);
-            pixels.direct.append(&row.direct);
-            let offset = pixels.weights.len() as u32;
-            pixels.continued.extend(row.continued.iter().map(|&(k, end)| (k, end + offset)));
-            pixels.terms.append(&row.terms);
-            pixels.weights.extend_from_slice(&row.weights);
-        }
-        pixels.len = n * n;
-        pixels.runs.shrink_to_fit();
-        pixels
-    }
-
-    fn empty() -> Self {
-        Pixels {
-            len: 0,
-            runs: Vec::new(),
-            direct: Directions::default(),
-            continued: Vec::new(),
-            terms: Directions::default(),
-            weights: Vec::new(),
-        }
-    }
-
+impl PixelRow {
     /// Appends pixel `k`, which holds `sample`.
     fn push(&mut self, k: u32, sample: Sample) {
         match sample {
@@ -475,12 +439,6 @@ impl Pixels {
                 self.continued.push((k, self.weights.len() as u32));
             }
         }
-        self.len += 1;
-    }
-
-    /// The number of pixels.
-    pub(crate) fn len(&self) -> usize {
-        self.len
     }
 }
 
@@ -491,58 +449,62 @@ impl Pixels {
 pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
     let block = &mut LookupBlock::new();
-    let mut start = 0;
-    for &(first, count) in &pixels.runs {
-        let (first, count) = (first as usize, count as usize);
-        table.lookup_many(wi, pixels.direct.slice(start..start + count), &mut out[first..first + count], block);
-        start += count;
-    }
     // The continued pixels' terms, a few hundred pixels at a time (at most 4 terms each).
     const TERMS: usize = 1024;
     let mut values = [0.0; TERMS];
-    let mut pixel = 0;
-    while pixel < pixels.continued.len() {
-        let first_term = pixel.checked_sub(1).map_or(0, |p| pixels.continued[p].1 as usize);
-        let mut end = pixel + 1;
-        while end < pixels.continued.len() && pixels.continued[end].1 as usize - first_term <= TERMS {
-            end += 1;
+    for row in &pixels.rows {
+        let mut start = 0;
+        for &(first, count) in &row.runs {
+            let (first, count) = (first as usize, count as usize);
+            table.lookup_many(wi, row.direct.slice(start..start + count), &mut out[first..first + count], block);
+            start += count;
         }
-        let last_term = pixels.continued[end - 1].1 as usize;
-        let values = &mut values[..last_term - first_term];
-        table.lookup_many(wi, pixels.terms.slice(first_term..last_term), values, block);
-        let mut term = first_term;
-        for &(k, term_end) in &pixels.continued[pixel..end] {
-            // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
-            let mut sum = 0.0;
-            for t in term..term_end as usize {
-                sum += pixels.weights[t] * values[t - first_term];
+        let mut pixel = 0;
+        while pixel < row.continued.len() {
+            let first_term = pixel.checked_sub(1).map_or(0, |p| row.continued[p].1 as usize);
+            let mut end = pixel + 1;
+            while end < row.continued.len() && row.continued[end].1 as usize - first_term <= TERMS {
+                end += 1;
             }
-            out[k as usize] = sum;
-            term = term_end as usize;
+            let last_term = row.continued[end - 1].1 as usize;
+            let values = &mut values[..last_term - first_term];
+            table.lookup_many(wi, row.terms.slice(first_term..last_term), values, block);
+            let mut term = first_term;
+            for &(k, term_end) in &row.continued[pixel..end] {
+                // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
+                let mut sum = 0.0;
+                for t in term..term_end as usize {
+                    sum += row.weights[t] * values[t - first_term];
+                }
+                out[k as usize] = sum;
+                term = term_end as usize;
+            }
+            pixel = end;
         }
-        pixel = end;
     }
 }
 
 /// [`render`] of any BRDF slice `f(wo)`: each pixel is [`Sample::eval`] of its sample.
 pub(crate) fn render_fn(pixels: &Pixels, f: impl Fn(DVec3) -> Option<f64>, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
-    let mut directions = pixels.direct.iter();
-    for &(first, count) in &pixels.runs {
-        for (value, wo) in out[first as usize..][..count as usize].iter_mut().zip(directions.by_ref()) {
-            *value = f(wo).unwrap_or(f64::NAN);
+    for row in &pixels.rows {
+        let mut directions = row.direct.iter();
+        for &(first, count) in &row.runs {
+            for (value, wo) in out[first as usize..][..count as usize].iter_mut().zip(directions.by_ref()) {
+                *value = f(wo).unwrap_or(f64::NAN);
+            }
         }
-    }
-    let mut start = 0;
-    let mut terms = pixels.terms.iter().zip(&pixels.weights);
-    for &(k, end) in &pixels.continued {
-        // Sample::eval: the sum of the weighted terms in order, None if any term has no value.
-        let mut sum = Some(0.0);
-        for (wo, &c) in terms.by_ref().take(end as usize - start) {
-            sum = sum.and_then(|s| f(wo).map(|v| s + c * v));
+        let mut start = 0;
+        let mut terms = row.terms.iter().zip(&row.weights);
+        for &(k, end) in &row.continued {
+            // Sample::eval: the sum of the weighted terms in order, None if any term has no value.
+            let mut sum = Some(0.0);
+            for (wo, &c) in terms.by_ref().take(end as usize - start) {
+                sum = sum.and_then(|s| f(wo).map(|v| s + c * v));
+            }
+            out[k as usize] = sum.unwrap_or(f64::NAN);
+            start = end as usize;
         }
-        out[k as usize] = sum.unwrap_or(f64::NAN);
-        start = end as usize;
     }
 }
 
@@ -746,8 +708,8 @@ mod tests {
     }
 
     /// The lobe image of the batch lookups is the one of the single lookup, bit for bit: the
-    /// runs of direct pixels and the continued pixels' terms (more than one buffer of them at
-    /// 64 x 64), with and without cells lacking data.
+    /// runs of direct pixels and the continued pixels' terms (at 1024 x 1024 rows of more than
+    /// one buffer of them, at 64 x 64 of less), with and without cells lacking data.
     #[test]
     fn render_is_render_fn_of_lookup_bit_for_bit() {
         let table = Analytic::Ggx { alpha: 0.1, f0: [0.9, 0.9, 0.9] }.table(Dims::MERL);
@@ -759,17 +721,25 @@ mod tests {
             }
         }
         let holes = MerlTable::from_raw(dims, raw).unwrap();
-        let pixels = Pixels::new(LobeMap::new(64));
-        assert!(pixels.weights.len() > 1024, "{} terms", pixels.weights.len());
-        for table in [table, holes] {
-            let luminance = LuminanceTable::new(&table);
-            for theta_i in [0.1, 0.8, 1.5] {
-                let wi = spherical_dir(theta_i, 0.0);
-                let (mut fast, mut single) = (vec![0.0; pixels.len()], vec![0.0; pixels.len()]);
-                render(&luminance, wi, &pixels, &mut fast);
-                render_fn(&pixels, |wo| luminance.lookup(wi, wo), &mut single);
-                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
-                assert_eq!(bits(&fast), bits(&single), "theta_i {theta_i}, complete {}", luminance.complete);
+        let tables = [table, holes].map(|table| LuminanceTable::new(&table));
+        for (size, more_than_a_buffer) in [(64, false), (1024, true)] {
+            let pixels = Pixels::new(LobeMap::new(size));
+            let most_terms = pixels.rows.iter().map(|row| row.weights.len()).max().unwrap();
+            assert_eq!(most_terms > 1024, more_than_a_buffer, "{most_terms} terms in a row at {size}");
+            for luminance in &tables {
+                for theta_i in [0.1, 0.8, 1.5] {
+                    let wi = spherical_dir(theta_i, 0.0);
+                    let (mut fast, mut single) = (vec![0.0; pixels.len()], vec![0.0; pixels.len()]);
+                    render(luminance, wi, &pixels, &mut fast);
+                    render_fn(&pixels, |wo| luminance.lookup(wi, wo), &mut single);
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+                    assert_eq!(
+                        bits(&fast),
+                        bits(&single),
+                        "{size}: theta_i {theta_i}, complete {}",
+                        luminance.complete
+                    );
+                }
             }
         }
     }
