@@ -128,19 +128,17 @@ fn describe(
     let rows = stored_kind == asset::AssetKind::BandwidthRows;
     let stored_texels = if rows { atlas.lobes_y * atlas.tile_len() } else { atlas.data.len() };
     let stats = &build.stats;
-    let mut sorted: Vec<f32> = atlas.data.clone();
-    sorted.sort_unstable_by(f32::total_cmp);
-    let quantile = |q: f64| f64::from(sorted[((sorted.len() - 1) as f64 * q).round() as usize]);
+    let [median, p90, p99, max] = quantiles(&atlas.data, [0.5, 0.9, 0.99, 1.0]);
     let n_lobes = atlas.n_lobes();
-    let flat = sorted.iter().filter(|v| **v == 0.0).count();
+    let flat = atlas.data.iter().filter(|v| **v == 0.0).count();
     let at_limit = stats.nyquist_lobes();
     let figures = object([
         ("lobes", json!(n_lobes)),
-        ("texels", json!(sorted.len())),
-        ("median", json!(quantile(0.5))),
-        ("p90", json!(quantile(0.9))),
-        ("p99", json!(quantile(0.99))),
-        ("max", json!(quantile(1.0))),
+        ("texels", json!(atlas.data.len())),
+        ("median", json!(median)),
+        ("p90", json!(p90)),
+        ("p99", json!(p99)),
+        ("max", json!(max)),
         ("flat_texels", json!(flat)),
         ("lobes_at_limit", json!(at_limit)),
         ("texels_at_limit", json!(stats.nyquist_texels)),
@@ -163,12 +161,9 @@ fn describe(
             config.analysis_size
         ),
         format!(
-            "bandwidth     cycles per radian: median {:.3}, 90% {:.3}, 99% {:.3}, max {:.3}; {flat} of {} texels flat (0)",
-            quantile(0.5),
-            quantile(0.9),
-            quantile(0.99),
-            quantile(1.0),
-            sorted.len()
+            "bandwidth     cycles per radian: median {median:.3}, 90% {p90:.3}, 99% {p99:.3}, max {max:.3}; {flat} of {} \
+             texels flat (0)",
+            atlas.data.len()
         ),
         format!(
             "limit         {at_limit} of {n_lobes} lobes reach the analysis grid's limit ({} texels): {}",
@@ -220,6 +215,21 @@ fn describe(
         ::picture::format_number(range.1)
     ));
     (figures, report)
+}
+
+/// The values of rank `round((n - 1) q)` in `values` (`n` of them, ordered by `total_cmp`) for
+/// each of the ascending quantiles `qs`: what indexing the sorted values gives, by selection
+/// (each selection leaves the values above its rank to the next; a sort of the million texels
+/// took as long as encoding the picture).
+fn quantiles<const Q: usize>(values: &[f32], qs: [f64; Q]) -> [f64; Q] {
+    let mut values = values.to_vec();
+    let mut start = 0;
+    qs.map(|q| {
+        let rank = ((values.len() - 1) as f64 * q).round() as usize;
+        let (_, value, _) = values[start..].select_nth_unstable_by(rank - start, f32::total_cmp);
+        start = rank;
+        f64::from(*value)
+    })
 }
 
 /// The full grid as an asset's payload (kind `bandwidth-atlas`, `data-schema/README.md`): what
@@ -315,4 +325,25 @@ fn atlas_of(
     };
     atlas.check().map_err(|e| e.to_string())?;
     Ok(atlas)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The selected quantiles are the sorted values' at the same ranks, on values with runs of
+    /// equal values, zeros and a negative zero, including equal and neighbouring ranks.
+    #[test]
+    fn quantiles_are_the_sorted_values_at_their_ranks() {
+        let values: Vec<f32> =
+            (0..10_007u32).map(|k| if k % 13 == 0 { -0.0 } else { ((k * 7919) % 1009) as f32 * 0.25 }).collect();
+        let mut sorted = values.clone();
+        sorted.sort_unstable_by(f32::total_cmp);
+        let qs = [0.0, 0.5, 0.5, 0.9, 0.9001, 0.99, 1.0];
+        let got = quantiles(&values, qs);
+        for (q, got) in qs.into_iter().zip(got) {
+            let expect = sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+            assert_eq!(got.to_bits(), f64::from(expect).to_bits(), "q {q}");
+        }
+    }
 }
