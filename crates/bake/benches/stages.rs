@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use bake::stage::{atlas, env_bandwidth, importance, layers, prefilter};
 use bake::{BakeConfig, Program, Source};
-use brdf_atlas::LuminanceTable;
+use brdf_atlas::{Analyser, LuminanceTable};
 
 const RUNS: usize = 5;
 const MATERIAL: &str = "gold-paint";
@@ -117,11 +117,13 @@ fn main() {
     print(
         "bandwidth atlas",
         &measure(|| {
-            atlas::run(&LuminanceTable::new(&table), &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas")
+            let analyser = Analyser::new(&config.atlas);
+            atlas::run(&LuminanceTable::new(&table), &analyser, &source, &PROGRAM, &|_| {}).expect("the atlas")
         }),
     );
     let (_, build) =
-        atlas::run(&LuminanceTable::new(&table), &source, &PROGRAM, &config.atlas, &|_| {}).expect("the atlas");
+        atlas::run(&LuminanceTable::new(&table), &Analyser::new(&config.atlas), &source, &PROGRAM, &|_| {})
+            .expect("the atlas");
     print("read the map", &measure(|| envmap::load(&map_path).expect("the map")));
     let map = envmap::load(&map_path).expect("the map");
     print(

@@ -261,8 +261,9 @@ pub fn run_bake(
         let now = done.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed) + n as u64;
         work(now, lobes);
     };
+    let analyser = brdf_atlas::Analyser::new(&config.atlas);
     let (staged, atlas_build) =
-        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &material_source, program, &config.atlas, &tick)?;
+        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &analyser, &material_source, program, &tick)?;
     let atlas_source = staged.file("bandwidth-atlas").map(|f| Source::of_bytes(Path::new(&f.name), &f.bytes));
     record(staged, &mut manifest)?;
     if let Some(max_error) = config.pca_max_error {

@@ -27,7 +27,8 @@ fn ggx_stage() -> &'static (Staged, AtlasBuild) {
     STAGE.get_or_init(|| {
         let table = Analytic::Ggx { alpha: 0.2, f0: [0.9, 0.6, 0.3] }.table(merl::Dims::MERL);
         let source = Source::of_bytes(Path::new("ggx.binary"), b"ggx");
-        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &source, &PROGRAM, &config(), &|_| {}).unwrap()
+        let analyser = brdf_atlas::Analyser::new(&config());
+        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &analyser, &source, &PROGRAM, &|_| {}).unwrap()
     })
 }
 

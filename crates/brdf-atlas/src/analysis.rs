@@ -180,6 +180,11 @@ impl Analyser {
         self.map
     }
 
+    /// The configuration it analyses with.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
     pub fn reduction(&self) -> &TileReduction {
         &self.reduction
     }

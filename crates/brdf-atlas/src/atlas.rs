@@ -340,8 +340,18 @@ pub fn build_atlas_of(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<AtlasBuild, Error> {
     config.check()?;
+    Ok(build_atlas_with(&Analyser::new(config), luminance, progress))
+}
+
+/// [`build_atlas_of`] with the analyser of its configuration ([`Analyser::config`]), which does
+/// not depend on the table: a caller can make it while the table is read.
+pub fn build_atlas_with(
+    analyser: &Analyser,
+    luminance: &LuminanceTable,
+    progress: &(dyn Fn(usize) + Sync),
+) -> AtlasBuild {
+    let config = analyser.config();
     let grid = IncidentGrid::new(config.lobes);
-    let analyser = Analyser::new(config);
     let tile_len = config.tile * config.tile;
 
     let mut rows = vec![0.0f32; config.lobes * tile_len];
@@ -400,5 +410,5 @@ pub fn build_atlas_of(
         stats.nyquist_texels += config.lobes * nyquist_texels;
         stats.filled_pixels += config.lobes * filled;
     }
-    Ok(AtlasBuild { atlas, stats, band_energy })
+    AtlasBuild { atlas, stats, band_energy }
 }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use bake::{Program, Source};
-use brdf_atlas::Config;
+use brdf_atlas::{Analyser, Config};
 use clap::Parser;
 
 /// Build the angular-bandwidth atlas of a MERL BRDF: for each incident direction of a
@@ -66,22 +66,29 @@ fn run(args: Args) -> Result<ExitCode> {
     let config = Config { lobes: args.lobes, tile: args.tile, analysis_size: args.analysis_size, ..Config::default() };
     config.check()?;
     let read = || format!("reading {}", args.material.display());
-    let bytes = merl::read_bytes(&args.material).with_context(read)?;
-    // The provenance's hash of the bytes read, beside their parsing; the atlas reads the
-    // luminance alone, so the table (and the bytes) go before the analysis's buffers come.
-    let (source, luminance) = rayon::join(
-        || Source::of_bytes(&args.material, &bytes),
-        || merl::MerlTable::parse(&bytes).map(|table| brdf_atlas::LuminanceTable::new(&table)),
+    // The analysis grid (what its pixels hold) does not depend on the table: it is made while
+    // the table is read. The provenance's hash of the bytes read, beside their parsing; the
+    // atlas reads the luminance alone, so the table (and the bytes) go before the analysis's
+    // buffers come.
+    let (analyser, read_table) = rayon::join(
+        || Analyser::new(&config),
+        || -> Result<_> {
+            let bytes = merl::read_bytes(&args.material).with_context(read)?;
+            let (source, luminance) = rayon::join(
+                || Source::of_bytes(&args.material, &bytes),
+                || merl::MerlTable::parse(&bytes).map(|table| brdf_atlas::LuminanceTable::new(&table)),
+            );
+            Ok((source, luminance.with_context(read)?))
+        },
     );
-    let luminance = luminance.with_context(read)?;
-    drop(bytes);
+    let (source, luminance) = read_table?;
     let progress = cli::Progress::new(args.quiet);
     progress.step("lobes".to_string());
     let total = (config.lobes * config.lobes) as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
     let tick =
         |n: usize| progress.work(done.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed) + n as u64, total);
-    let (staged, _) = bake::stage::atlas::run(&luminance, &source, &PROGRAM, &config, &tick)?;
+    let (staged, _) = bake::stage::atlas::run(&luminance, &analyser, &source, &PROGRAM, &tick)?;
     progress.finish();
     let dir = &args.out_dir;
     staged.write(dir)?;

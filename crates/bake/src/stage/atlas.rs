@@ -10,7 +10,7 @@
 
 pub(crate) mod picture;
 
-use brdf_atlas::{Atlas, AtlasBuild, Config, LuminanceTable, build_atlas_of};
+use brdf_atlas::{Analyser, Atlas, AtlasBuild, Config, LuminanceTable, build_atlas_with};
 use serde_json::json;
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
@@ -19,17 +19,18 @@ pub const ASSET: &str = "bandwidth-atlas.asset";
 pub const EXR: &str = "bandwidth-atlas.exr";
 pub const PICTURE: &str = "bandwidth-atlas.png";
 
-/// Builds the atlas of a table's luminance ([`LuminanceTable::new`]) with `config`; `tick(n)` is
-/// called as `n` more lobes are done (a progress bar's hook).
+/// Builds the atlas of a table's luminance ([`LuminanceTable::new`]) with `analyser`, made of
+/// a checked configuration ([`Config::check`]); `tick(n)` is called as `n` more lobes are done
+/// (a progress bar's hook).
 pub fn run(
     luminance: &LuminanceTable,
+    analyser: &Analyser,
     source: &Source,
     program: &Program,
-    config: &Config,
     tick: &(dyn Fn(usize) + Sync),
 ) -> Result<(Staged, AtlasBuild), Error> {
-    config.check().map_err(|e| Error::stage("bandwidth atlas", e))?;
-    let build = build_atlas_of(luminance, config, tick).map_err(|e| Error::stage("bandwidth atlas", e))?;
+    let config = analyser.config();
+    let build = build_atlas_with(analyser, luminance, tick);
     let atlas = &build.atlas;
     let notes = format!(
         "{} {} of {} lobes reach the analysis grid's limit: their values are lower bounds ({:.2} cycles per \
