@@ -81,9 +81,23 @@ impl LuminanceTable {
     /// compiler vectorizes, then their trilinear reads; compiled for the best instruction set the
     /// processor has ([`Lookups`]).
     /// `block` holds the arrays of each block of lookups ([`Block`]), made once by the caller.
-    pub(crate) fn lookup_many(&self, wi: DVec3, wo: DirectionsRef<'_>, out: &mut [f64], block: &mut LookupBlock) {
+    ///
+    /// With `mirror`, and `wi` in the `x z` plane (`wi.y == 0`), also the lookups of the mirror
+    /// images `(x, -y, z)` of the directions into `mirror`, bit for bit, mostly from the same
+    /// angles ([`Self::mirror_coords_many`]): a lobe image's rows `y` and `size - 1 - y`.
+    pub(crate) fn lookup_many(
+        &self,
+        wi: DVec3,
+        wo: DirectionsRef<'_>,
+        out: &mut [f64],
+        mirror: Option<&mut [f64]>,
+        block: &mut LookupBlock,
+    ) {
         assert_eq!(wo.x.len(), out.len(), "one value per direction");
-        pulp::Arch::new().dispatch(Lookups { table: self, wi, wo, out, block });
+        if let Some(mirror) = &mirror {
+            assert!(wi.y == 0.0 && mirror.len() == out.len(), "mirror images of wi's plane, one value per direction");
+        }
+        pulp::Arch::new().dispatch(Lookups { table: self, wi, wo, out, mirror, block });
     }
 
     /// [`Self::grid_coords`] of `wi` and each direction of `wo` (at most `N`) into
@@ -104,9 +118,32 @@ impl LuminanceTable {
         for ((angle, &y), &x) in coords.as_flattened_mut().iter_mut().zip(y.as_flattened()).zip(x.as_flattened()) {
             *angle = atan2(y, x);
         }
+        block.phi_d[..n].copy_from_slice(&coords[2][..n]);
         let [x_h, x_d, x_p] = coords;
         for ((h, d), p) in x_h[..n].iter_mut().zip(&mut x_d[..n]).zip(&mut x_p[..n]) {
             [*h, *d, *p] = self.scale(*h, *d, *p);
+        }
+    }
+
+    /// `block.coords` of the mirror images `(x, -y, z)` of the directions `wo` whose coordinates
+    /// it holds ([`Self::grid_coords_many`]), for a `wi` with `wi.y == 0`. Then `theta_h` and
+    /// `theta_d` are the same, and so is every argument of [`Self::angle_arguments`] but `dy`,
+    /// which changes sign exactly where it is not zero (`wi.y s.x` is a zero of the same sign for
+    /// both, `wi.x s.y` changes sign), and so does `phi_d = atan2(dy, dx)` ([`crate::atan::atan2`]
+    /// is odd in `y`, exactly): the mirror image's `x_p` is the grid coordinate of `-phi_d`.
+    /// Where `dy` is zero (`s.y = 0`, or the half vector the normal: no pixel of a lobe image)
+    /// `phi_d` is 0 or pi and the signs of zeros decide: the coordinates are computed afresh.
+    #[inline(always)]
+    fn mirror_coords_many<const N: usize>(&self, wi: DVec3, wo: DirectionsRef<'_>, block: &mut Block<N>) {
+        let n = wo.x.len();
+        for (x_p, &phi_d) in block.coords[2][..n].iter_mut().zip(&block.phi_d[..n]) {
+            *x_p = self.scale_phi_d(-phi_d);
+        }
+        for k in (0..n).filter(|&k| block.y[2][k] == 0.0) {
+            let coords = self.grid_coords(wi, DVec3::new(wo.x[k], -wo.y[k], wo.z[k]));
+            for (c, value) in block.coords.iter_mut().zip(coords) {
+                c[k] = value;
+            }
         }
     }
 
@@ -159,9 +196,16 @@ impl LuminanceTable {
         let d = self.dims;
         let x_h = (theta_h.max(0.0) * FRAC_2_PI).sqrt() * d.n_theta_h as f64;
         let x_d = theta_d * FRAC_2_PI * d.n_theta_d as f64;
+        [x_h, x_d, self.scale_phi_d(phi_d)]
+    }
+
+    /// [`Self::scale`]'s grid coordinate of `phi_d`.
+    #[inline(always)]
+    fn scale_phi_d(&self, phi_d: f64) -> f64 {
+        let d = self.dims;
         let range = d.phi_d_range();
         let phi_d = if phi_d < 0.0 { phi_d + range } else { phi_d };
-        [x_h, x_d, phi_d * (d.n_phi_d as f64 / range)]
+        phi_d * (d.n_phi_d as f64 / range)
     }
 
     /// The same interpolation as `merl`'s `trilinear`, on one channel: corners that are NaN
@@ -243,6 +287,19 @@ impl LuminanceTable {
             *o = s / t;
         }
     }
+
+    /// [`Self::trilinear`] at `block.coords` (the first `out.len()`) into `out`, NaN for `None`.
+    #[inline(always)]
+    fn trilinear_many<const N: usize>(&self, block: &mut Block<N>, out: &mut [f64]) {
+        if self.complete {
+            self.trilinear_complete_many(block, out);
+        } else {
+            let [x_h, x_d, x_p] = &block.coords;
+            for (((value, &x_h), &x_d), &x_p) in out.iter_mut().zip(x_h).zip(x_d).zip(x_p) {
+                *value = self.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
+            }
+        }
+    }
 }
 
 /// The arrays of one block of [`LuminanceTable::lookup_many`]'s lookups, made once per lobe image
@@ -254,6 +311,8 @@ pub(crate) struct Block<const N: usize> {
     x: [[f64; N]; 3],
     /// The angles, then their grid coordinates.
     coords: [[f64; N]; 3],
+    /// The angles `phi_d` ([`LuminanceTable::mirror_coords_many`] reads them).
+    phi_d: [f64; N],
     /// Each corner's cell, weight and value ([`LuminanceTable::corners`]).
     cells: [[usize; N]; 8],
     weights: [[f64; N]; 8],
@@ -269,6 +328,7 @@ impl<const N: usize> Block<N> {
             y: [[0.0; N]; 3],
             x: [[0.0; N]; 3],
             coords: [[0.0; N]; 3],
+            phi_d: [0.0; N],
             cells: [[0; N]; 8],
             weights: [[0.0; N]; 8],
             values: [[0.0; N]; 8],
@@ -285,6 +345,7 @@ struct Lookups<'a> {
     wi: DVec3,
     wo: DirectionsRef<'a>,
     out: &'a mut [f64],
+    mirror: Option<&'a mut [f64]>,
     block: &'a mut LookupBlock,
 }
 
@@ -293,18 +354,16 @@ impl pulp::WithSimd for Lookups<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) {
-        let Self { table, wi, wo, out, block } = self;
+        let Self { table, wi, wo, out, mut mirror, block } = self;
         let mut start = 0;
         while start < out.len() {
             let end = (start + block.cells[0].len()).min(out.len());
-            table.grid_coords_many(wi, wo.slice(start..end), block);
-            if table.complete {
-                table.trilinear_complete_many(block, &mut out[start..end]);
-            } else {
-                let [x_h, x_d, x_p] = &block.coords;
-                for (((value, &x_h), &x_d), &x_p) in out[start..end].iter_mut().zip(x_h).zip(x_d).zip(x_p) {
-                    *value = table.trilinear(x_h, x_d, x_p).unwrap_or(f64::NAN);
-                }
+            let wo = wo.slice(start..end);
+            table.grid_coords_many(wi, wo, block);
+            table.trilinear_many(block, &mut out[start..end]);
+            if let Some(mirror) = mirror.as_deref_mut() {
+                table.mirror_coords_many(wi, wo, block);
+                table.trilinear_many(block, &mut mirror[start..end]);
             }
             start = end;
         }
@@ -379,6 +438,9 @@ impl Directions {
 pub(crate) struct Pixels {
     len: usize,
     rows: Vec<PixelRow>,
+    /// For each row `y` of the top half, whether row `size - 1 - y` holds its mirror images
+    /// ([`PixelRow::mirrored_by`]): [`render`] looks such pairs up together.
+    mirrored: Vec<bool>,
 }
 
 impl Pixels {
@@ -386,17 +448,18 @@ impl Pixels {
     pub(crate) fn new(map: LobeMap) -> Self {
         use rayon::prelude::*;
         let n = map.size;
-        let rows = (0..n)
+        let rows: Vec<PixelRow> = (0..n)
             .into_par_iter()
             .map(|y| {
                 let mut row = PixelRow::default();
                 for x in 0..n {
-                    row.push((y * n + x) as u32, map.sample(x, y));
+                    row.push(x as u32, map.sample(x, y));
                 }
                 row
             })
             .collect();
-        Pixels { len: n * n, rows }
+        let mirrored = (0..n / 2).into_par_iter().map(|y| rows[y].mirrored_by(&rows[n - 1 - y])).collect();
+        Pixels { len: n * n, rows, mirrored }
     }
 
     /// The number of pixels.
@@ -407,7 +470,7 @@ impl Pixels {
 
 /// The pixels of one row of a [`Pixels`]: the directions of the pixels on the hemisphere, in
 /// runs of consecutive pixels, and for each continued pixel below it the points of nonzero
-/// weight (the terms [`Sample::eval`] sums, in its order).
+/// weight (the terms [`Sample::eval`] sums, in its order). Pixels are numbered by their column.
 #[derive(Clone, Debug, Default)]
 struct PixelRow {
     /// `(first pixel, count)` of each run of direct pixels; their directions in `direct`.
@@ -421,13 +484,13 @@ struct PixelRow {
 }
 
 impl PixelRow {
-    /// Appends pixel `k`, which holds `sample`.
-    fn push(&mut self, k: u32, sample: Sample) {
+    /// Appends pixel `x`, which holds `sample`.
+    fn push(&mut self, x: u32, sample: Sample) {
         match sample {
             Sample::Direct(wo) => {
                 match self.runs.last_mut() {
-                    Some((first, count)) if *first + *count == k => *count += 1,
-                    _ => self.runs.push((k, 1)),
+                    Some((first, count)) if *first + *count == x => *count += 1,
+                    _ => self.runs.push((x, 1)),
                 }
                 self.direct.push(wo);
             }
@@ -436,58 +499,111 @@ impl PixelRow {
                     self.terms.push(w);
                     self.weights.push(c);
                 }
-                self.continued.push((k, self.weights.len() as u32));
+                self.continued.push((x, self.weights.len() as u32));
             }
         }
     }
+
+    /// Whether `other` holds, pixel for pixel and bit for bit, the mirror images `(x, -y, z)`
+    /// of this row's directions with the same weights: rows `y` and `size - 1 - y` of a lobe
+    /// map (whose `b` coordinates are each other's negatives, exactly, for a power-of-two size).
+    fn mirrored_by(&self, other: &PixelRow) -> bool {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        let mirror = |a: &Directions, b: &Directions| {
+            let negated: Vec<f64> = a.y.iter().map(|y| -y).collect();
+            bits(&a.x) == bits(&b.x) && bits(&negated) == bits(&b.y) && bits(&a.z) == bits(&b.z)
+        };
+        self.runs == other.runs
+            && self.continued == other.continued
+            && bits(&self.weights) == bits(&other.weights)
+            && mirror(&self.direct, &other.direct)
+            && mirror(&self.terms, &other.terms)
+    }
 }
+
+/// The continued pixels' terms [`render`] looks up at once: a few hundred pixels (at most 4
+/// terms each).
+const TERMS: usize = 1024;
 
 /// Fills `out` (row-major, `map.size^2` values) with the luminance of the BRDF at `wi` for the
 /// map's pixels (`pixels`, from [`LobeMap::sample`]); NaN where the table holds no data
 /// around a pair the pixel needs: [`render_fn`] of [`LuminanceTable::lookup`], bit for bit, by
-/// [`LuminanceTable::lookup_many`].
+/// [`LuminanceTable::lookup_many`]. For a `wi` in the `x z` plane (`wi.y == 0`, as in the frame
+/// of the plane of incidence) each mirrored pair of rows is looked up together.
 pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
-    let block = &mut LookupBlock::new();
-    // The continued pixels' terms, a few hundred pixels at a time (at most 4 terms each).
-    const TERMS: usize = 1024;
-    let mut values = [0.0; TERMS];
-    for row in &pixels.rows {
-        let mut start = 0;
-        for &(first, count) in &row.runs {
-            let (first, count) = (first as usize, count as usize);
-            table.lookup_many(wi, row.direct.slice(start..start + count), &mut out[first..first + count], block);
-            start += count;
+    let n = pixels.rows.len();
+    let (block, values) = (&mut LookupBlock::new(), &mut [[0.0; TERMS]; 2]);
+    let mut out_rows: Vec<Option<&mut [f64]>> = out.chunks_exact_mut(n).map(Some).collect();
+    for (y, row) in pixels.rows.iter().enumerate() {
+        // None: rendered with the row it mirrors.
+        let Some(out_row) = out_rows[y].take() else { continue };
+        let m = n - 1 - y;
+        let mirror = (wi.y == 0.0 && y < m && pixels.mirrored[y])
+            .then(|| (&pixels.rows[m], out_rows[m].take().expect("a row below is not rendered yet")));
+        render_row(table, wi, row, out_row, mirror, block, values);
+    }
+}
+
+/// One row of [`render`] into `out` (the row's `size` values), and with `mirror`, the mirror
+/// images' row (which [`PixelRow::mirrored_by`] this one) into its values.
+fn render_row(
+    table: &LuminanceTable,
+    wi: DVec3,
+    row: &PixelRow,
+    out: &mut [f64],
+    mut mirror: Option<(&PixelRow, &mut [f64])>,
+    block: &mut LookupBlock,
+    values: &mut [[f64; TERMS]; 2],
+) {
+    let mut start = 0;
+    for &(first, count) in &row.runs {
+        let pixels = first as usize..(first + count) as usize;
+        let mirror_out = mirror.as_mut().map(|(_, out)| &mut out[pixels.clone()]);
+        table.lookup_many(
+            wi,
+            row.direct.slice(start..start + pixels.len()),
+            &mut out[pixels.clone()],
+            mirror_out,
+            block,
+        );
+        start += pixels.len();
+    }
+    let mut pixel = 0;
+    while pixel < row.continued.len() {
+        let first_term = pixel.checked_sub(1).map_or(0, |p| row.continued[p].1 as usize);
+        let mut end = pixel + 1;
+        while end < row.continued.len() && row.continued[end].1 as usize - first_term <= TERMS {
+            end += 1;
         }
-        let mut pixel = 0;
-        while pixel < row.continued.len() {
-            let first_term = pixel.checked_sub(1).map_or(0, |p| row.continued[p].1 as usize);
-            let mut end = pixel + 1;
-            while end < row.continued.len() && row.continued[end].1 as usize - first_term <= TERMS {
-                end += 1;
-            }
-            let last_term = row.continued[end - 1].1 as usize;
-            let values = &mut values[..last_term - first_term];
-            table.lookup_many(wi, row.terms.slice(first_term..last_term), values, block);
+        let last_term = row.continued[end - 1].1 as usize;
+        let [values, mirror_values] = values.each_mut().map(|v| &mut v[..last_term - first_term]);
+        let terms = row.terms.slice(first_term..last_term);
+        table.lookup_many(wi, terms, values, mirror.is_some().then_some(&mut *mirror_values), block);
+        // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
+        let sums = |weights: &[f64], values: &[f64], out: &mut [f64]| {
             let mut term = first_term;
-            for &(k, term_end) in &row.continued[pixel..end] {
-                // Sample::eval's sum in its order; a term without a value (NaN) makes the sum NaN.
+            for &(x, term_end) in &row.continued[pixel..end] {
                 let mut sum = 0.0;
                 for t in term..term_end as usize {
-                    sum += row.weights[t] * values[t - first_term];
+                    sum += weights[t] * values[t - first_term];
                 }
-                out[k as usize] = sum;
+                out[x as usize] = sum;
                 term = term_end as usize;
             }
-            pixel = end;
+        };
+        sums(&row.weights, values, out);
+        if let Some((mirror_row, mirror_out)) = &mut mirror {
+            sums(&mirror_row.weights, mirror_values, mirror_out);
         }
+        pixel = end;
     }
 }
 
 /// [`render`] of any BRDF slice `f(wo)`: each pixel is [`Sample::eval`] of its sample.
 pub(crate) fn render_fn(pixels: &Pixels, f: impl Fn(DVec3) -> Option<f64>, out: &mut [f64]) {
     assert_eq!(out.len(), pixels.len, "one value per pixel");
-    for row in &pixels.rows {
+    for (row, out) in pixels.rows.iter().zip(out.chunks_exact_mut(pixels.rows.len())) {
         let mut directions = row.direct.iter();
         for &(first, count) in &row.runs {
             for (value, wo) in out[first as usize..][..count as usize].iter_mut().zip(directions.by_ref()) {
@@ -496,13 +612,13 @@ pub(crate) fn render_fn(pixels: &Pixels, f: impl Fn(DVec3) -> Option<f64>, out: 
         }
         let mut start = 0;
         let mut terms = row.terms.iter().zip(&row.weights);
-        for &(k, end) in &row.continued {
+        for &(x, end) in &row.continued {
             // Sample::eval: the sum of the weighted terms in order, None if any term has no value.
             let mut sum = Some(0.0);
             for (wo, &c) in terms.by_ref().take(end as usize - start) {
                 sum = sum.and_then(|s| f(wo).map(|v| s + c * v));
             }
-            out[k as usize] = sum.unwrap_or(f64::NAN);
+            out[x as usize] = sum.unwrap_or(f64::NAN);
             start = end as usize;
         }
     }
@@ -684,26 +800,44 @@ mod tests {
         assert!(!holes.complete);
         let mut rng = StdRng::seed_from_u64(34);
         for luminance in [complete, holes] {
-            let wi = random_pair(&mut rng).0;
-            let mut directions = Directions::default();
-            for _ in 0..10_000 {
-                directions.push(random_pair(&mut rng).1);
-            }
-            // The mirror direction: h on the normal.
-            directions.push(DVec3::new(-wi.x, -wi.y, wi.z));
-            let n = directions.x.len();
-            let mut out = vec![0.0; n];
-            luminance.lookup_many(wi, directions.slice(0..n), &mut out, &mut LookupBlock::new());
-            let (mut none, mut some) = (0, 0);
-            for (wo, got) in directions.iter().zip(&out) {
-                let expect = luminance.lookup(wi, wo);
-                match expect {
-                    Some(v) => assert_eq!(v.to_bits(), got.to_bits(), "{wi} {wo}"),
-                    None => assert!(got.is_nan(), "{wi} {wo}"),
+            // Any wi; and one in the x z plane, with the mirror images looked up too, among
+            // them those whose dy is zero (computed afresh): s.y = 0 (wo.y = +-0) and h on the
+            // normal.
+            let any = random_pair(&mut rng).0;
+            let in_plane = DVec3::new(any.x.hypot(any.y), 0.0, any.z);
+            for (wi, mirrored) in [(any, false), (in_plane, true)] {
+                let mut directions = Directions::default();
+                for _ in 0..10_000 {
+                    directions.push(random_pair(&mut rng).1);
                 }
-                (none, some) = if expect.is_some() { (none, some + 1) } else { (none + 1, some) };
+                // The mirror direction: h on the normal.
+                directions.push(DVec3::new(-wi.x, -wi.y, wi.z));
+                for y in [0.0, -0.0] {
+                    // phi_d 0 and (nearer the horizon than wi) pi.
+                    directions.push(DVec3::new(0.6, y, 0.8));
+                    directions.push(DVec3::new(0.995, y, (1.0f64 - 0.995 * 0.995).sqrt()));
+                }
+                let n = directions.x.len();
+                let (mut out, mut mirror) = (vec![0.0; n], vec![0.0; n]);
+                let block = &mut LookupBlock::new();
+                luminance.lookup_many(wi, directions.slice(0..n), &mut out, mirrored.then_some(&mut mirror[..]), block);
+                let mut checked = vec![(directions.iter().collect::<Vec<_>>(), &out)];
+                if mirrored {
+                    checked.push((directions.iter().map(|w| DVec3::new(w.x, -w.y, w.z)).collect(), &mirror));
+                }
+                let (mut none, mut some) = (0, 0);
+                for (directions, out) in checked {
+                    for (&wo, got) in directions.iter().zip(out) {
+                        let expect = luminance.lookup(wi, wo);
+                        match expect {
+                            Some(v) => assert_eq!(v.to_bits(), got.to_bits(), "{wi} {wo}"),
+                            None => assert!(got.is_nan(), "{wi} {wo}"),
+                        }
+                        (none, some) = if expect.is_some() { (none, some + 1) } else { (none + 1, some) };
+                    }
+                }
+                println!("{some} values, {none} without");
             }
-            println!("{some} values, {none} without");
         }
     }
 
@@ -724,6 +858,8 @@ mod tests {
         let tables = [table, holes].map(|table| LuminanceTable::new(&table));
         for (size, more_than_a_buffer) in [(64, false), (1024, true)] {
             let pixels = Pixels::new(LobeMap::new(size));
+            // Each row of the top half has its mirror image below: render looks them up together.
+            assert!(pixels.mirrored.len() == size / 2 && pixels.mirrored.iter().all(|&m| m), "{size}");
             let most_terms = pixels.rows.iter().map(|row| row.weights.len()).max().unwrap();
             assert_eq!(most_terms > 1024, more_than_a_buffer, "{most_terms} terms in a row at {size}");
             for luminance in &tables {
