@@ -168,9 +168,8 @@ impl Analyser {
     pub fn new(config: &Config) -> Self {
         let n = config.analysis_size;
         let map = LobeMap::new(n);
-        let at = |k: usize| (k % n, k / n);
-        let pixels_per_radian = (0..n * n).into_par_iter().map(|k| map.pixels_per_radian(at(k).0, at(k).1)).collect();
-        let inside = (0..n * n).into_par_iter().map(|k| map.inside(at(k).0, at(k).1)).collect();
+        let pixels_per_radian = mirrored_rows(n, |x, y| map.pixels_per_radian(x, y));
+        let inside = mirrored_rows(n, |x, y| map.inside(x, y));
         let reduction = TileReduction::new(n, config.tile);
         let plan = Continuation::new(n);
         Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, inside, reduction, plan }
@@ -282,6 +281,21 @@ impl Analyser {
     pub(crate) fn nyquist_pixels(&self, scratch: &Scratch) -> usize {
         scratch.level.iter().zip(&self.inside).filter(|&(&l, &inside)| l == 1 && inside).count()
     }
+}
+
+/// `f(x, y)` at every pixel of an `n x n` grid (`n` even) that is symmetric across its middle
+/// row, row-major: the top half computed in parallel, each row of the bottom half a copy of its
+/// mirror row ([`LobeMap`]'s rows).
+fn mirrored_rows<T: Copy + Default + Send + Sync>(n: usize, f: impl Fn(usize, usize) -> T + Sync) -> Vec<T> {
+    let mut values = vec![T::default(); n * n];
+    let (top, bottom) = values.split_at_mut(n * n / 2);
+    top.par_chunks_exact_mut(n).enumerate().for_each(|(y, row)| {
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = f(x, y);
+        }
+    });
+    bottom.par_chunks_exact_mut(n).zip(top.par_chunks_exact(n).rev()).for_each(|(row, top)| row.copy_from_slice(top));
+    values
 }
 
 /// The largest magnitude of a lobe image: the scale of its noise floor (the estimate's and the
@@ -544,13 +558,24 @@ mod tests {
     #[test]
     fn the_analysers_pixels_render_what_the_map_samples() {
         // The compact pixels (runs of directions, the continued pixels' weighted terms) give
-        // lobe_image_from_fn's image bit for bit, holes (None, then filled) included.
-        let config = Config { analysis_size: 64, tile: 8, ..Config::default() };
-        let analyser = Analyser::new(&config);
-        let f = |w: glam::DVec3| (w.x > -0.9).then(|| (3.0 * w.x).sin() + w.z.max(0.0).powi(7) + 2.0);
-        let compact = analyser.lobe_image(f);
-        let direct = crate::lobe_image_from_fn(analyser.map(), f);
-        assert!(compact.iter().zip(&direct).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // lobe_image_from_fn's image bit for bit, holes (None, then filled) included: the top
+        // half sampled and the bottom half mirrored from it (f tells the mirror images apart),
+        // at the smallest size, the default and one between; the Jacobian factors and the
+        // hemisphere's pixels are the map's own.
+        for size in [16, 64, 1024] {
+            let config = Config { analysis_size: size, tile: 8, ..Config::default() };
+            let analyser = Analyser::new(&config);
+            let f = |w: glam::DVec3| (w.x > -0.9).then(|| (3.0 * w.x + w.y).sin() + w.z.max(0.0).powi(7) + 2.0);
+            let compact = analyser.lobe_image(f);
+            let direct = crate::lobe_image_from_fn(analyser.map(), f);
+            assert!(compact.iter().zip(&direct).all(|(a, b)| a.to_bits() == b.to_bits()), "{size}");
+            let map = analyser.map();
+            for (y, x) in (0..size).flat_map(|y| (0..size).map(move |x| (y, x))) {
+                let factor = analyser.pixels_per_radian(x, y);
+                assert_eq!(factor.to_bits(), map.pixels_per_radian(x, y).to_bits(), "{size}: {x} {y}");
+                assert_eq!(analyser.inside[y * size + x], map.inside(x, y), "{size}: {x} {y}");
+            }
+        }
     }
 
     #[test]

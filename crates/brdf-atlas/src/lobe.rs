@@ -438,17 +438,21 @@ impl Directions {
 pub(crate) struct Pixels {
     len: usize,
     rows: Vec<PixelRow>,
-    /// For each row `y` of the top half, whether row `size - 1 - y` holds its mirror images
-    /// ([`PixelRow::mirrored_by`]): [`render`] looks such pairs up together.
-    mirrored: Vec<bool>,
+    /// Whether each row `size - 1 - y` holds the mirror images `(x, -y, z)` of row `y`'s
+    /// directions, with the same weights: [`render`] looks such pairs up together.
+    mirrored: bool,
 }
 
 impl Pixels {
-    /// The samples of `map`'s pixels, computed in parallel over rows.
+    /// The samples of `map`'s pixels, computed in parallel over rows. At a power-of-two size
+    /// (every analysis size), row `size - 1 - y` is row `y` mirrored across the plane of
+    /// incidence, bit for bit ([`LobeMap`]): only the top half is sampled.
     pub(crate) fn new(map: LobeMap) -> Self {
         use rayon::prelude::*;
         let n = map.size;
-        let rows: Vec<PixelRow> = (0..n)
+        let mirrored = n.is_power_of_two() && n >= 2;
+        let sampled = if mirrored { n / 2 } else { n };
+        let mut rows: Vec<PixelRow> = (0..sampled)
             .into_par_iter()
             .map(|y| {
                 let mut row = PixelRow::default();
@@ -458,7 +462,10 @@ impl Pixels {
                 row
             })
             .collect();
-        let mirrored = (0..n / 2).into_par_iter().map(|y| rows[y].mirrored_by(&rows[n - 1 - y])).collect();
+        if mirrored {
+            let bottom: Vec<PixelRow> = rows.par_iter().rev().map(PixelRow::mirrored).collect();
+            rows.extend(bottom);
+        }
         Pixels { len: n * n, rows, mirrored }
     }
 
@@ -504,20 +511,18 @@ impl PixelRow {
         }
     }
 
-    /// Whether `other` holds, pixel for pixel and bit for bit, the mirror images `(x, -y, z)`
-    /// of this row's directions with the same weights: rows `y` and `size - 1 - y` of a lobe
-    /// map (whose `b` coordinates are each other's negatives, exactly, for a power-of-two size).
-    fn mirrored_by(&self, other: &PixelRow) -> bool {
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
-        let mirror = |a: &Directions, b: &Directions| {
-            let negated: Vec<f64> = a.y.iter().map(|y| -y).collect();
-            bits(&a.x) == bits(&b.x) && bits(&negated) == bits(&b.y) && bits(&a.z) == bits(&b.z)
-        };
-        self.runs == other.runs
-            && self.continued == other.continued
-            && bits(&self.weights) == bits(&other.weights)
-            && mirror(&self.direct, &other.direct)
-            && mirror(&self.terms, &other.terms)
+    /// The row of the mirror images `(x, -y, z)` of this row's directions, with the same
+    /// weights.
+    fn mirrored(&self) -> PixelRow {
+        let mirror =
+            |d: &Directions| Directions { x: d.x.clone(), y: d.y.iter().map(|y| -y).collect(), z: d.z.clone() };
+        PixelRow {
+            runs: self.runs.clone(),
+            direct: mirror(&self.direct),
+            continued: self.continued.clone(),
+            terms: mirror(&self.terms),
+            weights: self.weights.clone(),
+        }
     }
 }
 
@@ -539,7 +544,7 @@ pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &m
         // None: rendered with the row it mirrors.
         let Some(out_row) = out_rows[y].take() else { continue };
         let m = n - 1 - y;
-        let mirror = (wi.y == 0.0 && y < m && pixels.mirrored[y])
+        let mirror = (wi.y == 0.0 && y < m && pixels.mirrored)
             .then(|| (&pixels.rows[m], out_rows[m].take().expect("a row below is not rendered yet")));
         render_row(table, wi, row, out_row, mirror, block, values);
     }
@@ -858,8 +863,7 @@ mod tests {
         let tables = [table, holes].map(|table| LuminanceTable::new(&table));
         for (size, more_than_a_buffer) in [(64, false), (1024, true)] {
             let pixels = Pixels::new(LobeMap::new(size));
-            // Each row of the top half has its mirror image below: render looks them up together.
-            assert!(pixels.mirrored.len() == size / 2 && pixels.mirrored.iter().all(|&m| m), "{size}");
+            assert!(pixels.mirrored, "{size}: render looks the mirrored rows up together");
             let most_terms = pixels.rows.iter().map(|row| row.weights.len()).max().unwrap();
             assert_eq!(most_terms > 1024, more_than_a_buffer, "{most_terms} terms in a row at {size}");
             for luminance in &tables {

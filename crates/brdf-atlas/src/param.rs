@@ -79,6 +79,11 @@ pub fn to_incidence_frame(w: DVec3, phi_i: f64) -> DVec3 {
 /// ([`Sample::Continued`]): with its value, slope and curvature at the horizon, so that the
 /// wavelets see no edge there, blending into the odd reflection `2 f(0) - f(-t)` deeper down
 /// (crate docs, "Lobe images").
+///
+/// Rows `y` and `size - 1 - y` are mirror images across the plane of incidence: at a
+/// power-of-two size their `b` are each other's negatives exactly, so their samples are mirror
+/// images `(x, -y, z)` of each other with the same weights, and their Jacobian factors are
+/// equal, bit for bit (the analysis computes the top half alone).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LobeMap {
     pub size: usize,
