@@ -59,7 +59,7 @@ impl TileReduction {
     pub fn new(size: usize, tile: usize) -> Self {
         assert!(tile > 0 && size.is_multiple_of(tile), "tile {tile} does not divide the analysis size {size}");
         let map = LobeMap::new(size);
-        let inside: Vec<bool> = (0..size * size).map(|k| map.inside(k % size, k / size)).collect();
+        let inside = mirrored_rows(size, |x, y| map.inside(x, y));
         let m = size / tile;
         let covers = |t: usize| {
             let (tx, ty) = (t % tile, t / tile);
@@ -90,32 +90,40 @@ impl TileReduction {
     /// (`tile^2` texels). Returns the number of texels that cover a pixel of the hemisphere at
     /// the grid's limit (`level == 1`).
     pub fn reduce(&self, cycles_per_radian: &[f64], level: &[u8], out: &mut [f32]) -> usize {
+        let n = self.size;
+        let rows = |y: usize, row: &mut [f64]| row.copy_from_slice(&cycles_per_radian[y * n..(y + 1) * n]);
+        self.reduce_rows(level, rows, out).0
+    }
+
+    /// [`Self::reduce`] of the bandwidths `row(y, values)` writes for each row `y`; returns the
+    /// texels and the pixels of the hemisphere at the grid's limit.
+    fn reduce_rows(&self, level: &[u8], mut row: impl FnMut(usize, &mut [f64]), out: &mut [f32]) -> (usize, usize) {
         let (n, t) = (self.size, self.tile);
         let m = n / t;
-        let mut nyquist_texels = 0;
-        // Row by row through each band of `m` rows, `m` pixels per texel: the values are
-        // finite and >= 0, so the largest of those on the hemisphere is the largest of the
-        // values with the others read as 0, which vectorizes.
-        let (mut best, mut nyquist) = (vec![0.0f64; t], vec![false; t]);
+        let (mut nyquist_texels, mut nyquist_pixels) = (0, 0);
+        // Per band of `m` rows, each column's largest value on the hemisphere and whether it
+        // has a pixel at the limit, row after row (the values are finite and >= 0, so the
+        // largest of those on the hemisphere is the largest of the values with the others read
+        // as 0: the loop vectorizes), then each texel's `m` columns.
+        let (mut best, mut nyquist, mut values) = (vec![0.0f64; n], vec![false; n], vec![0.0f64; n]);
+        let larger = |a: f64, b: f64| if b > a { b } else { a };
         for ty in 0..t {
             best.fill(0.0);
             nyquist.fill(false);
             for y in ty * m..(ty + 1) * m {
-                let row = y * n..(y + 1) * n;
-                let pixels = cycles_per_radian[row.clone()].chunks_exact(m).zip(level[row.clone()].chunks_exact(m));
-                for (((b, q), (v, l)), inside) in
-                    best.iter_mut().zip(&mut nyquist).zip(pixels).zip(self.inside[row].chunks_exact(m))
-                {
-                    for ((&v, &l), &inside) in v.iter().zip(l).zip(inside) {
-                        let v = if inside { v } else { 0.0 };
-                        *b = if v > *b { v } else { *b };
-                        *q |= inside & (l == 1);
-                    }
+                row(y, &mut values);
+                let range = y * n..(y + 1) * n;
+                let pixels = values.iter().zip(&level[range.clone()]).zip(&self.inside[range]);
+                for ((b, q), ((&v, &l), &inside)) in best.iter_mut().zip(&mut nyquist).zip(pixels) {
+                    *b = larger(*b, if inside { v } else { 0.0 });
+                    let limit = inside & (l == 1);
+                    *q |= limit;
+                    nyquist_pixels += usize::from(limit);
                 }
             }
-            for (tx, (&b, &q)) in best.iter().zip(&nyquist).enumerate() {
-                out[ty * t + tx] = b as f32;
-                nyquist_texels += usize::from(q);
+            for (tx, (b, q)) in best.chunks_exact(m).zip(nyquist.chunks_exact(m)).enumerate() {
+                out[ty * t + tx] = b.iter().fold(0.0, |a, &v| larger(a, v)) as f32;
+                nyquist_texels += usize::from(q.contains(&true));
             }
         }
         for (k, &s) in self.source.iter().enumerate() {
@@ -123,29 +131,20 @@ impl TileReduction {
                 out[k] = out[s as usize];
             }
         }
-        nyquist_texels
+        (nyquist_texels, nyquist_pixels)
     }
 }
 
-/// Reusable buffers for one thread: a lobe image, its periodic continuation, hole filling, the
-/// per-pixel results.
+/// Reusable buffers for one thread: a lobe image, its periodic continuation's rows that hold
+/// the image, hole filling, the estimated levels.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     pub image: Vec<f64>,
-    /// The mirror tiling of the band energies, then the periodic continuation, then (its first
-    /// `n^2` values, [`Scratch::cycles_per_radian`]) the analysis's bandwidths: one buffer.
     pub extended: Vec<f64>,
     holes: Vec<(usize, f64)>,
     /// The estimator's buffers (and the transform's, which the band energies borrow).
     pub estimator: bandwidth::Workspace,
     pub level: Vec<u8>,
-}
-
-impl Scratch {
-    /// The bandwidth of each pixel of the last analysed lobe image, cycles per radian, row-major.
-    pub fn cycles_per_radian(&self) -> &[f64] {
-        &self.extended[..self.level.len()]
-    }
 }
 
 /// Everything about the analysis grid that does not depend on the lobe: what its pixels hold,
@@ -156,7 +155,6 @@ pub struct Analyser {
     map: LobeMap,
     pixels: Pixels,
     pixels_per_radian: Vec<f64>,
-    inside: Vec<bool>,
     reduction: TileReduction,
     /// The periodic continuation's steps ([`extend_periodic`]).
     plan: Continuation,
@@ -169,10 +167,9 @@ impl Analyser {
         let n = config.analysis_size;
         let map = LobeMap::new(n);
         let pixels_per_radian = mirrored_rows(n, |x, y| map.pixels_per_radian(x, y));
-        let inside = mirrored_rows(n, |x, y| map.inside(x, y));
         let reduction = TileReduction::new(n, config.tile);
         let plan = Continuation::new(n);
-        Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, inside, reduction, plan }
+        Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, reduction, plan }
     }
 
     pub fn map(&self) -> LobeMap {
@@ -220,8 +217,32 @@ impl Analyser {
     }
 
     fn finish(&self, scratch: Scratch) -> LobeBandwidth {
-        let cycles_per_radian = scratch.cycles_per_radian().to_vec();
-        LobeBandwidth { size: self.map.size, image: scratch.image, cycles_per_radian, level: scratch.level }
+        let n = self.map.size;
+        let mut cycles_per_radian = vec![0.0; n * n];
+        for (y, row) in cycles_per_radian.chunks_exact_mut(n).enumerate() {
+            self.cycles_per_radian_row(&scratch.level, y, row);
+        }
+        LobeBandwidth { size: n, image: scratch.image, cycles_per_radian, level: scratch.level }
+    }
+
+    /// Row `y` of the bandwidths of `level` (the estimated levels per pixel), cycles per radian:
+    /// the frequency each level reads, through the lobe map's Jacobian.
+    fn cycles_per_radian_row(&self, level: &[u8], y: usize, row: &mut [f64]) {
+        let n = self.map.size;
+        let frequency_of = |j: u8| bandwidth::level_frequency(self.config.c, j);
+        let frequency_of: [f64; 16] = std::array::from_fn(|j| frequency_of(j as u8));
+        let pixels = level[y * n..(y + 1) * n].iter().zip(&self.pixels_per_radian[y * n..(y + 1) * n]);
+        for (out, (&j, &s)) in row.iter_mut().zip(pixels) {
+            *out = frequency_of[usize::from(j)] * s;
+        }
+    }
+
+    /// The tile of `scratch`'s analysed lobe into `out` ([`TileReduction::reduce`]), the
+    /// bandwidths made row by row as it reads them; returns the texels and the pixels of the
+    /// hemisphere at the grid's limit.
+    pub(crate) fn reduce(&self, scratch: &Scratch, out: &mut [f32]) -> (usize, usize) {
+        let row = |y: usize, row: &mut [f64]| self.cycles_per_radian_row(&scratch.level, y, row);
+        self.reduction.reduce_rows(&scratch.level, row, out)
     }
 
     /// The lobe image of any BRDF slice `f(wo)` on this analyser's grid, holes filled: what
@@ -241,8 +262,8 @@ impl Analyser {
         fill_holes(self.map.size, &mut scratch.image, &mut scratch.holes)
     }
 
-    /// Analyses `scratch.image` into [`Scratch::cycles_per_radian`] and `scratch.level`: the
-    /// periodic continuation
+    /// Analyses `scratch.image` into `scratch.level` (the estimated level per pixel, which
+    /// [`Self::reduce`] converts): the periodic continuation
     /// ([`extend_periodic`]), the estimate with [`analysis_levels`] levels and the noise floor
     /// scaled to the lobe's peak, the estimate of the image's own pixels converted to cycles per
     /// radian. Returns the peak ([`peak`]), which the band energy's noise floor scales with too.
@@ -266,20 +287,9 @@ impl Analyser {
         // Only the image's own pixels are kept: the estimate of the top-left quarter alone.
         let levels = estimator.levels_top_left(&extended, &config, n, n).expect("the configuration was checked");
 
-        // The continuation is no longer needed: its buffer takes the bandwidths.
         level.clear();
         level.extend_from_slice(levels);
-        let frequency_of: Vec<f64> =
-            (0..=analysis_levels(n) as u8).map(|j| bandwidth::level_frequency(self.config.c, j)).collect();
-        for ((out, &j), s) in ext[..n * n].iter_mut().zip(level.iter()).zip(&self.pixels_per_radian) {
-            *out = frequency_of[j as usize] * s;
-        }
         peak
-    }
-
-    /// Pixels of the hemisphere at the grid's limit in `scratch.level`.
-    pub(crate) fn nyquist_pixels(&self, scratch: &Scratch) -> usize {
-        scratch.level.iter().zip(&self.inside).filter(|&(&l, &inside)| l == 1 && inside).count()
     }
 }
 
@@ -573,7 +583,7 @@ mod tests {
             for (y, x) in (0..size).flat_map(|y| (0..size).map(move |x| (y, x))) {
                 let factor = analyser.pixels_per_radian(x, y);
                 assert_eq!(factor.to_bits(), map.pixels_per_radian(x, y).to_bits(), "{size}: {x} {y}");
-                assert_eq!(analyser.inside[y * size + x], map.inside(x, y), "{size}: {x} {y}");
+                assert_eq!(analyser.reduction.inside[y * size + x], map.inside(x, y), "{size}: {x} {y}");
             }
         }
     }

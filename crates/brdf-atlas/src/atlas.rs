@@ -376,11 +376,10 @@ pub fn build_atlas_with(
                 config.relative_noise_floor * peak,
                 scratch.estimator.transform(),
             );
-            let nyquist_texels = analyser.reduction().reduce(scratch.cycles_per_radian(), &scratch.level, tile);
+            let (nyquist_texels, nyquist_pixels) = analyser.reduce(scratch, tile);
             progress(config.lobes);
-            let nyquist_pixels = analyser.nyquist_pixels(scratch) as u32;
             scratches.lock().expect("no panic while held").push(set);
-            (nyquist_pixels, nyquist_texels, filled, band_energy)
+            (nyquist_pixels as u32, nyquist_texels, filled, band_energy)
         })
         .collect();
 
