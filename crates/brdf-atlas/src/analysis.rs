@@ -259,7 +259,8 @@ impl Analyser {
     pub(crate) fn render(&self, table: &LuminanceTable, theta_i: f64, scratch: &mut Scratch) -> usize {
         scratch.image.resize(self.pixels.len(), 0.0);
         render(table, merl::spherical_dir(theta_i, 0.0), &self.pixels, &mut scratch.image);
-        fill_holes(self.map.size, &mut scratch.image, &mut scratch.holes)
+        // Every lookup of a table without holes has a value: no pixel to look for.
+        if table.is_complete() { 0 } else { fill_holes(self.map.size, &mut scratch.image, &mut scratch.holes) }
     }
 
     /// Analyses `scratch.image` into `scratch.level` (the estimated level per pixel, which

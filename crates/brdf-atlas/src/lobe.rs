@@ -58,6 +58,11 @@ impl LuminanceTable {
         self.dims
     }
 
+    /// Whether every cell holds a value: then every lookup has one.
+    pub(crate) fn is_complete(&self) -> bool {
+        self.complete
+    }
+
     /// The luminance of the BRDF for a pair of unit directions, trilinear between cells as in
     /// [`merl::MerlTable::lookup`] with [`merl::Interp::Trilinear`], the cells without data
     /// continued (module docs); `None` where all eight corners are in columns without data.
