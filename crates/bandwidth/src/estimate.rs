@@ -366,11 +366,13 @@ impl pulp::WithSimd for Eq7Row<'_> {
         let (lambdas, rest) = scratch.split_at_mut(levels * out_w);
         let (max, sum) = rest.split_at_mut(out_w);
         let lambdas_of = lambdas.chunks_exact_mut(out_w).zip(prepared).zip(covered.iter_mut());
-        for (j, ((lambda, prepared), covered)) in lambdas_of.enumerate() {
+        let mut changed = false;
+        for ((lambda, prepared), covered) in lambdas_of {
             // lambda_j of this row: the maximum over the covering coefficient rows.
             let cover_y = prepared.cover_y.as_ref().expect("prepared above");
             let (first, count) = (cover_y.first[y], cover_y.count[y]);
             if *covered != Some((first, count)) {
+                changed = true;
                 let row = |ky: usize| &prepared.rows[prepared.slot[ky] as usize * out_w..][..out_w];
                 lambda.fill(0.0);
                 let mut ky = first as usize;
@@ -382,10 +384,12 @@ impl pulp::WithSimd for Eq7Row<'_> {
                 }
                 *covered = Some((first, count));
             }
-            if j == 0 {
-                max.copy_from_slice(lambda);
-            } else {
-                for (m, l) in max.iter_mut().zip(lambda.iter()) {
+        }
+        // Their maximum, kept while no lambda changes (level 1's changes every second row).
+        if changed {
+            max.copy_from_slice(&lambdas[..out_w]);
+            for lambda in lambdas.chunks_exact(out_w).skip(1) {
+                for (m, l) in max.iter_mut().zip(lambda) {
                     *m = larger(*m, *l);
                 }
             }
