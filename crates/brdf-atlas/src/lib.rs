@@ -179,27 +179,31 @@
 //!
 //! One analysis per row: 64 lobe images of `n^2` pixels (one trilinear lookup each on the
 //! hemisphere, two to four below the horizon) and 64 estimates of the `2n x 2n` continuation,
-//! in parallel over rows. The lobe map's samples are computed once, in parallel, and kept
-//! compactly; a row in progress holds one set of buffers (the lobe image, the continuation's
-//! rows that hold the image, the transform's and the estimator's workspaces,
-//! [`bandwidth::Workspace`]), taken from and given back to a pool, so that no row faults in fresh
-//! memory. The continuation's rows below the image are made as the transform reads them
-//! ([`dwt::Rows`]), as are the band energies' mirror tiling's, never stored; and only the
-//! continuation's top-left `n x n` pixels, the image's own, are estimated
-//! ([`bandwidth::Workspace::levels_top_left`], whose transform computes the details of the
-//! coefficient rows it reads alone). Every step computes what the straightforward version
-//! computes, bit for bit, except the band energies' order of summation and the lookups' angles
-//! ("Angles": the tests compare them; `cargo bench -p bake --bench stages` times the atlas, row
-//! `bandwidth atlas`).
+//! in parallel over rows. The lobe map's samples are computed once, in parallel, for its top
+//! half alone: row `n - 1 - y` holds the mirror images of row `y`'s directions
+//! ([`LobeMap`]). A lobe image's two mirrored rows are looked up together: for `wi` in the
+//! plane of incidence, a direction and its mirror image have the same `theta_h` and `theta_d`
+//! and opposite `phi_d`, exactly, so the second row's angles cost a negation. A row in progress
+//! holds one set of buffers (the lobe image, the continuation's rows that hold the image, the
+//! transform's and the estimator's workspaces, [`bandwidth::Workspace`]), taken from and given
+//! back to a pool, so that no row faults in fresh memory. The continuation's rows below the
+//! image are made as the transform reads them ([`dwt::Rows`]), each once, as are the band
+//! energies' mirror tiling's, never stored; and only the continuation's top-left `n x n`
+//! pixels, the image's own, are estimated ([`bandwidth::Workspace::levels_top_left`], whose
+//! transform computes the details of the coefficient rows it reads alone). Every step computes
+//! what the straightforward version computes, bit for bit, except the band energies' order of
+//! summation and the lookups' angles ("Angles": the tests compare them; `cargo bench -p bake
+//! --bench stages` times the atlas, row `bandwidth atlas`).
 //!
 //! The band energies' details are summed as they are made, never stored. The loops (the
-//! lookups, the transform's rows, eq. 7, the band energies' sums) are compiled for the best
-//! instruction set the processor has, AVX-512 or AVX2 where present, chosen at run time
-//! (`pulp`); the compiler never fuses a multiply and an add unasked, so every processor computes
-//! the same bits. At the default size the lookups take about two fifths of the CPU time (`perf
-//! record target/release/brdf-bandwidth gold-paint.binary --out-dir DIR`, gold-paint), the two
-//! D4 transforms per row (the continuation's and the band energies' mirror tiling) about a
-//! third, the estimator's per-pixel levels about a tenth.
+//! lookups, with their reads of the table's cells as gathers, the transform's rows, eq. 7, the
+//! band energies' sums) are compiled for the best instruction set the processor has, AVX-512 or
+//! AVX2 where present, chosen at run time (`pulp`); the compiler never fuses a multiply and an
+//! add unasked, so every processor computes the same bits. At the default size, of about 2.3 s
+//! of CPU time on gold-paint, the lookups take two fifths, the two D4 transforms per row (the
+//! continuation's and the band energies' mirror tiling, with their rows made on demand) a
+//! little less, eq. 7 with its per-level maxima about a tenth (`perf record
+//! target/release/brdf-bandwidth target/merl/gold-paint.binary --out-dir DIR`).
 //!
 //! # Angles
 //!
