@@ -22,7 +22,8 @@ use clap::Parser;
 /// for renderers, one float channel Y) and bandwidth-atlas.png (false colour, log scale).
 /// Parameterizations and layout: data-schema/brdf-atlas.md.
 ///
-/// Exit status: 0 ok, 2 error.
+/// Exit status: 0 ok, 1 most lobes reach the analysis grid's limit (a validation problem: the
+/// files are written, and the problem says which analysis size resolves more), 2 error.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
