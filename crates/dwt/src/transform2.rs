@@ -639,8 +639,13 @@ mod tests {
         }
     }
 
-    /// An image given row by row, made in the buffer (not the stored rows).
-    struct Copied<'a>(&'a Image);
+    /// An image given row by row, made in the buffer (not the stored rows), counting the rows
+    /// it makes.
+    struct Copied<'a>(&'a Image, std::sync::atomic::AtomicUsize);
+
+    fn copied(image: &Image) -> Copied<'_> {
+        Copied(image, std::sync::atomic::AtomicUsize::new(0))
+    }
 
     impl Rows for Copied<'_> {
         fn width(&self) -> usize {
@@ -653,26 +658,8 @@ mod tests {
             None
         }
         fn make_row(&self, r: usize, buffer: &mut [f64]) {
-            buffer.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
-        }
-    }
-
-    /// [`Copied`], counting the rows it makes.
-    struct Counted<'a>(Copied<'a>, std::sync::atomic::AtomicUsize);
-
-    impl Rows for Counted<'_> {
-        fn width(&self) -> usize {
-            self.0.width()
-        }
-        fn height(&self) -> usize {
-            self.0.height()
-        }
-        fn stored_row(&self, _: usize) -> Option<&[f64]> {
-            None
-        }
-        fn make_row(&self, r: usize, buffer: &mut [f64]) {
             self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            self.0.make_row(r, buffer);
+            buffer.copy_from_slice(&self.0.data()[r * self.0.width()..][..self.0.width()]);
         }
     }
 
@@ -686,7 +673,7 @@ mod tests {
                 let image = Image::new(w, h, data).unwrap();
                 let stored = wavedec2(&image, wavelet, levels).unwrap();
                 let mut workspace = Workspace2::default();
-                let made = workspace.wavedec2_where(&Copied(&image), wavelet, levels, &|_, _| true).unwrap();
+                let made = workspace.wavedec2_where(&copied(&image), wavelet, levels, &|_, _| true).unwrap();
                 let bits = |d: &Decomposition2| {
                     let images = std::iter::once(&d.approx).chain(d.details.iter().flatten());
                     images.flat_map(|i| i.data().iter().map(|v| v.to_bits())).collect::<Vec<u64>>()
@@ -698,7 +685,7 @@ mod tests {
         // (a few jobs, each starting with empty slots) a row is made about once, not twice.
         let (w, h) = (256, 256);
         let image = Image::new(w, h, (0..w * h).map(|k| k as f64).collect()).unwrap();
-        let counted = Counted(Copied(&image), std::sync::atomic::AtomicUsize::new(0));
+        let counted = copied(&image);
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         one.install(|| Workspace2::default().wavedec2_where(&counted, Wavelet::D4, 1, &|_, _| true).map(|_| ()))
             .unwrap();
@@ -718,7 +705,7 @@ mod tests {
         let floor = |level: usize| 0.05 * (1u64 << level) as f64;
         for wavelet in [Wavelet::Haar, Wavelet::D4] {
             let stored = wavedec2(&image, wavelet, levels).unwrap();
-            let streamed = Workspace2::default().detail_energy(&Copied(&image), wavelet, levels, &floor).unwrap();
+            let streamed = Workspace2::default().detail_energy(&copied(&image), wavelet, levels, &floor).unwrap();
             for (j, (level, &got)) in stored.details.iter().zip(&streamed).enumerate() {
                 let squares: Vec<f64> =
                     level.iter().flat_map(Image::data).filter(|c| c.abs() >= floor(j + 1)).map(|c| c * c).collect();
@@ -728,13 +715,13 @@ mod tests {
                 assert!((got - expect).abs() <= bound, "{wavelet:?} level {}: {got} against {expect}", j + 1);
             }
             let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-            let alone = one.install(|| Workspace2::default().detail_energy(&Copied(&image), wavelet, levels, &floor));
+            let alone = one.install(|| Workspace2::default().detail_energy(&copied(&image), wavelet, levels, &floor));
             assert_eq!(alone.unwrap(), streamed, "{wavelet:?} on one thread");
         }
         // A non-finite value is named by its index, as the stored transform names it.
         let mut bad = image.clone();
         bad.data_mut()[5 * w + 7] = f64::NAN;
-        let err = Workspace2::default().detail_energy(&Copied(&bad), Wavelet::D4, levels, &floor).unwrap_err();
+        let err = Workspace2::default().detail_energy(&copied(&bad), Wavelet::D4, levels, &floor).unwrap_err();
         assert_eq!(err, wavedec2(&bad, Wavelet::D4, levels).unwrap_err());
         assert_eq!(err, Error::NonFinite { what: "image".into(), index: 5 * w + 7 });
     }
