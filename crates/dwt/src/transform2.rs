@@ -435,9 +435,10 @@ impl<const F: usize> MadeRows<F> {
     /// row is made only when no slot holds it).
     fn rows<'a>(&'a mut self, rows: &'a dyn Rows, indices: [usize; F]) -> [&'a [f64]; F] {
         let w = self.buffer.len() / F;
+        let stored = indices.map(|r| rows.stored_row(r));
         let mut slot_of = [0; F];
-        for (slot_of, &r) in slot_of.iter_mut().zip(&indices) {
-            if rows.stored_row(r).is_some() {
+        for ((slot_of, &r), stored) in slot_of.iter_mut().zip(&indices).zip(&stored) {
+            if stored.is_some() {
                 continue;
             }
             *slot_of = match self.held.iter().position(|&held| held == r) {
@@ -451,7 +452,7 @@ impl<const F: usize> MadeRows<F> {
             };
         }
         let buffer = &self.buffer;
-        std::array::from_fn(|j| rows.stored_row(indices[j]).unwrap_or(&buffer[slot_of[j] * w..(slot_of[j] + 1) * w]))
+        std::array::from_fn(|j| stored[j].unwrap_or(&buffer[slot_of[j] * w..(slot_of[j] + 1) * w]))
     }
 }
 
