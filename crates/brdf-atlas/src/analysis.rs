@@ -59,7 +59,7 @@ impl TileReduction {
     pub fn new(size: usize, tile: usize) -> Self {
         assert!(tile > 0 && size.is_multiple_of(tile), "tile {tile} does not divide the analysis size {size}");
         let map = LobeMap::new(size);
-        let inside = mirrored_rows(size, |x, y| map.inside(x, y));
+        let inside = mirrored_rows(map, |x, y| map.inside(x, y));
         let m = size / tile;
         let covers = |t: usize| {
             let (tx, ty) = (t % tile, t / tile);
@@ -166,7 +166,7 @@ impl Analyser {
     pub fn new(config: &Config) -> Self {
         let n = config.analysis_size;
         let map = LobeMap::new(n);
-        let pixels_per_radian = mirrored_rows(n, |x, y| map.pixels_per_radian(x, y));
+        let pixels_per_radian = mirrored_rows(map, |x, y| map.pixels_per_radian(x, y));
         let reduction = TileReduction::new(n, config.tile);
         let plan = Continuation::new(n);
         Self { config: *config, map, pixels: Pixels::new(map), pixels_per_radian, reduction, plan }
@@ -218,19 +218,25 @@ impl Analyser {
 
     fn finish(&self, scratch: Scratch) -> LobeBandwidth {
         let n = self.map.size;
+        let frequency_of = self.level_frequencies();
         let mut cycles_per_radian = vec![0.0; n * n];
         for (y, row) in cycles_per_radian.chunks_exact_mut(n).enumerate() {
-            self.cycles_per_radian_row(&scratch.level, y, row);
+            self.cycles_per_radian_row(&frequency_of, &scratch.level, y, row);
         }
         LobeBandwidth { size: n, image: scratch.image, cycles_per_radian, level: scratch.level }
     }
 
+    /// The frequency each level `j` reads (index `j`, 0: no significant level), cycles per
+    /// pixel.
+    fn level_frequencies(&self) -> Vec<f64> {
+        (0..=analysis_levels(self.map.size) as u8).map(|j| bandwidth::level_frequency(self.config.c, j)).collect()
+    }
+
     /// Row `y` of the bandwidths of `level` (the estimated levels per pixel), cycles per radian:
-    /// the frequency each level reads, through the lobe map's Jacobian.
-    fn cycles_per_radian_row(&self, level: &[u8], y: usize, row: &mut [f64]) {
+    /// the frequency each level reads ([`Self::level_frequencies`]), through the lobe map's
+    /// Jacobian.
+    fn cycles_per_radian_row(&self, frequency_of: &[f64], level: &[u8], y: usize, row: &mut [f64]) {
         let n = self.map.size;
-        let frequency_of = |j: u8| bandwidth::level_frequency(self.config.c, j);
-        let frequency_of: [f64; 16] = std::array::from_fn(|j| frequency_of(j as u8));
         let pixels = level[y * n..(y + 1) * n].iter().zip(&self.pixels_per_radian[y * n..(y + 1) * n]);
         for (out, (&j, &s)) in row.iter_mut().zip(pixels) {
             *out = frequency_of[usize::from(j)] * s;
@@ -241,7 +247,8 @@ impl Analyser {
     /// bandwidths made row by row as it reads them; returns the texels and the pixels of the
     /// hemisphere at the grid's limit.
     pub(crate) fn reduce(&self, scratch: &Scratch, out: &mut [f32]) -> (usize, usize) {
-        let row = |y: usize, row: &mut [f64]| self.cycles_per_radian_row(&scratch.level, y, row);
+        let frequency_of = self.level_frequencies();
+        let row = |y: usize, row: &mut [f64]| self.cycles_per_radian_row(&frequency_of, &scratch.level, y, row);
         self.reduction.reduce_rows(&scratch.level, row, out)
     }
 
@@ -294,12 +301,15 @@ impl Analyser {
     }
 }
 
-/// `f(x, y)` at every pixel of an `n x n` grid (`n` even) that is symmetric across its middle
-/// row, row-major: the top half computed in parallel, each row of the bottom half a copy of its
-/// mirror row ([`LobeMap`]'s rows).
-fn mirrored_rows<T: Copy + Default + Send + Sync>(n: usize, f: impl Fn(usize, usize) -> T + Sync) -> Vec<T> {
+/// `f(x, y)` at every pixel of `map`, row-major, for an `f` of the distance from the centre (the
+/// same on mirrored rows): computed in parallel over rows, and where the map's rows are mirror
+/// images of each other ([`LobeMap::rows_mirrored`]) for the top half alone, each row of the
+/// bottom half a copy of its mirror row.
+fn mirrored_rows<T: Copy + Default + Send + Sync>(map: LobeMap, f: impl Fn(usize, usize) -> T + Sync) -> Vec<T> {
+    let n = map.size;
     let mut values = vec![T::default(); n * n];
-    let (top, bottom) = values.split_at_mut(n * n / 2);
+    let computed = if map.rows_mirrored() { n / 2 } else { n };
+    let (top, bottom) = values.split_at_mut(computed * n);
     top.par_chunks_exact_mut(n).enumerate().for_each(|(y, row)| {
         for (x, v) in row.iter_mut().enumerate() {
             *v = f(x, y);
@@ -564,6 +574,18 @@ mod tests {
         }
         let ext = extend_periodic(&image, 16);
         assert!((0..16).all(|y| (0..16).all(|x| ext.get(x, y) == image[y * 16 + x])));
+    }
+
+    #[test]
+    fn the_reductions_hemisphere_is_the_maps_at_any_size() {
+        // Mirrored from the top half at a power-of-two size, computed row by row at the others
+        // (odd ones included, which have a middle row).
+        for (size, tile) in [(16, 4), (24, 8), (15, 5), (1, 1)] {
+            let (map, reduction) = (LobeMap::new(size), TileReduction::new(size, tile));
+            for (y, x) in (0..size).flat_map(|y| (0..size).map(move |x| (y, x))) {
+                assert_eq!(reduction.inside[y * size + x], map.inside(x, y), "{size}: {x} {y}");
+            }
+        }
     }
 
     #[test]

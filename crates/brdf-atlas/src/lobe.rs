@@ -455,7 +455,7 @@ impl Pixels {
     pub(crate) fn new(map: LobeMap) -> Self {
         use rayon::prelude::*;
         let n = map.size;
-        let mirrored = n.is_power_of_two() && n >= 2;
+        let mirrored = map.rows_mirrored();
         let sampled = if mirrored { n / 2 } else { n };
         let mut rows: Vec<PixelRow> = (0..sampled)
             .into_par_iter()
@@ -556,7 +556,7 @@ pub(crate) fn render(table: &LuminanceTable, wi: DVec3, pixels: &Pixels, out: &m
 }
 
 /// One row of [`render`] into `out` (the row's `size` values), and with `mirror`, the mirror
-/// images' row (which [`PixelRow::mirrored_by`] this one) into its values.
+/// images' row ([`PixelRow::mirrored`] of this one) into its values.
 fn render_row(
     table: &LuminanceTable,
     wi: DVec3,

@@ -147,6 +147,12 @@ impl LobeMap {
         Self { size }
     }
 
+    /// Whether rows `y` and `size - 1 - y` are mirror images of each other bit for bit (see the
+    /// type's docs): at a power-of-two size of at least 2.
+    pub fn rows_mirrored(&self) -> bool {
+        self.size.is_power_of_two() && self.size >= 2
+    }
+
     /// The square coordinates `(a, b)` of the centre of pixel `(x, y)`.
     fn square(&self, x: usize, y: usize) -> (f64, f64) {
         let n = self.size as f64;
