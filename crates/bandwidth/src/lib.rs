@@ -183,7 +183,7 @@
 //! `x` run on those rows, one row at a time (parallel over levels); the sliding maximum along `y`
 //! and eq. 7 run per output row, in bands of 16 rows (parallel over bands), a level's maximum
 //! kept while the coefficient rows covering the output row stay the same, in one scratch buffer
-//! of `(J + 2) x width` values per band; eq. 7 adds the levels of a whole row at once, each
+//! of `(J + 2) x width` values per rayon job; eq. 7 adds the levels of a whole row at once, each
 //! pixel's sum in its own order. The loops are compiled for AVX-512 or AVX2 where the processor
 //! has them (the same bits). Nothing is allocated per pixel. [`Workspace`] keeps every buffer
 //! between estimates of images of one size, and [`Workspace::levels_top_left`] estimates only a

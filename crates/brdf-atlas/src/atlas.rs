@@ -322,29 +322,22 @@ pub struct AtlasBuild {
 ///
 /// A MERL table is isotropic (it has no `phi_h` axis), so in the frame of its plane of
 /// incidence the lobe of `wi` depends on `theta_i` alone: every lobe of a row of the incident
-/// grid is the same image. Each row is analysed once, in parallel over rows with one set of
-/// buffers per thread, and its tile is written into every column of the row.
+/// grid is the same image. Each row is analysed once, in parallel over rows, each row in
+/// progress with a set of buffers from a pool, and its tile is written into every column of the
+/// row.
 pub fn build_atlas(
     table: &merl::MerlTable,
     config: &Config,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<AtlasBuild, Error> {
-    build_atlas_of(&LuminanceTable::new(table), config, progress)
-}
-
-/// [`build_atlas`] of the table's luminance, which is all the atlas reads: a caller that needs
-/// the table for nothing else can drop it first (35 MB at MERL's size).
-pub fn build_atlas_of(
-    luminance: &LuminanceTable,
-    config: &Config,
-    progress: &(dyn Fn(usize) + Sync),
-) -> Result<AtlasBuild, Error> {
     config.check()?;
-    Ok(build_atlas_with(&Analyser::new(config), luminance, progress))
+    Ok(build_atlas_with(&Analyser::new(config), &LuminanceTable::new(table), progress))
 }
 
-/// [`build_atlas_of`] with the analyser of its configuration ([`Analyser::config`]), which does
-/// not depend on the table: a caller can make it while the table is read.
+/// [`build_atlas`] of the table's luminance ([`LuminanceTable::new`]), which is all the atlas
+/// reads (a caller that needs the table for nothing else can drop it first, 35 MB at MERL's
+/// size), with the analyser of its configuration ([`Analyser::config`]), which does not depend
+/// on the table (a caller can make it while the table is read).
 pub fn build_atlas_with(
     analyser: &Analyser,
     luminance: &LuminanceTable,

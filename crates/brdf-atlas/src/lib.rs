@@ -247,9 +247,7 @@ pub mod pca;
 pub mod view;
 
 pub use analysis::{Analyser, LobeBandwidth, TileReduction, analysis_levels, extend_periodic, mirror_tiling};
-pub use atlas::{
-    Atlas, AtlasBuild, BuildStats, Config, MAX_TEXELS, Parameterization, build_atlas, build_atlas_of, build_atlas_with,
-};
+pub use atlas::{Atlas, AtlasBuild, BuildStats, Config, MAX_TEXELS, Parameterization, build_atlas, build_atlas_with};
 pub use error::Error;
 pub use lobe::{LuminanceTable, lobe_image, lobe_image_from_fn};
 pub use param::{IncidentGrid, LobeMap, Sample, to_incidence_frame};
