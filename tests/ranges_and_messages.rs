@@ -79,7 +79,14 @@ fn numeric_options_are_refused_outside_their_range() {
             command("merl-synth", &["phong", "-n", "1e308", "--out", out]),
             "--n must be a number in (0, 1e6], found 1e308",
         ),
-        (command("merl-synth", &["ggx", "--alpha", "1e308", "--out", out]), "--alpha must be a number in (0, 1e2]"),
+        (command("merl-synth", &["ggx", "--alpha", "1e308", "--out", out]), "--alpha must be a number in [1e-3, 1e2]"),
+        // A width far narrower than a cell made an infinite cell and panicked.
+        (
+            command("merl-synth", &["ggx", "--alpha", "1e-10", "--out", out]),
+            "--alpha must be a number in [1e-3, 1e2], found 1e-10",
+        ),
+        (command("merl-synth", &["ggx", "--alpha", "1e-320", "--out", out]), "found 1e-320"),
+        (command("merl-synth", &["ggx", "--alpha", "0", "--out", out]), "found 0.0"),
         (
             command("merl-synth", &["blinn-phong", "-n", "-1", "--out", out]),
             "--n must be a number in (0, 1e6], found -1",

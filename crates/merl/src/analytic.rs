@@ -30,6 +30,17 @@ pub enum Analytic {
 }
 
 impl Analytic {
+    /// The largest Phong and Blinn-Phong exponent: a lobe about 1e-3 radians wide, finer than
+    /// MERL's finest cells resolve.
+    pub const MAX_EXPONENT: f64 = 1e6;
+    /// The narrowest GGX width: a lobe about 1e-3 radians wide, the sharpest Phong exponent's.
+    /// Narrower is a mirror a table cannot hold: its one cell at `theta_h = 0` grows as
+    /// `1 / alpha^2` while every other goes to 0, and below about 1e-8 that cell is infinite
+    /// (`alpha^2 - 1` rounds to `-1` in `D`).
+    pub const MIN_ALPHA: f64 = 1e-3;
+    /// The largest GGX width: far past the roughest material (1 is already very rough).
+    pub const MAX_ALPHA: f64 = 100.0;
+
     /// The BRDF for directions above the horizon (`wi.z > 0`, `wo.z > 0`); zero otherwise.
     pub fn eval(&self, wi: DVec3, wo: DVec3) -> [f64; 3] {
         if wi.z <= 0.0 || wo.z <= 0.0 {
@@ -60,6 +71,10 @@ impl Analytic {
 
     /// A MERL table of this BRDF, sampled at the lower edge of every cell. Cells whose sample
     /// directions are within [`HORIZON_EPS`] of the horizon or below it hold no data.
+    ///
+    /// Every value is finite for exponents in `(0, MAX_EXPONENT]`, widths in
+    /// `[MIN_ALPHA, MAX_ALPHA]` and reflectances in `[0, 1]`; outside them the table may not be,
+    /// and this panics (the callers check their arguments against these ranges first).
     pub fn table(&self, dims: Dims) -> MerlTable {
         MerlTable::from_fn(dims, |hd| {
             let (wi, wo) = hd.to_dirs();
@@ -122,6 +137,29 @@ mod tests {
             Analytic::Phong { n: 1000.0, ks: [1.0; 3], kd: [0.0; 3] }.to_string(),
             "normalized phong n 1000, ks 1 1 1"
         );
+    }
+
+    /// The ranges `table` documents give finite tables at their ends (a width of 1e-10 was
+    /// accepted by `merl-synth` and panicked on an infinite cell).
+    #[test]
+    fn tables_at_the_ends_of_the_ranges_are_finite() {
+        let (one, zero) = ([1.0; 3], [0.0; 3]);
+        let ends = [
+            Analytic::Ggx { alpha: Analytic::MIN_ALPHA, f0: one },
+            Analytic::Ggx { alpha: Analytic::MIN_ALPHA, f0: zero },
+            Analytic::Ggx { alpha: Analytic::MAX_ALPHA, f0: one },
+            Analytic::Phong { n: Analytic::MAX_EXPONENT, ks: one, kd: one },
+            Analytic::Phong { n: f64::MIN_POSITIVE, ks: one, kd: zero },
+            Analytic::BlinnPhong { n: Analytic::MAX_EXPONENT, ks: one },
+            Analytic::BlinnPhong { n: f64::MIN_POSITIVE, ks: one },
+        ];
+        for brdf in ends {
+            let table = brdf.table(Dims::MERL);
+            assert!(table.raw().iter().all(|v| v.is_finite()), "{brdf}");
+        }
+        // What the lower bound excludes: a narrower lobe's cells at theta_h = 0 are infinite.
+        assert!(ggx_d(Analytic::MIN_ALPHA, 1.0).is_finite());
+        assert!(!ggx_d(1e-10, 1.0).is_finite());
     }
 
     #[test]

@@ -77,7 +77,7 @@ enum Brdf {
     /// GGX microfacets with height-correlated Smith masking and Schlick Fresnel.
     #[command(allow_negative_numbers = true)]
     Ggx {
-        /// Roughness alpha, the GGX width, in (0, 100].
+        /// Roughness alpha, the GGX width, in [1e-3, 100]: narrower is a mirror a table cannot hold.
         #[arg(long, value_name = "ALPHA")]
         alpha: f64,
         /// Reflectance at normal incidence: one value, or three (r,g,b), each in [0, 1].
@@ -98,8 +98,8 @@ fn rgb(name: &str, v: &[f64], max: f64) -> Result<[f64; 3]> {
     Ok(rgb)
 }
 
-/// `v` in `(0, max]`: an exponent or width beyond `max` gives a table of values that overflow (or
-/// a lobe far narrower than a MERL cell).
+/// `v` in `(0, max]`: an exponent beyond `max` gives a table of values that overflow (or a lobe far
+/// narrower than a MERL cell).
 fn positive(name: &str, v: f64, max: f64) -> Result<f64> {
     if !(v > 0.0 && v <= max) {
         bail!("--{name} must be a number in (0, {max:e}], found {v:?}");
@@ -107,11 +107,13 @@ fn positive(name: &str, v: f64, max: f64) -> Result<f64> {
     Ok(v)
 }
 
-/// The largest Phong and Blinn-Phong exponent: a lobe about 1e-3 radians wide, finer than MERL's
-/// finest cells resolve.
-const MAX_EXPONENT: f64 = 1e6;
-/// The largest GGX width: far past the roughest material (1 is already very rough).
-const MAX_ALPHA: f64 = 100.0;
+/// `v` in `[min, max]` (the GGX width: [`Analytic::MIN_ALPHA`] says why it has a lower bound).
+fn within(name: &str, v: f64, min: f64, max: f64) -> Result<f64> {
+    if !(v >= min && v <= max) {
+        bail!("--{name} must be a number in [{min:e}, {max:e}], found {v:?}");
+    }
+    Ok(v)
+}
 
 fn main() -> ExitCode {
     cli::main(|| run(cli::args()?))
@@ -131,15 +133,15 @@ fn run(args: Args) -> Result<ExitCode> {
             (Analytic::Lambertian { albedo }, "lambertian", json!({ "albedo": albedo }))
         }
         Brdf::Phong { n, ks, kd } => {
-            let (n, ks, kd) = (positive("n", *n, MAX_EXPONENT)?, rgb("ks", ks, 1.0)?, rgb("kd", kd, 1.0)?);
+            let (n, ks, kd) = (positive("n", *n, Analytic::MAX_EXPONENT)?, rgb("ks", ks, 1.0)?, rgb("kd", kd, 1.0)?);
             (Analytic::Phong { n, ks, kd }, "phong", json!({ "n": n, "ks": ks, "kd": kd }))
         }
         Brdf::BlinnPhong { n, ks } => {
-            let (n, ks) = (positive("n", *n, MAX_EXPONENT)?, rgb("ks", ks, 1.0)?);
+            let (n, ks) = (positive("n", *n, Analytic::MAX_EXPONENT)?, rgb("ks", ks, 1.0)?);
             (Analytic::BlinnPhong { n, ks }, "blinn-phong", json!({ "n": n, "ks": ks }))
         }
         Brdf::Ggx { alpha, f0 } => {
-            let (alpha, f0) = (positive("alpha", *alpha, MAX_ALPHA)?, rgb("f0", f0, 1.0)?);
+            let (alpha, f0) = (within("alpha", *alpha, Analytic::MIN_ALPHA, Analytic::MAX_ALPHA)?, rgb("f0", f0, 1.0)?);
             (Analytic::Ggx { alpha, f0 }, "ggx", json!({ "alpha": alpha, "f0": f0 }))
         }
     };
