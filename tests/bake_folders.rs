@@ -246,6 +246,46 @@ fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
     }
 }
 
+/// `make-cases.sh` (`../shared/data/hostile/bake2/`) on a copy of the reference bake, case
+/// `switch-blocked`: a non-empty folder where a rebake with `--cube` writes `layers-cube.ktx2`; and
+/// the same with `--engine-textures` and a non-empty `engine-merl.ktx2/`. Each rebake exits 2 with
+/// one line naming the folder in the way and changes nothing: the previous manifest and every file
+/// it lists, with its checksum, the folder in the way with its note, no temporary file (issue 42:
+/// the switch renamed new files over the old ones, met the folder, and its undo deleted the new
+/// files, leaving 3 of 21 files and no manifest).
+#[test]
+fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
+    let tmp = temp_dir();
+    let good = copy_of_reference(tmp.path(), "good");
+    let cases = tmp.path().join("cases");
+    let mut cmd = Command::new("bash");
+    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    run(cmd, "").expect_code(0);
+    let engine = copy_of_reference(tmp.path(), "engine-blocked");
+    std::fs::create_dir(engine.join("engine-merl.ktx2")).unwrap();
+    std::fs::write(engine.join("engine-merl.ktx2/note"), b"keep\n").unwrap();
+
+    let before = contents(&good);
+    for (dir, flag, name) in
+        [(cases.join("switch-blocked"), "--cube", "layers-cube.ktx2"), (engine, "--engine-textures", "engine-merl.ktx2")]
+    {
+        let (r, _) = run_within(bake_command(&dir, &[flag, "--quiet"]), NO_HANG);
+        let r = r.expect_one_error_line(&format!("{}: refusing to replace a folder", dir.join(name).display()));
+        let mut names: Vec<String> =
+            std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        names.sort();
+        let mut expected: Vec<String> = before.keys().cloned().chain([name.to_string()]).collect();
+        expected.sort();
+        assert_eq!(names, expected, "{flag}: the folder holds the previous bake, the folder in the way, nothing else\n{r}");
+        for (file, bytes) in &before {
+            assert!(std::fs::read(dir.join(file)).unwrap() == *bytes, "{flag}: {file} changed\n{r}");
+        }
+        let listed = check_manifest_inside(&dir);
+        assert_eq!(listed.len() + 1, before.len(), "{flag}: every file but the manifest is listed");
+        assert_eq!(std::fs::read(dir.join(name).join("note")).unwrap(), b"keep\n", "{flag}\n{r}");
+    }
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

@@ -35,9 +35,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// then are they renamed into place, in order, with the last of `files` (the one that names the
 /// others, such as an asset that records its linked files' SHA-256) removed first and renamed
 /// last: an interruption at any moment leaves either the old set, or new files that no index names
-/// yet, never an index naming a file that does not match it. If a rename fails, the files already
-/// renamed are removed, so the set is absent rather than partly new. Temporary files an earlier
-/// interrupted run left for these names (`.NAME.XXXXXX.tmp`) are removed first.
+/// yet, never an index naming a file that does not match it. A name that holds a folder (or
+/// anything but a regular file or a link) fails the set before anything is replaced; if a rename
+/// fails, the old files are put back, so the folder holds the old set rather than part of the new
+/// one. Temporary files an earlier interrupted run left for these names (`.NAME.XXXXXX.tmp`) are
+/// removed first.
 ///
 /// `dir` is created if it is missing, the folder itself only: its parent must exist.
 ///
@@ -67,12 +69,13 @@ pub fn create_folder(dir: &Path) -> std::io::Result<()> {
 pub struct Staging {
     dir: PathBuf,
     files: Vec<(PathBuf, tempfile::NamedTempFile)>,
+    retired: Vec<PathBuf>,
 }
 
 impl Staging {
     /// An empty set of files for the folder `dir` (which must exist).
     pub fn new(dir: &Path) -> Staging {
-        Staging { dir: dir.to_path_buf(), files: Vec::new() }
+        Staging { dir: dir.to_path_buf(), files: Vec::new(), retired: Vec::new() }
     }
 
     /// Writes `bytes` for the file `name` of the folder to a synced temporary file. Errors name
@@ -84,48 +87,154 @@ impl Staging {
         Ok(())
     }
 
-    /// Switches the files into place: the last one added (the index, which names the others) is
-    /// removed first, then every other file is renamed over its target in the order added,
-    /// `before_index` runs, and the index is renamed last; the folder is synced after the removal
-    /// and at the end. Renames need no space, so on a full disk the folder still switches. If a
-    /// rename fails, the files this call renamed are removed again.
+    /// Removes the file `name` (a plain file name) of the folder in the switch, after the new
+    /// files land and before the index does; a commit that fails puts it back. Only a regular
+    /// file is removed (anything else under the name fails the commit before anything changes);
+    /// a missing one is skipped.
+    pub fn retire(&mut self, name: &str) {
+        self.retired.push(self.dir.join(name));
+    }
+
+    /// Switches the files into place, by renames and links alone (no free space needed, so on a
+    /// full disk the folder still switches):
+    ///
+    /// 1. Every target must be replaceable (nothing, a regular file or a link; the index anything
+    ///    but a folder, so that a damaged index, a FIFO say, never keeps a set from landing) and
+    ///    every retired name a regular file or nothing: otherwise this fails naming it, and
+    ///    nothing has changed.
+    /// 2. The old index (the last file added, which names the others) is set aside: it leaves its
+    ///    name, which no reader then finds, and the folder is synced.
+    /// 3. Every other file is renamed over its target in the order added, the old file kept under
+    ///    a temporary name (a second link to it); then the retired files are set aside,
+    ///    `before_index` runs, and the index is renamed into place; the folder is synced.
+    /// 4. The old files kept aside are removed.
+    ///
+    /// If anything fails in 2 or 3, every step already taken is undone: each old file is renamed
+    /// back over its name (the new one removed where there was none) and the old index is put
+    /// back, so the folder lists the previous set again. An interruption (a kill) leaves complete
+    /// files, no index and the kept files as temporaries ([`remove_temporaries`] removes them).
     pub fn commit(
         self,
         before_index: impl FnOnce() -> Result<(), (PathBuf, std::io::Error)>,
     ) -> Result<(), (PathBuf, std::io::Error)> {
-        let dir = self.dir;
-        let mut files = self.files;
-        let Some((index, _)) = files.last() else { return Ok(()) };
-        match std::fs::remove_file(index) {
-            Ok(()) => sync_folder(&dir).map_err(|e| (dir.clone(), e))?,
+        let Staging { dir, mut files, retired } = self;
+        let Some((index, index_file)) = files.pop() else { return Ok(()) };
+        for (path, _) in &files {
+            check_replaceable(path).map_err(|e| (path.clone(), e))?;
+        }
+        check_index_replaceable(&index).map_err(|e| (index.clone(), e))?;
+        for path in &retired {
+            check_removable(path).map_err(|e| (path.clone(), e))?;
+        }
+        let mut switch = Switch { dir: &dir, undo: Vec::new() };
+        let result = (|| {
+            switch.set_aside(&index)?;
+            sync_folder(&dir).map_err(|e| (dir.clone(), e))?;
+            for (path, file) in files {
+                switch.replace(path, file)?;
+            }
+            for path in &retired {
+                switch.set_aside(path)?;
+            }
+            before_index()?;
+            switch.replace(index, index_file)?;
+            sync_folder(&dir).map_err(|e| (dir.clone(), e))
+        })();
+        match result {
+            Ok(()) => {
+                // The kept old files go with the undo log (each `TempPath` removes its file).
+                drop(switch);
+                Ok(())
+            }
+            Err(e) => {
+                switch.undo();
+                Err(e)
+            }
+        }
+    }
+}
+
+/// The steps of a [`Staging::commit`] taken so far, with what undoes each.
+struct Switch<'a> {
+    dir: &'a Path,
+    undo: Vec<Step>,
+}
+
+enum Step {
+    /// A new file renamed over `target`; `old` is the file it replaced, if there was one.
+    Replaced { target: PathBuf, old: Option<tempfile::TempPath> },
+    /// The file at `target` moved to `old`, leaving the name free.
+    SetAside { target: PathBuf, old: tempfile::TempPath },
+}
+
+impl Switch<'_> {
+    /// Renames `file` over `target`, keeping the file it replaces.
+    fn replace(&mut self, target: PathBuf, file: tempfile::NamedTempFile) -> Result<(), (PathBuf, std::io::Error)> {
+        let old = keep(self.dir, &target).map_err(|e| (target.clone(), e))?;
+        match file.persist(&target) {
+            Ok(_) => {
+                self.undo.push(Step::Replaced { target, old });
+                Ok(())
+            }
+            Err(e) => {
+                // The old file is still at the target (only the extra link to it goes when `old`
+                // drops), unless `keep` had to rename it away: then it goes back.
+                if let Some(old) = old
+                    && std::fs::symlink_metadata(&target).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+                {
+                    let _ = old.persist(&target);
+                }
+                Err((target, e.error))
+            }
+        }
+    }
+
+    /// Moves the file at `target` aside (a link under a temporary name, then `target` unlinked);
+    /// nothing there is nothing to do.
+    fn set_aside(&mut self, target: &Path) -> Result<(), (PathBuf, std::io::Error)> {
+        let Some(old) = keep(self.dir, target).map_err(|e| (target.to_path_buf(), e))? else { return Ok(()) };
+        match std::fs::remove_file(target) {
+            Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err((index.clone(), e)),
+            Err(e) => return Err((target.to_path_buf(), e)),
         }
-        let last = files.pop().expect("a last file");
-        let mut landed: Vec<PathBuf> = Vec::with_capacity(files.len() + 1);
-        let undo = |landed: &[PathBuf]| {
-            for done in landed {
-                let _ = std::fs::remove_file(done);
+        self.undo.push(Step::SetAside { target: target.to_path_buf(), old });
+        Ok(())
+    }
+
+    /// Every step taken, undone in reverse order; best effort (the error that stopped the switch
+    /// is the one reported).
+    fn undo(self) {
+        for step in self.undo.into_iter().rev() {
+            match step {
+                Step::Replaced { target, old: Some(old) } | Step::SetAside { target, old } => {
+                    let _ = old.persist(&target);
+                }
+                Step::Replaced { target, old: None } => {
+                    let _ = std::fs::remove_file(&target);
+                }
             }
-            let _ = sync_folder(&dir);
-        };
-        for (path, file) in files {
-            if let Err(e) = file.persist(&path) {
-                undo(&landed);
-                return Err((path, e.error));
-            }
-            landed.push(path);
         }
-        if let Err(e) = before_index() {
-            undo(&landed);
-            return Err(e);
-        }
-        let (path, file) = last;
-        if let Err(e) = file.persist(&path) {
-            undo(&landed);
-            return Err((path, e.error));
-        }
-        sync_folder(&dir).map_err(|e| (dir.clone(), e))
+        let _ = sync_folder(self.dir);
+    }
+}
+
+/// A second name for the file (or link) at `target`, a temporary one in `dir`
+/// (`.NAME.XXXXXX.tmp`, removed when the returned path drops): a hard link, or, where the file
+/// system has none, the file itself renamed there. `None` when nothing is at `target`.
+fn keep(dir: &Path, target: &Path) -> std::io::Result<Option<tempfile::TempPath>> {
+    let prefix = temporary_prefix(target);
+    let kept = temporary_builder(&prefix).make_in(dir, |backup| {
+        std::fs::hard_link(target, backup).or_else(|e| {
+            let no_links = matches!(e.kind(), std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::Unsupported);
+            let renameable = std::fs::symlink_metadata(target).is_ok_and(|m| m.is_file() || m.is_symlink());
+            if no_links && renameable { std::fs::rename(target, backup) } else { Err(e) }
+        })
+    });
+    match kept {
+        Ok(file) => Ok(Some(file.into_temp_path())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(without_temporary_path(e)),
     }
 }
 
@@ -170,17 +279,46 @@ fn folder_of(path: &Path) -> &Path {
 fn check_replaceable(path: &Path) -> std::io::Result<()> {
     match std::fs::symlink_metadata(path) {
         Ok(meta) if meta.is_file() || meta.is_symlink() => Ok(()),
-        Ok(meta) => Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!(
-                "refusing to replace {} (a {}, not a regular file)",
-                path.display(),
-                if meta.is_dir() { "folder" } else { "fifo, device or socket" }
-            ),
-        )),
+        Ok(meta) => Err(not_a_file("replace", "a regular file or a link", &meta)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(e),
     }
+}
+
+/// The index of a set is replaced whatever it is (a link, a FIFO, a device node: a damaged or
+/// hostile index must not keep a set from landing) except a folder.
+fn check_index_replaceable(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.is_dir() => Err(not_a_file("replace", "anything but a folder", &meta)),
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
+/// What is at a path a set retires may be removed only if it is a regular file (or nothing).
+fn check_removable(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.is_file() => Ok(()),
+        Ok(meta) => Err(not_a_file("remove", "a regular file", &meta)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
+/// The error for a name the caller (who names the path) may not replace or remove.
+fn not_a_file(verb: &str, allowed: &str, meta: &std::fs::Metadata) -> std::io::Error {
+    let kind = if meta.is_dir() {
+        "folder"
+    } else if meta.is_symlink() {
+        "symbolic link"
+    } else {
+        "fifo, device or socket"
+    };
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("refusing to {verb} a {kind} (only {allowed} is {verb}d): nothing was changed"),
+    )
 }
 
 /// An output's folder must be there already: say so plainly rather than "no such file".
@@ -203,27 +341,43 @@ fn check_folder(folder: &Path) -> std::io::Result<()> {
 /// ones. Errors carry no temporary path (the caller names the target); the file is removed
 /// when the handle is dropped unpersisted.
 fn temporary(folder: &Path, target: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
-    let mut prefix = std::ffi::OsString::from(".");
-    prefix.push(target.file_name().unwrap_or_default());
-    prefix.push(".");
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp").rand_bytes(TEMPORARY_RANDOM_CHARS);
+    let prefix = temporary_prefix(target);
+    let mut builder = temporary_builder(&prefix);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    // `tempfile` appends "at path ..." to its errors: keep the system's message only.
-    let mut file = builder.tempfile_in(folder).map_err(|e| {
-        let message = e.to_string();
-        let message = message.split(" at path ").next().unwrap_or(&message).to_string();
-        std::io::Error::new(e.kind(), message)
-    })?;
+    let mut file = builder.tempfile_in(folder).map_err(without_temporary_path)?;
     let handle = file.as_file_mut();
     handle.write_all(bytes)?;
     handle.flush()?;
     handle.sync_all()?;
     Ok(file)
+}
+
+/// The start of the names of `target`'s temporary files, `.NAME.` of `.NAME.XXXXXX.tmp`
+/// ([`temporary_target`]).
+fn temporary_prefix(target: &Path) -> std::ffi::OsString {
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(target.file_name().unwrap_or_default());
+    prefix.push(".");
+    prefix
+}
+
+/// Names temporary files `PREFIX` + six random characters + `.tmp` ([`temporary_prefix`]).
+fn temporary_builder(prefix: &std::ffi::OsStr) -> tempfile::Builder<'_, 'static> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(prefix).suffix(".tmp").rand_bytes(TEMPORARY_RANDOM_CHARS);
+    builder
+}
+
+/// `tempfile` appends "at path ..." to its errors: keep the system's message only (the caller
+/// names the target, never a temporary file).
+fn without_temporary_path(e: std::io::Error) -> std::io::Error {
+    let message = e.to_string();
+    let message = message.split(" at path ").next().unwrap_or(&message).to_string();
+    std::io::Error::new(e.kind(), message)
 }
 
 fn sync_folder(folder: &Path) -> std::io::Result<()> {

@@ -136,6 +136,90 @@ fn a_staged_set_lands_on_commit_only() {
     assert_eq!(std::fs::read(dir.path().join("index")).unwrap(), b"new index");
 }
 
+/// The previous set of a folder: `data`, `gone` (which the new set retires), `index`; the new set
+/// writes `data`, `extra` and `index`.
+fn previous_set(dir: &std::path::Path) -> asset::Staging {
+    for (name, bytes) in [("data", "old data"), ("gone", "old gone"), ("index", "old index")] {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let mut staging = asset::Staging::new(dir);
+    staging.add("data", b"new data").unwrap();
+    staging.add("extra", b"new extra").unwrap();
+    staging.retire("gone");
+    staging.add("index", b"new index").unwrap();
+    staging
+}
+
+fn contents(dir: &std::path::Path) -> Vec<(String, String)> {
+    entries(dir).into_iter().map(|n| (n.clone(), std::fs::read_to_string(dir.join(&n)).unwrap_or_default())).collect()
+}
+
+fn old_set() -> Vec<(String, String)> {
+    [("data", "old data"), ("gone", "old gone"), ("index", "old index")].map(|(n, c)| (n.into(), c.into())).to_vec()
+}
+
+/// A name the set writes that holds a folder (or a FIFO) fails the commit before anything is
+/// touched: the old set, its index included, is as it was (issue 42: a rebake's switch renamed
+/// files over the old ones, met the folder, and its undo deleted the new files, leaving 3 of 21).
+#[test]
+fn a_commit_blocked_by_a_folder_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let staging = previous_set(dir.path());
+    std::fs::create_dir(dir.path().join("extra")).unwrap();
+    std::fs::write(dir.path().join("extra/note"), b"keep").unwrap();
+    let (path, e) = staging.commit(|| Ok(())).unwrap_err();
+    assert_eq!(path, dir.path().join("extra"));
+    assert_eq!(e.to_string(), "refusing to replace a folder (only a regular file or a link is replaced): nothing was changed");
+    std::fs::remove_dir_all(dir.path().join("extra")).unwrap();
+    assert_eq!(contents(dir.path()), old_set());
+
+    #[cfg(unix)]
+    {
+        let staging = previous_set(dir.path());
+        std::fs::remove_file(dir.path().join("gone")).unwrap();
+        std::os::unix::fs::symlink("data", dir.path().join("gone")).unwrap();
+        let (path, e) = staging.commit(|| Ok(())).unwrap_err();
+        assert_eq!(path, dir.path().join("gone"));
+        assert!(e.to_string().starts_with("refusing to remove a symbolic link"), "{e}");
+        assert_eq!(std::fs::read_link(dir.path().join("gone")).unwrap(), std::path::Path::new("data"));
+
+        // A FIFO at the index's name (a damaged index) does not keep the set from landing.
+        std::fs::remove_file(dir.path().join("gone")).unwrap();
+        std::fs::remove_file(dir.path().join("index")).unwrap();
+        let staging = previous_set(dir.path());
+        std::fs::remove_file(dir.path().join("index")).unwrap();
+        assert!(std::process::Command::new("mkfifo").arg(dir.path().join("index")).status().unwrap().success());
+        staging.commit(|| Ok(())).unwrap();
+        assert_eq!(std::fs::read(dir.path().join("index")).unwrap(), b"new index");
+        assert_eq!(entries(dir.path()), ["data", "extra", "index"]);
+    }
+}
+
+/// A switch that fails after files have landed puts the old ones back, the index and the retired
+/// file included, and removes the files that had no old one: the folder lists the old set again.
+#[test]
+fn a_commit_that_fails_midway_restores_the_old_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let staging = previous_set(dir.path());
+    let failure = || Err((dir.path().join("index"), std::io::Error::other("injected")));
+    let seen = std::cell::RefCell::new(Vec::new());
+    let (path, e) = staging
+        .commit(|| {
+            // The new files have landed and the old ones are gone from their names.
+            seen.borrow_mut().extend(["data", "extra", "gone", "index"].map(|n| std::fs::read(dir.path().join(n)).ok()));
+            failure()
+        })
+        .unwrap_err();
+    assert_eq!((path, e.to_string()), (dir.path().join("index"), "injected".to_string()));
+    assert_eq!(seen.into_inner(), [Some(b"new data".to_vec()), Some(b"new extra".to_vec()), None, None]);
+    assert_eq!(contents(dir.path()), old_set(), "the old set, and nothing else (no temporaries)");
+
+    // Committed, the new set lands, the retired file goes, no kept copy stays behind.
+    previous_set(dir.path()).commit(|| Ok(())).unwrap();
+    let new = [("data", "new data"), ("extra", "new extra"), ("index", "new index")];
+    assert_eq!(contents(dir.path()), new.map(|(n, c)| (n.to_string(), c.to_string())));
+}
+
 /// A FIFO or a device is refused without blocking or reading; a link is followed for a path
 /// given as it is, never for a name an asset links (`linked_file_status`).
 #[cfg(unix)]

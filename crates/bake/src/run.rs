@@ -421,36 +421,26 @@ impl BakeFolder {
     }
 
     /// The switch (step 4 of [`run_bake`]): `staging` holds the new files; the manifest is added
-    /// as the set's index and everything is renamed into place, the previous bake's files that
-    /// the new manifest does not list removed just before the manifest lands.
+    /// as the set's index, the previous bake's files that the new manifest does not list are
+    /// retired, and everything is switched into place ([`asset::Staging::commit`]: every name
+    /// checked first, the old files restored if any step fails).
     fn switch(
         &self,
         mut staging: asset::Staging,
         previous: Option<&BakeManifest>,
         manifest: &BakeManifest,
     ) -> Result<(), Error> {
-        let dir = self.folder.path();
         // Decided before the switch: only files some stage writes, still as described.
-        let obsolete: Vec<&str> = previous
+        let obsolete = previous
             .into_iter()
             .flat_map(BakeManifest::outputs)
             .filter(|old| manifest.output_by_path(&old.path).is_none() && crate::stage::is_output_name(&old.path))
-            .filter(|old| old.matches_file(&self.folder).unwrap_or(false))
-            .map(|old| old.path.as_str())
-            .collect();
+            .filter(|old| old.matches_file(&self.folder).unwrap_or(false));
+        for old in obsolete {
+            staging.retire(&old.path);
+        }
         staging.add(MANIFEST, manifest.to_json().as_bytes()).map_err(|(path, e)| Error::write(&path, e))?;
-        staging
-            .commit(|| {
-                for name in &obsolete {
-                    match self.folder.remove_file(name) {
-                        Ok(()) => {}
-                        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                        Err(e) => return Err((dir.join(name), e)),
-                    }
-                }
-                Ok(())
-            })
-            .map_err(|(path, e)| Error::write(&path, e))
+        staging.commit(|| Ok(())).map_err(|(path, e)| Error::write(&path, e))
     }
 }
 
