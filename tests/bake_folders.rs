@@ -286,6 +286,54 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
     }
 }
 
+/// `make-cases.sh`'s `duplicate-1000` (the manifest lists `importance.png` 1000 more times) and a
+/// 100 000-entry one made here (compact JSON, under the 16 MiB limit): every reader (a preview,
+/// `--sheet`, `brdf-wavelet` adding its stage) refuses the manifest at once with one line naming
+/// it and the path listed twice, instead of hashing or drawing every copy (issue 42: 29 s for
+/// 3 000 copies, an allocation failure for 100 000); `brdf-bake` counts it as no manifest and
+/// bakes again, hashing nothing it lists.
+#[test]
+fn a_manifest_listing_a_path_twice_is_refused_by_every_reader() {
+    let tmp = temp_dir();
+    let good = copy_of_reference(tmp.path(), "good");
+    let cases = tmp.path().join("cases");
+    let mut cmd = Command::new("bash");
+    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    run(cmd, "").expect_code(0);
+    let large = copy_of_reference(tmp.path(), "duplicate-100000");
+    let text = std::fs::read_to_string(large.join(MANIFEST)).unwrap();
+    let mut manifest: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let outputs = manifest["stages"][0]["outputs"].as_array_mut().unwrap();
+    let copy = outputs.iter().find(|o| o["path"] == "importance.png").unwrap().clone();
+    outputs.extend(std::iter::repeat_n(copy, 100_000));
+    let text = serde_json::to_string(&manifest).unwrap();
+    assert!(text.len() < 16 << 20, "{} bytes: the size limit would refuse it first", text.len());
+    std::fs::write(large.join(MANIFEST), text).unwrap();
+
+    let quick = Duration::from_secs(10);
+    for dir in [cases.join("duplicate-1000"), large] {
+        let needle = format!(
+            "reading {}: invalid bake manifest: output \"importance.png\" is listed twice",
+            dir.join(MANIFEST).display()
+        );
+        let png = tmp.path().join("p.png");
+        let mut sheet = tool("brdf-preview");
+        sheet.arg(&dir).arg("--sheet").arg(&png);
+        let mut wavelet = tool("brdf-wavelet");
+        wavelet.arg(ggx_copper()).arg("--out-dir").arg(&dir).args(["--side", "8"]);
+        for cmd in [preview_command(&dir, &png), sheet, wavelet] {
+            let (r, took) = run_within(cmd, NO_HANG);
+            r.expect_one_error_line(&needle);
+            assert!(took < quick, "{took:?}");
+        }
+        assert!(!png.exists());
+    }
+    let (r, took) = run_within(bake_command(&tmp.path().join("duplicate-100000"), &["--quiet"]), NO_HANG);
+    r.expect_code(0);
+    check_complete(&tmp.path().join("duplicate-100000"));
+    eprintln!("brdf-bake over a manifest of 100 001 entries: {took:?} (a whole bake)");
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

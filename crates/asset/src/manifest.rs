@@ -215,7 +215,8 @@ impl BakeManifest {
 
     /// Parses a manifest of any readable version (version 1 is converted: its outputs are
     /// assets whose role is their kind's name, with no figures and no bake parameters) and checks
-    /// what the types cannot (paths, asset fields). The JSON Schema says more (hash patterns).
+    /// what the types cannot (paths, asset fields, no path listed twice). The JSON Schema says
+    /// more (hash patterns).
     pub fn from_json(text: &str) -> Result<BakeManifest, Error> {
         let invalid = |e: serde_json::Error| Error::Invalid(format!("invalid bake manifest: {e}"));
         let value: serde_json::Value = serde_json::from_str(text).map_err(invalid)?;
@@ -234,8 +235,13 @@ impl BakeManifest {
         };
         // Every version: paths name files inside the folder (version 1's schema allowed any
         // relative path; its readers apply the same rule as version 2's).
+        // A path listed twice is refused rather than read, hashed or drawn again for each copy.
+        let mut paths = std::collections::HashSet::new();
         for output in manifest.outputs() {
             output.check().map_err(|e| Error::Invalid(format!("invalid bake manifest: {e}")))?;
+            if !paths.insert(output.path.as_str()) {
+                return Err(Error::Invalid(format!("invalid bake manifest: output {:?} is listed twice", output.path)));
+            }
         }
         Ok(manifest)
     }

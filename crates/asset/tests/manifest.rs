@@ -340,3 +340,25 @@ fn an_unknown_manifest_version_is_named() {
         other => panic!("expected an unsupported version, got {other:?}"),
     }
 }
+
+/// A path listed twice, in one stage or in two, of either version, is refused naming the path
+/// (issue 42: a manifest listing one file 1000 times had readers hash and draw every copy).
+#[test]
+fn a_path_listed_twice_is_refused() {
+    let mut in_one_stage = example();
+    let output = in_one_stage["stages"][0]["outputs"][1].clone();
+    in_one_stage["stages"][0]["outputs"].as_array_mut().unwrap().push(output.clone());
+    let mut in_two_stages = example();
+    let mut stage = in_two_stages["stages"][0].clone();
+    stage["name"] = json!("other");
+    stage["outputs"] = json!([output]);
+    in_two_stages["stages"].as_array_mut().unwrap().push(stage);
+    let mut v1 = example_v1();
+    let output = v1["stages"][0]["outputs"][0].clone();
+    v1["stages"][0]["outputs"].as_array_mut().unwrap().push(output);
+    for (manifest, path) in [(in_one_stage, "picture.png"), (in_two_stages, "picture.png"), (v1, "material-info.asset")] {
+        let e = BakeManifest::from_json(&manifest.to_string()).unwrap_err().to_string();
+        assert_eq!(e, format!("invalid bake manifest: output \"{path}\" is listed twice"));
+    }
+    assert!(BakeManifest::from_json(&example().to_string()).is_ok());
+}
