@@ -334,6 +334,59 @@ fn a_manifest_listing_a_path_twice_is_refused_by_every_reader() {
     eprintln!("brdf-bake over a manifest of 100 001 entries: {took:?} (a whole bake)");
 }
 
+/// `make-cases.sh`'s `control-chars` (an output path holding a newline and ANSI colour codes that
+/// forge a second, green `error: none, the bake is fine` line), the same in the material's
+/// `source_path` and in an asset's provenance: every message is one line, the name in it with its
+/// control characters escaped, and no raw control character reaches the terminal (issue 42).
+#[test]
+fn names_from_a_file_cannot_forge_messages() {
+    let tmp = temp_dir();
+    let good = copy_of_reference(tmp.path(), "good");
+    let cases = tmp.path().join("cases");
+    let mut cmd = Command::new("bash");
+    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    run(cmd, "").expect_code(0);
+    let dir = cases.join("control-chars");
+    let forged = "\n\u{1b}[32merror: none, the bake is fine\u{1b}[0m";
+    let shown = "\\n\\u{1b}[32merror: none, the bake is fine\\u{1b}[0m";
+    let source = copy_of_reference(tmp.path(), "source-path");
+    let text = std::fs::read_to_string(source.join(MANIFEST)).unwrap();
+    let mut manifest: serde_json::Value = serde_json::from_str(&text).unwrap();
+    manifest["material"]["source_path"] = format!("gold{forged}.binary").into();
+    std::fs::write(source.join(MANIFEST), serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    let good_asset = asset::read_file(&good.join("importance.asset")).unwrap();
+    let mut provenance = good_asset.provenance.clone();
+    provenance.source_name = format!("gold{forged}");
+    provenance.parameters.push((format!("seed{forged}"), format!("7{forged}")));
+    let forged_asset = tmp.path().join("provenance.asset");
+    std::fs::write(&forged_asset, asset::encode(&asset::Asset { provenance, payload: good_asset.payload })).unwrap();
+
+    let no_raw_controls = |r: &crate::support::Run| {
+        let raw = r.stderr.chars().chain(r.stdout.chars()).any(|c| c.is_control() && c != '\n');
+        assert!(!raw, "a raw control character was printed\n{r}");
+    };
+    let png = tmp.path().join("p.png");
+    let mut sheet = tool("brdf-preview");
+    sheet.arg(&dir).arg("--sheet").arg(&png);
+    let refusals = [
+        (preview_command(&dir, &png), format!("{}: no such file", dir.join(format!("importance{shown}.asset")).display())),
+        (sheet, format!("importance{shown}.asset")),
+        (preview_command(&source, &png), format!("reading gold{shown}.binary: no such file")),
+    ];
+    for (cmd, needle) in refusals {
+        let (r, _) = run_within(cmd, NO_HANG);
+        no_raw_controls(&r.expect_one_error_line(&needle));
+    }
+    let mut cmd = tool("asset-info");
+    cmd.arg(&forged_asset);
+    let r = run(cmd, "").expect_code(0);
+    assert!(r.stdout.contains(&format!("gold{shown}")) && r.stdout.contains(&format!("seed{shown} = 7{shown}")), "{r}");
+    no_raw_controls(&r);
+    // The bake itself prints no name of the manifest's: it rebakes quietly.
+    let (r, _) = run_within(bake_command(&dir, &["--quiet"]), NO_HANG);
+    no_raw_controls(&r.expect_code(0));
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

@@ -1,6 +1,7 @@
 //! What can go wrong in a bake, with the file it concerns. The cause is the error's `source`, so
 //! a tool printing the chain (`cli::main`) says `error: reading gold.binary: expected 34992012
-//! bytes, found 1200`.
+//! bytes, found 1200`. The path is shown with its control characters escaped
+//! ([`fsguard::printable`]): it may come from a manifest.
 
 use std::path::{Path, PathBuf};
 
@@ -10,21 +11,21 @@ type Cause = Box<dyn std::error::Error + Send + Sync>;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// An input could not be read or is not what it should be.
-    #[error("reading {}", path.display())]
+    #[error("reading {}", fsguard::printable_path(path))]
     Read {
         path: PathBuf,
         #[source]
         source: Cause,
     },
     /// An input was read but its analysis refused it (e.g. a size the estimator cannot take).
-    #[error("analysing {}", path.display())]
+    #[error("analysing {}", fsguard::printable_path(path))]
     Analyse {
         path: PathBuf,
         #[source]
         source: Cause,
     },
     /// An output could not be written.
-    #[error("writing {}", path.display())]
+    #[error("writing {}", fsguard::printable_path(path))]
     Write {
         path: PathBuf,
         #[source]
@@ -44,7 +45,7 @@ pub enum Error {
     #[error(
         "{}: another bake is writing this folder (it holds the folder's lock): wait for it to finish, or bake into \
          another folder",
-        .0.display()
+        fsguard::printable_path(.0)
     )]
     Busy(PathBuf),
     /// A bug: a value the code made does not pass its own checks.

@@ -6,7 +6,9 @@
 //!
 //! It also holds the one way tools print what they did ([`finish`]: a report for people, or with
 //! `--json` one JSON object on stdout and the human lines on stderr) and the one progress bar
-//! ([`Progress`]).
+//! ([`Progress`]). The error line and the lines of [`finish`] are printed through
+//! [`printable`] (`fsguard`'s): a name a file gave (a manifest's path, a material's
+//! `source_path`) can neither break them into lines nor send escape sequences to a terminal.
 //!
 //! Only tools depend on this crate.
 
@@ -15,6 +17,7 @@ use std::io::{ErrorKind, IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+pub use fsguard::{printable, printable_path};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// Runs a tool's `run` and turns its result into the process exit status.
@@ -24,7 +27,7 @@ pub fn main(run: impl FnOnce() -> anyhow::Result<ExitCode>) -> ExitCode {
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             let chain: Vec<String> = e.chain().map(|c| lower_case_start(&c.to_string())).collect();
-            eprintln!("error: {}", chain.join(": "));
+            eprintln!("error: {}", printable(&chain.join(": ")));
             ExitCode::from(2)
         }
     }
@@ -208,6 +211,8 @@ pub fn finish(
     problems: &[String],
     written: &[String],
 ) -> ExitCode {
+    let found_problems = !problems.is_empty();
+    let (report, problems) = (report.iter().map(|l| printable(l)), problems.iter().map(|p| printable(p)));
     if json {
         for line in report {
             eprintln!("{line}");
@@ -225,9 +230,9 @@ pub fn finish(
         }
     }
     if !written.is_empty() {
-        eprintln!("wrote {}", written.join(", "));
+        eprintln!("wrote {}", printable(&written.join(", ")));
     }
-    if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) }
+    if found_problems { ExitCode::from(1) } else { ExitCode::SUCCESS }
 }
 
 /// The progress bar of a long job, on stderr. It appears only on a terminal, only once the job has

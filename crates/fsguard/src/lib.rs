@@ -15,6 +15,10 @@
 //!   plain name (never through a link, never anything but a regular file) and takes the folder's
 //!   advisory lock (`flock(2)` on the folder itself).
 //!
+//! - [`printable`]: a name taken from a file (a manifest's output path, a material's
+//!   `source_path`) as a message may print it, control characters escaped, so that a name cannot
+//!   break a message into lines or send escape sequences to a terminal.
+//!
 //! Messages are lower case and name the problem, not the path: callers add the path.
 //!
 //! Unix only: the toolchain runs where `openat(2)` and `flock(2)` exist.
@@ -61,6 +65,30 @@ pub fn read_to_end(file: File, limit: u64) -> io::Result<Vec<u8>> {
         ));
     }
     Ok(bytes)
+}
+
+/// `name` as a message prints it: every control character (`char::is_control`: C0, DEL and C1,
+/// newlines, tabs and ANSI escapes among them) written as its Rust escape (`\n`, `\t`,
+/// `\u{1b}`), everything else (spaces, any letter or symbol) as it is. Borrowed when there is
+/// nothing to escape; escaping escaped text changes nothing.
+pub fn printable(name: &str) -> std::borrow::Cow<'_, str> {
+    if !name.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(name);
+    }
+    let mut out = String::with_capacity(name.len() + 8);
+    for c in name.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// [`printable`] of a path (as `Path::display` shows it).
+pub fn printable_path(path: &Path) -> String {
+    printable(&path.to_string_lossy()).into_owned()
 }
 
 /// Checks that `relative` names a file inside a folder: `/`-separated components, none of them
@@ -284,6 +312,21 @@ mod tests {
 
     fn message(e: io::Error) -> String {
         e.to_string()
+    }
+
+    /// The forged line of issue 42: a newline and ANSI colour codes in an output path.
+    #[test]
+    fn printable_escapes_control_characters_only() {
+        let forged = "importance\n\u{1b}[32merror: none, the bake is fine\u{1b}[0m.asset";
+        let shown = printable(forged);
+        assert_eq!(shown, "importance\\n\\u{1b}[32merror: none, the bake is fine\\u{1b}[0m.asset");
+        assert!(!shown.chars().any(char::is_control));
+        assert_eq!(printable(&shown), shown, "escaping twice changes nothing");
+        for plain in ["gold-paint.binary", "über café/ø.png", "a b\\n"] {
+            assert!(matches!(printable(plain), std::borrow::Cow::Borrowed(p) if p == plain), "{plain}");
+        }
+        assert_eq!(printable("\t\r\u{7f}\u{85}\0"), "\\t\\r\\u{7f}\\u{85}\\u{0}");
+        assert_eq!(printable_path(Path::new("dir/a\nb")), "dir/a\\nb");
     }
 
     #[test]

@@ -82,14 +82,15 @@ fn run() -> anyhow::Result<ExitCode> {
         })
         .collect();
     if !stale.is_empty() {
-        eprintln!("error: checking {}: linked file {}", args.file.display(), stale.join("; "));
+        let stale = cli::printable(&stale.join("; ")).into_owned();
+        eprintln!("error: checking {}: linked file {stale}", cli::printable_path(&args.file));
         return Ok(ExitCode::from(1));
     }
     if report.asset.is_some() {
         return Ok(ExitCode::SUCCESS);
     }
     let mismatch = Error::ChecksumMismatch { header: report.header, computed: report.computed };
-    eprintln!("error: {:#}", anyhow::Error::new(mismatch).context(context()));
+    eprintln!("error: {}", cli::printable(&format!("{:#}", anyhow::Error::new(mismatch).context(context()))));
     Ok(ExitCode::from(1))
 }
 
@@ -106,7 +107,7 @@ fn print_linked(linked: &[(&LinkedFile, LinkedStatus)]) {
             LinkedStatus::Differs { found } => format!("DIFFERS (found sha256 {})", hex(found)),
             LinkedStatus::Unreadable(e) => format!("UNREADABLE ({e})"),
         };
-        cli::outln!("  {:<22} {found}", f.name);
+        cli::outln!("  {:<22} {}", cli::printable(&f.name), cli::printable(&found));
     }
 }
 
@@ -139,7 +140,7 @@ fn print_text(report: &Report) {
             cli::outln!("checksum           ok (sha256 {})", hex(&header.checksum));
             print_provenance(&asset.provenance);
             for line in asset.payload.describe().lines {
-                cli::outln!("{line}");
+                cli::outln!("{}", cli::printable(&line));
             }
         }
     }
@@ -147,15 +148,15 @@ fn print_text(report: &Report) {
 
 fn print_provenance(p: &Provenance) {
     cli::outln!("provenance");
-    cli::outln!("  source           {}", p.source_name);
+    cli::outln!("  source           {}", cli::printable(&p.source_name));
     cli::outln!("  source sha256    {}", hex(&p.source_sha256));
-    cli::outln!("  tool             {} {}", p.tool, p.tool_version);
+    cli::outln!("  tool             {} {}", cli::printable(&p.tool), cli::printable(&p.tool_version));
     if p.parameters.is_empty() {
         cli::outln!("  parameters       (none)");
     }
     for (i, (name, value)) in p.parameters.iter().enumerate() {
         let label = if i == 0 { "parameters" } else { "" };
-        cli::outln!("  {label:<16} {name} = {value}");
+        cli::outln!("  {label:<16} {} = {}", cli::printable(name), cli::printable(value));
     }
 }
 
