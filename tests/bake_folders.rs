@@ -387,6 +387,54 @@ fn names_from_a_file_cannot_forge_messages() {
     no_raw_controls(&r.expect_code(0));
 }
 
+/// Tools that write one file (`merl-info --asset`, `brdf-preview --out`) into a bake folder: a
+/// name the manifest lists (or the manifest) is refused with one line, the bake left as it was;
+/// while a bake holds the folder's lock (taken here by `flock(1)`, as a bake takes it) any name is
+/// refused at once; an unlisted name is written when no bake runs (issue 42: both wrote into a
+/// folder during a bake, and `merl-info --asset BAKE/importance.asset` overwrote a listed file).
+#[test]
+fn tools_that_write_one_file_leave_a_bake_alone() {
+    let tmp = temp_dir();
+    let dir = copy_of_reference(tmp.path(), "bake");
+    let before = contents(&dir);
+    let merl_info = |name: &str| {
+        let mut cmd = tool("merl-info");
+        cmd.arg(ggx_copper()).arg("--asset").arg(dir.join(name));
+        cmd
+    };
+    let preview = |name: &str| preview_command(&dir, &dir.join(name));
+    let listed = |name: &str| format!("{name} is a file of the bake in {} (its manifest lists it)", dir.display());
+    for (cmd, name) in [(merl_info("importance.asset"), "importance.asset"), (preview("importance.png"), "importance.png")] {
+        let (r, _) = run_within(cmd, NO_HANG);
+        r.expect_one_error_line(&listed(name));
+    }
+    let (r, _) = run_within(merl_info(MANIFEST), NO_HANG);
+    r.expect_one_error_line(&listed(MANIFEST));
+    assert!(contents(&dir) == before, "a refused tool changed the bake");
+    check_complete(&dir);
+
+    let mut lock = Command::new("flock");
+    lock.arg("--close").arg(&dir).args(["sleep", "60"]);
+    let mut lock = lock.spawn().expect("running flock");
+    let held = || !Command::new("flock").args(["--nonblock", "--shared"]).arg(&dir).arg("true").status().unwrap().success();
+    let start = std::time::Instant::now();
+    while !held() {
+        assert!(start.elapsed() < NO_HANG, "flock took no lock");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    for cmd in [merl_info("material-info.asset"), preview("preview.png")] {
+        let (r, _) = run_within(cmd, NO_HANG);
+        r.expect_one_error_line("a bake is writing this folder (it holds the folder's lock)");
+    }
+    lock.kill().expect("ending flock");
+    lock.wait().expect("flock ended");
+    assert!(contents(&dir) == before, "a tool wrote into a folder a bake held");
+    for cmd in [merl_info("material-info.asset"), preview("preview.png")] {
+        run_within(cmd, NO_HANG).0.expect_code(0);
+    }
+    check_manifest_inside(&dir);
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

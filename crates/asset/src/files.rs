@@ -20,10 +20,16 @@ use sha2::{Digest, Sha256};
 /// a chain of folders made from the root (tools create their `--out-dir` itself, [`write_set`]).
 /// Nor is anything but a regular file or a link replaced: `--out /dev/zero` or a FIFO is an
 /// error, not a device node renamed away.
+///
+/// Beside a bake: the folder's shared lock is held while the file is written (while a bake holds
+/// the folder this is an error at once, and no bake starts meanwhile), and a name the folder's
+/// manifest lists, or the manifest itself, is never written (a file of the bake would no longer
+/// be the one its manifest describes).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let folder = folder_of(path);
     check_folder(folder)?;
     check_replaceable(path)?;
+    let _lock = beside_a_bake(folder, path)?;
     let file = temporary(folder, path, bytes)?;
     file.persist(path).map_err(|e| e.error)?;
     // The rename itself is durable only once the folder's entry is on disk.
@@ -272,6 +278,32 @@ fn folder_of(path: &Path) -> &Path {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     }
+}
+
+/// The folder `folder` held with its shared lock, once `path` is known not to be a file of the
+/// bake the folder may hold ([`write_atomic`]).
+fn beside_a_bake(folder: &Path, path: &Path) -> std::io::Result<fsguard::Folder> {
+    let held = fsguard::Folder::open(folder)?;
+    if !held.try_lock_shared()? {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::WouldBlock,
+            "a bake is writing this folder (it holds the folder's lock): wait for it to finish, or write elsewhere",
+        ));
+    }
+    let name = path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
+    if let Ok(manifest) = crate::BakeManifest::read(&held)
+        && (name == crate::MANIFEST_FILE || manifest.output_by_path(&name).is_some())
+    {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            format!(
+                "{} is a file of the bake in {} (its manifest lists it): write elsewhere, or bake again with brdf-bake",
+                fsguard::printable(&name),
+                fsguard::printable_path(folder)
+            ),
+        ));
+    }
+    Ok(held)
 }
 
 /// What is at an output's path may be replaced only if it is a regular file or a link (or

@@ -220,6 +220,45 @@ fn a_commit_that_fails_midway_restores_the_old_set() {
     assert_eq!(contents(dir.path()), new.map(|(n, c)| (n.to_string(), c.to_string())));
 }
 
+/// Beside a bake, `write_atomic` writes no name the bake's manifest lists, nor the manifest, and
+/// nothing while a bake holds the folder's lock (issue 42: `merl-info --asset BAKE/importance.asset`
+/// overwrote a listed file, and wrote into a folder a bake was writing).
+#[test]
+fn write_atomic_leaves_a_bakes_files_and_a_locked_folder_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let listed = asset::StageOutput::of_bytes("importance.png", asset::FileFormat::Png, "picture", b"bake's").unwrap();
+    let tool = asset::Tool { name: "brdf-bake".into(), version: "0".into() };
+    let source = asset::SourceFile { name: "m".into(), source_path: "m.binary".into(), source_sha256: "0".repeat(64) };
+    let mut manifest = asset::BakeManifest::new(source, None, tool, serde_json::Map::new());
+    let stage = asset::Stage {
+        name: "importance".into(),
+        parameters: serde_json::Map::new(),
+        figures: serde_json::Map::new(),
+        outputs: vec![listed],
+    };
+    manifest.stages.push(stage);
+    std::fs::write(dir.path().join("importance.png"), b"bake's").unwrap();
+    std::fs::write(dir.path().join(asset::MANIFEST_FILE), manifest.to_json()).unwrap();
+    for name in ["importance.png", asset::MANIFEST_FILE] {
+        let e = write_atomic(&dir.path().join(name), b"mine").unwrap_err().to_string();
+        let expected = format!("{name} is a file of the bake in {} (its manifest lists it)", dir.path().display());
+        assert!(e.starts_with(&expected), "{e}");
+    }
+    assert_eq!(std::fs::read(dir.path().join("importance.png")).unwrap(), b"bake's");
+    assert_eq!(std::fs::read_to_string(dir.path().join(asset::MANIFEST_FILE)).unwrap(), manifest.to_json());
+    write_atomic(&dir.path().join("preview.png"), b"mine").unwrap();
+
+    // A bake holds the folder (here this process, through another open description of it).
+    let bake = fsguard::Folder::open(dir.path()).unwrap();
+    assert!(bake.try_lock().unwrap());
+    let e = write_atomic(&dir.path().join("other.png"), b"mine").unwrap_err().to_string();
+    assert!(e.starts_with("a bake is writing this folder"), "{e}");
+    assert!(!dir.path().join("other.png").exists());
+    drop(bake);
+    write_atomic(&dir.path().join("other.png"), b"mine").unwrap();
+    assert_eq!(entries(dir.path()), ["importance.png", "manifest.json", "other.png", "preview.png"]);
+}
+
 /// A FIFO or a device is refused without blocking or reading; a link is followed for a path
 /// given as it is, never for a name an asset links (`linked_file_status`).
 #[cfg(unix)]

@@ -223,6 +223,17 @@ impl Folder {
         }
     }
 
+    /// Takes the folder's shared advisory lock without waiting: `true` when taken, `false` when
+    /// another process holds the exclusive one ([`Folder::try_lock`], a bake). Any number of
+    /// processes hold it at once; it keeps a bake from starting while they write beside one.
+    pub fn try_lock_shared(&self) -> io::Result<bool> {
+        match rustix::fs::flock(&self.dir, FlockOperation::NonBlockingLockShared) {
+            Ok(()) => Ok(true),
+            Err(Errno::WOULDBLOCK) => Ok(false),
+            Err(e) => Err(e.into()),
+        }
+    }
+
     /// Makes the folder's entries durable (`fsync` of the folder): after a rename or a removal.
     pub fn sync(&self) -> io::Result<()> {
         rustix::fs::fsync(&self.dir)?;
