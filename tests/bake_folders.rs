@@ -435,6 +435,38 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
     check_manifest_inside(&dir);
 }
 
+/// A bake whose manifest is just under the readers' 16 MiB limit (a stage's figures padded):
+/// `brdf-wavelet` adding its stage would write a manifest over it, which every reader refuses; it
+/// exits 2 with one line instead and leaves the bake as it was (issue 42: it exited 0 with a
+/// 24 MB manifest).
+#[test]
+fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
+    let tmp = temp_dir();
+    let dir = copy_of_reference(tmp.path(), "bake");
+    let text = std::fs::read_to_string(dir.join(MANIFEST)).unwrap();
+    let mut manifest: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let pretty = |m: &serde_json::Value| serde_json::to_string_pretty(m).unwrap() + "\n";
+    let limit = 16 << 20;
+    manifest["stages"][0]["figures"]["padding"] = "".into();
+    let room = limit - pretty(&manifest).len() - 300;
+    manifest["stages"][0]["figures"]["padding"] = "x".repeat(room).into();
+    let text = pretty(&manifest);
+    assert!(text.len() <= limit);
+    std::fs::write(dir.join(MANIFEST), &text).unwrap();
+    let before = contents(&dir);
+    let out = tmp.path().join("p.png");
+    run_within(preview_command(&dir, &out), NO_HANG).0.expect_code(0);
+
+    let mut cmd = tool("brdf-wavelet");
+    cmd.arg(ggx_copper()).arg("--out-dir").arg(&dir).args(["--side", "8"]);
+    let (r, _) = run_within(cmd, NO_HANG);
+    r.expect_one_error_line(&format!(
+        "writing {}: the new manifest would be refused by its readers (manifest length",
+        dir.join(MANIFEST).display()
+    ));
+    assert!(contents(&dir) == before, "the refused stage changed the bake");
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

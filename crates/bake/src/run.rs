@@ -439,7 +439,14 @@ impl BakeFolder {
         for old in obsolete {
             staging.retire(&old.path);
         }
-        staging.add(MANIFEST, manifest.to_json().as_bytes()).map_err(|(path, e)| Error::write(&path, e))?;
+        // Never a manifest its readers would refuse (a hostile previous manifest near the size
+        // limit, with a stage added, would pass it).
+        let json = manifest.to_json();
+        let path = self.folder.join(MANIFEST);
+        BakeManifest::from_bytes(json.as_bytes()).map_err(|e| {
+            Error::write(&path, format!("the new manifest would be refused by its readers ({e}): nothing was changed"))
+        })?;
+        staging.add(MANIFEST, json.as_bytes()).map_err(|(path, e)| Error::write(&path, e))?;
         staging.commit(|| Ok(())).map_err(|(path, e)| Error::write(&path, e))
     }
 }
