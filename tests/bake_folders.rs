@@ -266,9 +266,10 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
     std::fs::write(engine.join("engine-merl.ktx2/note"), b"keep\n").unwrap();
 
     let before = contents(&good);
-    for (dir, flag, name) in
-        [(cases.join("switch-blocked"), "--cube", "layers-cube.ktx2"), (engine, "--engine-textures", "engine-merl.ktx2")]
-    {
+    for (dir, flag, name) in [
+        (cases.join("switch-blocked"), "--cube", "layers-cube.ktx2"),
+        (engine, "--engine-textures", "engine-merl.ktx2"),
+    ] {
         let (r, _) = run_within(bake_command(&dir, &[flag, "--quiet"]), NO_HANG);
         let r = r.expect_one_error_line(&format!("{}: refusing to replace a folder", dir.join(name).display()));
         let mut names: Vec<String> =
@@ -276,7 +277,10 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
         names.sort();
         let mut expected: Vec<String> = before.keys().cloned().chain([name.to_string()]).collect();
         expected.sort();
-        assert_eq!(names, expected, "{flag}: the folder holds the previous bake, the folder in the way, nothing else\n{r}");
+        assert_eq!(
+            names, expected,
+            "{flag}: the folder holds the previous bake, the folder in the way, nothing else\n{r}"
+        );
         for (file, bytes) in &before {
             assert!(std::fs::read(dir.join(file)).unwrap() == *bytes, "{flag}: {file} changed\n{r}");
         }
@@ -369,7 +373,10 @@ fn names_from_a_file_cannot_forge_messages() {
     let mut sheet = tool("brdf-preview");
     sheet.arg(&dir).arg("--sheet").arg(&png);
     let refusals = [
-        (preview_command(&dir, &png), format!("{}: no such file", dir.join(format!("importance{shown}.asset")).display())),
+        (
+            preview_command(&dir, &png),
+            format!("{}: no such file", dir.join(format!("importance{shown}.asset")).display()),
+        ),
         (sheet, format!("importance{shown}.asset")),
         (preview_command(&source, &png), format!("reading gold{shown}.binary: no such file")),
     ];
@@ -404,7 +411,9 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
     };
     let preview = |name: &str| preview_command(&dir, &dir.join(name));
     let listed = |name: &str| format!("{name} is a file of the bake in {} (its manifest lists it)", dir.display());
-    for (cmd, name) in [(merl_info("importance.asset"), "importance.asset"), (preview("importance.png"), "importance.png")] {
+    for (cmd, name) in
+        [(merl_info("importance.asset"), "importance.asset"), (preview("importance.png"), "importance.png")]
+    {
         let (r, _) = run_within(cmd, NO_HANG);
         r.expect_one_error_line(&listed(name));
     }
@@ -416,7 +425,8 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
     let mut lock = Command::new("flock");
     lock.arg("--close").arg(&dir).args(["sleep", "60"]);
     let mut lock = lock.spawn().expect("running flock");
-    let held = || !Command::new("flock").args(["--nonblock", "--shared"]).arg(&dir).arg("true").status().unwrap().success();
+    let held =
+        || !Command::new("flock").args(["--nonblock", "--shared"]).arg(&dir).arg("true").status().unwrap().success();
     let start = std::time::Instant::now();
     while !held() {
         assert!(start.elapsed() < NO_HANG, "flock took no lock");

@@ -169,7 +169,10 @@ fn a_commit_blocked_by_a_folder_changes_nothing() {
     std::fs::write(dir.path().join("extra/note"), b"keep").unwrap();
     let (path, e) = staging.commit(|| Ok(())).unwrap_err();
     assert_eq!(path, dir.path().join("extra"));
-    assert_eq!(e.to_string(), "refusing to replace a folder (only a regular file or a link is replaced): nothing was changed");
+    assert_eq!(
+        e.to_string(),
+        "refusing to replace a folder (only a regular file or a link is replaced): nothing was changed"
+    );
     std::fs::remove_dir_all(dir.path().join("extra")).unwrap();
     assert_eq!(contents(dir.path()), old_set());
 
@@ -206,7 +209,8 @@ fn a_commit_that_fails_midway_restores_the_old_set() {
     let (path, e) = staging
         .commit(|| {
             // The new files have landed and the old ones are gone from their names.
-            seen.borrow_mut().extend(["data", "extra", "gone", "index"].map(|n| std::fs::read(dir.path().join(n)).ok()));
+            seen.borrow_mut()
+                .extend(["data", "extra", "gone", "index"].map(|n| std::fs::read(dir.path().join(n)).ok()));
             failure()
         })
         .unwrap_err();

@@ -356,7 +356,8 @@ fn a_path_listed_twice_is_refused() {
     let mut v1 = example_v1();
     let output = v1["stages"][0]["outputs"][0].clone();
     v1["stages"][0]["outputs"].as_array_mut().unwrap().push(output);
-    for (manifest, path) in [(in_one_stage, "picture.png"), (in_two_stages, "picture.png"), (v1, "material-info.asset")] {
+    for (manifest, path) in [(in_one_stage, "picture.png"), (in_two_stages, "picture.png"), (v1, "material-info.asset")]
+    {
         let e = BakeManifest::from_json(&manifest.to_string()).unwrap_err().to_string();
         assert_eq!(e, format!("invalid bake manifest: output \"{path}\" is listed twice"));
     }
