@@ -219,11 +219,16 @@ impl BakeManifest {
     /// more (hash patterns).
     pub fn from_json(text: &str) -> Result<BakeManifest, Error> {
         let invalid = |e: serde_json::Error| Error::Invalid(format!("invalid bake manifest: {e}"));
-        let value: serde_json::Value = serde_json::from_str(text).map_err(invalid)?;
-        let version = value.get("manifest_version").and_then(serde_json::Value::as_u64);
-        let manifest = match version {
-            Some(1) => serde_json::from_value::<v1::BakeManifest>(value).map_err(invalid)?.into(),
-            Some(2) => serde_json::from_value::<BakeManifest>(value).map_err(invalid)?,
+        // Parsed from the text, not through a `Value`, so that a key given twice is named
+        // (`duplicate field `manifest_version``) rather than the last one read silently.
+        #[derive(Deserialize)]
+        struct Version {
+            manifest_version: Option<serde_json::Value>,
+        }
+        let version = serde_json::from_str::<Version>(text).map_err(invalid)?.manifest_version;
+        let manifest = match version.as_ref().and_then(serde_json::Value::as_u64) {
+            Some(1) => serde_json::from_str::<v1::BakeManifest>(text).map_err(invalid)?.into(),
+            Some(2) => serde_json::from_str::<BakeManifest>(text).map_err(invalid)?,
             Some(found) => {
                 return Err(Error::UnsupportedVersion {
                     what: "manifest",

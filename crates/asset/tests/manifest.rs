@@ -363,3 +363,23 @@ fn a_path_listed_twice_is_refused() {
     }
     assert!(BakeManifest::from_json(&example().to_string()).is_ok());
 }
+
+/// A key given twice is named, whichever comes first (issue 42: a second `manifest_version` of 1
+/// after a 2 was reported as "unknown field `parameters`").
+#[test]
+fn a_key_given_twice_is_named() {
+    let text = example().to_string();
+    for (first, second) in [(2, 1), (1, 2), (2, 2)] {
+        let twice = text.replacen(
+            "\"manifest_version\":2",
+            &format!("\"manifest_version\":{first},\"manifest_version\":{second}"),
+            1,
+        );
+        assert_ne!(twice, text);
+        let e = BakeManifest::from_json(&twice).unwrap_err().to_string();
+        assert!(e.starts_with("invalid bake manifest: duplicate field `manifest_version`"), "{first}, {second}: {e}");
+    }
+    let twice = text.replacen("\"tool\":{", "\"tool\":{\"name\":\"x\",", 1);
+    let e = BakeManifest::from_json(&twice).unwrap_err().to_string();
+    assert!(e.starts_with("invalid bake manifest: duplicate field `name`"), "{e}");
+}
