@@ -139,7 +139,7 @@ pub(crate) fn assemble(
     } else {
         None
     };
-    Ok((render::Material { table, samples, view_layers, wavelet_brdf: None }, lighting))
+    Ok((render::Material::new(table, samples, view_layers), lighting))
 }
 
 /// What adaptive shading predicts from: the environment's bandwidth and the material's atlas.

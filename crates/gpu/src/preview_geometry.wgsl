@@ -183,8 +183,24 @@ fn duff_tangent(n: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
 }
 
+// `render::COS_O_MIN`.
+const COS_O_MIN: f32 = 1e-4;
+
+// `render::shade::bend_towards`: `n` rotated towards `wo` until `n . wo = COS_O_MIN`.
+fn bend_towards(n: vec3<f32>, wo: vec3<f32>, cos_o: f32) -> vec3<f32> {
+    let across = n - cos_o * wo;
+    let len = length(across);
+    var p: vec3<f32>;
+    if (len < 1e-6) {
+        p = duff_tangent(wo);
+    } else {
+        p = across / len;
+    }
+    return COS_O_MIN * wo + sqrt(1.0 - COS_O_MIN * COS_O_MIN) * p;
+}
+
 // `render::shade::ShadingFrame::new`; `valid` is false where the pixel is black: the normal
-// interpolated to zero or faces away from the eye (silhouettes).
+// interpolated to zero.
 struct MaybeFrame {
     valid: bool,
     frame: ShadingFrame,
@@ -194,14 +210,18 @@ struct MaybeFrame {
 fn shading_frame(hit: Hit) -> MaybeFrame {
     var none: MaybeFrame;
     none.valid = false;
-    let n = hit.normal;
+    var n = hit.normal;
     if (all(n == vec3<f32>(0.0))) {
         return none;
     }
     let wo = normalize(shade.eye.xyz - hit.position);
-    let cos_o = dot(n, wo);
-    if (!(cos_o > 0.0)) {
+    var cos_o = dot(n, wo);
+    if (cos_o != cos_o) {
         return none;
+    }
+    if (cos_o < COS_O_MIN) {
+        n = bend_towards(n, wo, cos_o);
+        cos_o = dot(n, wo);
     }
     let tangent = wo - cos_o * n;
     let sin_o = length(tangent);

@@ -43,22 +43,27 @@ fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, c
     let words = pixel_words(pixel);
     let light = sampled_light();
     var blend = LayerBlend(0u, 0.0);
+    var diffuse = vec3<f32>(0.0);
+    var sum = vec3<f32>(0.0);
     if (shade.mode == MODE_PREFILTERED) {
         blend = layer_blend(frame);
+        // The diffuse part's integral, once per term (the terms' sum is divided by their count).
+        diffuse = shade.diffuse.xyz;
+        sum = (PI * diffuse * env_bilinear(shade.layers_first, env_uv(frame.n))) * f32(count);
     }
-    var sum = vec3<f32>(0.0);
     for (var j = first; j < first + count; j++) {
         let index = base + j;
         let s = brdf_sample(k, sequence_point(words.xy, index));
         if (s.pdf > 0.0 && s.wi.z > 0.0) {
             let brdf = material_brdf(s.wi, frame.wo_local);
+            let rest = brdf - diffuse;
             // No data counts as 0; the CPU skips zeros too.
-            if (any(brdf != vec3<f32>(0.0))) {
+            if (any(brdf != vec3<f32>(0.0)) || any(rest != vec3<f32>(0.0))) {
                 let uv = env_uv(to_world(frame, s.wi));
                 if (shade.mode == MODE_FIS) {
                     sum += brdf * mip_trilinear(uv, mip_lod(s.pdf)) * (s.wi.z / s.pdf);
                 } else if (shade.mode == MODE_PREFILTERED) {
-                    sum += brdf * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
+                    sum += rest * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
                 }
                 if (light.valid) {
                     let weight = mis_weight(s.pdf, latlong_pdf(light.distribution, uv));

@@ -39,7 +39,7 @@ pub static PREVIEW_ENVIRONMENT: Wgsl =
 /// The shading pass's entry points.
 pub static PREVIEW_SHADE: Wgsl = wgsl!(
     "preview_shade.wgsl",
-    [WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
+    [MERL_LOOKUP, WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
 /// An adaptive frame, a file per stage of `render::adaptive` named as its Rust twin there
 /// (`predict.rs`: `predict.wgsl`), beside the host side in `preview/adaptive/`. The prediction.

@@ -25,7 +25,7 @@ fn material() -> &'static Material {
         let config = importance::Config { n_theta_o: 16, n_vectors: 4, n_samples: 64, ..Default::default() };
         let tables = importance::build(&table, &config).expect("a valid config");
         let samples = SampleSet::new(&tables);
-        Material { table, samples, view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0], wavelet_brdf: None }
+        Material::new(table, samples, vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0])
     })
 }
 

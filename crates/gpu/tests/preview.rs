@@ -50,12 +50,7 @@ fn material(brdf: Analytic) -> Material {
     let table = brdf.table(Dims::MERL);
     let config = importance::Config { n_theta_o: 90, n_vectors: 8, n_samples: 64, ..Default::default() };
     let tables = importance::build(&table, &config).expect("a valid config");
-    Material {
-        samples: SampleSet::new(&tables),
-        table,
-        view_layers: vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0],
-        wavelet_brdf: None,
-    }
+    Material::new(table, SampleSet::new(&tables), vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0])
 }
 
 fn lambertian() -> &'static Material {

@@ -31,9 +31,15 @@
 //! # The shading frame
 //!
 //! At a covered pixel with interpolated position `p` and normal `n` (normalized after
-//! interpolation): `wo = normalize(eye - p)`, `cos_o = n . wo`. If `cos_o <= 0` the pixel is black
-//! (the interpolated normal faces away, at silhouettes), and so is a pixel whose normal
-//! interpolates to zero. Otherwise `t = wo - cos_o n`; if `|t| < 1e-6` (`wo` along the normal)
+//! interpolation): `wo = normalize(eye - p)`, `cos_o = n . wo`. A pixel whose normal interpolates
+//! to zero is black. Where `cos_o <` [`COS_O_MIN`] (`1e-4`, Filament's `MIN_N_DOT_V`) the interpolated
+//! normal turns away from the eye, or nearly: at a silhouette, the pixel centre falls on a triangle
+//! whose vertex normals lie beyond it. Such a normal is bent towards the eye, as engines do:
+//! rotated in the plane of `n` and `wo` until `n . wo =
+//! COS_O_MIN`, `n = COS_O_MIN wo + sqrt(1 - COS_O_MIN^2) p` with `p` the part of `n` across `wo`,
+//! normalized (where `n = -wo`, Duff et al.'s first tangent for `wo`, below), and `cos_o = n . wo`
+//! computed again. Every estimator, the converged one included, shades the bent frame, so the
+//! silhouette has no black pixels and the estimators still agree there. Then `t = wo - cos_o n`; if `|t| < 1e-6` (`wo` along the normal)
 //! `t` is the first tangent of the branchless basis of Duff et al. 2017 for `n`
 //! (`s = copysign(1, n.z)`, `a = -1 / (s + n.z)`, `t = (1 + s n.x^2 a, s n.x n.y a, -s n.x)`),
 //! else `t / |t|`; `b = n x t`. In this frame `wo` is
@@ -121,7 +127,17 @@
 //!   0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the level a footprint of
 //!   solid angle `1 / (spp p_b)` gets at the equator, wherever it lies; "Small bright sources"
 //!   says why); `M` the environment's peaks, `p_l` theirs ([`Peaks`]).
-//! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"): `F` the smooth part's Phong layers
+//! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"), with the BRDF split in two: its
+//!   diffuse part `f_d` ([`diffuse_split`]: the table's least value within 60 degrees of the
+//!   normal, [`diffuse_part`],
+//!   where the first layer is the cosine lobe `n = 1`; else 0) and the rest. The diffuse part's
+//!   integral against the smooth part is a layer: `int f_d L_s cos = pi f_d L_1(n)`, `L_1` the
+//!   cosine layer (`(1 / pi) max(0, w . n)`) read at the normal, added once per pixel and
+//!   without noise. Read in the BRDF samples' directions instead, as the rest is, a broad
+//!   layer blurs the light around each direction, and a diffuse lobe's directions reach the
+//!   horizon: the light of the ground wrapped over a Lambertian sphere's lower half (9.5 levels
+//!   of 8-bit bias). The rest, `f - f_d` in the `F` term (the `M` term keeps `f`): `F` the
+//!   smooth part's Phong layers
 //!   ([`Lighting::smooth_layers`]) blended at the pixel's layer coordinate `x` =
 //!   [`view_layer`]`(cos_o)` (the material's [`Material::view_layers`], one per row of the
 //!   bandwidth atlas, interpolated between the rows' centres) `+ layer_shift`, at most the last
@@ -205,16 +221,18 @@ pub mod metrics;
 pub mod raster;
 
 mod camera;
+mod diffuse;
 mod error;
 mod lighting;
 mod mesh;
 mod shade;
 
 pub use camera::{Camera, Rays};
+pub use diffuse::{DIFFUSE_MIN_COS, diffuse_part, diffuse_split};
 pub use error::Error;
 pub use lighting::{Lighting, PEAK_CONTRAST, Peaks};
 pub use mesh::Mesh;
-pub use shade::{Image, check_inputs, check_settings, render, render_with_progress};
+pub use shade::{COS_O_MIN, Image, check_inputs, check_settings, render, render_with_progress};
 
 use merl::MerlTable;
 use sampling::OwenSobol2D;
@@ -267,13 +285,27 @@ pub struct Material {
     pub samples: SampleSet,
     /// For [`Mode::Prefiltered`]: where each of `R` view elevations, in equal steps of
     /// `cos theta_o`, falls among the Phong layers of [`Lighting::layers`], as a layer coordinate
-    /// (`brdf_atlas::view::layer_coordinate`: `k + t` blends layer `k` and `k + 1` by `t`). Row
+    /// (`brdf_atlas::view::view_coordinates`: the layer of twice the view's bandwidth, `k + t`
+    /// blending layer `k` and `k + 1` by `t`). Row
     /// `r` is for `1 - cos theta_o = (r + 1/2) / R`; a pixel interpolates the rows around it
     /// ([`view_layer`]).
     pub view_layers: Vec<f32>,
+    /// The table's diffuse part `f_d` (1/sr per channel, [`diffuse_part`]), which
+    /// [`Mode::Prefiltered`] reads from the cosine layer at the normal (crate documentation, "The
+    /// estimators").
+    pub diffuse: [f32; 3],
     /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
     /// the table (`brdf-preview --brdf wavelet-brdf`): see "The BRDF" in the crate docs.
     pub wavelet_brdf: Option<WaveletBrdf>,
+}
+
+impl Material {
+    /// The material of a table, its sample set and view layers, with the table's diffuse part
+    /// ([`diffuse_part`]) and no wavelet encoding.
+    pub fn new(table: MerlTable, samples: SampleSet, view_layers: Vec<f32>) -> Material {
+        let diffuse = diffuse_part(&table);
+        Material { table, samples, view_layers, diffuse, wavelet_brdf: None }
+    }
 }
 
 /// A wavelet encoding of the material (asset kind `wavelet-brdf`, crate `wavelet_brdf`) and the

@@ -50,7 +50,7 @@ pub fn render_with_progress(
 }
 
 /// The image of `scene`: `pixel(frame, x, y)` where a triangle of `gbuffer` covers the pixel and
-/// has a shading frame, black where the frame is degenerate, the environment (`level0`) where
+/// has a shading frame, black where its normal interpolates to zero, the environment (`level0`) where
 /// none covers it. In parallel over rows, calling `progress(rows done, rows)` as they finish.
 pub(crate) fn shade_rows(
     scene: &Scene,
@@ -111,7 +111,8 @@ pub(crate) struct ShadingFrame {
 }
 
 impl ShadingFrame {
-    /// `None` where the pixel is black: the normal interpolated to zero or faces away from the eye.
+    /// `None` where the pixel is black: the normal interpolated to zero (or not a number). A
+    /// normal that turns away from the eye, or nearly, is bent towards it ([`bend_towards`]).
     pub fn new(hit: &Hit, eye: DVec3) -> Option<ShadingFrame> {
         let n = hit.normal;
         if n == DVec3::ZERO {
@@ -119,9 +120,15 @@ impl ShadingFrame {
         }
         let wo = (eye - hit.position).normalize();
         let cos_o = n.dot(wo);
-        if cos_o.is_nan() || cos_o <= 0.0 {
+        if cos_o.is_nan() {
             return None;
         }
+        let (n, cos_o) = if cos_o < COS_O_MIN {
+            let bent = bend_towards(n, wo, cos_o);
+            (bent, bent.dot(wo))
+        } else {
+            (n, cos_o)
+        };
         let tangent = wo - cos_o * n;
         let sin_o = tangent.length();
         let t = if sin_o < 1e-6 { duff_tangent(n) } else { tangent / sin_o };
@@ -142,6 +149,22 @@ impl ShadingFrame {
     pub fn theta_o(&self) -> f64 {
         self.wo_local.x.atan2(self.wo_local.z)
     }
+}
+
+/// The least `cos theta_o` a shading frame has: a normal that turns further from the eye is bent
+/// towards it until `n . wo` is this (crate documentation, "The shading frame"). Filament's
+/// `MIN_N_DOT_V`.
+pub const COS_O_MIN: f64 = 1e-4;
+
+/// The unit normal `n` (with `cos_o = n . wo < COS_O_MIN`) rotated towards `wo` in the plane of
+/// the two until `n . wo = COS_O_MIN`: `COS_O_MIN wo + sqrt(1 - COS_O_MIN^2) p`, `p` the part of
+/// `n` across `wo` normalized (the first tangent of Duff et al.'s basis for `wo` where `n` is
+/// `-wo`, so that the two renderers agree).
+pub(crate) fn bend_towards(n: DVec3, wo: DVec3, cos_o: f64) -> DVec3 {
+    let across = n - cos_o * wo;
+    let length = across.length();
+    let p = if length < 1e-6 { duff_tangent(wo) } else { across / length };
+    COS_O_MIN * wo + (1.0 - COS_O_MIN * COS_O_MIN).sqrt() * p
 }
 
 /// The first tangent of the branchless orthonormal basis of Duff et al. 2017 ("Building an
@@ -210,6 +233,17 @@ pub(crate) fn shade(
         (_, Some(peaks)) => Some((&peaks.sampling, &peaks.map)),
         (_, None) => None,
     };
+    // The diffuse part the prefiltered estimator takes out of the BRDF, and its integral (crate
+    // documentation, "The estimators").
+    let (diffuse, diffuse_radiance) = match settings.mode {
+        Mode::Prefiltered => {
+            let f_d = crate::diffuse_split(material, lighting).map(f64::from);
+            let (u, v) = envmap::uv(frame.n);
+            let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
+            (f_d, std::array::from_fn(|c| std::f64::consts::PI * f_d[c] * f64::from(l_1[c])))
+        }
+        Mode::Reference | Mode::Fis => ([0.0; 3], [0.0; 3]),
+    };
     let mut total = [0.0f64; 3];
     let mut add = |f: [f64; 3], radiance: [f32; 3], weight: f64| {
         for c in 0..3 {
@@ -225,7 +259,8 @@ pub(crate) fn shade(
             let wi_local = sample.wi;
             if sample.pdf > 0.0 && wi_local.z > 0.0 {
                 let f = brdf(material, wi_local, frame.wo_local);
-                if f != [0.0; 3] {
+                let rest: [f64; 3] = std::array::from_fn(|c| f[c] - diffuse[c]);
+                if f != [0.0; 3] || rest != [0.0; 3] {
                     let wi = frame.to_world(wi_local);
                     let (u, v) = envmap::uv(wi);
                     match filtered {
@@ -235,7 +270,7 @@ pub(crate) fn shade(
                             } else {
                                 a.lookup_uv(u, v)
                             };
-                            add(f, radiance, wi_local.z / sample.pdf);
+                            add(rest, radiance, wi_local.z / sample.pdf);
                         }
                         Some(Source::Mips(mips)) => {
                             let lod = mips.lod_solid_angle(spp as usize, sample.pdf);
@@ -264,7 +299,7 @@ pub(crate) fn shade(
         }
     }
     let samples = f64::from(spp) * f64::from(settings.frames);
-    total.map(|t| t / samples)
+    std::array::from_fn(|c| total[c] / samples + diffuse_radiance[c])
 }
 
 /// `(1 - t) a + t b`.

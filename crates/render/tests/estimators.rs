@@ -47,7 +47,7 @@ fn the_reference_modes_error_carries_no_structure() {
     let table = merl::analytic::Analytic::Lambertian { albedo: [0.5; 3] }.table(merl::Dims::MERL);
     let config = importance::Config { n_vectors: 2, n_samples: 64, ..importance::Config::default() };
     let samples = render::SampleSet::new(&importance::build(&table, &config).expect("a valid config"));
-    let material = &Material { table, samples, view_layers: vec![0.0], wavelet_brdf: None };
+    let material = &Material::new(table, samples, vec![0.0]);
     let settings = Settings { mode: Mode::Reference, spp: 64, frames: render::frames_to_exhaust(2, 64, 64), seed: 1 };
     let image = render::render(&scene, material, &lighting, &settings).expect("valid inputs");
     let truth = converged(&scene, material, &lighting, 256, 9).expect("valid inputs");
@@ -93,8 +93,10 @@ const SUN_TEXEL: (usize, usize) = (10, 22);
 /// not the whole light: what the filters make of the smooth sky is the other test's business
 /// (a Lambertian's broadest layer, read at cosine-distributed directions, blurs this sky's
 /// horizon twice, 5% dark with or without the sun). The same lighting without its peaks (the
-/// papers' estimators, the whole map filtered) misses by more than 10% in at least one case:
-/// the scene is one that needs them.
+/// papers' estimators, the whole map filtered) misses by more than 4% in at least one case
+/// (measured: 4.5%, prefiltered phong 100 with the sun behind; fis 2%; the Lambertian's
+/// prefiltered diffuse part reads the cosine layer at the normal, exact with the sun in it): the
+/// scene is one that needs them.
 #[test]
 fn the_filtered_modes_hold_the_light_of_a_small_bright_source() {
     let (sunny, plain) = (sunny_lighting(2000.0), sunny_lighting(1.0));
@@ -133,7 +135,7 @@ fn the_filtered_modes_hold_the_light_of_a_small_bright_source() {
             }
         }
     }
-    assert!(worst_unsplit > 0.1, "without the peaks the worst case is only {worst_unsplit:.4} off");
+    assert!(worst_unsplit > 0.04, "without the peaks the worst case is only {worst_unsplit:.4} off");
 }
 
 /// The prefiltered mode blends the two layers around a view's coordinate, and the coordinate moves
@@ -141,12 +143,14 @@ fn the_filtered_modes_hold_the_light_of_a_small_bright_source() {
 /// layers, the second twice the first, and two rows, the first on layer 0 and the second on layer
 /// 1: reading each row's layer whole doubles the light between neighbouring pixels where the rows
 /// meet; blended, the light ramps between the rows' centres, by 12% per pixel at most along the
-/// sphere's middle row (measured: 9%; the noise of a Lambertian's 256 samples is 1%).
+/// sphere's middle row (measured: 9%; the noise of a Lambertian's 256 samples is 1%). The
+/// Lambertian's diffuse part set to 0, so that the whole lobe is read in the layers (its diffuse
+/// part is read from the first layer at the normal, whatever the view's coordinate).
 #[test]
 fn the_prefiltered_mode_leaves_no_seam_where_the_layer_changes() {
     let layer = |k: f32| EnvMap::constant(64, 32, support::L.map(|c| c * k)).expect("a 2:1 map");
     let lighting = Lighting::new(MipChain::new(&layer(1.0)), vec![layer(1.0), layer(2.0)], vec![1, 4]).expect("valid");
-    let material = Material { view_layers: vec![0.0, 1.0], ..support::lambertian(0).clone() };
+    let material = Material { view_layers: vec![0.0, 1.0], diffuse: [0.0; 3], ..support::lambertian(0).clone() };
     let scene = support::sphere_scene(64, 64);
     let settings = Settings { mode: Mode::Prefiltered, spp: 64, frames: 4, seed: 2 };
     let image = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
@@ -158,4 +162,115 @@ fn the_prefiltered_mode_leaves_no_seam_where_the_layer_changes() {
     println!("middle row: light from {lo:.3} to {hi:.3}, largest step between neighbours {:.1}%", 100.0 * worst);
     assert!(hi / lo > 1.8, "the row does not cross from one layer to the other: {lo} to {hi}");
     assert!(worst < 0.12, "a step of {:.1}% between neighbouring pixels", 100.0 * worst);
+}
+
+/// The diffuse part of the analytic tables: all of a Lambertian's value (albedo / pi), none of a
+/// Phong lobe's (it falls to 0 away from its mirror direction), and a Phong lobe's Lambertian base.
+/// The table holds each value scaled into MERL's integer-free doubles, so the least cell equals
+/// the analytic value to rounding (1e-9 relative).
+#[test]
+fn the_diffuse_part_of_a_table_is_its_lambertian_base() {
+    use merl::analytic::Analytic;
+    let pi = std::f64::consts::PI;
+    let part = |brdf: Analytic| render::diffuse_part(&brdf.table(merl::Dims::MERL)).map(f64::from);
+    let close = |a: [f64; 3], b: [f64; 3]| a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= 1e-6 * y.abs().max(1e-3));
+    let albedo = [0.2, 0.5, 0.8];
+    let lambertian = part(Analytic::Lambertian { albedo });
+    assert!(close(lambertian, albedo.map(|a| a / pi)), "lambertian: {lambertian:?}");
+    let phong = part(Analytic::Phong { n: 200.0, ks: [1.0; 3], kd: [0.0; 3] });
+    assert!(phong.iter().all(|&v| v < 1e-6), "phong: {phong:?}");
+    let kd = [0.1, 0.2, 0.3];
+    let base = part(Analytic::Phong { n: 200.0, ks: [0.5; 3], kd });
+    assert!(close(base, kd.map(|a| a / pi)), "phong over a lambertian base: {base:?}");
+    // A GGX lobe never reaches 0: its diffuse part is the least value the renderers look up with
+    // both directions within 60 degrees of the normal, so the rest `f - f_d` is never negative
+    // there. Held to the table's nearest lookup at 100 000 direction pairs drawn uniformly over
+    // those caps (a pair's cells may reach a degree further out, where the lobe is no lower).
+    for alpha in [0.1, 0.5] {
+        let table = Analytic::Ggx { alpha, f0: [0.9, 0.6, 0.3] }.table(merl::Dims::MERL);
+        let f_d = render::diffuse_part(&table).map(f64::from);
+        assert!(f_d.iter().all(|&v| v > 0.0), "ggx {alpha}: {f_d:?}");
+        let mut state = 7u32;
+        let mut next = || {
+            state = render::pcg_hash(state);
+            f64::from(state) / 4_294_967_296.0
+        };
+        let mut upper = || merl::spherical_dir((1.0 - 0.5 * next()).acos(), 2.0 * pi * next());
+        let below = (0..100_000)
+            .filter(|_| {
+                // A cell without data counts as 0 in the renderers and in the split alike.
+                let Some(f) = table.lookup(upper(), upper(), merl::Interp::Nearest) else { return false };
+                (0..3).any(|c| f[c] < f_d[c] * (1.0 - 1e-6))
+            })
+            .count();
+        println!("ggx alpha {alpha}: diffuse part {f_d:?}, lookups below it {below}");
+        assert_eq!(below, 0, "ggx {alpha}: {below} lookups below the diffuse part {f_d:?}");
+    }
+}
+
+/// A Lambertian's prefiltered image is the converged estimate's: its diffuse part is read from
+/// the cosine layer at the normal. Read from the layers in the BRDF samples' directions (a
+/// material whose diffuse part is set to 0), the broad layer around each direction blurs the
+/// light across the horizon: the lower half of the sphere, lit by the dim ground and the sky's
+/// wrap, was several percent too bright. On `sky_lighting`, with its sun among the peaks (sampled
+/// unfiltered), 128 x 128: the mean luminance over the lower half within 1% of the converged
+/// estimate (1024 samples per strategy: its noise on that mean is below 0.2%), and the picture's
+/// within 1%; without the split at least 3% off on the lower half (measured below).
+#[test]
+fn the_prefiltered_lambertian_reads_its_diffuse_part_at_the_normal() {
+    let lighting = support::sky_lighting();
+    let scene = support::sphere_scene(128, 128);
+    let material = Material { view_layers: vec![0.0; 8], ..support::lambertian(0).clone() };
+    assert!(material.diffuse.iter().all(|&v| (f64::from(v) - 0.5 / std::f64::consts::PI).abs() < 1e-6));
+    let truth = converged(&scene, &material, &lighting, 1024, 5).expect("valid inputs");
+    let settings = Settings { mode: Mode::Prefiltered, spp: 16, frames: 8, seed: 6 };
+    let split = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
+    let unsplit_material = Material { diffuse: [0.0; 3], ..material.clone() };
+    let unsplit = render::render(&scene, &unsplit_material, &lighting, &settings).expect("valid inputs");
+    let lower = |image: &Image| {
+        let covered = (0..image.covered.len()).map(|i| image.covered[i] && i / image.width >= image.height / 2);
+        metrics::mean_luminance(&Image { covered: covered.collect(), ..image.clone() })
+    };
+    let off = |image: &Image| {
+        (lower(image) / lower(&truth) - 1.0, metrics::mean_luminance(image) / metrics::mean_luminance(&truth) - 1.0)
+    };
+    let ((split_lower, split_all), (unsplit_lower, unsplit_all)) = (off(&split), off(&unsplit));
+    println!(
+        "lower half / whole sphere against the converged estimate: split {split_lower:+.4} / {split_all:+.4}, \
+         unsplit {unsplit_lower:+.4} / {unsplit_all:+.4}"
+    );
+    assert!(split_lower.abs() < 0.01 && split_all.abs() < 0.01, "split: {split_lower:+.4} / {split_all:+.4}");
+    assert!(unsplit_lower.abs() > 0.03, "the unsplit estimate is only {unsplit_lower:+.4} off: the test shows nothing");
+}
+
+/// No covered pixel is black at the silhouette: at 512 x 512 the default sphere and camera put
+/// pixel centres on triangles whose interpolated normals turn away from the eye (16 of them were
+/// black), and every one is shaded with its normal bent towards the eye. Prefiltered, on a
+/// Lambertian under a constant light: each pixel is then its diffuse part alone, `albedo L`
+/// exactly, whatever the normal, and no pixel may be 0.
+#[test]
+fn no_covered_pixel_is_black_at_the_silhouette() {
+    let lighting = support::constant_lighting();
+    let scene = Scene { mesh: render::Mesh::sphere(1.0, 128, 64), camera: Camera::default(), width: 512, height: 512 };
+    let gbuffer = render::raster::rasterize(&scene.mesh, scene.camera.view_proj(1.0), 512, 512).expect("a valid scene");
+    let eye = scene.camera.eye().as_dvec3();
+    let turned = (gbuffer.hits.iter().flatten())
+        .filter(|hit| hit.normal.dot((eye - hit.position).normalize()) < render::COS_O_MIN)
+        .count();
+    assert!(turned > 0, "no pixel's normal turns away from the eye: the test shows nothing");
+    let material = Material { view_layers: vec![0.0; 8], ..support::lambertian(0).clone() };
+    let settings = Settings { mode: Mode::Prefiltered, spp: 1, frames: 1, seed: 0 };
+    let image = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
+    let expected = support::L.map(|l| 0.5 * f64::from(l));
+    let wrong: Vec<usize> = (0..512 * 512)
+        .filter(|&i| image.covered[i])
+        .filter(|&i| (0..3).any(|c| (f64::from(image.rgb[3 * i + c]) - expected[c]).abs() > 1e-5 * expected[c]))
+        .collect();
+    println!("{turned} pixels' normals turn away from the eye; {} covered pixels differ from albedo L", wrong.len());
+    assert!(
+        wrong.is_empty(),
+        "{} covered pixels are not albedo L, the first {:?}",
+        wrong.len(),
+        &wrong[..wrong.len().min(8)]
+    );
 }

@@ -18,7 +18,7 @@ fn material(brdf: Analytic, bake_seed: u64) -> Material {
     let table = brdf.table(Dims::MERL);
     let config = Config { n_vectors: 16, n_samples: 512, seed: bake_seed, ..Config::default() };
     let tables = importance::build(&table, &config).expect("a valid config");
-    Material { samples: SampleSet::new(&tables), table, view_layers: vec![0.0; 8], wavelet_brdf: None }
+    Material::new(table, SampleSet::new(&tables), vec![0.0; 8])
 }
 
 /// Lambertian, albedo 0.5, baked with seed 0 or 1.

@@ -242,6 +242,13 @@ export class Bake {
         const defaults = this.defaults(mode);
         spp = spp ?? defaults.spp;
         frames = frames ?? defaults.frames;
+        const diffuse = f.diffuse;
+        if (!(Array.isArray(diffuse) && diffuse.length === 3 && diffuse.every((v) => Number.isFinite(v) && v >= 0))) {
+            throw new BakeError(
+                `error: manifest.json: the engine textures' diffuse is ${JSON.stringify(diffuse)}, expected three ` +
+                    'finite values of at least 0 (a bake older than this loader: bake it again)',
+            );
+        }
         if (!(spp > 0 && (spp & (spp - 1)) === 0 && f.samples % spp === 0)) {
             throw new BakeError(`error: spp ${spp} must be a power of two dividing the bake's ${f.samples} samples`);
         }
@@ -258,6 +265,7 @@ export class Bake {
             uRows: { value: f.rows },
             uSectors: { value: f.sectors },
             uPeaks: { value: Boolean(f.peaks) },
+            uDiffuse: { value: new THREE.Vector3(...diffuse) },
             uFirstFrame: { value: firstFrame },
             uFrameCount: { value: frames },
             uDivisor: { value: divisor ?? frames },

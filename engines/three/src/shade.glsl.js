@@ -177,6 +177,9 @@ uniform uint uSamples;
 uniform uint uRows;
 uniform uint uSectors;
 uniform bool uPeaks;
+// render::diffuse_split (the manifest's diffuse): the BRDF's diffuse part f_d, which the
+// prefiltered estimator reads from the cosine layer (the first) at the normal.
+uniform vec3 uDiffuse;
 // The frames this draw sums (first, count), and what the sum is divided by.
 uniform uint uFirstFrame;
 uniform uint uFrameCount;
@@ -484,15 +487,31 @@ vec3 duff_tangent(vec3 n) {
     return vec3(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
 }
 
-// render::shade::ShadingFrame::new (shading_frame); false where the pixel is black.
+// render::COS_O_MIN (COS_O_MIN).
+const float COS_O_MIN = 1e-4;
+
+// render::shade::bend_towards (bend_towards): n rotated towards wo until n . wo = COS_O_MIN.
+vec3 bend_towards(vec3 n, vec3 wo, float cos_o) {
+    vec3 across = n - cos_o * wo;
+    float len = length(across);
+    vec3 p = len < 1e-6 ? duff_tangent(wo) : across / len;
+    return COS_O_MIN * wo + sqrt(1.0 - COS_O_MIN * COS_O_MIN) * p;
+}
+
+// render::shade::ShadingFrame::new (shading_frame); false where the pixel is black (a normal
+// interpolated to zero).
 bool shading_frame(vec3 position, vec3 n, out ShadingFrame frame) {
     if (all(equal(n, vec3(0.0)))) {
         return false;
     }
     vec3 wo = normalize(cameraPosition - position);
     float cos_o = dot(n, wo);
-    if (!(cos_o > 0.0)) {
+    if (isnan(cos_o)) {
         return false;
+    }
+    if (cos_o < COS_O_MIN) {
+        n = bend_towards(n, wo, cos_o);
+        cos_o = dot(n, wo);
     }
     vec3 tangent = wo - cos_o * n;
     float sin_o = length(tangent);
@@ -572,19 +591,24 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     bool light_valid = reference || uPeaks;
     int light = reference ? 0 : 1;
     LayerBlend blend = LayerBlend(0, 0.0);
+    vec3 diffuse = vec3(0.0);
+    vec3 sum = vec3(0.0);
     if (uMode == MODE_PREFILTERED) {
         blend = layer_blend(frame);
+        // The diffuse part's integral, once per term (the sum is divided by spp).
+        diffuse = uDiffuse;
+        sum = (PI * diffuse * env_bilinear(uLayers, 0, env_uv(frame.n))) * float(spp);
     }
-    vec3 sum = vec3(0.0);
     for (uint j = 0u; j < spp; j++) {
         uint index = base + j;
         DirectionSample s = brdf_sample(k, sequence_point(words.xy, index));
         if (s.pdf > 0.0 && s.wi.z > 0.0) {
             vec3 brdf = material_brdf(s.wi, frame.wo_local);
-            if (any(notEqual(brdf, vec3(0.0)))) {
+            vec3 rest = brdf - diffuse;
+            if (any(notEqual(brdf, vec3(0.0))) || any(notEqual(rest, vec3(0.0)))) {
                 vec2 uv = env_uv(to_world(frame, s.wi));
                 if (uMode == MODE_PREFILTERED) {
-                    sum += brdf * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
+                    sum += rest * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
                 }
                 if (light_valid) {
                     float weight = mis_weight(s.pdf, latlong_pdf(light, uv));

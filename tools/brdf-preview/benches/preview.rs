@@ -72,8 +72,7 @@ fn main() {
         let samples = render::SampleSet::new(&tables);
         for (env, lighting, preview) in &environments {
             let start = Instant::now();
-            let material =
-                Material { table: table.clone(), samples: samples.clone(), view_layers: vec![0.0], wavelet_brdf: None };
+            let material = Material::new(table.clone(), samples.clone(), vec![0.0]);
             let converged =
                 render::converged::converged(&scene, &material, lighting, converged_samples, 1).expect("converged");
             let converged_picture = metrics::tonemap(&converged, preview);
@@ -152,8 +151,7 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
 
 /// PSNR of one CPU render against the case's converged estimate.
 fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<f32>, mode: Mode, spp: u32, frames: u32) -> f64 {
-    let material =
-        Material { table: case.table.clone(), samples: case.samples.clone(), view_layers, wavelet_brdf: None };
+    let material = Material::new(case.table.clone(), case.samples.clone(), view_layers);
     let image =
         render::render(scene, &material, &case.lighting, &Settings { mode, spp, frames, seed: 0 }).expect("render");
     metrics::psnr_db(&metrics::tonemap(&image, &case.preview), &case.converged_picture)
@@ -172,12 +170,11 @@ fn modes(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene, exponents: &[u32]) {
             select_layers_of_table(&pair[0].table, &config, exponents, bake::stage::layers::DEFAULT_REDUCTION)
                 .expect("selection");
         for case in pair {
-            let material = Material {
-                table: case.table.clone(),
-                samples: case.samples.clone(),
-                view_layers: view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth),
-                wavelet_brdf: None,
-            };
+            let material = Material::new(
+                case.table.clone(),
+                case.samples.clone(),
+                view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth),
+            );
             let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let runs = [
                 (Mode::Reference, 16, 1),
@@ -225,12 +222,7 @@ fn expectation(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene) {
         let tables = importance::build(&pair[0].table, &config).expect("importance tables");
         let samples = render::SampleSet::new(&tables);
         for case in pair {
-            let material = Material {
-                table: case.table.clone(),
-                samples: samples.clone(),
-                view_layers: vec![0.0],
-                wavelet_brdf: None,
-            };
+            let material = Material::new(case.table.clone(), samples.clone(), vec![0.0]);
             let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let spp = 256;
             let frames = render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp);

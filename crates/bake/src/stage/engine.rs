@@ -141,6 +141,7 @@ pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Resul
         ("exponents", json!(lighting.exponents)),
         ("peaks", json!(lighting.peaks.is_some())),
         ("peak_threshold", json!(lighting.peaks.as_ref().map(|p| p.threshold))),
+        ("diffuse", json!(render::diffuse_split(material, lighting))),
         ("exposure_ev", json!(exposure_ev)),
         ("previewer", json!({ "reference": defaults(Mode::Reference), "prefiltered": defaults(Mode::Prefiltered) })),
     ]);

@@ -207,6 +207,9 @@ pub struct Renderer {
     n_levels: u32,
     n_layers: usize,
     view_layers: Vec<f32>,
+    /// `render::diffuse_split`: the BRDF's diffuse part the prefiltered estimator reads at the
+    /// normal.
+    diffuse: [f32; 3],
     maps: MapLayout,
     tables: TableLayout,
 }
@@ -705,6 +708,7 @@ impl Renderer {
             _pad0: 0,
             _pad1: 0,
             _pad2: 0,
+            diffuse: [self.diffuse[0], self.diffuse[1], self.diffuse[2], 0.0],
         }
     }
 

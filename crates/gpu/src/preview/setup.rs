@@ -318,6 +318,7 @@ impl Renderer {
                 n_levels: lighting.mips.n_levels() as u32,
                 n_layers: lighting.layers.len(),
                 view_layers: material.view_layers.clone(),
+                diffuse: render::diffuse_split(material, lighting),
                 maps,
                 tables: sampling_layout,
             }

@@ -70,6 +70,8 @@ pub(crate) struct ShadeUniform {
     pub(crate) _pad0: u32,
     pub(crate) _pad1: u32,
     pub(crate) _pad2: u32,
+    /// `render::diffuse_split` (w unused): the prefiltered estimator's diffuse part.
+    pub(crate) diffuse: [f32; 4],
 }
 
 /// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,
