@@ -62,3 +62,34 @@ fn auto_exposure_maps_the_log_average_to_the_key() {
     assert_eq!(metrics::tonemap(&image, &preview), envmap::tonemap_rgb8(&image.rgb, &preview));
     assert_ne!(metrics::tonemap(&image, &ToneMapping::default()), metrics::tonemap(&image, &preview));
 }
+
+#[test]
+fn windowed_bias_keeps_offsets_and_averages_noise() {
+    let (w, h) = (20, 20);
+    let all = vec![true; w * h];
+    // A constant offset of 2 levels is a bias of 2 everywhere, whatever the window.
+    let bias = metrics::windowed_bias(&vec![102; 3 * w * h], &vec![100; 3 * w * h], w, h, &all);
+    assert_eq!((bias.p99, bias.max, bias.mean), (2.0, 2.0, 2.0));
+    // A checkerboard of +-7 levels: noise, not structure. Inside, a window holds 25 of one sign
+    // and 24 of the other: 7 / 49 = 1/7 of a level at most (partial windows at the edges hold
+    // more of one sign, up to 2 of 6 at a corner's 4 x 4: 7 * 2 / 16).
+    let a: Vec<u8> = (0..w * h).flat_map(|i| [if (i % w + i / w) % 2 == 0 { 107 } else { 93 }; 3]).collect();
+    let bias = metrics::windowed_bias(&a, &vec![100; 3 * w * h], w, h, &all);
+    assert!(bias.max <= 7.0 * 2.0 / 16.0 + 1e-12 && bias.p99 <= 7.0 * 2.0 / 16.0 + 1e-12, "{bias:?}");
+    // One pixel 49 levels off: 1 level over its window's 49 pixels.
+    let mut a = vec![100u8; 3 * w * h];
+    a[3 * (10 * w + 10)] = 149;
+    let bias = metrics::windowed_bias(&a, &vec![100; 3 * w * h], w, h, &all);
+    assert_eq!(bias.max, 1.0);
+    // Excluded pixels enter no window: a band of +50 outside the mask changes nothing.
+    let mut include = all.clone();
+    let mut a = vec![100u8; 3 * w * h];
+    for x in 0..w {
+        include[x] = false;
+        a[3 * x..3 * x + 3].fill(150);
+    }
+    let bias = metrics::windowed_bias(&a, &vec![100; 3 * w * h], w, h, &include);
+    assert_eq!((bias.p99, bias.max), (0.0, 0.0));
+    let none = metrics::windowed_bias(&a, &a, w, h, &vec![false; w * h]);
+    assert_eq!(none.max, 0.0);
+}

@@ -3,8 +3,10 @@
 //!
 //! # What is compared
 //!
-//! Twelve cases: white-paint, gold-paint and chrome (real-derived MERL tables, target/merl/) under
-//! quarry_01 (a small, very bright sun) and studio_small_03 (softboxes), each seen by two cameras:
+//! Sixteen cases: a Lambertian (`merl-synth lambertian`'s table, albedo 0.5, made under
+//! target/bench-mitsuba/), white-paint, gold-paint and chrome (real-derived MERL tables,
+//! target/merl/) under quarry_01 (a small, very bright sun) and studio_small_03 (an indoor map of
+//! softboxes), each seen by two cameras:
 //! `sun`, in the direction of the map's brightest texel (the camera then sees that light's mirror
 //! reflection at the sphere's centre), and `away`, at the opposite azimuth and the same elevation
 //! (the light behind the sphere). The project's UV sphere of the previewer (`Mesh::sphere(1, 128,
@@ -13,12 +15,16 @@
 //!
 //! Our images, as `brdf-preview` makes them by default: the converged estimate
 //! (`render::converged`, 1024 samples per strategy), then `reference`, `fis` and `prefiltered` at
-//! the previewer's defaults (`render::Settings::previewer`). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
+//! the previewer's defaults (`render::Settings::previewer`), and one frame of `adaptive` and
+//! `adaptive-prefiltered` at theirs ([`ours`]). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
 //! renderer computes; a convex sphere has no interreflection), 4096 spp, two seeds. Per case and
 //! mode: the PSNR against Mitsuba's seed 0 on the 8-bit pictures (`render::metrics`, one exposure
 //! for all: `metrics::auto_tone_mapping` of the map), over the whole picture (the background included,
 //! as `metrics::psnr_db` takes it) and over the sphere alone; the ratio of the sphere's mean
-//! luminance to Mitsuba's and the same per channel. Mitsuba's floor: its seed 1 against its seed
+//! luminance to Mitsuba's and the same per channel; and the structure of the difference, with the
+//! noise averaged out (`metrics::windowed_bias`: the signed 8-bit difference averaged over the
+//! sphere's pixels of a 7 x 7 window, its 99th percentile and maximum magnitude in levels), which
+//! shows bands, blocks and shading errors where a PSNR mixes them with noise. Mitsuba's floor: its seed 1 against its seed
 //! 0, the same figures. An image without error scores about 3 dB above the floor (it differs from
 //! seed 0 by seed 0's noise alone, where two seeds differ by twice its variance); an image exactly
 //! as noisy as Mitsuba's scores the floor. The floor's luminance ratio says how far Mitsuba's mean
@@ -85,11 +91,23 @@ use std::time::Instant;
 use envmap::EnvMap;
 use picture::Canvas;
 use picture::layout::Grid;
-use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, metrics};
+use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, adaptive, metrics};
 use serde_json::{Value, json};
 
 const MAPS: [&str; 2] = ["quarry_01", "studio_small_03"];
-const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
+const MATERIALS: [&str; 4] = ["lambertian", "white-paint", "gold-paint", "chrome"];
+
+/// A case's MERL table: `lambertian` is `merl-synth lambertian`'s (albedo 0.5), written under
+/// target/bench-mitsuba/; the others are real-derived ([`material_path`]).
+fn table_path(material: &str) -> PathBuf {
+    if material != "lambertian" {
+        return material_path(material);
+    }
+    let path = work().join("lambertian.binary");
+    let table = merl::analytic::Analytic::Lambertian { albedo: [0.5; 3] }.table(merl::Dims::MERL);
+    write(&path, &table.to_bytes());
+    path
+}
 const VIEWS: [&str; 2] = ["sun", "away"];
 
 fn work() -> PathBuf {
@@ -150,7 +168,7 @@ fn options() -> Options {
 fn bake(material: &str, map: &str) -> bake::Loaded {
     let dir = work().join(format!("{material}-{map}"));
     let environment = shared().join("data/env").join(format!("{map}_1k.hdr"));
-    let config = bake::BakeConfig::new(material_path(material), Some(environment), dir.clone());
+    let config = bake::BakeConfig::new(table_path(material), Some(environment), dir.clone());
     let program = bake::Program { name: "mitsuba-bench", version: env!("CARGO_PKG_VERSION") };
     bake::run_bake(&config, &program, &|_| {}).unwrap_or_else(|e| panic!("baking {material} under {map}: {e}"));
     bake::load(&dir, None).unwrap_or_else(|e| panic!("loading the bake {}: {e}", dir.display()))
@@ -181,9 +199,17 @@ fn scene(azimuth: f32, elevation: f32, size: usize) -> Scene {
 }
 
 /// Our images of a case, as `brdf-preview` renders them by default (its `run`): the converged
-/// estimate, then each mode at its default samples and frames. The one place that builds
-/// `render`'s settings.
-fn ours(scene: &Scene, material: &Material, lighting: &Lighting, converged: u32) -> Vec<(&'static str, Image, f64)> {
+/// estimate, then each mode at its default samples and frames, then one adaptive frame of each
+/// estimator at `brdf-preview`'s defaults (its `--help`: 8 samples per pixel for `adaptive`, 4
+/// for `adaptive-prefiltered`, `--predict-level 2`, the area allocation, no supersampling, the
+/// default layer shift). The one place that builds `render`'s settings.
+fn ours(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &adaptive::Bandwidths,
+    converged: u32,
+) -> Vec<(&'static str, Image, f64)> {
     let start = Instant::now();
     let image = render::converged::converged(scene, material, lighting, converged, 0).expect("the converged estimate");
     let mut images = vec![("converged", image, start.elapsed().as_secs_f64())];
@@ -193,6 +219,17 @@ fn ours(scene: &Scene, material: &Material, lighting: &Lighting, converged: u32)
         let image = render::render(scene, material, lighting, &settings)
             .unwrap_or_else(|e| panic!("rendering {}: {e}", mode.name()));
         images.push((mode.name(), image, start.elapsed().as_secs_f64()));
+    }
+    for (name, mode, spp) in [("adaptive", Mode::Reference, 8), ("adaptive-prefiltered", Mode::Prefiltered, 4)] {
+        let settings = adaptive::Settings {
+            predict_level: 2,
+            allocation: adaptive::Allocation::Area,
+            ..adaptive::Settings::new(mode, spp)
+        };
+        let start = Instant::now();
+        let frame = adaptive::render(scene, material, lighting, bandwidths, &settings)
+            .unwrap_or_else(|e| panic!("rendering {name}: {e}"));
+        images.push((name, frame.image, start.elapsed().as_secs_f64()));
     }
     images
 }
@@ -208,9 +245,10 @@ fn background(scene: &Scene, level0: &EnvMap) -> Vec<f32> {
 /// of the figures on the sphere. There the view's cosine changes by more than this within a
 /// thousandth of a pixel, so the two renderers' roundings (ours snaps the projected vertices to
 /// 1/256 pixel and interpolates at the pixel centre; Mitsuba intersects the ray in `f32`) decide
-/// whether a pixel is black (`cos theta_o <= 0`, crate `render`, "The shading frame") or lit: one
-/// such pixel of gold-paint (ours black, Mitsuba's at `cos theta_o` = 7e-4 lit) took the whole
-/// picture's PSNR of our converged estimate from 57 to 44 dB. At 128 x 128 about one pixel in a
+/// how a pixel is shaded (ours bends a normal turned from the eye to `cos theta_o` = 1e-4, crate
+/// `render`, "The shading frame"; Mitsuba's shading normal there is its own): one such pixel of
+/// gold-paint (then ours black, Mitsuba's at `cos theta_o` = 7e-4 lit) took the whole picture's
+/// PSNR of our converged estimate from 57 to 44 dB. At 128 x 128 about one pixel in a
 /// thousand of the sphere's is left out; the report gives the count.
 const GRAZING_COS: f64 = 0.02;
 
@@ -436,6 +474,8 @@ struct Figures {
     luminance_ratio: f64,
     /// The same per channel.
     channel_ratio: [f64; 3],
+    /// The 7 x 7 windowed bias over the compared pixels of the sphere, in 8-bit levels.
+    bias: metrics::Bias,
 }
 
 impl Figures {
@@ -445,6 +485,9 @@ impl Figures {
             "psnr_sphere_db": db_json(self.psnr_sphere_db),
             "luminance_ratio": self.luminance_ratio,
             "channel_ratio": self.channel_ratio,
+            "bias_p99_levels": self.bias.p99,
+            "bias_max_levels": self.bias.max,
+            "bias_mean_levels": self.bias.mean,
         })
     }
 }
@@ -476,6 +519,7 @@ fn compare(image: &Image, against: &Image, compared: &Compared, preview: &envmap
         psnr_sphere_db: psnr(&compared.sphere),
         luminance_ratio: metrics::mean_luminance(&sphere(image)) / metrics::mean_luminance(&sphere(against)),
         channel_ratio: std::array::from_fn(|c| channel_mean(image, c) / channel_mean(against, c)),
+        bias: metrics::windowed_bias(&a, &b, image.width, image.height, &compared.sphere),
     }
 }
 
@@ -534,7 +578,7 @@ fn main() {
                 let (azimuth, elevation) = view_angles(level0, view);
                 let scene = scene(azimuth, elevation, size);
                 let dir = work().join(format!("{material_name}-{map_name}-{view}-{size}"));
-                let scene_file = export(&dir, &scene, level0, &material_path(material_name));
+                let scene_file = export(&dir, &scene, level0, &table_path(material_name));
                 if !checked.iter().any(|(m, _, _)| *m == material_name) {
                     let (pairs, differ) = check_lookup(&scene_file, &loaded.material.table, &options);
                     checked.push((material_name, pairs, differ));
@@ -562,7 +606,8 @@ fn main() {
                 variant = seeds[0].info["variant"].as_str().unwrap_or("?").to_string();
 
                 let start = Instant::now();
-                let images = ours(&scene, &loaded.material, lighting, options.converged);
+                let bandwidths = loaded.bandwidths.as_ref().expect("the bake has an environment");
+                let images = ours(&scene, &loaded.material, lighting, bandwidths, options.converged);
                 defaults_described = Mode::ALL
                     .iter()
                     .map(|&mode| {
@@ -570,7 +615,8 @@ fn main() {
                         format!("{} {} spp x {} frames", mode.name(), settings.spp, settings.frames)
                     })
                     .collect::<Vec<_>>()
-                    .join(", ");
+                    .join(", ")
+                    + ", adaptive 8 spp and adaptive-prefiltered 4 spp (one frame each, predict level 2, area allocation)";
                 let ours_s = start.elapsed().as_secs_f64();
                 for (mode, image, _) in &images {
                     let planes: [Vec<f32>; 3] =
@@ -643,16 +689,20 @@ fn main() {
                     );
                     writeln!(
                         table,
-                        "| {name} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} | {:.2} | {:.4} | {seconds:.1} |",
+                        "| {name} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} / {:.2} | {:.2} | {:.2} | {:.4} | {:.2} / {:.2} | {seconds:.1} |",
                         f.psnr_db,
                         f.psnr_sphere_db,
                         f.luminance_ratio,
                         f.channel_ratio[0],
                         f.channel_ratio[1],
                         f.channel_ratio[2],
+                        f.bias.p99,
+                        f.bias.max,
                         floor.psnr_db,
                         floor.psnr_sphere_db,
                         floor.luminance_ratio,
+                        floor.bias.p99,
+                        floor.bias.max,
                     )
                     .unwrap();
                     figures.push(json!({ "mode": mode, "seconds": seconds, "against_mitsuba": f.json() }));
@@ -695,11 +745,11 @@ fn main() {
         "Mitsuba's image of the map alone (1 spp through the pixel centres) against our renderer's background; pixels whose \
          coverage differs between our rasterizer and Mitsuba's ray casts; pixels of the sphere seen at grazing angles (cos \
          theta_o < {GRAZING_COS}). Both kinds are left out of the figures. The wall times of Mitsuba's two renders (as \
-         its script measured them) and of our four images."
+         its script measured them) and of our six images."
     ));
     out(String::new());
     out("| case | camera az, el (deg) | coverage differs | grazing pixels left out | background PSNR dB | background rel. error \
-         | Mitsuba s (2 seeds) | ours s (4 images) |"
+         | Mitsuba s (2 seeds) | ours s (6 images) |"
         .into());
     out("|---|---|---:|---:|---:|---:|---:|---:|".into());
     out(background_table.trim_end().to_string());
@@ -723,12 +773,15 @@ fn main() {
          per-channel means of the sphere's, ours over Mitsuba's; the floor is Mitsuba's seed 1 against its seed 0, the same \
          figures (an image without error scores about 3 dB above its PSNR; its luminance ratio is how far Mitsuba's own mean \
          can be trusted: a light reflected in chrome is a few pixels hundreds of times brighter than the rest, and carries the \
-         mean)."
+         mean). The 7x7 bias: the signed difference of the 8-bit pictures averaged over each sphere pixel's 7 x 7 window \
+         (the sphere's pixels only), its 99th percentile and largest magnitude, in levels: structure, with the noise \
+         averaged out."
         .into());
     out(String::new());
-    out("| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | floor dB | floor sphere dB | floor luminance | ours s |"
+    out("| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | 7x7 bias p99 / max | floor dB | floor sphere dB \
+         | floor luminance | floor 7x7 bias p99 / max | ours s |"
         .into());
-    out("|---|---|---:|---:|---:|---|---:|---:|---:|---:|".into());
+    out("|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|".into());
     out(table.trim_end().to_string());
     std::fs::write(work().join("report.md"), &report).expect("writing report.md");
     let value = json!({
