@@ -477,6 +477,56 @@ fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
     assert!(contents(&dir) == before, "the refused stage changed the bake");
 }
 
+/// A folder moved while a bake runs (`mv D D.old; mkdir D`), and a second bake into the new `D`
+/// at once, at seeded random offsets into the first: each folder ends one complete bake (its
+/// manifest lists exactly the files there, each with its size and hash); where both ran, the first
+/// landed in `D.old` and the second in `D` (issue 42: the staging, the manifest's removal and the
+/// renames went by path, so `D` ended with the first bake's files, or one manifest and 14 unlisted
+/// files, and the moved folder's manifest named files the bake had deleted).
+#[test]
+fn a_folder_moved_during_a_bake_keeps_both_bakes_whole() {
+    let tmp = temp_dir();
+    // The first bake changes a setting (so that it rebakes); the second bakes the reference's.
+    let first_bake = |dir: &Path| bake_command(dir, &["--vectors", "1", "--quiet"]);
+    let measure = copy_of_reference(tmp.path(), "measure");
+    let start = std::time::Instant::now();
+    run(first_bake(&measure), "").expect_code(0);
+    let duration = start.elapsed();
+    let vectors = |m: &serde_json::Value| m["parameters"]["importance"]["vectors"].as_u64();
+
+    let mut rng = rand::rngs::StdRng::seed_from_u64(42);
+    let mut both_ran = 0;
+    for case in 0..4 {
+        let dir = copy_of_reference(tmp.path(), &format!("d{case}"));
+        let moved = tmp.path().join(format!("d{case}.old"));
+        let offset = duration.mul_f64(rng.random_range(0.2..0.9));
+        let first = std::thread::spawn({
+            let cmd = first_bake(&dir);
+            move || run_within(cmd, NO_HANG).0
+        });
+        std::thread::sleep(offset);
+        std::fs::rename(&dir, &moved).unwrap();
+        // The first bake may have created the path again if it had not opened its folder yet.
+        let _ = std::fs::create_dir(&dir);
+        let second = run_within(bake_command(&dir, &["--quiet"]), NO_HANG).0;
+        let first = first.join().expect("the first bake");
+        for r in [&first, &second] {
+            match r.code {
+                Some(0) => {}
+                Some(2) => assert!(r.stderr.contains("another bake is writing this folder"), "case {case}\n{r}"),
+                _ => panic!("case {case}, offset {offset:?}\n{r}"),
+            }
+        }
+        let (old, new) = (check_complete(&moved), check_complete(&dir));
+        if first.code == Some(0) && second.code == Some(0) {
+            both_ran += 1;
+            assert_eq!(vectors(&old), Some(1), "case {case}: the first bake is not in the moved folder\n{first}");
+            assert_ne!(vectors(&new), Some(1), "case {case}: the second bake is not in the new folder\n{second}");
+        }
+    }
+    assert!(both_ran >= 2, "{both_ran} of 4 cases moved the folder while the first bake held it");
+}
+
 /// `brdf-wavelet` into a bake folder adds its stage as `brdf-bake --wavelet-brdf-ratio` would, through
 /// the bake's protocol: the manifest lists the files with their hashes and the settings, the
 /// previewer renders from it by default, and a rebake without the wavelet removes them again.

@@ -28,7 +28,7 @@ use sha2::{Digest, Sha256};
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let folder = folder_of(path);
     check_folder(folder)?;
-    check_replaceable(path)?;
+    check_replaceable_path(path)?;
     let _lock = beside_a_bake(folder, path)?;
     let file = temporary(folder, path, bytes)?;
     file.persist(path).map_err(|e| e.error)?;
@@ -51,10 +51,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 ///
 /// Errors name the target file the caller asked for, never a temporary one.
 pub fn write_set(dir: &Path, files: &[(&str, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
-    create_folder(dir).map_err(|e| (dir.to_path_buf(), e))?;
+    let folder = fsguard::Folder::create(dir).map_err(|e| (dir.to_path_buf(), e))?;
     let names: Vec<&str> = files.iter().map(|(name, _)| *name).collect();
-    remove_temporaries(dir, |target| names.contains(&target)).map_err(|e| (dir.to_path_buf(), e))?;
-    let mut staging = Staging::new(dir);
+    remove_temporaries(&folder, |target| names.contains(&target)).map_err(|e| (dir.to_path_buf(), e))?;
+    let mut staging = Staging::new(&folder).map_err(|e| (dir.to_path_buf(), e))?;
     for (name, bytes) in files {
         staging.add(name, bytes)?;
     }
@@ -71,25 +71,29 @@ pub fn create_folder(dir: &Path) -> std::io::Result<()> {
 /// (`.NAME.XXXXXX.tmp`), and then switched into place by renames alone ([`Staging::commit`]): a
 /// failure while they are written (a full disk, a read-only folder) removes them and leaves the
 /// folder as it was; dropping a `Staging` without committing does the same.
+///
+/// Every step goes through the folder's open descriptor (`openat`, `renameat`, `linkat`,
+/// `unlinkat`), never its path: a folder moved or replaced meanwhile is still the one written,
+/// wherever it is. Names are plain file names (no `/`).
 #[derive(Debug)]
 pub struct Staging {
-    dir: PathBuf,
-    files: Vec<(PathBuf, tempfile::NamedTempFile)>,
-    retired: Vec<PathBuf>,
+    folder: fsguard::Folder,
+    /// Each target's name and its temporary file's.
+    files: Vec<(String, String)>,
+    retired: Vec<String>,
 }
 
 impl Staging {
-    /// An empty set of files for the folder `dir` (which must exist).
-    pub fn new(dir: &Path) -> Staging {
-        Staging { dir: dir.to_path_buf(), files: Vec::new(), retired: Vec::new() }
+    /// An empty set of files for the open folder `folder`.
+    pub fn new(folder: &fsguard::Folder) -> std::io::Result<Staging> {
+        Ok(Staging { folder: folder.try_clone()?, files: Vec::new(), retired: Vec::new() })
     }
 
     /// Writes `bytes` for the file `name` of the folder to a synced temporary file. Errors name
     /// the target, never the temporary file.
     pub fn add(&mut self, name: &str, bytes: &[u8]) -> Result<(), (PathBuf, std::io::Error)> {
-        let path = self.dir.join(name);
-        let file = temporary(&self.dir, &path, bytes).map_err(|e| (path.clone(), e))?;
-        self.files.push((path, file));
+        let temporary = write_temporary(&self.folder, name, bytes).map_err(|e| (self.folder.join(name), e))?;
+        self.files.push((name.to_string(), temporary));
         Ok(())
     }
 
@@ -98,7 +102,7 @@ impl Staging {
     /// file is removed (anything else under the name fails the commit before anything changes);
     /// a missing one is skipped.
     pub fn retire(&mut self, name: &str) {
-        self.retired.push(self.dir.join(name));
+        self.retired.push(name.to_string());
     }
 
     /// Switches the files into place, by renames and links alone (no free space needed, so on a
@@ -120,36 +124,44 @@ impl Staging {
     /// back, so the folder lists the previous set again. An interruption (a kill) leaves complete
     /// files, no index and the kept files as temporaries ([`remove_temporaries`] removes them).
     pub fn commit(
-        self,
+        mut self,
         before_index: impl FnOnce() -> Result<(), (PathBuf, std::io::Error)>,
     ) -> Result<(), (PathBuf, std::io::Error)> {
-        let Staging { dir, mut files, retired } = self;
-        let Some((index, index_file)) = files.pop() else { return Ok(()) };
-        for (path, _) in &files {
-            check_replaceable(path).map_err(|e| (path.clone(), e))?;
+        let mut files = std::mem::take(&mut self.files);
+        let retired = std::mem::take(&mut self.retired);
+        let folder = &self.folder;
+        let at = |name: &str, e: std::io::Error| (folder.join(name), e);
+        let Some((index, index_temporary)) = files.pop() else { return Ok(()) };
+        // Until a temporary file is renamed, dropping it (an early return) removes it.
+        let mut pending: Vec<Pending> = files.iter().map(|(_, t)| Pending::new(folder, t)).collect();
+        let index_pending = Pending::new(folder, &index_temporary);
+        for (name, _) in &files {
+            check_replaceable(folder, name).map_err(|e| at(name, e))?;
         }
-        check_index_replaceable(&index).map_err(|e| (index.clone(), e))?;
-        for path in &retired {
-            check_removable(path).map_err(|e| (path.clone(), e))?;
+        check_index_replaceable(folder, &index).map_err(|e| at(&index, e))?;
+        for name in &retired {
+            check_removable(folder, name).map_err(|e| at(name, e))?;
         }
-        let mut switch = Switch { dir: &dir, undo: Vec::new() };
+        let mut switch = Switch { folder, undo: Vec::new() };
         let result = (|| {
             switch.set_aside(&index)?;
-            sync_folder(&dir).map_err(|e| (dir.clone(), e))?;
-            for (path, file) in files {
-                switch.replace(path, file)?;
+            folder.sync().map_err(|e| (folder.path().to_path_buf(), e))?;
+            for ((name, temporary), pending) in files.iter().zip(&mut pending) {
+                switch.replace(name, temporary)?;
+                pending.landed();
             }
-            for path in &retired {
-                switch.set_aside(path)?;
+            for name in &retired {
+                switch.set_aside(name)?;
             }
             before_index()?;
-            switch.replace(index, index_file)?;
-            sync_folder(&dir).map_err(|e| (dir.clone(), e))
+            switch.replace(&index, &index_temporary)?;
+            folder.sync().map_err(|e| (folder.path().to_path_buf(), e))
         })();
         match result {
             Ok(()) => {
-                // The kept old files go with the undo log (each `TempPath` removes its file).
-                drop(switch);
+                index_pending.landed_for_good();
+                pending.into_iter().for_each(Pending::landed_for_good);
+                switch.forget();
                 Ok(())
             }
             Err(e) => {
@@ -160,52 +172,107 @@ impl Staging {
     }
 }
 
+impl Drop for Staging {
+    /// Files staged and never committed leave no temporary file behind.
+    fn drop(&mut self) {
+        for (_, temporary) in &self.files {
+            let _ = self.folder.unlink(temporary);
+        }
+    }
+}
+
+/// A temporary file of a commit that is removed when this drops, unless it was renamed into place.
+struct Pending<'a> {
+    folder: &'a fsguard::Folder,
+    name: Option<String>,
+}
+
+impl<'a> Pending<'a> {
+    fn new(folder: &'a fsguard::Folder, name: &str) -> Pending<'a> {
+        Pending { folder, name: Some(name.to_string()) }
+    }
+
+    /// Renamed: nothing left under its name. (An undo renames no new file back: it is removed or
+    /// replaced by the old one.)
+    fn landed(&mut self) {
+        self.name = None;
+    }
+
+    fn landed_for_good(mut self) {
+        self.name = None;
+    }
+}
+
+impl Drop for Pending<'_> {
+    fn drop(&mut self) {
+        if let Some(name) = &self.name {
+            let _ = self.folder.unlink(name);
+        }
+    }
+}
+
 /// The steps of a [`Staging::commit`] taken so far, with what undoes each.
 struct Switch<'a> {
-    dir: &'a Path,
+    folder: &'a fsguard::Folder,
     undo: Vec<Step>,
 }
 
 enum Step {
-    /// A new file renamed over `target`; `old` is the file it replaced, if there was one.
-    Replaced { target: PathBuf, old: Option<tempfile::TempPath> },
-    /// The file at `target` moved to `old`, leaving the name free.
-    SetAside { target: PathBuf, old: tempfile::TempPath },
+    /// A new file renamed over `target`; `old` is the temporary name of the file it replaced,
+    /// if there was one.
+    Replaced { target: String, old: Option<String> },
+    /// The file at `target` moved to the temporary name `old`, leaving the name free.
+    SetAside { target: String, old: String },
 }
 
 impl Switch<'_> {
-    /// Renames `file` over `target`, keeping the file it replaces.
-    fn replace(&mut self, target: PathBuf, file: tempfile::NamedTempFile) -> Result<(), (PathBuf, std::io::Error)> {
-        let old = keep(self.dir, &target).map_err(|e| (target.clone(), e))?;
-        match file.persist(&target) {
-            Ok(_) => {
-                self.undo.push(Step::Replaced { target, old });
+    /// Renames the temporary file `temporary` over `target`, keeping the file it replaces.
+    fn replace(&mut self, target: &str, temporary: &str) -> Result<(), (PathBuf, std::io::Error)> {
+        let at = |e| (self.folder.join(target), e);
+        let old = keep(self.folder, target).map_err(at)?;
+        match self.folder.rename(temporary, target) {
+            Ok(()) => {
+                self.undo.push(Step::Replaced { target: target.to_string(), old });
                 Ok(())
             }
             Err(e) => {
-                // The old file is still at the target (only the extra link to it goes when `old`
-                // drops), unless `keep` had to rename it away: then it goes back.
-                if let Some(old) = old
-                    && std::fs::symlink_metadata(&target).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
-                {
-                    let _ = old.persist(&target);
+                // The old file is still at the target (only the extra name goes), unless `keep`
+                // had to rename it away: then it goes back.
+                if let Some(old) = old {
+                    let _ = match self.folder.entry(target) {
+                        Ok(None) => self.folder.rename(&old, target),
+                        _ => self.folder.unlink(&old),
+                    };
                 }
-                Err((target, e.error))
+                Err(at(e))
             }
         }
     }
 
-    /// Moves the file at `target` aside (a link under a temporary name, then `target` unlinked);
-    /// nothing there is nothing to do.
-    fn set_aside(&mut self, target: &Path) -> Result<(), (PathBuf, std::io::Error)> {
-        let Some(old) = keep(self.dir, target).map_err(|e| (target.to_path_buf(), e))? else { return Ok(()) };
-        match std::fs::remove_file(target) {
+    /// Moves the file at `target` aside (a second name, then `target` unlinked); nothing there is
+    /// nothing to do.
+    fn set_aside(&mut self, target: &str) -> Result<(), (PathBuf, std::io::Error)> {
+        let at = |e| (self.folder.join(target), e);
+        let Some(old) = keep(self.folder, target).map_err(at)? else { return Ok(()) };
+        match self.folder.unlink(target) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err((target.to_path_buf(), e)),
+            Err(e) => {
+                let _ = self.folder.unlink(&old);
+                return Err(at(e));
+            }
         }
-        self.undo.push(Step::SetAside { target: target.to_path_buf(), old });
+        self.undo.push(Step::SetAside { target: target.to_string(), old });
         Ok(())
+    }
+
+    /// The switch succeeded: the kept old files go.
+    fn forget(self) {
+        for step in self.undo {
+            if let Step::Replaced { old: Some(old), .. } | Step::SetAside { old, .. } = step {
+                let _ = self.folder.unlink(&old);
+            }
+        }
     }
 
     /// Every step taken, undone in reverse order; best effort (the error that stopped the switch
@@ -214,34 +281,87 @@ impl Switch<'_> {
         for step in self.undo.into_iter().rev() {
             match step {
                 Step::Replaced { target, old: Some(old) } | Step::SetAside { target, old } => {
-                    let _ = old.persist(&target);
+                    let _ = self.folder.rename(&old, &target);
                 }
                 Step::Replaced { target, old: None } => {
-                    let _ = std::fs::remove_file(&target);
+                    let _ = self.folder.unlink(&target);
                 }
             }
         }
-        let _ = sync_folder(self.dir);
+        let _ = self.folder.sync();
     }
 }
 
-/// A second name for the file (or link) at `target`, a temporary one in `dir`
-/// (`.NAME.XXXXXX.tmp`, removed when the returned path drops): a hard link, or, where the file
-/// system has none, the file itself renamed there. `None` when nothing is at `target`.
-fn keep(dir: &Path, target: &Path) -> std::io::Result<Option<tempfile::TempPath>> {
-    let prefix = temporary_prefix(target);
-    let kept = temporary_builder(&prefix).make_in(dir, |backup| {
-        std::fs::hard_link(target, backup).or_else(|e| {
-            let no_links = matches!(e.kind(), std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::Unsupported);
-            let renameable = std::fs::symlink_metadata(target).is_ok_and(|m| m.is_file() || m.is_symlink());
-            if no_links && renameable { std::fs::rename(target, backup) } else { Err(e) }
-        })
-    });
-    match kept {
-        Ok(file) => Ok(Some(file.into_temp_path())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(without_temporary_path(e)),
+/// A second name for the file (or link) `target` of the folder, a temporary one
+/// (`.NAME.XXXXXX.tmp`): a hard link, or, where the file system has none, the file itself
+/// renamed there. `None` when nothing is at `target`.
+fn keep(folder: &fsguard::Folder, target: &str) -> std::io::Result<Option<String>> {
+    for _ in 0..TEMPORARY_ATTEMPTS {
+        let name = temporary_name(target);
+        match folder.link(target, &name) {
+            Ok(()) => return Ok(Some(name)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => {
+                let no_links =
+                    matches!(e.kind(), std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::Unsupported);
+                let renameable = matches!(folder.entry(target)?, Some(fsguard::Entry::File | fsguard::Entry::Link));
+                let free = folder.entry(&name)?.is_none();
+                if no_links && renameable && free {
+                    folder.rename(target, &name)?;
+                    return Ok(Some(name));
+                }
+                return Err(e);
+            }
+        }
     }
+    Err(too_many_temporaries())
+}
+
+/// A new temporary file for `target` in the folder, holding `bytes`, synced; its name. Removed
+/// again if it cannot be written in full.
+fn write_temporary(folder: &fsguard::Folder, target: &str, bytes: &[u8]) -> std::io::Result<String> {
+    for _ in 0..TEMPORARY_ATTEMPTS {
+        let name = temporary_name(target);
+        let mut file = match folder.create_new(&name) {
+            Ok(file) => file,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        };
+        let written = file.write_all(bytes).and_then(|()| file.flush()).and_then(|()| file.sync_all());
+        return match written {
+            Ok(()) => Ok(name),
+            Err(e) => {
+                let _ = folder.unlink(&name);
+                Err(e)
+            }
+        };
+    }
+    Err(too_many_temporaries())
+}
+
+/// Names tried for a temporary file before giving up (each random: a clash is a hostile folder).
+const TEMPORARY_ATTEMPTS: usize = 64;
+
+fn too_many_temporaries() -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary file name: too many temporary files")
+}
+
+/// `.NAME.XXXXXX.tmp` for `target`, six random letters and digits ([`temporary_target`]).
+fn temporary_name(target: &str) -> String {
+    use std::hash::{BuildHasher, Hasher};
+    const ALPHABET: &[u8; 62] = b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz";
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let mut hasher = std::collections::hash_map::RandomState::new().build_hasher();
+    hasher.write_u64(COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed));
+    hasher.write_u32(std::process::id());
+    let mut bits = hasher.finish();
+    let mut random = String::with_capacity(TEMPORARY_RANDOM_CHARS);
+    for _ in 0..TEMPORARY_RANDOM_CHARS {
+        random.push(ALPHABET[(bits % 62) as usize] as char);
+        bits /= 62;
+    }
+    format!(".{target}.{random}.tmp")
 }
 
 /// The file a temporary file of [`write_atomic`] or [`write_set`] was for: `NAME` of
@@ -255,15 +375,13 @@ pub fn temporary_target(file_name: &str) -> Option<&str> {
     ours.then_some(target)
 }
 
-/// Removes from `dir` the temporary files ([`temporary_target`]) an interrupted run left for the
-/// files `of` accepts: they are never outputs. Returns how many were removed.
-pub fn remove_temporaries(dir: &Path, of: impl Fn(&str) -> bool) -> std::io::Result<usize> {
+/// Removes from the folder the temporary files ([`temporary_target`]) an interrupted run left for
+/// the files `of` accepts: they are never outputs. Returns how many were removed.
+pub fn remove_temporaries(folder: &fsguard::Folder, of: impl Fn(&str) -> bool) -> std::io::Result<usize> {
     let mut removed = 0;
-    for entry in std::fs::read_dir(dir)? {
-        let entry = entry?;
-        let ours = entry.file_name().to_str().and_then(temporary_target).is_some_and(&of);
-        if ours && entry.file_type()?.is_file() {
-            std::fs::remove_file(entry.path())?;
+    for (name, entry) in folder.entries()? {
+        if entry == fsguard::Entry::File && temporary_target(&name).is_some_and(&of) {
+            folder.unlink(&name)?;
             removed += 1;
         }
     }
@@ -308,48 +426,62 @@ fn beside_a_bake(folder: &Path, path: &Path) -> std::io::Result<fsguard::Folder>
 
 /// What is at an output's path may be replaced only if it is a regular file or a link (or
 /// nothing).
-fn check_replaceable(path: &Path) -> std::io::Result<()> {
+fn check_replaceable_path(path: &Path) -> std::io::Result<()> {
     match std::fs::symlink_metadata(path) {
         Ok(meta) if meta.is_file() || meta.is_symlink() => Ok(()),
-        Ok(meta) => Err(not_a_file("replace", "a regular file or a link", &meta)),
+        Ok(meta) => {
+            let what = if meta.is_dir() { "a folder" } else { "a fifo, device or socket" };
+            Err(not_a_file("replace", what, "a regular file or a link"))
+        }
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(e),
     }
+}
+
+/// A target of a set may be replaced only if it is a regular file or a link (or nothing).
+fn check_replaceable(folder: &fsguard::Folder, name: &str) -> std::io::Result<()> {
+    use fsguard::Entry;
+    check_entry(folder, name, "replace", "a regular file or a link", |e| matches!(e, Entry::File | Entry::Link))
 }
 
 /// The index of a set is replaced whatever it is (a link, a FIFO, a device node: a damaged or
 /// hostile index must not keep a set from landing) except a folder.
-fn check_index_replaceable(path: &Path) -> std::io::Result<()> {
-    match std::fs::symlink_metadata(path) {
-        Ok(meta) if meta.is_dir() => Err(not_a_file("replace", "anything but a folder", &meta)),
-        Ok(_) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(e),
-    }
+fn check_index_replaceable(folder: &fsguard::Folder, name: &str) -> std::io::Result<()> {
+    check_entry(folder, name, "replace", "anything but a folder", |e| e != fsguard::Entry::Folder)
 }
 
-/// What is at a path a set retires may be removed only if it is a regular file (or nothing).
-fn check_removable(path: &Path) -> std::io::Result<()> {
-    match std::fs::symlink_metadata(path) {
-        Ok(meta) if meta.is_file() => Ok(()),
-        Ok(meta) => Err(not_a_file("remove", "a regular file", &meta)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(e),
+/// What a set retires may be removed only if it is a regular file (or nothing).
+fn check_removable(folder: &fsguard::Folder, name: &str) -> std::io::Result<()> {
+    check_entry(folder, name, "remove", "a regular file", |e| e == fsguard::Entry::File)
+}
+
+fn check_entry(
+    folder: &fsguard::Folder,
+    name: &str,
+    verb: &str,
+    allowed: &str,
+    ok: impl Fn(fsguard::Entry) -> bool,
+) -> std::io::Result<()> {
+    match folder.entry(name)? {
+        None => Ok(()),
+        Some(entry) if ok(entry) => Ok(()),
+        Some(entry) => {
+            let what = match entry {
+                fsguard::Entry::Folder => "a folder",
+                fsguard::Entry::Link => "a symbolic link",
+                fsguard::Entry::File => "a regular file",
+                fsguard::Entry::Other(what) => what,
+            };
+            Err(not_a_file(verb, what, allowed))
+        }
     }
 }
 
 /// The error for a name the caller (who names the path) may not replace or remove.
-fn not_a_file(verb: &str, allowed: &str, meta: &std::fs::Metadata) -> std::io::Error {
-    let kind = if meta.is_dir() {
-        "folder"
-    } else if meta.is_symlink() {
-        "symbolic link"
-    } else {
-        "fifo, device or socket"
-    };
+fn not_a_file(verb: &str, what: &str, allowed: &str) -> std::io::Error {
     std::io::Error::new(
         std::io::ErrorKind::InvalidInput,
-        format!("refusing to {verb} a {kind} (only {allowed} is {verb}d): nothing was changed"),
+        format!("refusing to {verb} {what} (only {allowed} is {verb}d): nothing was changed"),
     )
 }
 

@@ -111,7 +111,7 @@ fn a_staged_set_lands_on_commit_only() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("data"), b"old data").unwrap();
     std::fs::write(dir.path().join("index"), b"old index").unwrap();
-    let mut staging = asset::Staging::new(dir.path());
+    let mut staging = asset::Staging::new(&fsguard::Folder::open(dir.path()).unwrap()).unwrap();
     staging.add("data", b"new data").unwrap();
     staging.add("index", b"new index").unwrap();
     assert_eq!(entries(dir.path()).len(), 4, "two temporaries beside the old files");
@@ -119,7 +119,7 @@ fn a_staged_set_lands_on_commit_only() {
     assert_eq!(entries(dir.path()), ["data", "index"]);
     assert_eq!(std::fs::read(dir.path().join("data")).unwrap(), b"old data");
 
-    let mut staging = asset::Staging::new(dir.path());
+    let mut staging = asset::Staging::new(&fsguard::Folder::open(dir.path()).unwrap()).unwrap();
     staging.add("data", b"new data").unwrap();
     staging.add("index", b"new index").unwrap();
     let seen = std::cell::RefCell::new(Vec::new());
@@ -142,7 +142,7 @@ fn previous_set(dir: &std::path::Path) -> asset::Staging {
     for (name, bytes) in [("data", "old data"), ("gone", "old gone"), ("index", "old index")] {
         std::fs::write(dir.join(name), bytes).unwrap();
     }
-    let mut staging = asset::Staging::new(dir);
+    let mut staging = asset::Staging::new(&fsguard::Folder::open(dir).unwrap()).unwrap();
     staging.add("data", b"new data").unwrap();
     staging.add("extra", b"new extra").unwrap();
     staging.retire("gone");
@@ -222,6 +222,23 @@ fn a_commit_that_fails_midway_restores_the_old_set() {
     previous_set(dir.path()).commit(|| Ok(())).unwrap();
     let new = [("data", "new data"), ("extra", "new extra"), ("index", "new index")];
     assert_eq!(contents(dir.path()), new.map(|(n, c)| (n.to_string(), c.to_string())));
+}
+
+/// A set goes through its folder's descriptor: a folder moved (and another made at its path)
+/// between staging and commit gets the whole set, the new folder nothing (issue 42: a bake's
+/// renames went by path and landed in the new folder).
+#[test]
+fn a_set_lands_in_its_folder_wherever_the_folder_moved() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (dir, moved) = (tmp.path().join("bake"), tmp.path().join("bake.old"));
+    std::fs::create_dir(&dir).unwrap();
+    let staging = previous_set(&dir);
+    std::fs::rename(&dir, &moved).unwrap();
+    std::fs::create_dir(&dir).unwrap();
+    staging.commit(|| Ok(())).unwrap();
+    let new = [("data", "new data"), ("extra", "new extra"), ("index", "new index")];
+    assert_eq!(contents(&moved), new.map(|(n, c)| (n.to_string(), c.to_string())));
+    assert!(entries(&dir).is_empty());
 }
 
 /// Beside a bake, `write_atomic` writes no name the bake's manifest lists, nor the manifest, and
@@ -313,7 +330,8 @@ fn temporary_files_are_recognised_by_their_whole_name() {
         tempfile::Builder::new().prefix(".x.asset.").suffix(".tmp").rand_bytes(6).tempfile_in(dir.path()).unwrap();
     let name = file.path().file_name().unwrap().to_str().unwrap().to_string();
     assert_eq!(temporary_target(&name), Some("x.asset"), "{name}");
-    assert_eq!(asset::remove_temporaries(dir.path(), |t| t == "other.png").unwrap(), 0);
-    assert_eq!(asset::remove_temporaries(dir.path(), |t| t == "x.asset").unwrap(), 1);
+    let folder = fsguard::Folder::open(dir.path()).unwrap();
+    assert_eq!(asset::remove_temporaries(&folder, |t| t == "other.png").unwrap(), 0);
+    assert_eq!(asset::remove_temporaries(&folder, |t| t == "x.asset").unwrap(), 1);
     assert!(!target.exists() && !file.path().exists());
 }

@@ -223,7 +223,7 @@ pub fn run_bake(
 
     // Temporary files an interrupted bake left: the folder is locked, so none is being written.
     folder.remove_temporaries()?;
-    let mut staging = asset::Staging::new(out);
+    let mut staging = folder.staging()?;
 
     let stages = stage_names(config);
     let mut reports = Vec::new();
@@ -349,7 +349,7 @@ pub fn write_stage(
     manifest.manifest_version = asset::MANIFEST_VERSION;
     manifest.parameters.insert(parameter.0.to_string(), parameter.1);
     folder.remove_temporaries()?;
-    let mut staging = asset::Staging::new(dir);
+    let mut staging = folder.staging()?;
     let mut stage = staged.stage(&mut staging)?;
     if !staged.problems.is_empty() {
         stage.figures.insert("problems".into(), json!(staged.problems));
@@ -416,8 +416,14 @@ impl BakeFolder {
     /// and for the manifest (`.NAME.XXXXXX.tmp`, regular files only).
     fn remove_temporaries(&self) -> Result<(), Error> {
         let ours = |target: &str| target == MANIFEST || crate::stage::is_output_name(target);
-        asset::remove_temporaries(self.folder.path(), ours).map_err(|e| Error::write(self.folder.path(), e))?;
+        asset::remove_temporaries(&self.folder, ours).map_err(|e| Error::write(self.folder.path(), e))?;
         Ok(())
+    }
+
+    /// An empty set of new files for the folder: written and switched in through its descriptor,
+    /// so that the bake lands in this folder wherever it is moved meanwhile.
+    fn staging(&self) -> Result<asset::Staging, Error> {
+        asset::Staging::new(&self.folder).map_err(|e| Error::write(self.folder.path(), e))
     }
 
     /// The switch (step 4 of [`run_bake`]): `staging` holds the new files; the manifest is added

@@ -239,6 +239,111 @@ impl Folder {
         rustix::fs::fsync(&self.dir)?;
         Ok(())
     }
+
+    /// Another handle on the same open folder (its descriptor duplicated). Like this one, it
+    /// stays on the folder wherever the folder is moved; its lock is this one's.
+    pub fn try_clone(&self) -> io::Result<Folder> {
+        let dir = rustix::io::fcntl_dupfd_cloexec(&self.dir, 0)?;
+        Ok(Folder { dir, path: self.path.clone() })
+    }
+
+    /// Creates the file `name` (a plain name) in the folder, for writing: it must not exist
+    /// (`O_EXCL`, so no link is followed either); permissions `0o666` less the umask, as
+    /// `File::create` gives.
+    pub fn create_new(&self, name: &str) -> io::Result<File> {
+        plain(name)?;
+        let flags = OFlags::WRONLY | OFlags::CREATE | OFlags::EXCL | OFlags::NOFOLLOW | OFlags::CLOEXEC;
+        let fd = rustix::fs::openat(&self.dir, name, flags, Mode::from_raw_mode(0o666))?;
+        Ok(File::from(fd))
+    }
+
+    /// What the folder holds under the plain name `name`, a link not followed; `None` for nothing.
+    pub fn entry(&self, name: &str) -> io::Result<Option<Entry>> {
+        plain(name)?;
+        match rustix::fs::statat(&self.dir, name, AtFlags::SYMLINK_NOFOLLOW) {
+            Ok(stat) => Ok(Some(Entry::of(rustix::fs::FileType::from_raw_mode(stat.st_mode)))),
+            Err(Errno::NOENT) => Ok(None),
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// The plain names the folder holds (`.` and `..` aside, and names that are not UTF-8, which
+    /// no tool of ours writes), each with what it is.
+    pub fn entries(&self) -> io::Result<Vec<(String, Entry)>> {
+        let mut out = Vec::new();
+        for entry in rustix::fs::Dir::read_from(&self.dir)? {
+            let entry = entry?;
+            let Ok(name) = entry.file_name().to_str() else { continue };
+            if name == "." || name == ".." {
+                continue;
+            }
+            let kind = match entry.file_type() {
+                rustix::fs::FileType::Unknown => match self.entry(name)? {
+                    Some(kind) => kind,
+                    None => continue,
+                },
+                kind => Entry::of(kind),
+            };
+            out.push((name.to_string(), kind));
+        }
+        Ok(out)
+    }
+
+    /// Renames the folder's `from` to `to` (plain names, `renameat(2)` within the folder): what
+    /// `to` held (anything but a non-empty folder) is replaced, a link there not followed.
+    pub fn rename(&self, from: &str, to: &str) -> io::Result<()> {
+        plain(from)?;
+        plain(to)?;
+        rustix::fs::renameat(&self.dir, from, &self.dir, to)?;
+        Ok(())
+    }
+
+    /// Gives the folder's `from` the second name `to` (plain names, `linkat(2)` within the folder,
+    /// a link at `from` linked itself, never followed); `to` must not exist.
+    pub fn link(&self, from: &str, to: &str) -> io::Result<()> {
+        plain(from)?;
+        plain(to)?;
+        rustix::fs::linkat(&self.dir, from, &self.dir, to, AtFlags::empty())?;
+        Ok(())
+    }
+
+    /// Removes the name `name` (a plain name, `unlinkat(2)`) whatever it names except a folder:
+    /// for the files a writer made itself. [`Folder::remove_file`] is for files a manifest names.
+    pub fn unlink(&self, name: &str) -> io::Result<()> {
+        plain(name)?;
+        rustix::fs::unlinkat(&self.dir, name, AtFlags::empty())?;
+        Ok(())
+    }
+}
+
+/// What a name in a folder is ([`Folder::entry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Entry {
+    File,
+    Link,
+    Folder,
+    /// A FIFO, a device or a socket: what it is, in words.
+    Other(&'static str),
+}
+
+impl Entry {
+    fn of(kind: rustix::fs::FileType) -> Entry {
+        match kind {
+            rustix::fs::FileType::RegularFile => Entry::File,
+            rustix::fs::FileType::Symlink => Entry::Link,
+            rustix::fs::FileType::Directory => Entry::Folder,
+            other => Entry::Other(describe(other)),
+        }
+    }
+}
+
+/// `name` must be one component of a path inside a folder ([`check_relative`], no `/`).
+fn plain(name: &str) -> io::Result<()> {
+    check_relative(name).map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
+    if name.contains('/') {
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("{name:?} is not a plain file name")));
+    }
+    Ok(())
 }
 
 impl AsFd for Folder {
