@@ -213,3 +213,60 @@ fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
     let r = run(cmd, "").expect_code(0);
     assert!(!r.stderr.contains("error:"), "a successful run printed an error line\n{r}");
 }
+
+/// Values behind valid checksums (issue 42, item 5): a bake whose importance samples, bandwidth
+/// rows or layer selection hold a value no bake writes, with the manifest's size and hash made to
+/// match, is refused by the previewer with one line naming the asset, the field and the value, and
+/// `asset-info` says the same of the asset (it used to report NaN samples as valid).
+#[test]
+fn values_behind_valid_checksums_are_refused_by_every_reader() {
+    let tmp = temp_dir();
+    /// The asset, what the message says, the edit.
+    type Case = (&'static str, &'static str, fn(&mut asset::Payload));
+    let cases: [Case; 4] = [
+        ("importance.asset", "wi (1e30, 1e30, 1e30) is not a unit direction", |p| {
+            let asset::Payload::ImportanceSamples(s) = p else { panic!("importance samples") };
+            s.samples.iter_mut().for_each(|t| *t = [1e30; 4]);
+        }),
+        ("importance.asset", "h density 0 is NaN, not a finite density", |p| {
+            let asset::Payload::ImportanceSamples(s) = p else { panic!("importance samples") };
+            s.h_density[0] = f32::NAN;
+        }),
+        ("bandwidth-atlas.asset", "texel 0 is 1e30, outside [0, ", |p| {
+            let asset::Payload::BandwidthRows(r) = p else { panic!("bandwidth rows") };
+            r.data.iter_mut().for_each(|b| *b = 1e30);
+        }),
+        ("layer-selection.asset", "view bandwidth 0 is 1e300, outside [0, ", |p| {
+            let asset::Payload::LayerSelection(l) = p else { panic!("layer selection") };
+            l.view_bandwidth[0] = 1e300;
+        }),
+    ];
+    for (i, (name, needle, edit)) in cases.into_iter().enumerate() {
+        let dir = tmp.path().join(format!("case-{i}"));
+        crate::support::copy_dir(&reference_bake().dir, &dir);
+        let mut asset = asset::read_file(&dir.join(name)).unwrap();
+        edit(&mut asset.payload);
+        let bytes = asset::encode(&asset);
+        std::fs::write(dir.join(name), &bytes).unwrap();
+        // The manifest made to describe the new bytes: only the values are wrong.
+        let text = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+        let mut manifest: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for stage in manifest["stages"].as_array_mut().unwrap() {
+            for output in stage["outputs"].as_array_mut().unwrap().iter_mut().filter(|o| o["path"] == name) {
+                output["size_bytes"] = bytes.len().into();
+                output["sha256"] = asset::hex(&asset::sha256(&bytes)).into();
+            }
+        }
+        std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+
+        let path = dir.join(name);
+        let mut cmd = tool("brdf-preview");
+        cmd.arg(&dir).arg("--out").arg(tmp.path().join("p.png")).args(["--size", "16x16", "--spp", "16"]);
+        let (r, _) = run_within(cmd, QUICK);
+        let r = r.expect_one_error_line(&format!("reading {}: invalid payload: ", path.display()));
+        assert!(r.stderr.contains(needle), "{r}");
+        let mut cmd = tool("asset-info");
+        cmd.arg(&path);
+        run(cmd, "").expect_error(&path, needle);
+    }
+}

@@ -70,6 +70,7 @@ pub use manifest::{
 };
 pub use types::{
     Asset, AssetKind, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples,
-    LayerSelection, LinkedFile, MAX_ROWS_COLUMNS, MAX_WAVELET_CHANNEL_MEAN, MAX_WAVELET_SIDE, MaterialInfo, Payload,
-    PrefilteredEnvmap, Provenance, WAVELET_EPSILON_RANGE, WAVELET_LOG_BOUND, WaveletBrdf, WaveletCoefficients,
+    LayerSelection, LinkedFile, MAX_LAYER_HEIGHT, MAX_ROWS_COLUMNS, MAX_WAVELET_CHANNEL_MEAN, MAX_WAVELET_SIDE,
+    MaterialInfo, Payload, PrefilteredEnvmap, Provenance, WAVELET_EPSILON_RANGE, WAVELET_LOG_BOUND, WaveletBrdf,
+    WaveletCoefficients,
 };

@@ -207,9 +207,42 @@ impl ImportanceSamples {
                 return Err(format!("importance samples: {what} has {found} values, expected {expected}"));
             }
         }
+        self.check_values()
+    }
+
+    /// What the values may be: every `wi` a unit direction (a reflection of `wo`, even where it
+    /// reflects nowhere) and every pdf finite and not negative; the CDFs within `[0, 1]`; the
+    /// half-vector densities finite and not negative. Samples of 1e30, -1 or 0 passed every
+    /// checksum and changed the picture.
+    fn check_values(&self) -> Result<(), String> {
+        let per_slice = self.n_vectors as usize * self.n_samples as usize;
+        for (i, &[x, y, z, pdf]) in self.samples.iter().enumerate() {
+            let length = (f64::from(x).powi(2) + f64::from(y).powi(2) + f64::from(z).powi(2)).sqrt();
+            let (slice, vector, sample) =
+                (i / per_slice, i % per_slice / self.n_samples as usize, i % self.n_samples as usize);
+            let at = format!("sample {i} (slice {slice}, vector {vector}, sample {sample})");
+            let off = (length - 1.0).abs();
+            if off.is_nan() || off > UNIT_TOLERANCE {
+                return Err(format!("importance samples: {at}: wi ({x:e}, {y:e}, {z:e}) is not a unit direction"));
+            }
+            if !(pdf.is_finite() && pdf >= 0.0) {
+                return Err(format!("importance samples: {at}: pdf {pdf:e} is not a finite density of 0 or more"));
+            }
+        }
+        for (what, cdf) in [("marginal cdf", &self.marginal_cdf), ("conditional cdf", &self.conditional_cdf)] {
+            if let Some((i, v)) = cdf.iter().enumerate().find(|(_, v)| !(0.0..=1.0).contains(*v)) {
+                return Err(format!("importance samples: {what} value {i} is {v:e}, outside [0, 1]"));
+            }
+        }
+        if let Some((i, d)) = self.h_density.iter().enumerate().find(|(_, d)| !(d.is_finite() && **d >= 0.0)) {
+            return Err(format!("importance samples: h density {i} is {d:e}, not a finite density of 0 or more"));
+        }
         Ok(())
     }
 }
+
+/// How far from 1 a stored direction's length may be: `f32` rounding makes about `1e-7`.
+const UNIT_TOLERANCE: f64 = 1e-4;
 
 /// The product of sizes read from a file, `None` past `u64`: no file holds that many, and a
 /// wrapped product could match what a damaged file holds. Every payload check multiplies sizes
@@ -307,6 +340,30 @@ impl PrefilteredEnvmap {
         if self.mip_levels == 0 {
             return Err("prefiltered envmap has no mip levels".into());
         }
+        // What the writer can make: a chain halves the source down to one texel at most, and a
+        // layer is at most MAX_LAYER_HEIGHT tall.
+        let most_levels = 1 + self.source_size[0].max(1).ilog2();
+        if self.mip_levels > most_levels {
+            return Err(format!(
+                "prefiltered envmap: {} mip levels of a {} x {} source, which has at most {most_levels}",
+                self.mip_levels, self.source_size[0], self.source_size[1]
+            ));
+        }
+        if self.layer_size[1] > MAX_LAYER_HEIGHT {
+            return Err(format!(
+                "prefiltered envmap: layers of {} x {}, taller than the {MAX_LAYER_HEIGHT} rows any writer makes",
+                self.layer_size[0], self.layer_size[1]
+            ));
+        }
+        let means = std::iter::once(&self.source_mean_radiance).chain(&self.layer_mean_radiance);
+        for (i, mean) in means.enumerate() {
+            if !mean.iter().all(|m| m.is_finite() && *m >= 0.0) {
+                let what = if i == 0 { "the source's".to_string() } else { format!("layer {}'s", i - 1) };
+                return Err(format!(
+                    "prefiltered envmap: {what} mean radiance {mean:?} is not finite and not negative"
+                ));
+            }
+        }
         let expect = [
             ("lobe bandwidths", self.lobe_bandwidth.len(), k),
             ("bandwidth thresholds", self.bandwidth_thresholds.len(), k - 1),
@@ -387,7 +444,45 @@ impl BandwidthAtlas {
                 texels.map_or("more than any file holds".to_string(), |t| t.to_string())
             ));
         }
+        self.analysis.check_bandwidths("bandwidth atlas: texel", &self.data)
+    }
+}
+
+/// The tallest layer a prefiltered environment holds (`prefilter::MAX_LAYER_HEIGHT`, the
+/// writer's own limit; layers are `2 h x h`).
+pub const MAX_LAYER_HEIGHT: u32 = 8192;
+
+impl BandwidthAnalysis {
+    /// The largest bandwidth a payload of this analysis may hold, in cycles per radian: twice the
+    /// grid's limit, the finest level's `c / 2` cycles per pixel at `n / 2` pixels per radian on
+    /// the horizon (`brdf_atlas`, "Units and the grid's limit"; the atlas reaches the limit, the
+    /// factor 2 leaves a margin). A bandwidth past it is no measurement of this analysis.
+    pub fn bandwidth_bound(&self) -> f64 {
+        self.c * f64::from(self.analysis_size) / 2.0
+    }
+
+    fn check(&self) -> Result<(), String> {
+        if self.analysis_size == 0 || !(self.c.is_finite() && self.c > 0.0) {
+            return Err(format!(
+                "analysis on a {} grid with constant c {:e}: expected a grid of at least 1 and a finite c above 0",
+                self.analysis_size, self.c
+            ));
+        }
         Ok(())
+    }
+
+    /// `data` (bandwidths, cycles per radian) within `[0, bandwidth_bound]`; the error names the
+    /// first value outside, as `what` `index`.
+    fn check_bandwidths<T: Into<f64> + Copy + std::fmt::LowerExp>(&self, what: &str, data: &[T]) -> Result<(), String> {
+        self.check()?;
+        let bound = self.bandwidth_bound();
+        match data.iter().enumerate().find(|(_, b)| !((**b).into() >= 0.0 && (**b).into() <= bound)) {
+            Some((i, b)) => Err(format!(
+                "{what} {i} is {b:e}, outside [0, {bound}] cycles per radian (twice the limit of a {} grid)",
+                self.analysis_size
+            )),
+            None => Ok(()),
+        }
     }
 }
 
@@ -438,7 +533,7 @@ impl BandwidthRows {
                 self.lobes_x
             ));
         }
-        Ok(())
+        self.analysis.check_bandwidths("bandwidth rows: texel", &self.data)
     }
 }
 
@@ -530,10 +625,8 @@ impl LayerSelection {
         if let Some(bad) = self.view_layer.iter().find(|&&l| l as usize >= k) {
             return Err(format!("layer selection names layer {bad} of {k}"));
         }
-        if !self.layer_bandwidth.iter().chain(&self.view_bandwidth).all(|b| b.is_finite() && *b >= 0.0) {
-            return Err("layer selection bandwidths must be finite and not negative".into());
-        }
-        Ok(())
+        self.analysis.check_bandwidths("layer selection: layer bandwidth", &self.layer_bandwidth)?;
+        self.analysis.check_bandwidths("layer selection: view bandwidth", &self.view_bandwidth)
     }
 }
 

@@ -47,6 +47,17 @@ fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
     std::array::from_fn(|_| random_f64(rng))
 }
 
+/// A value that a field held to "finite and not negative" (bandwidths, densities, radiances)
+/// accepts: zero of either sign and denormals among them.
+fn random_non_negative(rng: &mut StdRng) -> f64 {
+    const SPECIAL: [f64; 4] = [0.0, -0.0, f64::MIN_POSITIVE / 2.0, 1e-40];
+    if rng.random_bool(0.1) {
+        SPECIAL[rng.random_range(0..SPECIAL.len())]
+    } else {
+        rng.random::<f64>() * 10f64.powi(rng.random_range(-8..8))
+    }
+}
+
 fn random_asset(rng: &mut StdRng) -> Asset {
     let angles = random_len(rng);
     let payload = match rng.random_range(0..6) {
@@ -81,26 +92,36 @@ fn random_asset(rng: &mut StdRng) -> Asset {
 }
 
 /// Consistent sizes (the payload's invariant), random contents.
+/// A grid of at least one pixel and a positive finite constant (what the payload checks hold
+/// bandwidths against); any threshold.
 fn random_analysis(rng: &mut StdRng) -> BandwidthAnalysis {
     BandwidthAnalysis {
         parameterization: random_string(rng),
-        analysis_size: rng.random(),
+        analysis_size: rng.random_range(1..=u32::MAX),
         eps: random_f64(rng),
-        c: random_f64(rng),
+        c: rng.random_range(f64::MIN_POSITIVE..10.0),
     }
+}
+
+/// `n` bandwidths of `analysis`: within `[0, its bound]`, zeros of either sign among them.
+fn random_bandwidths(rng: &mut StdRng, analysis: &BandwidthAnalysis, n: usize) -> Vec<f32> {
+    // Rounding to f32 may go past the bound by a hair: stay a little inside.
+    let most = analysis.bandwidth_bound() * 0.999;
+    let mut one = || match rng.random_range(0..10) {
+        0 => -0.0,
+        1 => most as f32,
+        _ => (most * rng.random::<f64>()) as f32,
+    };
+    (0..n).map(|_| one()).collect()
 }
 
 /// Consistent sizes (the payload's invariant), random contents.
 fn random_bandwidth_atlas(rng: &mut StdRng) -> Payload {
     let (lobes_x, lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32), rng.random_range(1..4u32));
     let n = (lobes_x * lobes_y * tile * tile) as usize;
-    Payload::BandwidthAtlas(BandwidthAtlas {
-        lobes_x,
-        lobes_y,
-        tile,
-        analysis: random_analysis(rng),
-        data: (0..n).map(|_| random_f64(rng) as f32).collect(),
-    })
+    let analysis = random_analysis(rng);
+    let data = random_bandwidths(rng, &analysis, n);
+    Payload::BandwidthAtlas(BandwidthAtlas { lobes_x, lobes_y, tile, analysis, data })
 }
 
 /// Consistent sizes (the payload's invariant), random contents; the columns the rows stand for
@@ -110,13 +131,9 @@ fn random_bandwidth_rows(rng: &mut StdRng) -> Payload {
     let lobes_x =
         if rng.random_bool(0.5) { rng.random_range(1..4u32) } else { rng.random_range(1..=asset::MAX_ROWS_COLUMNS) };
     let n = (lobes_y * tile * tile) as usize;
-    Payload::BandwidthRows(BandwidthRows {
-        lobes_x,
-        lobes_y,
-        tile,
-        analysis: random_analysis(rng),
-        data: (0..n).map(|_| random_f64(rng) as f32).collect(),
-    })
+    let analysis = random_analysis(rng);
+    let data = random_bandwidths(rng, &analysis, n);
+    Payload::BandwidthRows(BandwidthRows { lobes_x, lobes_y, tile, analysis, data })
 }
 
 /// Consistent sizes (the payload's invariant), random contents.
@@ -142,12 +159,17 @@ fn random_bandwidth_pca(rng: &mut StdRng) -> Payload {
 fn random_importance_samples(rng: &mut StdRng) -> Payload {
     let (slices, rows, cols) = (rng.random_range(1..4), rng.random_range(1..5), rng.random_range(1..6));
     let (vectors, samples) = (rng.random_range(1..3u32), rng.random_range(1..5u32));
-    let mut f32s = |n: usize| -> Vec<f32> { (0..n).map(|_| random_f64(rng) as f32).collect() };
-    let samples_data =
-        f32s(4 * slices * (vectors * samples) as usize).chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-    let marginal_cdf = f32s(slices * (rows + 1));
-    let conditional_cdf = f32s(slices * rows * (cols + 1));
-    let h_density = f32s(slices * rows * cols);
+    // What the values may be: unit directions, densities finite and not negative, CDFs in [0, 1].
+    let samples_data = (0..slices * (vectors * samples) as usize)
+        .map(|_| {
+            let (z, phi) = (rng.random_range(-1.0..=1.0f64), rng.random_range(0.0..std::f64::consts::TAU));
+            let r = (1.0 - z * z).sqrt();
+            [(r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32, random_non_negative(rng) as f32]
+        })
+        .collect();
+    let mut cdf = |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(0.0..=1.0f32)).collect() };
+    let (marginal_cdf, conditional_cdf) = (cdf(slices * (rows + 1)), cdf(slices * rows * (cols + 1)));
+    let h_density = (0..slices * rows * cols).map(|_| random_non_negative(rng) as f32).collect();
     Payload::ImportanceSamples(ImportanceSamples {
         theta_o: (0..slices).map(|_| random_f64(rng)).collect(),
         n_vectors: vectors,
@@ -189,17 +211,20 @@ fn random_prefiltered_envmap(rng: &mut StdRng) -> Payload {
     let (layers_ktx2, mips_ktx2, contact_sheet_png) = (file(0), file(1), file(2));
     let layer_exrs = (3..3 + layers).map(file).collect();
     let height = rng.random_range(1..u32::MAX / 2);
+    let layer_height = rng.random_range(1..=asset::MAX_LAYER_HEIGHT);
+    let mut rgb = || [0; 3].map(|_| random_non_negative(rng));
+    let (source_mean_radiance, layer_mean_radiance) = (rgb(), (0..layers).map(|_| rgb()).collect());
     Payload::PrefilteredEnvmap(PrefilteredEnvmap {
         source_size: [2 * height, height],
-        source_mean_radiance: random_rgb(rng),
-        layer_size: [2 * (height / 3 + 1), height / 3 + 1],
-        mip_levels: rng.random_range(1..20),
+        source_mean_radiance,
+        layer_size: [2 * layer_height, layer_height],
+        mip_levels: rng.random_range(1..=1 + (2 * height).ilog2()),
         layers_radiance_scale: 0.5f64.powi(rng.random_range(0..20)),
         mips_radiance_scale: 0.5f64.powi(rng.random_range(0..20)),
         exponents,
         lobe_bandwidth,
         bandwidth_thresholds,
-        layer_mean_radiance: (0..layers).map(|_| random_rgb(rng)).collect(),
+        layer_mean_radiance,
         layers_ktx2,
         layer_exrs,
         mips_ktx2,

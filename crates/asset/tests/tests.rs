@@ -7,6 +7,7 @@ mod golden;
 mod invalid_fixtures;
 mod manifest;
 mod roundtrip;
+mod values;
 
 use std::path::PathBuf;
 
