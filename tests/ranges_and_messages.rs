@@ -270,3 +270,28 @@ fn values_behind_valid_checksums_are_refused_by_every_reader() {
         run(cmd, "").expect_error(&path, needle);
     }
 }
+
+/// A map of finite radiance whose layers overflow (every texel RGBE exponent 255, about 1e38): the
+/// error names the map (issue 42: `error: prefilter: layer of the phong n 4096: non-finite
+/// radiance inf` named no file).
+#[test]
+fn a_map_whose_layers_overflow_is_named() {
+    let tmp = temp_dir();
+    let hdr = tmp.path().join("e255.hdr");
+    let (w, h) = (64, 32);
+    let mut bytes = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();
+    bytes.extend([200, 200, 200, 255].repeat(w * h));
+    std::fs::write(&hdr, bytes).unwrap();
+    let material = ggx_copper().to_str().unwrap();
+    let out = tmp.path().join("out");
+    let (hdr_text, out) = (hdr.to_str().unwrap(), out.to_str().unwrap());
+    let needle = format!("analysing {hdr_text}: prefilter: ");
+    for cmd in [
+        command("brdf-bake", &[material, "--env", hdr_text, "--out-dir", out, "--analysis-size", "64"]),
+        command("envmap-prefilter", &[hdr_text, "--out-dir", out]),
+    ] {
+        let (r, _) = run_within(cmd, QUICK);
+        let r = r.expect_one_error_line(&needle);
+        assert!(r.stderr.contains("non-finite radiance inf"), "{r}");
+    }
+}

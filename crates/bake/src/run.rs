@@ -279,9 +279,10 @@ pub fn run_bake(
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
         begin("environment bandwidth");
-        record(env_bandwidth::run_on_map(path, map, &config.env_bandwidth)?, &mut manifest)?;
+        record(env_bandwidth::run_on_map(path, map, &config.env_bandwidth).map_err(of_map(path))?, &mut manifest)?;
         begin("phong layers and mip chain");
-        let (staged, _prefiltered) = prefilter::run(map, source, program, &config.prefilter, &work)?;
+        let (staged, _prefiltered) =
+            prefilter::run(map, source, program, &config.prefilter, &work).map_err(of_map(path))?;
         record(staged, &mut manifest)?;
         begin("layer selection");
         let exponents = &config.prefilter.exponents;
@@ -454,6 +455,15 @@ impl BakeFolder {
         })?;
         staging.add(MANIFEST, json.as_bytes()).map_err(|(path, e)| Error::write(&path, e))?;
         staging.commit(|| Ok(())).map_err(|(path, e)| Error::write(&path, e))
+    }
+}
+
+/// An environment stage's own failure, which names no file (a layer whose radiance overflows,
+/// say), names the map it was made from.
+fn of_map(path: &Path) -> impl Fn(Error) -> Error + '_ {
+    move |e| match e {
+        Error::Stage { .. } => Error::analyse(path, e),
+        other => other,
     }
 }
 

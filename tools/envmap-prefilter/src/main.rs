@@ -134,7 +134,8 @@ fn run(args: Args) -> Result<ExitCode> {
     let source = Source::hash(&args.env)?;
     progress.step("prefiltering".to_string());
     let (mut staged, prefiltered) =
-        bake::stage::prefilter::run(&map, &source, &PROGRAM, &config, &|done, total| progress.work(done, total))?;
+        bake::stage::prefilter::run(&map, &source, &PROGRAM, &config, &|done, total| progress.work(done, total))
+            .with_context(|| format!("analysing {}", args.env.display()))?;
     progress.finish();
     let dir = &args.out_dir;
     staged.write(dir)?;
