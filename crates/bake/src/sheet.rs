@@ -26,10 +26,11 @@ pub const PANEL_WIDTH: usize = 1024;
 /// Pictures per row.
 pub const COLUMNS: usize = 2;
 
-/// The sheet of the bake whose manifest is `manifest`, its files in `dir`. Each picture is read
-/// inside the folder without following a link and only when it is the file the manifest
-/// describes (size and SHA-256: `asset::StageOutput::read`). Errors name the file that could not
-/// be read or decoded.
+/// The sheet of the bake whose manifest is `manifest`, its files in `dir`: the first picture of
+/// each role of `PICTURES` (a bake writes one), so at most that many, however many outputs the
+/// manifest lists. Each picture is read inside the folder without following a link and only when
+/// it is the file the manifest describes (size and SHA-256: `asset::StageOutput::read`). Errors
+/// name the file that could not be read or decoded.
 pub fn contact_sheet(dir: &Path, manifest: &BakeManifest) -> Result<Canvas, Error> {
     let folder = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
     let mut grid = Grid::new(COLUMNS);
@@ -39,8 +40,8 @@ pub fn contact_sheet(dir: &Path, manifest: &BakeManifest) -> Result<Canvas, Erro
     };
     grid.title(title);
     for (role, what) in PICTURES {
-        let outputs = manifest.stages.iter().flat_map(|s| &s.outputs);
-        for output in outputs.filter(|o| o.format == FileFormat::Png && o.role == role) {
+        let mut outputs = manifest.stages.iter().flat_map(|s| &s.outputs);
+        if let Some(output) = outputs.find(|o| o.format == FileFormat::Png && o.role == role) {
             let path = dir.join(&output.path);
             let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
             let picture = read_png(&path, &bytes)?;
@@ -154,6 +155,25 @@ mod tests {
         let sheet = contact_sheet(dir.path(), &manifest(dir.path(), &outputs[..2], false)).unwrap();
         assert!(sheet.find(&Canvas::label("bake of gold-paint")).is_some());
         assert!(sheet.find(&Canvas::label("under")).is_none());
+    }
+
+    /// A manifest listing many pictures of one role (distinct files, each as described) gets the
+    /// first of them drawn: a sheet has at most one picture per role (issue 42: a manifest
+    /// listing one picture 100 000 times made `--sheet` abort on allocation).
+    #[test]
+    fn one_picture_per_role() {
+        let dir = tempfile::tempdir().unwrap();
+        let names: Vec<String> = (0..40).map(|i| format!("i{i}.png")).collect();
+        for name in &names {
+            write_png(dir.path(), name, &Canvas::new(300, 100, [200, 20, 30]));
+        }
+        let outputs: Vec<(&str, FileFormat, &str)> =
+            names.iter().map(|n| (n.as_str(), FileFormat::Png, "importance-picture")).collect();
+        let sheet = contact_sheet(dir.path(), &manifest(dir.path(), &outputs, false)).unwrap();
+        assert!(sheet.find(&Canvas::label("importance samples over the lobe (i0.png)")).is_some());
+        assert!(sheet.find(&Canvas::label("importance samples over the lobe (i1.png)")).is_none());
+        let one = contact_sheet(dir.path(), &manifest(dir.path(), &outputs[..1], false)).unwrap();
+        assert_eq!((sheet.width, sheet.height), (one.width, one.height));
     }
 
     /// A missing or damaged picture is an error naming its file.
