@@ -47,7 +47,10 @@ fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, c
     var sum = vec3<f32>(0.0);
     if (shade.mode == MODE_PREFILTERED) {
         blend = layer_blend(frame);
-        // The diffuse part's integral, once per term (the terms' sum is divided by their count).
+    }
+    // The filtered modes' diffuse part and its integral, once per term (the terms' sum is divided
+    // by their count); never nonzero without a cosine layer to read.
+    if (shade.mode != MODE_REFERENCE && any(shade.diffuse.xyz != vec3<f32>(0.0))) {
         diffuse = shade.diffuse.xyz;
         sum = (PI * diffuse * env_bilinear(shade.layers_first, env_uv(frame.n))) * f32(count);
     }
@@ -61,7 +64,7 @@ fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, c
             if (any(brdf != vec3<f32>(0.0)) || any(rest != vec3<f32>(0.0))) {
                 let uv = env_uv(to_world(frame, s.wi));
                 if (shade.mode == MODE_FIS) {
-                    sum += brdf * mip_trilinear(uv, mip_lod(s.pdf)) * (s.wi.z / s.pdf);
+                    sum += rest * mip_trilinear(uv, mip_lod(s.pdf)) * (s.wi.z / s.pdf);
                 } else if (shade.mode == MODE_PREFILTERED) {
                     sum += rest * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
                 }

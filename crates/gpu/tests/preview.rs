@@ -283,7 +283,8 @@ fn a_render_with_another_seed_fails_the_comparison() {
     assert!(relative > 10.0 * MAX_RELATIVE_ERROR, "relative error {relative:.2e}: the bar does not see noise");
 }
 
-/// So does a render in another mode: FIS reads blurred levels where the reference reads level 0.
+/// So does a render in another mode: FIS reads blurred levels where the reference reads level 0
+/// (measured: 45.1 dB, relative error 4e-2; the comparison fails on either figure).
 #[test]
 fn a_render_in_another_mode_fails_the_comparison() {
     let scene = sphere_scene(SIZE);
@@ -291,7 +292,10 @@ fn a_render_in_another_mode_fails_the_comparison() {
     let cpu = render_cpu(&scene, ggx(), sky_lighting(), &settings(Mode::Reference));
     let (psnr, relative) = compare(&gpu, &cpu);
     log(&format!("ggx fis against reference: psnr {psnr:.1} dB, relative error {relative:.2e}"));
-    assert!(psnr < MIN_PSNR_DB && relative > MAX_RELATIVE_ERROR, "psnr {psnr:.1} dB, relative error {relative:.2e}");
+    assert!(
+        psnr < MIN_PSNR_DB || relative > 10.0 * MAX_RELATIVE_ERROR,
+        "psnr {psnr:.1} dB, relative error {relative:.2e}"
+    );
 }
 
 /// Moving the camera draws the G-buffer again: the image is the one a renderer set up with that

@@ -126,7 +126,9 @@
 //!   smooth part ([`Lighting::smooth_mips`]), trilinear at `lod = max(log4(w h / (spp p_b 2 pi^2)),
 //!   0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the level a footprint of
 //!   solid angle `1 / (spp p_b)` gets at the equator, wherever it lies; "Small bright sources"
-//!   says why); `M` the environment's peaks, `p_l` theirs ([`Peaks`]).
+//!   says why); `M` the environment's peaks, `p_l` theirs ([`Peaks`]). The BRDF split as in the
+//!   prefiltered mode (below): the diffuse part read from the cosine layer at the normal, the rest
+//!   `f - f_d` in the `F` term.
 //! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"), with the BRDF split in two: its
 //!   diffuse part `f_d` ([`diffuse_split`]: the table's least value within 60 degrees of the
 //!   normal, [`diffuse_part`],

@@ -233,16 +233,18 @@ pub(crate) fn shade(
         (_, Some(peaks)) => Some((&peaks.sampling, &peaks.map)),
         (_, None) => None,
     };
-    // The diffuse part the prefiltered estimator takes out of the BRDF, and its integral (crate
-    // documentation, "The estimators").
-    let (diffuse, diffuse_radiance) = match settings.mode {
-        Mode::Prefiltered => {
-            let f_d = crate::diffuse_split(material, lighting).map(f64::from);
-            let (u, v) = envmap::uv(frame.n);
-            let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
-            (f_d, std::array::from_fn(|c| std::f64::consts::PI * f_d[c] * f64::from(l_1[c])))
-        }
-        Mode::Reference | Mode::Fis => ([0.0; 3], [0.0; 3]),
+    // The diffuse part the filtered estimators take out of the BRDF, and its integral (crate
+    // documentation, "The estimators"); a diffuse part is never 0 without a cosine layer to read.
+    let diffuse = match settings.mode {
+        Mode::Reference => [0.0; 3],
+        Mode::Fis | Mode::Prefiltered => crate::diffuse_split(material, lighting).map(f64::from),
+    };
+    let diffuse_radiance: [f64; 3] = if diffuse == [0.0; 3] {
+        [0.0; 3]
+    } else {
+        let (u, v) = envmap::uv(frame.n);
+        let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
+        std::array::from_fn(|c| std::f64::consts::PI * diffuse[c] * f64::from(l_1[c]))
     };
     let mut total = [0.0f64; 3];
     let mut add = |f: [f64; 3], radiance: [f32; 3], weight: f64| {
@@ -274,7 +276,7 @@ pub(crate) fn shade(
                         }
                         Some(Source::Mips(mips)) => {
                             let lod = mips.lod_solid_angle(spp as usize, sample.pdf);
-                            add(f, mips.lookup_uv(u, v, lod), wi_local.z / sample.pdf);
+                            add(rest, mips.lookup_uv(u, v, lod), wi_local.z / sample.pdf);
                         }
                         None => {}
                     }
