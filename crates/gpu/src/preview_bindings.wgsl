@@ -104,8 +104,8 @@ struct Shade {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
-    // `render::diffuse_split` (w unused): the BRDF's diffuse part `f_d`, which the prefiltered
-    // estimator reads from the cosine layer (the first) at the normal.
+    // `render::diffuse_split` (w unused): the BRDF's diffuse part `f_d`, which the filtered
+    // estimators read from the cosine layer (the first) at the normal.
     diffuse: vec4<f32>,
 }
 

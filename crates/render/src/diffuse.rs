@@ -1,4 +1,4 @@
-//! The diffuse part of a measured table, which the pre-filtered estimator reads without noise
+//! The diffuse part of a measured table, which the filtered estimators read without noise
 //! (crate documentation, "The estimators").
 
 use merl::MerlTable;
@@ -26,8 +26,8 @@ pub const DIFFUSE_MIN_COS: f64 = 0.5;
 /// both directions within [`DIFFUSE_MIN_COS`] of the normal, cells without data left out (0 if
 /// none is left). So the rest `f - f_d` is non-negative away from grazing angles: a Lambertian
 /// table is all `f_d`, a Phong lobe (which falls to 0 away from its mirror direction within
-/// those angles) has none, a Phong lobe over a Lambertian base has the base's. A few
-/// milliseconds for a MERL-sized table.
+/// those angles) has none, a Phong lobe over a Lambertian base has the base's. One parallel pass
+/// over the cells, made once per material ([`Material::new`]).
 pub fn diffuse_part(table: &MerlTable) -> [f32; 3] {
     let dims = table.dims();
     let least = (0..dims.cells())
@@ -40,7 +40,7 @@ pub fn diffuse_part(table: &MerlTable) -> [f32; 3] {
     least.map(|v| if v.is_finite() { v.max(0.0) as f32 } else { 0.0 })
 }
 
-/// The `f_d` the pre-filtered estimator takes out of the BRDF and reads from the cosine layer at
+/// The `f_d` the filtered estimators (fis and prefiltered) take out of the BRDF and reads from the cosine layer at
 /// the normal: [`Material::diffuse`], where the lighting's first layer is the cosine lobe
 /// (exponent 1); `[0; 3]` otherwise (every layer then read in the BRDF's sample directions).
 pub fn diffuse_split(material: &Material, lighting: &Lighting) -> [f32; 3] {

@@ -32,14 +32,14 @@
 //!
 //! At a covered pixel with interpolated position `p` and normal `n` (normalized after
 //! interpolation): `wo = normalize(eye - p)`, `cos_o = n . wo`. A pixel whose normal interpolates
-//! to zero is black. Where `cos_o <` [`COS_O_MIN`] (`1e-4`, Filament's `MIN_N_DOT_V`) the interpolated
-//! normal turns away from the eye, or nearly: at a silhouette, the pixel centre falls on a triangle
-//! whose vertex normals lie beyond it. Such a normal is bent towards the eye, as engines do:
-//! rotated in the plane of `n` and `wo` until `n . wo =
-//! COS_O_MIN`, `n = COS_O_MIN wo + sqrt(1 - COS_O_MIN^2) p` with `p` the part of `n` across `wo`,
-//! normalized (where `n = -wo`, Duff et al.'s first tangent for `wo`, below), and `cos_o = n . wo`
-//! computed again. Every estimator, the converged one included, shades the bent frame, so the
-//! silhouette has no black pixels and the estimators still agree there. Then `t = wo - cos_o n`; if `|t| < 1e-6` (`wo` along the normal)
+//! to zero is black. Where `cos_o <` [`COS_O_MIN`] (`1e-4`, Filament's `MIN_N_DOT_V`) the
+//! interpolated normal turns away from the eye, or nearly: at a silhouette, the pixel centre falls
+//! on a triangle whose vertex normals lie beyond it. Such a normal is bent towards the eye, as
+//! engines do: rotated in the plane of `n` and `wo` until `n . wo = COS_O_MIN`, `n = COS_O_MIN wo +
+//! sqrt(1 - COS_O_MIN^2) p` with `p` the part of `n` across `wo`, normalized (where `n = -wo`, Duff
+//! et al.'s first tangent for `wo`, below), and `cos_o = n . wo` computed again. Every estimator,
+//! the converged one included, shades the bent frame, so the silhouette has no black pixels and the
+//! estimators still agree there. Then `t = wo - cos_o n`; if `|t| < 1e-6` (`wo` along the normal)
 //! `t` is the first tangent of the branchless basis of Duff et al. 2017 for `n`
 //! (`s = copysign(1, n.z)`, `a = -1 / (s + n.z)`, `t = (1 + s n.x^2 a, s n.x n.y a, -s n.x)`),
 //! else `t / |t|`; `b = n x t`. In this frame `wo` is
@@ -292,9 +292,9 @@ pub struct Material {
     /// `r` is for `1 - cos theta_o = (r + 1/2) / R`; a pixel interpolates the rows around it
     /// ([`view_layer`]).
     pub view_layers: Vec<f32>,
-    /// The table's diffuse part `f_d` (1/sr per channel, [`diffuse_part`]), which
-    /// [`Mode::Prefiltered`] reads from the cosine layer at the normal (crate documentation, "The
-    /// estimators").
+    /// The table's diffuse part `f_d` (1/sr per channel, [`diffuse_part`]), which the filtered
+    /// modes ([`Mode::Fis`], [`Mode::Prefiltered`]) read from the cosine layer at the normal
+    /// (crate documentation, "The estimators").
     pub diffuse: [f32; 3],
     /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
     /// the table (`brdf-preview --brdf wavelet-brdf`): see "The BRDF" in the crate docs.

@@ -207,7 +207,7 @@ pub struct Renderer {
     n_levels: u32,
     n_layers: usize,
     view_layers: Vec<f32>,
-    /// `render::diffuse_split`: the BRDF's diffuse part the prefiltered estimator reads at the
+    /// `render::diffuse_split`: the BRDF's diffuse part the filtered estimators read at the
     /// normal.
     diffuse: [f32; 3],
     maps: MapLayout,

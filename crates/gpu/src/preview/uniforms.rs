@@ -70,7 +70,7 @@ pub(crate) struct ShadeUniform {
     pub(crate) _pad0: u32,
     pub(crate) _pad1: u32,
     pub(crate) _pad2: u32,
-    /// `render::diffuse_split` (w unused): the prefiltered estimator's diffuse part.
+    /// `render::diffuse_split` (w unused): the filtered estimators' diffuse part.
     pub(crate) diffuse: [f32; 4],
 }
 
