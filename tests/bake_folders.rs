@@ -250,7 +250,7 @@ fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
 /// `switch-blocked`: a non-empty folder where a rebake with `--cube` writes `layers-cube.ktx2`; and
 /// the same with `--engine-textures` and a non-empty `engine-merl.ktx2/`. Each rebake exits 2 with
 /// one line naming the folder in the way and changes nothing: the previous manifest and every file
-/// it lists, with its checksum, the folder in the way with its note, no temporary file (issue 42:
+/// it lists, with its checksum, the folder in the way with its note, no temporary file (before this,
 /// the switch renamed new files over the old ones, met the folder, and its undo deleted the new
 /// files, leaving 3 of 21 files and no manifest).
 #[test]
@@ -293,7 +293,7 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
 /// `make-cases.sh`'s `duplicate-1000` (the manifest lists `importance.png` 1000 more times) and a
 /// 100 000-entry one made here (compact JSON, under the 16 MiB limit): every reader (a preview,
 /// `--sheet`, `brdf-wavelet` adding its stage) refuses the manifest at once with one line naming
-/// it and the path listed twice, instead of hashing or drawing every copy (issue 42: 29 s for
+/// it and the path listed twice, instead of hashing or drawing every copy (before this, 29 s for
 /// 3 000 copies, an allocation failure for 100 000); `brdf-bake` counts it as no manifest and
 /// bakes again, hashing nothing it lists.
 #[test]
@@ -341,7 +341,7 @@ fn a_manifest_listing_a_path_twice_is_refused_by_every_reader() {
 /// `make-cases.sh`'s `control-chars` (an output path holding a newline and ANSI colour codes that
 /// forge a second, green `error: none, the bake is fine` line), the same in the material's
 /// `source_path` and in an asset's provenance: every message is one line, the name in it with its
-/// control characters escaped, and no raw control character reaches the terminal (issue 42).
+/// control characters escaped, and no raw control character reaches the terminal.
 #[test]
 fn names_from_a_file_cannot_forge_messages() {
     let tmp = temp_dir();
@@ -397,7 +397,7 @@ fn names_from_a_file_cannot_forge_messages() {
 /// Tools that write one file (`merl-info --asset`, `brdf-preview --out`) into a bake folder: a
 /// name the manifest lists (or the manifest) is refused with one line, the bake left as it was;
 /// while a bake holds the folder's lock (taken here by `flock(1)`, as a bake takes it) any name is
-/// refused at once; an unlisted name is written when no bake runs (issue 42: both wrote into a
+/// refused at once; an unlisted name is written when no bake runs (before this, both wrote into a
 /// folder during a bake, and `merl-info --asset BAKE/importance.asset` overwrote a listed file).
 #[test]
 fn tools_that_write_one_file_leave_a_bake_alone() {
@@ -447,7 +447,7 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
 
 /// A bake whose manifest is just under the readers' 16 MiB limit (a stage's figures padded):
 /// `brdf-wavelet` adding its stage would write a manifest over it, which every reader refuses; it
-/// exits 2 with one line instead and leaves the bake as it was (issue 42: it exited 0 with a
+/// exits 2 with one line instead and leaves the bake as it was (before this, it exited 0 with a
 /// 24 MB manifest).
 #[test]
 fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
@@ -480,7 +480,7 @@ fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
 /// A folder moved while a bake runs (`mv D D.old; mkdir D`), and a second bake into the new `D`
 /// at once, at seeded random offsets into the first: each folder ends one complete bake (its
 /// manifest lists exactly the files there, each with its size and hash); where both ran, the first
-/// landed in `D.old` and the second in `D` (issue 42: the staging, the manifest's removal and the
+/// landed in `D.old` and the second in `D` (before this, the staging, the manifest's removal and the
 /// renames went by path, so `D` ended with the first bake's files, or one manifest and 14 unlisted
 /// files, and the moved folder's manifest named files the bake had deleted).
 #[test]

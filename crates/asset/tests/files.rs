@@ -159,7 +159,7 @@ fn old_set() -> Vec<(String, String)> {
 }
 
 /// A name the set writes that holds a folder (or a FIFO) fails the commit before anything is
-/// touched: the old set, its index included, is as it was (issue 42: a rebake's switch renamed
+/// touched: the old set, its index included, is as it was (before this, a rebake's switch renamed
 /// files over the old ones, met the folder, and its undo deleted the new files, leaving 3 of 21).
 #[test]
 fn a_commit_blocked_by_a_folder_changes_nothing() {
@@ -225,7 +225,7 @@ fn a_commit_that_fails_midway_restores_the_old_set() {
 }
 
 /// A set goes through its folder's descriptor: a folder moved (and another made at its path)
-/// between staging and commit gets the whole set, the new folder nothing (issue 42: a bake's
+/// between staging and commit gets the whole set, the new folder nothing (before this, a bake's
 /// renames went by path and landed in the new folder).
 #[test]
 fn a_set_lands_in_its_folder_wherever_the_folder_moved() {
@@ -242,7 +242,7 @@ fn a_set_lands_in_its_folder_wherever_the_folder_moved() {
 }
 
 /// Beside a bake, `write_atomic` writes no name the bake's manifest lists, nor the manifest, and
-/// nothing while a bake holds the folder's lock (issue 42: `merl-info --asset BAKE/importance.asset`
+/// nothing while a bake holds the folder's lock (before this, `merl-info --asset BAKE/importance.asset`
 /// overwrote a listed file, and wrote into a folder a bake was writing).
 #[test]
 fn write_atomic_leaves_a_bakes_files_and_a_locked_folder_alone() {

@@ -1,4 +1,4 @@
-//! Values behind valid checksums (issue 42, item 5): each field a reader takes is held to the
+//! Values behind valid checksums: each field a reader takes is held to the
 //! range its meaning allows, and a value outside it is refused with the field and the value,
 //! whatever its sizes say. One table: the kind, the edit, what the message says.
 

@@ -158,7 +158,7 @@ mod tests {
     }
 
     /// A manifest listing many pictures of one role (distinct files, each as described) gets the
-    /// first of them drawn: a sheet has at most one picture per role (issue 42: a manifest
+    /// first of them drawn: a sheet has at most one picture per role (before this, a manifest
     /// listing one picture 100 000 times made `--sheet` abort on allocation).
     #[test]
     fn one_picture_per_role() {

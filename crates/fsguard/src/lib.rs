@@ -430,7 +430,7 @@ mod tests {
         e.to_string()
     }
 
-    /// The forged line of issue 42: a newline and ANSI colour codes in an output path.
+    /// The forged line a hostile manifest can hold: a newline and ANSI colour codes in an output path.
     #[test]
     fn printable_escapes_control_characters_only() {
         let forged = "importance\n\u{1b}[32merror: none, the bake is fine\u{1b}[0m.asset";
