@@ -1,6 +1,6 @@
-//! `Mode::Adaptive` and `Mode::AdaptivePrefiltered`: one frame of bandwidth-driven
+//! `Mode::Adaptive` and `Mode::AdaptivePrefiltered`: frames of bandwidth-driven
 //! multi-resolution shading on the GPU (`gpu::preview::Renderer::render_adaptive`, held to
-//! `render::adaptive`), its checks and its debug views.
+//! `render::adaptive`), averaged, their checks and the first frame's debug views.
 
 use std::path::Path;
 
@@ -13,7 +13,8 @@ use crate::checks::{
 };
 use crate::{Error, Host, Output, Rendered, Request};
 
-/// One adaptive frame as `request` asks for it, written to `out`.
+/// The mean of the adaptive frames `request` asks for (`render::adaptive`, "Frames"), written to
+/// `out`.
 pub(crate) fn render(
     request: &Request,
     loaded: &bake::Loaded,
@@ -37,6 +38,7 @@ pub(crate) fn render(
         seed: request.seed,
         ..render::adaptive::Settings::new(mode, request.spp.unwrap_or(if mode == Estimator::Reference { 8 } else { 4 }))
     };
+    let frames = request.frames.unwrap_or(render::adaptive::FRAMES);
     let scene = scene(request)?;
     let ss = settings.supersample;
     let pixels = (scene.width * ss * scene.height * ss) as u128;
@@ -46,12 +48,13 @@ pub(crate) fn render(
     } else {
         0
     };
+    let frames_samples = u128::from(frames) * frame_samples;
     check_work(
         request,
         &[
-            // A first frame compiles the pipelines, then the frame that is timed.
-            ("on the GPU", 2 * frame_samples),
-            ("for --validate on the CPU", if request.validate { frame_samples } else { 0 }),
+            // A first frame compiles the pipelines, then the frames that are timed.
+            ("on the GPU", frame_samples + frames_samples),
+            ("for --validate on the CPU", if request.validate { frames_samples } else { 0 }),
             ("for the converged estimate on the CPU", converged_samples),
         ],
     )?;
@@ -62,31 +65,57 @@ pub(crate) fn render(
     renderer.set_bandwidths(bandwidths)?;
     host.step(format!("{} on the GPU", request.mode.name()));
     // A driver may compile a pipeline at its first dispatch (lavapipe does, tens of
-    // milliseconds): a frame first, so that ms_per_frame times the frame. The G-buffer and its
+    // milliseconds): a frame first, so that ms_per_frame times the frames. The G-buffer and its
     // upload are the camera's, made once for all its frames as the other modes' raster pass is.
     renderer.render_adaptive(&loaded.material, lighting, &settings, Default::default())?;
     let geometry = renderer.adaptive_geometry(ss)?;
-    // The frame's buffers come back after its timings, for the views and the checks that read them.
+    // Each frame's buffers come back after its timings, for the views and the checks that read
+    // them; the checks run frame by frame, so that no frame's buffers are kept but the first's
+    // (the debug views) and, for the ceiling, the predictions.
     let details = request.debug_views || request.validate || request.converged.is_some();
     let options = gpu::preview::FrameOptions { details, ..Default::default() };
-    let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
-    check_finite(request, &frame.image.rgb, "the GPU's adaptive frame")?;
-    let t = frame.timings;
+    let mut mean = render::adaptive::FrameMean::default();
+    let mut validation = Validation::default();
+    let mut predictions = Vec::new();
+    let mut first = None;
+    let mut sum = Sums::default();
+    for f in 0..frames {
+        let settings = render::adaptive::Settings { seed: render::adaptive::frame_seed(settings.seed, f), ..settings };
+        let frame = renderer.render_adaptive(&loaded.material, lighting, &settings, options)?;
+        check_finite(request, &frame.image.rgb, "the GPU's adaptive frame")?;
+        mean.add(&frame.image);
+        sum.add(&frame);
+        if request.validate {
+            host.step(format!("{} frame {} of {frames} on the CPU (--validate)", request.mode.name(), f + 1));
+            validation.add(&frame, &geometry, loaded, lighting, bandwidths, &settings)?;
+        }
+        if ss == 1 && (request.validate || request.converged.is_some()) {
+            predictions.push((settings, frame.details().predictions.clone()));
+        }
+        if f == 0 {
+            first = Some(frame);
+        }
+    }
+    let (Some(frame), Some(image)) = (first, mean.mean()) else {
+        return Err(Error::Invalid("--frames: expected at least one frame".into()));
+    };
+    let t = sum.timings(frames);
     let ms_per_frame = t.total_ms;
-    let picture = metrics::tonemap(&frame.image, &tone_mapping);
+    let picture = metrics::tonemap(&image, &tone_mapping);
     let aa = settings.supersample * settings.supersample;
     // The pre-convolved estimator's layers, where they are not the bake's.
     let layers = match (mode, settings.layer_shift) {
         (Estimator::Prefiltered, n) if n > 0 => format!(" ({n} layer{} sharper)", if n == 1 { "" } else { "s" }),
         _ => String::new(),
     };
+    let shaded_fraction = sum.shaded_fraction / f64::from(frames);
     let caption = format!(
-        "{} | {}{layers} | {} spp budget, {} samples | shaded fraction {:.3} | AA {aa}x | {}x{} | exposure {:+.2} EV",
+        "{} | {}{layers} | {} spp budget x {frames} frames, {} samples | shaded fraction {shaded_fraction:.3} | AA {aa}x | \
+         {}x{} | exposure {:+.2} EV",
         names(&loaded.manifest),
         request.mode.name(),
         settings.spp,
-        frame.samples,
-        frame.shaded_fraction(),
+        sum.samples,
         scene.width,
         scene.height,
         tone_mapping.exposure_ev
@@ -98,11 +127,13 @@ pub(crate) fn render(
         bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
     }];
     if request.debug_views {
+        // The first frame's: the frames' plans differ a little (their own predictions).
+        let first_picture = metrics::tonemap(&frame.image, &tone_mapping);
         let sheet = crate::views::debug_views(
             &frame,
             settings.allocation,
-            &picture,
-            &format!("{}: {}", request.mode.name(), names(&loaded.manifest)),
+            &first_picture,
+            &format!("{}: {} (frame 1 of {frames})", request.mode.name(), names(&loaded.manifest)),
         );
         files.push(Output {
             path: sibling(out, "debug"),
@@ -124,22 +155,22 @@ pub(crate) fn render(
         ),
     };
     let mut report = vec![format!(
-        "{}: {} on {} ({}), {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU before, once: {:.1}); \
-         shaded fraction {:.4}, {} samples of a budget of {}",
+        "{}: {} on {} ({}), {frames} frames of {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU before, \
+         once: {:.1}); shaded fraction {shaded_fraction:.4}, {} samples of a budget of {}",
         out.display(),
         request.mode.name(),
         gpu.adapter_summary(),
         request.mesh,
         t.gbuffer_ms,
-        frame.shaded_fraction(),
-        frame.samples,
-        frame.budget
+        sum.samples,
+        sum.budget
     )];
     let mut value = json!({
         "bake": request.bake.display().to_string(),
         "mode": request.mode.name(),
         "adapter": gpu.adapter_summary(),
         "spp": settings.spp,
+        "frames": frames,
         "aa": aa,
         "predict_level": settings.predict_level,
         "allocation": settings.allocation.name(),
@@ -157,40 +188,24 @@ pub(crate) fn render(
             "submissions": t.submissions,
             "gpu_clock": t.gpu_clock,
         },
-        "shaded_fraction": frame.shaded_fraction(),
+        "shaded_fraction": shaded_fraction,
         "shaded_per_level": frame.shaded_per_level,
-        "samples": frame.samples,
-        "budget": frame.budget,
-        "mean_luminance": metrics::mean_luminance(&frame.image),
+        "samples": sum.samples,
+        "budget": sum.budget,
+        "mean_luminance": metrics::mean_luminance(&image),
     });
     let mut problems = Vec::new();
-    if request.validate {
-        // The CPU's own prediction: the levels equal but where a direction on the edge of a
-        // nearest texel reads its neighbour in f32 (the tests hold 98% of them equal). Only the
-        // predictions are read, so its blocks are not shaded.
-        host.step(format!("{} on the CPU (--validate)", request.mode.name()));
-        let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
-        let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
-        let own = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let predicted =
-            frame.details().predictions.iter().zip(&own.details().predictions).filter(|(g, _)| g.level >= 0);
-        let (pixels, differ) =
-            predicted.fold((0usize, 0usize), |(n, d), (g, c)| (n + 1, d + usize::from(g.level != c.level)));
-        // The same frame with the GPU's predictions on the CPU: the plan is the same (the weights
-        // to f32 rounding: the GPU's are f32), the values equal to rounding.
-        let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
-        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
-        let cpu = render::adaptive::render_with(&geometry, &loaded.material, lighting, bandwidths, &settings, hooks)?;
-        let cpu_picture = metrics::tonemap(&cpu.image, &tone_mapping);
+    if let Some(cpu) = validation.cpu.mean() {
+        let Validation { pixels, differ, ref plan, .. } = validation;
+        let cpu_picture = metrics::tonemap(&cpu, &tone_mapping);
         let psnr = metrics::psnr_db(&picture, &cpu_picture);
-        let relative = metrics::relative_error(&frame.image.rgb, &cpu.image.rgb);
-        let plan = frame.details().plan.compare(&cpu.details().plan, 1e-5);
+        let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
         let same_plan = plan.is_ok();
         report.push(format!(
             "against the CPU: {differ} of {pixels} pixels predicted at another level than the CPU predicts; \
              with the GPU's predictions ({}): PSNR {} dB, relative error {relative:.2e}",
-            match &plan {
-                Ok(worst) => format!("the same plan, weights within {worst:.1e}"),
+            match plan {
+                Ok(worst) => format!("the same plans, weights within {worst:.1e}"),
                 Err(e) => format!("NOT the same plan: {e}"),
             },
             db(psnr)
@@ -216,7 +231,7 @@ pub(crate) fn render(
     if request.validate || request.converged.is_some() {
         let n = request.converged.unwrap_or(256);
         let Converged { image: converged, picture: converged_picture, psnr, relative } =
-            converged(request, &scene, &loaded.material, lighting, n, (&frame.image, &picture), &tone_mapping, host)?;
+            converged(request, &scene, &loaded.material, lighting, n, (&image, &picture), &tone_mapping, host)?;
         files.push(Output {
             path: sibling(out, "converged"),
             role: "converged",
@@ -231,28 +246,123 @@ pub(crate) fn render(
         value["converged"] = json!({ "samples_per_strategy": n, "psnr_db": json_db(psnr), "relative_error": relative });
         check_psnr(request, "against the converged estimate", psnr, &mut problems);
         if ss == 1 {
-            // The same plan with the converged values in its shaded blocks: the up-sampling's
-            // error alone, the PSNR no budget can pass (render pixels are the converged
-            // estimate's pixels only without anti-aliasing).
-            let predictions = &frame.details().predictions;
-            let ceiling = render::adaptive::ceiling(
-                &geometry,
-                &loaded.material,
-                lighting,
-                bandwidths,
-                &settings,
-                predictions,
-                &converged,
-                None,
-            )?;
-            let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling.image, &tone_mapping), &converged_picture);
-            report.push(format!(
-                "the plan's ceiling (its shaded blocks given the converged values, as exact as they are): PSNR {} dB; \
-                 near it, more --spp does not help, the up-sampling is the error",
-                db(ceiling)
-            ));
-            value["ceiling_db"] = json_db(ceiling);
+            // The same plans with the converged values in their shaded blocks, averaged: the
+            // up-sampling's error alone, the PSNR no budget can pass (render pixels are the
+            // converged estimate's pixels only without anti-aliasing).
+            let mut ceiling = render::adaptive::FrameMean::default();
+            for (settings, predictions) in &predictions {
+                let frame = render::adaptive::ceiling(
+                    &geometry,
+                    &loaded.material,
+                    lighting,
+                    bandwidths,
+                    settings,
+                    predictions,
+                    &converged,
+                    None,
+                )?;
+                ceiling.add(&frame.image);
+            }
+            if let Some(ceiling) = ceiling.mean() {
+                let ceiling = metrics::psnr_db(&metrics::tonemap(&ceiling, &tone_mapping), &converged_picture);
+                report.push(format!(
+                    "the plans' ceiling (their shaded blocks given the converged values, as exact as they are): PSNR \
+                     {} dB; near it, more --spp does not help, the up-sampling is the error",
+                    db(ceiling)
+                ));
+                value["ceiling_db"] = json_db(ceiling);
+            }
         }
     }
     Ok(Rendered { files, report, problems, json: value })
+}
+
+/// The frames' figures, summed.
+#[derive(Default)]
+struct Sums {
+    timings: render::adaptive::Timings,
+    shaded_fraction: f64,
+    samples: u64,
+    budget: u64,
+}
+
+impl Sums {
+    fn add(&mut self, frame: &render::adaptive::Adaptive) {
+        let (t, s) = (&frame.timings, &mut self.timings);
+        s.gbuffer_ms = t.gbuffer_ms;
+        s.predict_ms += t.predict_ms;
+        s.plan_ms += t.plan_ms;
+        s.shade_ms += t.shade_ms;
+        s.total_ms += t.total_ms;
+        s.submissions = t.submissions;
+        s.gpu_clock = t.gpu_clock;
+        self.shaded_fraction += frame.shaded_fraction();
+        self.samples += frame.samples;
+        self.budget += frame.budget;
+    }
+
+    /// The timings of a mean frame of `frames`.
+    fn timings(&self, frames: u32) -> render::adaptive::Timings {
+        let n = f64::from(frames.max(1));
+        let t = self.timings;
+        render::adaptive::Timings {
+            predict_ms: t.predict_ms / n,
+            plan_ms: t.plan_ms / n,
+            shade_ms: t.shade_ms / n,
+            total_ms: t.total_ms / n,
+            ..t
+        }
+    }
+}
+
+/// `--validate`, frame by frame: the CPU's own predictions against the GPU's, and each frame
+/// again on the CPU from the GPU's predictions (the same plan, the values equal to rounding).
+struct Validation {
+    /// Predicted pixels, and those the CPU predicts at another level.
+    pixels: usize,
+    differ: usize,
+    /// The largest weight difference of the frames' plans, or the first frame planned otherwise.
+    plan: Result<f64, String>,
+    cpu: render::adaptive::FrameMean,
+}
+
+impl Default for Validation {
+    fn default() -> Self {
+        Validation { pixels: 0, differ: 0, plan: Ok(0.0), cpu: Default::default() }
+    }
+}
+
+impl Validation {
+    fn add(
+        &mut self,
+        frame: &render::adaptive::Adaptive,
+        geometry: &render::adaptive::Geometry,
+        loaded: &bake::Loaded,
+        lighting: &render::Lighting,
+        bandwidths: &render::adaptive::Bandwidths,
+        settings: &render::adaptive::Settings,
+    ) -> Result<(), Error> {
+        // The CPU's own prediction: the levels equal but where a direction on the edge of a
+        // nearest texel reads its neighbour in f32 (the tests hold 98% of them equal). Only the
+        // predictions are read, so its blocks are not shaded.
+        let mut unshaded = |blocks: &[(u32, u32)]| Ok(vec![[0.0f32; 3]; blocks.len()]);
+        let hooks = render::adaptive::Hooks { shader: Some(&mut unshaded), ..Default::default() };
+        let own = render::adaptive::render_with(geometry, &loaded.material, lighting, bandwidths, settings, hooks)?;
+        for (g, c) in frame.details().predictions.iter().zip(&own.details().predictions).filter(|(g, _)| g.level >= 0) {
+            self.pixels += 1;
+            self.differ += usize::from(g.level != c.level);
+        }
+        // The same frame with the GPU's predictions on the CPU: the plan is the same (the weights
+        // to f32 rounding: the GPU's are f32), the values equal to rounding.
+        let mut replay = render::adaptive::replay_predictor(&frame.details().predictions);
+        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let cpu = render::adaptive::render_with(geometry, &loaded.material, lighting, bandwidths, settings, hooks)?;
+        self.plan = match (&self.plan, frame.details().plan.compare(&cpu.details().plan, 1e-5)) {
+            (Err(e), _) => Err(e.clone()),
+            (Ok(_), Err(e)) => Err(e.to_string()),
+            (Ok(a), Ok(b)) => Ok(a.max(f64::from(b))),
+        };
+        self.cpu.add(&cpu.image);
+        Ok(())
+    }
 }

@@ -1,5 +1,5 @@
-//! `--mode adaptive` and `--mode adaptive-prefiltered`: one frame of bandwidth-driven
-//! multi-resolution shading (`render::adaptive`, on the GPU) and its debug views.
+//! `--mode adaptive` and `--mode adaptive-prefiltered`: the debug views of an adaptive frame
+//! (`render::adaptive`, on the GPU).
 
 use picture::colormap::{Scale, inferno, viridis};
 use picture::layout::{Axis, Grid as Panels, caption, heat_map, stack};

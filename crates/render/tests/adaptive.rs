@@ -10,16 +10,41 @@ use crate::fixtures::bandwidths;
 use crate::support::{phong, sky_lighting, sphere_scene};
 
 #[test]
-fn eq_11_takes_the_nyquist_rate() {
-    // Sampling rate 2 nu per pixel; level floor(log2(1 / (2 nu))) in [0, top].
+fn eq_11_takes_twice_the_nyquist_rate() {
+    // Sampling rate 4 nu per pixel; level floor(log2(1 / (4 nu))) in [0, top].
+    assert_eq!(adaptive::SAMPLES_PER_CYCLE, 4.0);
     assert_eq!(adaptive::level_of(0.5, 6), 0);
-    assert_eq!(adaptive::level_of(0.3, 6), 0);
-    assert_eq!(adaptive::level_of(0.25, 6), 1);
-    assert_eq!(adaptive::level_of(0.2, 6), 1);
-    assert_eq!(adaptive::level_of(1.0 / 64.0, 6), 5);
+    assert_eq!(adaptive::level_of(0.25, 6), 0);
+    assert_eq!(adaptive::level_of(0.2, 6), 0);
+    assert_eq!(adaptive::level_of(0.125, 6), 1);
+    assert_eq!(adaptive::level_of(0.1, 6), 1);
+    assert_eq!(adaptive::level_of(1.0 / 128.0, 6), 5);
+    assert_eq!(adaptive::level_of(1.0 / 129.0, 6), 5);
+    assert_eq!(adaptive::level_of(1.0 / 256.0, 6), 6);
     assert_eq!(adaptive::level_of(1e-9, 6), 6);
     assert_eq!(adaptive::level_of(0.0, 6), 6);
     assert_eq!(adaptive::level_of(40.0, 6), 0);
+}
+
+#[test]
+fn frames_average_the_noise_of_the_shaded_blocks() {
+    // Frame 0 is the single frame's; the mean of 8 frames (their own seeds, so their own
+    // predictions and samples) is nearer the converged estimate than one frame. A Phong lobe
+    // under the sky at 4 samples per pixel: one frame's error is mostly noise.
+    let (scene, material, lighting, bandwidths) = (sphere_scene(48, 48), phong(0), sky_lighting(), bandwidths());
+    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Mode::Reference, 4) };
+    let one = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap().image;
+    assert_eq!(adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings, 1).unwrap(), one);
+    let eight = adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings, 8).unwrap();
+    assert_eq!(eight.covered, one.covered);
+    let truth = render::converged::converged(&scene, material, &lighting, 256, 1).unwrap();
+    let error = |image: &render::Image| render::metrics::relative_error(&image.rgb, &truth.rgb);
+    // Independent frames: the noise's share of the error falls by sqrt(8) = 2.8; the bound
+    // leaves room for the up-sampling's bias, which frames do not average.
+    println!("8 frames {:.4}, one {:.4}", error(&eight), error(&one));
+    assert!(error(&eight) < 0.6 * error(&one), "8 frames {:.4} against one {:.4}", error(&eight), error(&one));
+    assert_ne!(adaptive::frame_seed(0, 1), adaptive::frame_seed(1, 1));
+    assert_eq!(adaptive::frame_seed(7, 0), 7);
 }
 
 #[test]
@@ -312,7 +337,7 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     // takes it back exactly, a coarser plan equals it at its shaded blocks' pixels only and
     // up-samples between them, and a reference too small is an error naming the pixel.
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
-    let scene = sphere_scene(40, 30);
+    let scene = sphere_scene(80, 60);
     let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
     let full = render::render(&scene, material, &lighting, &settings).unwrap();
     let reference = render::Image { rgb: (0..full.rgb.len()).map(|i| (i / 3 * 7919 % 1000) as f32).collect(), ..full };
@@ -329,14 +354,14 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     };
     let fine = adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Mode::Reference, 8) };
     let frame = render_exact(&fine, &reference).unwrap();
-    for i in (0..40 * 30).filter(|&i| frame.details().predictions[i].level >= 0) {
+    for i in (0..80 * 60).filter(|&i| frame.details().predictions[i].level >= 0) {
         assert_eq!(frame.image.rgb[3 * i], reference.rgb[3 * i], "pixel {i}");
     }
     let coarse = adaptive::Settings::new(Mode::Reference, 8);
     let frame = render_exact(&coarse, &reference).unwrap();
     let is_exact = |i: usize| frame.image.rgb[3 * i] == reference.rgb[3 * i];
     let from =
-        |level: fn(i32) -> bool| (0..40 * 30).filter(|&i| level(frame.details().shaded_level[i])).collect::<Vec<_>>();
+        |level: fn(i32) -> bool| (0..80 * 60).filter(|&i| level(frame.details().shaded_level[i])).collect::<Vec<_>>();
     let (own, upsampled) = (from(|l| l == 0), from(|l| l > 0));
     assert!(own.iter().all(|&i| is_exact(i)), "pixels shaded on their own take their reference value");
     assert!(!upsampled.is_empty(), "the plan shades coarse blocks");

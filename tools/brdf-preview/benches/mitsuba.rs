@@ -15,8 +15,8 @@
 //!
 //! Our images, as `brdf-preview` makes them by default: the converged estimate
 //! (`render::converged`, 1024 samples per strategy), then `reference`, `fis` and `prefiltered` at
-//! the previewer's defaults (`render::Settings::previewer`), and one frame of `adaptive` and
-//! `adaptive-prefiltered` at theirs ([`ours`]). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
+//! the previewer's defaults (`render::Settings::previewer`), and `adaptive` and
+//! `adaptive-prefiltered` at theirs ([`ours`]: `render::adaptive::FRAMES` frames averaged). Mitsuba's: the `path` integrator, `max_depth` 2 (direct light only, which is what our
 //! renderer computes; a convex sphere has no interreflection), 4096 spp, two seeds. Per case and
 //! mode: the PSNR against Mitsuba's seed 0 on the 8-bit pictures (`render::metrics`, one exposure
 //! for all: `metrics::auto_tone_mapping` of the map), over the whole picture (the background included,
@@ -199,8 +199,8 @@ fn scene(azimuth: f32, elevation: f32, size: usize) -> Scene {
 }
 
 /// Our images of a case, as `brdf-preview` renders them by default (its `run`): the converged
-/// estimate, then each mode at its default samples and frames, then one adaptive frame of each
-/// estimator at `brdf-preview`'s defaults (its `--help`: 8 samples per pixel for `adaptive`, 4
+/// estimate, then each mode at its default samples and frames, then adaptive frames of each
+/// estimator at `brdf-preview`'s defaults (its `--help`: 8 frames; 8 samples per pixel for `adaptive`, 4
 /// for `adaptive-prefiltered`, `--predict-level 2`, the area allocation, no supersampling, the
 /// default layer shift). The one place that builds `render`'s settings.
 fn ours(
@@ -227,9 +227,9 @@ fn ours(
             ..adaptive::Settings::new(mode, spp)
         };
         let start = Instant::now();
-        let frame = adaptive::render(scene, material, lighting, bandwidths, &settings)
+        let image = adaptive::render_frames(scene, material, lighting, bandwidths, &settings, adaptive::FRAMES)
             .unwrap_or_else(|e| panic!("rendering {name}: {e}"));
-        images.push((name, frame.image, start.elapsed().as_secs_f64()));
+        images.push((name, image, start.elapsed().as_secs_f64()));
     }
     images
 }
@@ -616,7 +616,10 @@ fn main() {
                     })
                     .collect::<Vec<_>>()
                     .join(", ")
-                    + ", adaptive 8 spp and adaptive-prefiltered 4 spp (one frame each, predict level 2, area allocation)";
+                    + &format!(
+                        ", adaptive 8 spp and adaptive-prefiltered 4 spp ({} frames each, predict level 2, area allocation)",
+                        adaptive::FRAMES
+                    );
                 let ours_s = start.elapsed().as_secs_f64();
                 for (mode, image, _) in &images {
                     let planes: [Vec<f32>; 3] =

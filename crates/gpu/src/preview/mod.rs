@@ -456,8 +456,9 @@ impl Renderer {
     /// bandwidths of [`Renderer::set_bandwidths`]: each pixel's image bandwidth (cycles per pixel)
     /// and variance. The curvature is the CPU's G-buffer's ([`Renderer::adaptive_geometry`], as
     /// an adaptive frame's is). A pixel the GPU's raster finds not shadeable (the renderers may
-    /// disagree at a few silhouette pixels: crate docs) predicts the Nyquist rate, bandwidth 1/2
-    /// and variance 0: level 0, shaded at full resolution, the safe side.
+    /// disagree at a few silhouette pixels: crate docs) predicts the bandwidth of a pixel grid's
+    /// Nyquist limit, 1/2 cycle per pixel, and variance 0: level 0, shaded at full resolution,
+    /// the safe side.
     pub fn predict_blocks(
         &self,
         settings: &render::adaptive::Settings,

@@ -131,6 +131,71 @@ pub fn render(
     render_with(&geometry, material, lighting, bandwidths, settings, Hooks::default())
 }
 
+/// Frames a previewer averages by default (module docs, "Frames").
+pub const FRAMES: u32 = 8;
+
+/// The seed of frame `frame` of frames started with `seed` (module docs, "Frames"): `seed`
+/// itself for the first, so that one frame is [`render`]'s; then a hash of both, so that two
+/// seeds' frames do not repeat each other's.
+pub fn frame_seed(seed: u32, frame: u32) -> u32 {
+    if frame == 0 { seed } else { crate::pcg_hash(seed ^ crate::pcg_hash(frame)) }
+}
+
+/// The mean of `frames` adaptive frames of `scene` (module docs, "Frames"): frame `f` rendered
+/// with [`frame_seed`]`(settings.seed, f)`, the [`Geometry`] made once. `frames` from 1.
+pub fn render_frames(
+    scene: &Scene,
+    material: &Material,
+    lighting: &Lighting,
+    bandwidths: &Bandwidths,
+    settings: &Settings,
+    frames: u32,
+) -> Result<Image, Error> {
+    check_settings(settings, material, lighting)?;
+    let geometry = Geometry::of_scene(scene, settings.supersample)?;
+    let mut mean = FrameMean::default();
+    for f in 0..frames {
+        let settings = Settings { seed: frame_seed(settings.seed, f), ..*settings };
+        mean.add(&render_with(&geometry, material, lighting, bandwidths, &settings, Hooks::default())?.image);
+    }
+    mean.mean().ok_or_else(|| Error::Invalid("adaptive frames: expected at least one frame".into()))
+}
+
+/// The mean of images of one size and coverage, added one at a time (in `f64`).
+#[derive(Clone, Debug, Default)]
+pub struct FrameMean {
+    first: Option<Image>,
+    sum: Vec<f64>,
+    count: u32,
+}
+
+impl FrameMean {
+    /// Adds `image`. Panics if its size differs from the first image's.
+    pub fn add(&mut self, image: &Image) {
+        if self.first.is_none() {
+            self.first = Some(image.clone());
+            self.sum = vec![0.0; image.rgb.len()];
+        }
+        assert_eq!(self.sum.len(), image.rgb.len(), "frames of different sizes");
+        for (s, &v) in self.sum.iter_mut().zip(&image.rgb) {
+            *s += f64::from(v);
+        }
+        self.count += 1;
+    }
+
+    /// The frames added so far.
+    pub fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// The mean image, `None` before the first.
+    pub fn mean(self) -> Option<Image> {
+        let n = f64::from(self.count);
+        let first = self.first?;
+        Some(Image { rgb: self.sum.iter().map(|s| (s / n) as f32).collect(), ..first })
+    }
+}
+
 /// What [`render_with`] may take from elsewhere instead of computing it here; the default takes
 /// nothing.
 #[derive(Default)]

@@ -181,10 +181,14 @@ pub fn bandwidth_at_eye(nu_env: f64, rho: f64, curvature: f64, depth: f64, cos_x
     nu[1].abs()
 }
 
-/// Eq. 11 with the Nyquist rate: `floor(log2(1 / (2 bandwidth)))` clamped to `[0, top]`.
+/// Samples per cycle of the predicted bandwidth that a pixel's level gives it (module docs, "The
+/// bandwidth buffer"): twice the Nyquist rate, a power of two.
+pub const SAMPLES_PER_CYCLE: f64 = 4.0;
+
+/// Eq. 11 at [`SAMPLES_PER_CYCLE`]: `floor(log2(1 / (4 bandwidth)))` clamped to `[0, top]`.
 pub fn level_of(bandwidth: f64, top: usize) -> i32 {
     if bandwidth.is_nan() || bandwidth <= 0.0 {
         return top as i32;
     }
-    (1.0 / (2.0 * bandwidth)).log2().floor().clamp(0.0, top as f64) as i32
+    (1.0 / (SAMPLES_PER_CYCLE * bandwidth)).log2().floor().clamp(0.0, top as f64) as i32
 }

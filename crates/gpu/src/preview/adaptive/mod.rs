@@ -522,6 +522,8 @@ mod tests {
         let declared = ADAPTIVE_STATE.source.lines().find(|l| l.starts_with("const MIN_WEIGHT")).unwrap();
         let value: f64 = declared.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
         assert_eq!(value, render::adaptive::MIN_WEIGHT, "{declared} against {weight}");
+        let rate = format!("const SAMPLES_PER_CYCLE: f32 = {:.1};", render::adaptive::SAMPLES_PER_CYCLE);
+        assert!(ADAPTIVE_STATE.source.contains(&rate), "the WGSL lacks {rate}");
         assert!(ADAPTIVE_STATE.source.contains("const NONE: u32 = 0xffffffffu;"));
         for (name, value) in [
             ("CONTROL_SHADED", CONTROL_SHADED),

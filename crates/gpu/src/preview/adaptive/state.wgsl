@@ -186,16 +186,19 @@ fn min_level(block: u32) -> i32 {
     return bitcast<i32>(levels[block].x);
 }
 
-// `render::adaptive::level_of` of an f32 bandwidth: the largest level k <= top with bandwidth <=
-// 2^-(k+1) (eq. 11 with the Nyquist rate, floor(log2(1 / (2 b)))), 0 when none; the top where
-// the bandwidth is 0. Exact comparisons with powers of two: for f32 bandwidths they give the
-// CPU's f64 logarithm's levels.
+// `render::adaptive::SAMPLES_PER_CYCLE`: a power of two.
+const SAMPLES_PER_CYCLE: f32 = 4.0;
+
+// `render::adaptive::level_of` of an f32 bandwidth: the largest level k <= top with
+// SAMPLES_PER_CYCLE * bandwidth <= 2^-k (eq. 11, floor(log2(1 / (4 b)))), 0 when none; the top
+// where the bandwidth is 0. Exact comparisons with powers of two: for f32 bandwidths they give
+// the CPU's f64 logarithm's levels.
 fn level_of(bandwidth: f32, top: u32) -> i32 {
     if (!(bandwidth > 0.0)) {
         return i32(top);
     }
     var k = 0u;
-    while (k < top && bandwidth * exp2(f32(k + 2u)) <= 1.0) {
+    while (k < top && SAMPLES_PER_CYCLE * bandwidth * exp2(f32(k + 1u)) <= 1.0) {
         k += 1u;
     }
     return i32(k);
