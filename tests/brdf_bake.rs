@@ -357,3 +357,39 @@ fn validation_problems_survive_an_up_to_date_rerun() {
     assert!(again.stdout.contains("problem: bandwidth-atlas:"), "{again}");
     assert_eq!(snapshot(&dir), before, "an up-to-date rerun wrote something");
 }
+
+/// A table whose values no material has (one cell reflecting hundreds of times the light it
+/// receives, which the albedo at merl-info's four elevations misses; every cell at 1e30) is a
+/// validation problem: exit 1, the problem with its figures, nothing written, the previous bake
+/// kept.
+#[test]
+fn an_unphysical_table_is_refused_before_anything_is_baked() {
+    let tmp = temp_dir();
+    let dir = tmp.path().join("bake");
+    let command = |table: &Path| {
+        let mut cmd = tool("brdf-bake");
+        cmd.arg(table).arg("--out-dir").arg(&dir).args(["--analysis-size", "128"]);
+        cmd
+    };
+    let good = run(command(ggx_copper()), "").expect_code(0);
+    let before = snapshot(&dir);
+    let table = merl::MerlTable::parse(&std::fs::read(ggx_copper()).unwrap()).unwrap();
+    let dims = table.dims();
+    let cell = dims.index(merl::Cell { theta_h: 0, theta_d: 68, phi_d: 105 });
+    let mut one_cell = table.raw().to_vec();
+    (0..3).for_each(|c| one_cell[c * dims.cells() + cell] = 1e15);
+    let all = vec![1e30; table.raw().len()];
+    for (name, raw, expect) in [("one-cell", one_cell, "on its own it reflects"), ("all", all, "albedo above 2")] {
+        let path = tmp.path().join(format!("{name}.binary"));
+        std::fs::write(&path, merl::MerlTable::from_raw(dims, raw).unwrap().to_bytes()).unwrap();
+        let mut cmd = command(&path);
+        cmd.arg("--json");
+        let r = run(cmd, "").expect_code(1);
+        let json: Value = serde_json::from_str(&r.stdout).unwrap_or_else(|e| panic!("{e}: {r}"));
+        let problems = json["problems"].as_array().unwrap();
+        assert!(problems.iter().any(|p| p.as_str().unwrap().contains(expect)), "{name}: {r}");
+        assert_eq!(json["files"].as_array().map(Vec::len), Some(0), "{name}: {r}");
+        assert!(r.stderr.contains("not a physical material, nothing baked"), "{name}: {r}");
+        assert_eq!(snapshot(&dir), before, "{name}: the previous bake changed ({good})");
+    }
+}

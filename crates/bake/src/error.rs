@@ -41,6 +41,14 @@ pub enum Error {
         #[source]
         source: Cause,
     },
+    /// The material's values are no material's (`stage::material_info::unphysical`): validation
+    /// found a problem, and nothing was baked from the table.
+    #[error(
+        "{}: not a physical material, nothing baked: {}",
+        fsguard::printable_path(path),
+        problems.join("; ")
+    )]
+    Unphysical { path: PathBuf, problems: Vec<String> },
     /// Another bake holds the folder's lock: one bake at a time per folder.
     #[error(
         "{}: another bake is writing this folder (it holds the folder's lock): wait for it to finish, or bake into \

@@ -215,6 +215,11 @@ pub fn run_bake(
     // previous one as it was.
     let table = merl::MerlTable::parse(&material_bytes).map_err(|e| Error::read(&config.material, e))?;
     drop(material_bytes);
+    let summary = merl::summary::summarize(&table, merl::Interp::Trilinear, merl::albedo::Quadrature::default());
+    let problems = crate::stage::material_info::unphysical(&summary);
+    if !problems.is_empty() {
+        return Err(Error::Unphysical { path: config.material.clone(), problems });
+    }
     let map = config
         .environment
         .as_deref()

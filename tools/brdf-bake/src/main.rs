@@ -26,8 +26,9 @@ use serde_json::json;
 /// counts give identical bytes. An interrupted bake leaves no manifest naming a missing or stale
 /// file; the next run cleans up and bakes again.
 ///
-/// Exit status: 0 ok, 1 a stage's validation found a problem (the bake is written and says so),
-/// 2 error.
+/// Exit status: 0 ok, 1 validation found a problem: a stage's (the bake is written and says so),
+/// or the table's values are no material's (it reflects more than twice the light it receives,
+/// at one of merl-info's elevations or through one cell alone; nothing is baked), 2 error.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {
@@ -170,8 +171,17 @@ fn run(args: Args) -> Result<ExitCode> {
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {
         Progress::Stage { index, count, name } => progress.step(format!("{}/{count} {name}", index + 1)),
         Progress::Work { done, total } => progress.work(done, total),
-    })?;
+    });
     progress.finish();
+    // Validation found the table is no material: its problems, exit 1, nothing written.
+    let outcome = match outcome {
+        Err(bake::Error::Unphysical { path, problems }) => {
+            let value = json!({ "up_to_date": false, "manifest": null, "problems": problems, "files": [] });
+            let report = [format!("{}: not a physical material, nothing baked", path.display())];
+            return Ok(cli::finish(args.json, &value, &report, &problems, &[]));
+        }
+        outcome => outcome?,
+    };
 
     let dir = &args.out_dir;
     let mut report = Vec::new();

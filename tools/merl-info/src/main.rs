@@ -15,7 +15,8 @@ use serde_json::json;
 /// per-channel statistics, directional albedo at theta_o = 0, 30, 60, 80 degrees and the peak.
 ///
 /// Exit status: 0 the table is valid, 1 it loaded but validation found a problem (albedo above
-/// 1, or a noticeable part of the hemisphere without data), 2 it could not be read.
+/// 1, one cell that on its own reflects more than the light received, or a noticeable part of
+/// the hemisphere without data), 2 it could not be read.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about, allow_negative_numbers = true)]
 struct Args {

@@ -1,7 +1,9 @@
 //! A material's validation summary (`merl-info`): dimensions, cells without data, per-channel
 //! statistics, directional albedo by a half-vector quadrature and the peak (`merl::summary`), as
 //! figures, a report and an asset of kind `material-info`; validation finds an albedo above what
-//! an energy-conserving table can show, or a noticeable share of the hemisphere without data.
+//! an energy-conserving table can show, a cell that alone reflects more than the light received
+//! (`merl::summary::cell_share`), or a noticeable share of the hemisphere without data. A bake
+//! refuses a table far beyond the first two ([`unphysical`]).
 
 use merl::albedo::Quadrature;
 use merl::summary::{ChannelStats, Summary, summarize};
@@ -17,6 +19,12 @@ pub const ASSET: &str = "material-info.asset";
 pub const ALBEDO_LIMIT: f64 = 1.01;
 /// Share of the cosine-weighted hemisphere without data above which the table is flagged.
 pub const NO_DATA_LIMIT: f64 = 0.01;
+/// A table that reflects more than this many times the light it receives, at one of the
+/// summary's elevations or through one cell alone (`merl::summary::cell_share`), is not a
+/// material but corrupt data: a bake refuses it ([`unphysical`]). Far above [`ALBEDO_LIMIT`],
+/// so that a measured table a little above 1 at grazing angles is flagged by `merl-info` and
+/// still baked.
+pub const UNPHYSICAL_LIMIT: f64 = 2.0;
 
 /// The summary of `table` (read from `source`), its directional albedo integrated with
 /// `albedo_interp` lookups.
@@ -51,18 +59,47 @@ fn interp_name(interp: Interp) -> &'static str {
     }
 }
 
-fn problems(s: &Summary) -> Vec<String> {
+/// Why a table with `s` for its summary is not a material (values no measurement gives), in the
+/// words of [`problems`]; empty when it may be baked.
+pub fn unphysical(s: &Summary) -> Vec<String> {
+    energy_problems(s, UNPHYSICAL_LIMIT)
+}
+
+/// The albedos and the cell share above `limit`.
+fn energy_problems(s: &Summary, limit: f64) -> Vec<String> {
     let mut out = Vec::new();
+    for (deg, a) in &s.albedo {
+        if a.rgb.iter().any(|v| v.is_nan() || *v > limit) {
+            out.push(format!(
+                "albedo above {limit} at theta_o {deg} deg ({:.4e} {:.4e} {:.4e}): the table reflects more than it receives",
+                a.rgb[0], a.rgb[1], a.rgb[2]
+            ));
+        }
+    }
+    if let Some(c) = s.largest_share.filter(|c| c.share.is_nan() || c.share > limit) {
+        out.push(format!(
+            "cell ({}, {}, {}) (theta_i {:.1} deg, theta_o {:.1} deg) holds {:.4e} {:.4e} {:.4e} 1/sr: on its own it \
+             reflects an estimated {:.4e} times the light received, above {limit}",
+            c.cell.theta_h,
+            c.cell.theta_d,
+            c.cell.phi_d,
+            c.theta_i.to_degrees(),
+            c.theta_o.to_degrees(),
+            c.rgb[0],
+            c.rgb[1],
+            c.rgb[2],
+            c.share
+        ));
+    }
+    out
+}
+
+fn problems(s: &Summary) -> Vec<String> {
+    let mut out = energy_problems(s, ALBEDO_LIMIT);
     if s.channels.is_none() {
         out.push("no cell holds data".to_string());
     }
     for (deg, a) in &s.albedo {
-        if a.rgb.iter().any(|v| *v > ALBEDO_LIMIT) {
-            out.push(format!(
-                "albedo above {ALBEDO_LIMIT} at theta_o {deg} deg ({:.4} {:.4} {:.4}): the table reflects more than it receives",
-                a.rgb[0], a.rgb[1], a.rgb[2]
-            ));
-        }
         if a.no_data_fraction > NO_DATA_LIMIT {
             out.push(format!(
                 "{:.1}% of the hemisphere above the horizon holds no data at theta_o {deg} deg",
@@ -116,6 +153,18 @@ fn report(source: &Source, s: &Summary, albedo_interp: Interp) -> Vec<String> {
             p.at.phi_d.to_degrees()
         ));
     }
+    if let Some(c) = &s.largest_share {
+        lines.push(format!(
+            "one cell   at most {:.3e} of the light received reflected by one cell alone: ({}, {}, {}), theta_i {:.1} \
+             deg, theta_o {:.1} deg",
+            c.share,
+            c.cell.theta_h,
+            c.cell.theta_d,
+            c.cell.phi_d,
+            c.theta_i.to_degrees(),
+            c.theta_o.to_degrees()
+        ));
+    }
     lines
 }
 
@@ -153,6 +202,16 @@ fn figures(s: &Summary, albedo_interp: Interp) -> serde_json::Map<String, serde_
         ("albedo_interp", json!(interp_name(albedo_interp))),
         ("albedo", json!(albedo)),
         ("peak", json!(peak)),
+        (
+            "largest_cell_share",
+            json!(s.largest_share.map(|c| json!({
+                "share": c.share,
+                "rgb": c.rgb,
+                "cell": [c.cell.theta_h, c.cell.theta_d, c.cell.phi_d],
+                "theta_i_deg": c.theta_i.to_degrees(),
+                "theta_o_deg": c.theta_o.to_degrees(),
+            }))),
+        ),
     ])
 }
 
