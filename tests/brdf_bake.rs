@@ -238,18 +238,20 @@ fn a_changed_parameter_rebakes_and_removes_the_files_it_no_longer_writes() {
     assert!(contents(&dir) == expected, "the folder differs from the reference bake\n{r}");
 }
 
-/// Ten bakes with `--force` killed (SIGKILL) after seeded random delays spread over the
-/// reference bake's duration. After each: any file with an output's name is whole (the bake is
-/// deterministic, so whole means equal to the reference's; pictures decode and assets read back
-/// as well), and a manifest, if there is one, names only files that are there with its sizes and
-/// hashes. Temporary files may remain; the next bake cleans them and finishes.
+/// Ten rebakes with `--force` killed (SIGKILL) after seeded random delays spread over the
+/// reference bake's duration. After each, once the switch it may have interrupted is recovered
+/// (`asset::recover_switch`, as the next bake or reader does): any file with an output's name is
+/// whole (the bake is deterministic, so whole means equal to the reference's; pictures decode and
+/// assets read back as well), and the old bake or the new one is listed: a manifest that names
+/// only files that are there with its sizes and hashes. Temporary files may remain; the next bake
+/// cleans them and finishes.
 #[test]
 fn killed_bakes_leave_no_stale_manifest_and_no_truncated_file() {
     let tmp = temp_dir();
     let (reference, dir) = copy_of_reference(&tmp);
     let expected = contents(&reference.dir);
     let mut rng = rand::rngs::StdRng::seed_from_u64(20_240_601);
-    let (mut interrupted, mut with_manifest, mut with_temporaries) = (0, 0, 0);
+    let (mut interrupted, mut in_switch, mut with_temporaries) = (0, 0, 0);
     let kills = 10;
     // The reference bake ran beside other tests: when a bake here finishes before its kill, its
     // own duration is the better estimate.
@@ -273,6 +275,13 @@ fn killed_bakes_leave_no_stale_manifest_and_no_truncated_file() {
         }
         child.wait().expect("waiting for brdf-bake");
 
+        // A kill inside the switch leaves its journal; the next holder of the folder (a bake, or
+        // a reader where none holds it) recovers the switch from it first, as here.
+        let journal = dir.join(asset::SWITCH_JOURNAL).exists();
+        let folder = fsguard::Folder::open(&dir).unwrap();
+        let recovery = asset::recover_switch(&folder).unwrap();
+        assert_eq!(journal, recovery != asset::Recovery::None, "kill {k} after {delay:?}: {recovery:?}");
+        in_switch += usize::from(journal);
         let names: Vec<String> = contents(&dir).into_keys().collect();
         let mut temporaries = 0;
         for name in &names {
@@ -286,14 +295,14 @@ fn killed_bakes_leave_no_stale_manifest_and_no_truncated_file() {
             assert!(&bytes == reference_bytes, "kill {k} after {delay:?}: {name} is not whole");
             check_decodable(&dir, name);
         }
-        if names.iter().any(|n| n == MANIFEST) {
-            with_manifest += 1;
-            checked_manifest(&dir);
-        }
+        // The old bake or the new one (the same bytes) whole and listed.
+        assert!(names.iter().any(|n| n == MANIFEST), "kill {k} after {delay:?}: no manifest");
+        checked_manifest(&dir);
         with_temporaries += usize::from(temporaries > 0);
     }
     eprintln!(
-        "{interrupted} of {kills} bakes killed while running; {with_manifest} left a manifest, {with_temporaries} temporary files"
+        "{interrupted} of {kills} bakes killed while running; {in_switch} inside the switch; {with_temporaries} left \
+         temporary files"
     );
     assert!(interrupted >= kills / 2, "most kills must land while the bake runs");
 

@@ -44,8 +44,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// yet, never an index naming a file that does not match it. A name that holds a folder (or
 /// anything but a regular file or a link) fails the set before anything is replaced; if a rename
 /// fails, the old files are put back, so the folder holds the old set rather than part of the new
-/// one. Temporary files an earlier interrupted run left for these names (`.NAME.XXXXXX.tmp`) are
-/// removed first.
+/// one. A switch an earlier run left interrupted is first finished or undone
+/// ([`recover_switch`]), and the temporary files it left for these names (`.NAME.XXXXXX.tmp`)
+/// are removed. The caller holds the folder (its lock) for both.
 ///
 /// `dir` is created if it is missing, the folder itself only: its parent must exist.
 ///
@@ -53,7 +54,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn write_set(dir: &Path, files: &[(&str, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
     let folder = fsguard::Folder::create(dir).map_err(|e| (dir.to_path_buf(), e))?;
     let names: Vec<&str> = files.iter().map(|(name, _)| *name).collect();
-    remove_temporaries(&folder, |target| names.contains(&target)).map_err(|e| (dir.to_path_buf(), e))?;
+    recover_switch(&folder).map_err(|e| (dir.to_path_buf(), e))?;
+    remove_temporaries(&folder, |target| names.contains(&target) || target == SWITCH_JOURNAL)
+        .map_err(|e| (dir.to_path_buf(), e))?;
     let mut staging = Staging::new(&folder).map_err(|e| (dir.to_path_buf(), e))?;
     for (name, bytes) in files {
         staging.add(name, bytes)?;
@@ -112,17 +115,22 @@ impl Staging {
     ///    but a folder, so that a damaged index, a FIFO say, never keeps a set from landing) and
     ///    every retired name a regular file or nothing: otherwise this fails naming it, and
     ///    nothing has changed.
-    /// 2. The old index (the last file added, which names the others) is set aside: it leaves its
-    ///    name, which no reader then finds, and the folder is synced.
-    /// 3. Every other file is renamed over its target in the order added, the old file kept under
-    ///    a temporary name (a second link to it); then the retired files are set aside,
-    ///    `before_index` runs, and the index is renamed into place; the folder is synced.
-    /// 4. The old files kept aside are removed.
+    /// 2. The switch's steps are planned, each old file's temporary name (`.NAME.XXXXXX.tmp`)
+    ///    chosen, and written to the folder's journal ([`SWITCH_JOURNAL`], synced) before any of
+    ///    them is taken.
+    /// 3. The old index (the last file added, which names the others) is set aside: it leaves its
+    ///    name, which no reader then finds, and the folder is synced. Every other file is renamed
+    ///    over its target in the order added, the old file kept under its planned name (a second
+    ///    link to it); then the retired files are set aside, `before_index` runs, and the index is
+    ///    renamed into place; the folder is synced.
+    /// 4. The journal is removed, then the old files kept aside.
     ///
-    /// If anything fails in 2 or 3, every step already taken is undone: each old file is renamed
-    /// back over its name (the new one removed where there was none) and the old index is put
-    /// back, so the folder lists the previous set again. An interruption (a kill) leaves complete
-    /// files, no index and the kept files as temporaries ([`remove_temporaries`] removes them).
+    /// If anything fails in 3, every step already taken is undone from the journal: each old
+    /// file is renamed back over its name (the new one removed where there was none) and the old
+    /// index is put back, so the folder lists the previous set again. An interruption (a kill)
+    /// leaves the journal: [`recover_switch`], which the next holder of the folder runs first,
+    /// undoes the switch if the new index had not landed and finishes it if it had. Either way the
+    /// folder then holds one whole set, listed by its index.
     pub fn commit(
         mut self,
         before_index: impl FnOnce() -> Result<(), (PathBuf, std::io::Error)>,
@@ -132,8 +140,8 @@ impl Staging {
         let folder = &self.folder;
         let at = |name: &str, e: std::io::Error| (folder.join(name), e);
         let Some((index, index_temporary)) = files.pop() else { return Ok(()) };
-        // Until a temporary file is renamed, dropping it (an early return) removes it.
-        let mut pending: Vec<Pending> = files.iter().map(|(_, t)| Pending::new(folder, t)).collect();
+        // Until the journal takes them over, dropping a temporary file (an early return) removes it.
+        let pending: Vec<Pending> = files.iter().map(|(_, t)| Pending::new(folder, t)).collect();
         let index_pending = Pending::new(folder, &index_temporary);
         for (name, _) in &files {
             check_replaceable(folder, name).map_err(|e| at(name, e))?;
@@ -142,34 +150,267 @@ impl Staging {
         for name in &retired {
             check_removable(folder, name).map_err(|e| at(name, e))?;
         }
-        let mut switch = Switch { folder, undo: Vec::new() };
+        let steps = plan(folder, (&index, &index_temporary), &files, &retired).map_err(|e| at(&index, e))?;
+        write_journal(folder, &steps).map_err(|e| at(SWITCH_JOURNAL, e))?;
+        index_pending.landed_for_good();
+        pending.into_iter().for_each(Pending::landed_for_good);
+        let sync = || folder.sync().map_err(|e| (folder.path().to_path_buf(), e));
+        let last = steps.len() - 1;
+        let mut before_index = Some(before_index);
         let result = (|| {
-            switch.set_aside(&index)?;
-            folder.sync().map_err(|e| (folder.path().to_path_buf(), e))?;
-            for ((name, temporary), pending) in files.iter().zip(&mut pending) {
-                switch.replace(name, temporary)?;
-                pending.landed();
+            for (i, step) in steps.iter().enumerate() {
+                if i == last
+                    && let Some(before_index) = before_index.take()
+                {
+                    before_index()?;
+                }
+                step.take(folder).map_err(|e| at(step.target(), e))?;
+                if i == 0 || i == last {
+                    sync()?;
+                }
             }
-            for name in &retired {
-                switch.set_aside(name)?;
-            }
-            before_index()?;
-            switch.replace(&index, &index_temporary)?;
-            folder.sync().map_err(|e| (folder.path().to_path_buf(), e))
+            Ok(())
         })();
         match result {
             Ok(()) => {
-                index_pending.landed_for_good();
-                pending.into_iter().for_each(Pending::landed_for_good);
-                switch.forget();
+                // The new set is listed: the journal goes first, then what it kept.
+                folder.unlink(SWITCH_JOURNAL).and_then(|()| folder.sync()).map_err(|e| at(SWITCH_JOURNAL, e))?;
+                roll_forward(folder, &steps);
                 Ok(())
             }
             Err(e) => {
-                switch.undo();
+                // Best effort: what cannot be undone now, recover_switch undoes from the journal.
+                if roll_back(folder, &steps).is_ok() {
+                    let _ = folder.unlink(SWITCH_JOURNAL).and_then(|()| folder.sync());
+                }
                 Err(e)
             }
         }
     }
+}
+
+/// The journal of a switch in progress ([`Staging::commit`]): its planned steps, one per line,
+/// written before the first is taken and removed once the new index is in place. Its presence
+/// means a switch was interrupted; [`recover_switch`] reads it.
+pub const SWITCH_JOURNAL: &str = ".switch.journal";
+
+/// The largest journal [`recover_switch`] reads: a bake's switch plans a few dozen steps.
+const JOURNAL_LIMIT: u64 = 1 << 20;
+
+/// One planned step of a switch. `kept`: the temporary name the old file at `target` is kept
+/// under, `None` when nothing was there when the switch was planned.
+#[derive(Clone, Debug, PartialEq)]
+enum Step {
+    /// The file at `target` moved to `kept`, leaving the name free.
+    Aside { target: String, kept: Option<String> },
+    /// The new file `new` (a temporary file) renamed over `target`, the old one kept.
+    Replace { target: String, kept: Option<String>, new: String },
+}
+
+impl Step {
+    fn target(&self) -> &str {
+        match self {
+            Step::Aside { target, .. } | Step::Replace { target, .. } => target,
+        }
+    }
+
+    fn kept(&self) -> Option<&str> {
+        match self {
+            Step::Aside { kept, .. } | Step::Replace { kept, .. } => kept.as_deref(),
+        }
+    }
+
+    fn take(&self, folder: &fsguard::Folder) -> std::io::Result<()> {
+        if let Some(kept) = self.kept() {
+            keep(folder, self.target(), kept)?;
+        }
+        match self {
+            Step::Aside { target, .. } => match folder.unlink(target) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+                _ => Ok(()),
+            },
+            Step::Replace { target, new, .. } => folder.rename(new, target),
+        }
+    }
+
+    /// Undoes the step, whether it was taken, half taken or not at all, and whether it was
+    /// undone before (a kill during an undo): the old file, if it was kept, back at `target`.
+    fn undo(&self, folder: &fsguard::Folder) -> std::io::Result<()> {
+        let exists = |name: &str| folder.entry(name).map(|e| e.is_some());
+        let restore = |kept: &str, target: &str| -> std::io::Result<()> {
+            if !exists(kept)? {
+                return Ok(());
+            }
+            // A second link to a file still at its name, or the file itself.
+            if exists(target)? { folder.unlink(kept) } else { folder.rename(kept, target) }
+        };
+        match self {
+            Step::Aside { target, kept } => kept.as_deref().map_or(Ok(()), |kept| restore(kept, target)),
+            Step::Replace { target, kept, new } if exists(new)? => {
+                // Not landed: the target is the old file's (or, without hard links, free).
+                folder.unlink(new)?;
+                kept.as_deref().map_or(Ok(()), |kept| restore(kept, target))
+            }
+            Step::Replace { target, kept: Some(kept), .. } => {
+                // Landed: the old file back over the new one, unless that was done before.
+                if exists(kept)? { folder.rename(kept, target) } else { Ok(()) }
+            }
+            Step::Replace { target, kept: None, .. } => match folder.unlink(target) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+                _ => Ok(()),
+            },
+        }
+    }
+
+    fn line(&self) -> String {
+        let kept = self.kept().unwrap_or("-");
+        match self {
+            Step::Aside { target, .. } => format!("aside\t{target}\t{kept}"),
+            Step::Replace { target, new, .. } => format!("replace\t{target}\t{kept}\t{new}"),
+        }
+    }
+
+    /// A journal line, checked: plain names, each temporary one of its target's.
+    fn parse(line: &str) -> Option<Step> {
+        let fields: Vec<&str> = line.split('\t').collect();
+        let plain = |name: &str| !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\0']);
+        let target = *fields.get(1)?;
+        let of_target = |name: &str| temporary_target(name) == Some(target);
+        let kept = match *fields.get(2)? {
+            "-" => None,
+            name if of_target(name) => Some(name.to_string()),
+            _ => return None,
+        };
+        if !plain(target) {
+            return None;
+        }
+        match (fields[0], fields.len()) {
+            ("aside", 3) => Some(Step::Aside { target: target.to_string(), kept }),
+            ("replace", 4) if of_target(fields[3]) => {
+                Some(Step::Replace { target: target.to_string(), kept, new: fields[3].to_string() })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The steps of a switch (see [`Staging::commit`]): the old index aside, each file replaced, each
+/// retired file aside, the new index in; a free temporary name for each old file there is.
+fn plan(
+    folder: &fsguard::Folder,
+    (index, index_temporary): (&str, &str),
+    files: &[(String, String)],
+    retired: &[String],
+) -> std::io::Result<Vec<Step>> {
+    let mut chosen: Vec<String> = Vec::new();
+    let mut kept_name = |target: &str| -> std::io::Result<Option<String>> {
+        if folder.entry(target)?.is_none() {
+            return Ok(None);
+        }
+        for _ in 0..TEMPORARY_ATTEMPTS {
+            let name = temporary_name(target);
+            if folder.entry(&name)?.is_none() && !chosen.contains(&name) {
+                chosen.push(name.clone());
+                return Ok(Some(name));
+            }
+        }
+        Err(too_many_temporaries())
+    };
+    let mut steps = vec![Step::Aside { target: index.to_string(), kept: kept_name(index)? }];
+    for (target, new) in files {
+        steps.push(Step::Replace { target: target.clone(), kept: kept_name(target)?, new: new.clone() });
+    }
+    for target in retired {
+        steps.push(Step::Aside { target: target.clone(), kept: kept_name(target)? });
+    }
+    steps.push(Step::Replace { target: index.to_string(), kept: None, new: index_temporary.to_string() });
+    if steps.iter().any(|s| s.line().lines().count() != 1 || Step::parse(&s.line()).as_ref() != Some(s)) {
+        return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "a file name a journal cannot hold"));
+    }
+    Ok(steps)
+}
+
+/// Writes the journal of `steps` in place of any other ([`SWITCH_JOURNAL`]), synced, and syncs
+/// the folder: on disk before the first step is taken.
+fn write_journal(folder: &fsguard::Folder, steps: &[Step]) -> std::io::Result<()> {
+    let text: String = steps.iter().map(|s| s.line() + "\n").collect();
+    let temporary = write_temporary(folder, SWITCH_JOURNAL, text.as_bytes())?;
+    if let Err(e) = folder.rename(&temporary, SWITCH_JOURNAL) {
+        let _ = folder.unlink(&temporary);
+        return Err(e);
+    }
+    folder.sync()
+}
+
+/// Every step undone, last first; the first error is returned after trying them all.
+fn roll_back(folder: &fsguard::Folder, steps: &[Step]) -> std::io::Result<()> {
+    let mut first = Ok(());
+    for step in steps.iter().rev() {
+        if let Err(e) = step.undo(folder)
+            && first.is_ok()
+        {
+            first = Err(e);
+        }
+    }
+    let _ = folder.sync();
+    first
+}
+
+/// The new set is in place: the old files kept aside go.
+fn roll_forward(folder: &fsguard::Folder, steps: &[Step]) {
+    for kept in steps.iter().filter_map(Step::kept) {
+        let _ = folder.unlink(kept);
+    }
+}
+
+/// What [`recover_switch`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Recovery {
+    /// No switch was interrupted.
+    None,
+    /// The new index had not landed: the previous set is back.
+    RolledBack,
+    /// The new index had landed: the old files kept aside are gone.
+    Finished,
+}
+
+/// Finishes or undoes a switch ([`Staging::commit`]) that an interruption left, from its journal
+/// ([`SWITCH_JOURNAL`]): the folder then holds one whole set again, listed by its index. The
+/// caller must hold the folder (its lock): nothing else may switch meanwhile. A journal that is
+/// not a regular file, is larger than a switch writes or holds a line that is not a step (each
+/// name plain, each temporary name one of its target's) is an error and nothing is touched.
+pub fn recover_switch(folder: &fsguard::Folder) -> std::io::Result<Recovery> {
+    let damaged = |why: String| {
+        std::io::Error::new(std::io::ErrorKind::InvalidData, format!("{SWITCH_JOURNAL}: {why}: remove it by hand"))
+    };
+    match folder.entry(SWITCH_JOURNAL)? {
+        None => return Ok(Recovery::None),
+        Some(fsguard::Entry::File) => {}
+        Some(_) => return Err(damaged("not a regular file".into())),
+    }
+    let bytes = fsguard::read_to_end(folder.open_file(SWITCH_JOURNAL)?, JOURNAL_LIMIT)?;
+    let text = String::from_utf8(bytes).map_err(|_| damaged("not text".into()))?;
+    let steps = text
+        .lines()
+        .enumerate()
+        .map(|(i, line)| Step::parse(line).ok_or_else(|| damaged(format!("line {} is not a switch step", i + 1))))
+        .collect::<std::io::Result<Vec<Step>>>()?;
+    let landed = match steps.last() {
+        Some(Step::Replace { target, kept: None, new }) => {
+            folder.entry(new)?.is_none() && folder.entry(target)?.is_some()
+        }
+        _ => return Err(damaged("it does not end with the index's step".into())),
+    };
+    let recovery = if landed {
+        roll_forward(folder, &steps);
+        Recovery::Finished
+    } else {
+        roll_back(folder, &steps)?;
+        Recovery::RolledBack
+    };
+    folder.unlink(SWITCH_JOURNAL)?;
+    folder.sync()?;
+    Ok(recovery)
 }
 
 impl Drop for Staging {
@@ -181,7 +422,8 @@ impl Drop for Staging {
     }
 }
 
-/// A temporary file of a commit that is removed when this drops, unless it was renamed into place.
+/// A temporary file of a commit that is removed when this drops, unless the switch's journal
+/// took it over.
 struct Pending<'a> {
     folder: &'a fsguard::Folder,
     name: Option<String>,
@@ -190,12 +432,6 @@ struct Pending<'a> {
 impl<'a> Pending<'a> {
     fn new(folder: &'a fsguard::Folder, name: &str) -> Pending<'a> {
         Pending { folder, name: Some(name.to_string()) }
-    }
-
-    /// Renamed: nothing left under its name. (An undo renames no new file back: it is removed or
-    /// replaced by the old one.)
-    fn landed(&mut self) {
-        self.name = None;
     }
 
     fn landed_for_good(mut self) {
@@ -211,111 +447,19 @@ impl Drop for Pending<'_> {
     }
 }
 
-/// The steps of a [`Staging::commit`] taken so far, with what undoes each.
-struct Switch<'a> {
-    folder: &'a fsguard::Folder,
-    undo: Vec<Step>,
-}
-
-enum Step {
-    /// A new file renamed over `target`; `old` is the temporary name of the file it replaced,
-    /// if there was one.
-    Replaced { target: String, old: Option<String> },
-    /// The file at `target` moved to the temporary name `old`, leaving the name free.
-    SetAside { target: String, old: String },
-}
-
-impl Switch<'_> {
-    /// Renames the temporary file `temporary` over `target`, keeping the file it replaces.
-    fn replace(&mut self, target: &str, temporary: &str) -> Result<(), (PathBuf, std::io::Error)> {
-        let at = |e| (self.folder.join(target), e);
-        let old = keep(self.folder, target).map_err(at)?;
-        match self.folder.rename(temporary, target) {
-            Ok(()) => {
-                self.undo.push(Step::Replaced { target: target.to_string(), old });
-                Ok(())
-            }
-            Err(e) => {
-                // The old file is still at the target (only the extra name goes), unless `keep`
-                // had to rename it away: then it goes back.
-                if let Some(old) = old {
-                    let _ = match self.folder.entry(target) {
-                        Ok(None) => self.folder.rename(&old, target),
-                        _ => self.folder.unlink(&old),
-                    };
-                }
-                Err(at(e))
-            }
+/// A second name `kept` for the file (or link) `target` of the folder: a hard link, or, where
+/// the file system has none, the file itself renamed there. Nothing at `target` (a step taken
+/// again) is nothing to do.
+fn keep(folder: &fsguard::Folder, target: &str, kept: &str) -> std::io::Result<()> {
+    match folder.link(target, kept) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => {
+            let no_links = matches!(e.kind(), std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::Unsupported);
+            let renameable = matches!(folder.entry(target)?, Some(fsguard::Entry::File | fsguard::Entry::Link));
+            if no_links && renameable && folder.entry(kept)?.is_none() { folder.rename(target, kept) } else { Err(e) }
         }
     }
-
-    /// Moves the file at `target` aside (a second name, then `target` unlinked); nothing there is
-    /// nothing to do.
-    fn set_aside(&mut self, target: &str) -> Result<(), (PathBuf, std::io::Error)> {
-        let at = |e| (self.folder.join(target), e);
-        let Some(old) = keep(self.folder, target).map_err(at)? else { return Ok(()) };
-        match self.folder.unlink(target) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => {
-                let _ = self.folder.unlink(&old);
-                return Err(at(e));
-            }
-        }
-        self.undo.push(Step::SetAside { target: target.to_string(), old });
-        Ok(())
-    }
-
-    /// The switch succeeded: the kept old files go.
-    fn forget(self) {
-        for step in self.undo {
-            if let Step::Replaced { old: Some(old), .. } | Step::SetAside { old, .. } = step {
-                let _ = self.folder.unlink(&old);
-            }
-        }
-    }
-
-    /// Every step taken, undone in reverse order; best effort (the error that stopped the switch
-    /// is the one reported).
-    fn undo(self) {
-        for step in self.undo.into_iter().rev() {
-            match step {
-                Step::Replaced { target, old: Some(old) } | Step::SetAside { target, old } => {
-                    let _ = self.folder.rename(&old, &target);
-                }
-                Step::Replaced { target, old: None } => {
-                    let _ = self.folder.unlink(&target);
-                }
-            }
-        }
-        let _ = self.folder.sync();
-    }
-}
-
-/// A second name for the file (or link) `target` of the folder, a temporary one
-/// (`.NAME.XXXXXX.tmp`): a hard link, or, where the file system has none, the file itself
-/// renamed there. `None` when nothing is at `target`.
-fn keep(folder: &fsguard::Folder, target: &str) -> std::io::Result<Option<String>> {
-    for _ in 0..TEMPORARY_ATTEMPTS {
-        let name = temporary_name(target);
-        match folder.link(target, &name) {
-            Ok(()) => return Ok(Some(name)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => {
-                let no_links =
-                    matches!(e.kind(), std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::Unsupported);
-                let renameable = matches!(folder.entry(target)?, Some(fsguard::Entry::File | fsguard::Entry::Link));
-                let free = folder.entry(&name)?.is_none();
-                if no_links && renameable && free {
-                    folder.rename(target, &name)?;
-                    return Ok(Some(name));
-                }
-                return Err(e);
-            }
-        }
-    }
-    Err(too_many_temporaries())
 }
 
 /// A new temporary file for `target` in the folder, holding `bytes`, synced; its name. Removed
@@ -632,4 +776,107 @@ pub fn sha256_from_hex(text: &str) -> Option<[u8; 32]> {
         *byte = digit(pair[0])? << 4 | digit(pair[1])?;
     }
     Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OLD: [(&str, &str); 3] = [("a", "old a"), ("b", "old b"), ("index", "old index")];
+    const NEW: [(&str, &str); 3] = [("a", "new a"), ("c", "new c"), ("index", "new index")];
+
+    /// The folder's files (no temporary, no journal may be left), by name.
+    fn contents(folder: &fsguard::Folder) -> Vec<(String, String)> {
+        let mut files: Vec<(String, String)> = folder
+            .entries()
+            .unwrap()
+            .into_iter()
+            .map(|(name, _)| {
+                let text = std::fs::read_to_string(folder.join(&name)).unwrap();
+                (name, text)
+            })
+            .collect();
+        files.sort();
+        files
+    }
+
+    fn set(files: &[(&str, &str)]) -> Vec<(String, String)> {
+        files.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect()
+    }
+
+    /// A switch from OLD to NEW (retiring `b`) killed after `taken` whole steps, with the next
+    /// one half taken (its old file kept, nothing else) when `half`, and, when `undone` is given,
+    /// an undo of its own killed after that many steps: what the folder holds once recovered.
+    fn recovered(taken: usize, half: bool, undone: Option<usize>) -> (Recovery, Vec<(String, String)>) {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = fsguard::Folder::open(dir.path()).unwrap();
+        for (name, text) in OLD {
+            std::fs::write(dir.path().join(name), text).unwrap();
+        }
+        let mut staging = Staging::new(&folder).unwrap();
+        for (name, text) in NEW {
+            staging.add(name, text.as_bytes()).unwrap();
+        }
+        staging.retire("b");
+        let mut files = std::mem::take(&mut staging.files);
+        let (index, index_temporary) = files.pop().unwrap();
+        let steps = plan(&folder, (&index, &index_temporary), &files, &["b".to_string()]).unwrap();
+        write_journal(&folder, &steps).unwrap();
+        for step in &steps[..taken.min(steps.len())] {
+            step.take(&folder).unwrap();
+        }
+        if half
+            && let Some(step) = steps.get(taken)
+            && let Some(kept) = step.kept()
+        {
+            keep(&folder, step.target(), kept).unwrap();
+        }
+        if let Some(undone) = undone {
+            for step in steps.iter().rev().take(undone) {
+                step.undo(&folder).unwrap();
+            }
+        }
+        let recovery = recover_switch(&folder).unwrap();
+        assert_eq!(recover_switch(&folder).unwrap(), Recovery::None, "the journal is gone");
+        (recovery, contents(&folder))
+    }
+
+    #[test]
+    fn a_switch_killed_at_any_step_recovers_one_whole_set() {
+        // Five steps: old index aside, a replaced, c added, b retired, new index in.
+        for taken in 0..=5 {
+            for half in [false, true] {
+                let (recovery, files) = recovered(taken, half, None);
+                let expect =
+                    if taken == 5 { (Recovery::Finished, set(&NEW)) } else { (Recovery::RolledBack, set(&OLD)) };
+                assert_eq!((recovery, files), expect, "killed after {taken} steps (half of the next: {half})");
+            }
+        }
+        // Killed again while undoing a failed switch: the undo is finished, whatever it had done.
+        for taken in 1..=5 {
+            for undone in 0..=taken {
+                let (_, files) = recovered(taken, false, Some(undone));
+                let whole = files == set(&OLD) || (taken == 5 && undone == 0 && files == set(&NEW));
+                assert!(whole, "killed after {taken} steps, then after undoing {undone}: {files:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_damaged_journal_touches_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = fsguard::Folder::open(dir.path()).unwrap();
+        std::fs::write(dir.path().join("index"), "old index").unwrap();
+        for journal in [
+            "",
+            "aside\tindex\t-\n",
+            "replace\tindex\t-\t.other.abcdef.tmp\n",
+            "aside\t../x\t-\nreplace\tindex\t-\t.index.abcdef.tmp\n",
+        ] {
+            std::fs::write(dir.path().join(SWITCH_JOURNAL), journal).unwrap();
+            let e = recover_switch(&folder).unwrap_err();
+            assert!(e.to_string().contains(SWITCH_JOURNAL), "{e}");
+            assert_eq!(std::fs::read_to_string(dir.path().join("index")).unwrap(), "old index");
+        }
+    }
 }

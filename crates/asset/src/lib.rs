@@ -61,8 +61,8 @@ pub use container::{
 pub use describe::Description;
 pub use error::Error;
 pub use files::{
-    LinkedStatus, Staging, create_folder, hex, linked_file_status, remove_temporaries, sha256, sha256_file,
-    sha256_from_hex, temporary_target, write_atomic, write_set,
+    LinkedStatus, Recovery, SWITCH_JOURNAL, Staging, create_folder, hex, linked_file_status, recover_switch,
+    remove_temporaries, sha256, sha256_file, sha256_from_hex, temporary_target, write_atomic, write_set,
 };
 pub use manifest::{
     BakeManifest, FileFormat, MANIFEST_FILE, MANIFEST_LIMIT, MANIFEST_VERSION, OUTPUT_LIMIT,

@@ -34,8 +34,26 @@ pub struct Loaded {
 /// [`asset::MANIFEST_LIMIT`], each output's against its `size_bytes`, then its SHA-256); the table
 /// (which may lie anywhere) as a regular file of at most [`merl::MAX_FILE_BYTES`], its SHA-256
 /// compared before anything in it is parsed or quoted.
+/// A switch a kill interrupted ([`asset::recover_switch`]) is finished or undone before the
+/// manifest is read, where no bake holds the folder (its lock, taken for the recovery alone): the
+/// folder then holds one whole bake. While a bake holds it, the reader goes on as it is.
+fn recover(folder: &fsguard::Folder, dir: &Path) -> Result<(), Error> {
+    let journal = dir.join(asset::SWITCH_JOURNAL);
+    if folder.entry(asset::SWITCH_JOURNAL).map_err(|e| Error::read(&journal, e))?.is_none() {
+        return Ok(());
+    }
+    // An open folder of its own (a lock belongs to an open file description, which a duplicated
+    // descriptor shares): dropping it releases the lock.
+    let held = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
+    if held.try_lock().map_err(|e| Error::read(dir, e))? {
+        asset::recover_switch(&held).map_err(|e| Error::write(&journal, e))?;
+    }
+    Ok(())
+}
+
 pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     let folder = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
+    recover(&folder, dir)?;
     let manifest_path = dir.join(MANIFEST);
     let manifest = match BakeManifest::read(&folder) {
         Ok(manifest) => manifest,

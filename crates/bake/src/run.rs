@@ -396,6 +396,9 @@ impl BakeFolder {
         if !folder.try_lock().map_err(|e| Error::write(dir, e))? {
             return Err(Error::Busy(dir.to_path_buf()));
         }
+        // A switch a kill interrupted is finished or undone first: the folder holds one whole
+        // bake again before anything reads its manifest.
+        asset::recover_switch(&folder).map_err(|e| Error::write(&dir.join(asset::SWITCH_JOURNAL), e))?;
         Ok(BakeFolder { folder })
     }
 
@@ -421,7 +424,9 @@ impl BakeFolder {
     /// Removes the temporary files an interrupted bake or tool left for the files a bake writes
     /// and for the manifest (`.NAME.XXXXXX.tmp`, regular files only).
     fn remove_temporaries(&self) -> Result<(), Error> {
-        let ours = |target: &str| target == MANIFEST || crate::stage::is_output_name(target);
+        let ours = |target: &str| {
+            target == MANIFEST || target == asset::SWITCH_JOURNAL || crate::stage::is_output_name(target)
+        };
         asset::remove_temporaries(&self.folder, ours).map_err(|e| Error::write(self.folder.path(), e))?;
         Ok(())
     }
