@@ -149,6 +149,18 @@ impl MaterialInfo {
                 self.albedo_no_data_fraction.len()
             ));
         }
+        // Statistics of a table whose cells are finite (the reader refuses others): finite,
+        // no-data fractions within [0, 1], albedo angles within the hemisphere.
+        let values = [self.channel_min, self.channel_max, self.channel_mean, self.peak_rgb].into_iter().flatten();
+        if let Some(v) = values.chain(self.albedo_rgb.iter().flatten().copied()).find(|v| !v.is_finite()) {
+            return Err(format!("material info: a statistic or an albedo is {v:e}, not finite"));
+        }
+        if let Some(f) = self.albedo_no_data_fraction.iter().find(|f| !(0.0..=1.0).contains(*f)) {
+            return Err(format!("material info: a no-data fraction is {f:e}, outside [0, 1]"));
+        }
+        if let Some(t) = self.albedo_theta_o.iter().find(|t| !(0.0..=std::f64::consts::FRAC_PI_2).contains(*t)) {
+            return Err(format!("material info: an albedo angle is {t:e} radians, outside [0, pi / 2]"));
+        }
         Ok(())
     }
 }
@@ -578,6 +590,35 @@ impl BandwidthPca {
                 let expected = expected.map_or("more than any file holds".to_string(), |e| e.to_string());
                 return Err(format!("bandwidth pca: {what} has {found} values, expected {expected}"));
             }
+        }
+        self.check_values(tile_len as usize)
+    }
+
+    /// The ranges the values' meanings allow: the mean tile's bandwidths within the analysis's
+    /// bound ([`BandwidthAnalysis::bandwidth_bound`]); each component of unit length (within
+    /// [`UNIT_TOLERANCE`]); each coefficient, a tile's projection on a unit component after the
+    /// mean is taken out, finite and at most `sqrt(tile_len)` times the bound in magnitude, the
+    /// length of a tile of bandwidths within the bound.
+    fn check_values(&self, tile_len: usize) -> Result<(), String> {
+        self.analysis.check_bandwidths("bandwidth pca: mean value", &self.mean)?;
+        for (k, component) in self.components.chunks_exact(tile_len).enumerate() {
+            let length = component.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>().sqrt();
+            let off = (length - 1.0).abs();
+            if off.is_nan() || off > UNIT_TOLERANCE {
+                return Err(format!("bandwidth pca: component {k} has length {length:e}, not 1"));
+            }
+        }
+        let bound = (tile_len as f64).sqrt() * self.analysis.bandwidth_bound();
+        let k = self.n_components as usize;
+        if let Some((i, c)) =
+            self.coefficients.iter().enumerate().find(|(_, c)| c.is_nan() || f64::from(c.abs()) > bound)
+        {
+            return Err(format!(
+                "bandwidth pca: coefficient {} of lobe {} is {c:e}, outside [-{bound}, {bound}] (a tile of bandwidths \
+                 within the analysis's bound)",
+                i % k,
+                i / k
+            ));
         }
         Ok(())
     }

@@ -43,8 +43,18 @@ fn random_f64(rng: &mut StdRng) -> f64 {
     }
 }
 
+/// A finite value of [`random_f64`]'s kinds (statistics of a table, whose cells are finite).
+fn random_finite_f64(rng: &mut StdRng) -> f64 {
+    loop {
+        let v = random_f64(rng);
+        if v.is_finite() {
+            return v;
+        }
+    }
+}
+
 fn random_rgb(rng: &mut StdRng) -> [f64; 3] {
-    std::array::from_fn(|_| random_f64(rng))
+    std::array::from_fn(|_| random_finite_f64(rng))
 }
 
 /// A value that a field held to "finite and not negative" (bandwidths, densities, radiances)
@@ -69,9 +79,9 @@ fn random_asset(rng: &mut StdRng) -> Asset {
             channel_mean: random_rgb(rng),
             peak_rgb: random_rgb(rng),
             peak_cell: rng.random(),
-            albedo_theta_o: (0..angles).map(|_| random_f64(rng)).collect(),
+            albedo_theta_o: (0..angles).map(|_| rng.random_range(0.0..=std::f64::consts::FRAC_PI_2)).collect(),
             albedo_rgb: (0..angles).map(|_| random_rgb(rng)).collect(),
-            albedo_no_data_fraction: (0..angles).map(|_| random_f64(rng)).collect(),
+            albedo_no_data_fraction: (0..angles).map(|_| rng.random_range(0.0..=1.0)).collect(),
         }),
         1 => random_importance_samples(rng),
         2 => random_prefiltered_envmap(rng),
@@ -141,14 +151,24 @@ fn random_bandwidth_pca(rng: &mut StdRng) -> Payload {
     let (lobes_x, lobes_y, tile) = (rng.random_range(1..4u32), rng.random_range(1..4u32), rng.random_range(1..4u32));
     let k = rng.random_range(0..4u32);
     let tile_len = (tile * tile) as usize;
-    let mut f32s = |n: usize| -> Vec<f32> { (0..n).map(|_| random_f64(rng) as f32).collect() };
-    let (mean, components, coefficients) =
-        (f32s(tile_len), f32s(k as usize * tile_len), f32s((lobes_x * lobes_y * k) as usize));
+    // What the values may be: the mean's bandwidths within the analysis's bound, unit components,
+    // coefficients within sqrt(tile_len) times the bound (a little inside: f32 rounding).
+    let analysis = random_analysis(rng);
+    let mean = random_bandwidths(rng, &analysis, tile_len);
+    let components = (0..k)
+        .flat_map(|_| {
+            let v: Vec<f64> = (0..tile_len).map(|_| rng.random_range(-1.0..=1.0) + 1e-3).collect();
+            let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            v.into_iter().map(move |x| (x / length) as f32)
+        })
+        .collect();
+    let most = (tile_len as f64).sqrt() * analysis.bandwidth_bound() * 0.999;
+    let coefficients = (0..lobes_x * lobes_y * k).map(|_| (most * rng.random_range(-1.0..=1.0)) as f32).collect();
     Payload::BandwidthPca(BandwidthPca {
         lobes_x,
         lobes_y,
         tile,
-        analysis: random_analysis(rng),
+        analysis,
         n_components: k,
         mean,
         components,

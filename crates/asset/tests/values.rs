@@ -3,8 +3,8 @@
 //! whatever its sizes say. One table: the kind, the edit, what the message says.
 
 use asset::{
-    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthRows, ImportanceSamples, LayerSelection, LinkedFile, Payload,
-    PrefilteredEnvmap,
+    Asset, BandwidthAnalysis, BandwidthAtlas, BandwidthPca, BandwidthRows, ImportanceSamples, LayerSelection,
+    LinkedFile, MaterialInfo, Payload, PrefilteredEnvmap,
 };
 
 fn importance() -> ImportanceSamples {
@@ -66,6 +66,35 @@ fn atlas() -> BandwidthAtlas {
     BandwidthAtlas { lobes_x: 1, lobes_y: 2, tile: 1, analysis: analysis(), data: vec![3.0, 0.0] }
 }
 
+/// Two lobes of 2 x 2 texels and one component.
+fn pca() -> BandwidthPca {
+    BandwidthPca {
+        lobes_x: 2,
+        lobes_y: 1,
+        tile: 2,
+        analysis: analysis(),
+        n_components: 1,
+        mean: vec![3.0, 1.0, 0.0, 2.0],
+        components: vec![0.5, 0.5, -0.5, -0.5],
+        coefficients: vec![1.5, -2.0],
+    }
+}
+
+fn material_info() -> MaterialInfo {
+    MaterialInfo {
+        dims: [90, 90, 180],
+        no_data_cells: 0,
+        channel_min: [0.1; 3],
+        channel_max: [2.0; 3],
+        channel_mean: [0.3; 3],
+        peak_rgb: [2.0; 3],
+        peak_cell: [0, 0, 0],
+        albedo_theta_o: vec![0.0, 1.0],
+        albedo_rgb: vec![[0.5; 3]; 2],
+        albedo_no_data_fraction: vec![0.0, 0.01],
+    }
+}
+
 /// The message decoding `payload` gives, or `None` when it reads.
 fn refusal(payload: Payload) -> Option<String> {
     let asset = Asset { provenance: crate::small_asset().provenance, payload };
@@ -74,7 +103,15 @@ fn refusal(payload: Payload) -> Option<String> {
 
 #[test]
 fn the_untouched_payloads_read() {
-    for payload in [importance().into(), prefiltered().into(), rows().into(), atlas().into(), selection().into()] {
+    for payload in [
+        importance().into(),
+        prefiltered().into(),
+        rows().into(),
+        atlas().into(),
+        selection().into(),
+        pca().into(),
+        material_info().into(),
+    ] {
         let payload: Payload = payload;
         assert_eq!(refusal(payload.clone()), None, "{payload:?}");
     }
@@ -145,4 +182,35 @@ fn values_outside_their_ranges_are_refused_with_the_field_and_the_value() {
     let mut p = selection();
     p.layer_bandwidth[0] = f64::INFINITY;
     assert!(refusal(p.into()).expect("refused").contains("layer bandwidth 0 is inf, outside"));
+}
+
+#[test]
+fn pca_and_material_info_values_outside_their_ranges_are_refused() {
+    type Edit<T> = fn(&mut T);
+    // The bound: 11.52 cycles per radian (see above); coefficients within sqrt(4) x 11.52 = 23.04.
+    let pca_cases: [(Edit<BandwidthPca>, &str); 5] = [
+        (|p| p.mean[1] = 1e30, "bandwidth pca: mean value 1 is 1e30, outside [0, 11.52] cycles per radian"),
+        (|p| p.mean[0] = -1.0, "mean value 0 is -1e0, outside"),
+        (|p| p.components[0] = 2.0, "bandwidth pca: component 0 has length 2.179449471770337e0, not 1"),
+        (|p| p.coefficients[1] = f32::NAN, "bandwidth pca: coefficient 0 of lobe 1 is NaN, outside [-23.04, 23.04]"),
+        (|p| p.coefficients[0] = 24.0, "coefficient 0 of lobe 0 is 2.4e1, outside"),
+    ];
+    for (edit, needle) in pca_cases {
+        let mut p = pca();
+        edit(&mut p);
+        let e = refusal(p.into()).expect("refused");
+        assert!(e.starts_with("invalid payload: bandwidth pca: ") && e.contains(needle), "{e}\nshould say {needle:?}");
+    }
+    let info_cases: [(Edit<MaterialInfo>, &str); 4] = [
+        (|p| p.channel_max[1] = f64::INFINITY, "material info: a statistic or an albedo is inf, not finite"),
+        (|p| p.albedo_rgb[1][2] = f64::NAN, "a statistic or an albedo is NaN"),
+        (|p| p.albedo_no_data_fraction[0] = 2.0, "material info: a no-data fraction is 2e0, outside [0, 1]"),
+        (|p| p.albedo_theta_o[1] = 4.0, "material info: an albedo angle is 4e0 radians, outside [0, pi / 2]"),
+    ];
+    for (edit, needle) in info_cases {
+        let mut p = material_info();
+        edit(&mut p);
+        let e = refusal(p.into()).expect("refused");
+        assert!(e.contains(needle), "{e}\nshould say {needle:?}");
+    }
 }
