@@ -179,14 +179,14 @@ struct Args {
     seed: u32,
 
     /// Also render on the CPU with the same estimator and samples; report PSNR and relative error
-    /// and write OUT-difference.png. For the adaptive modes, count the pixels the GPU predicted
-    /// at another level than the CPU predicts (exit 1 over 2%), compare with the same frame
-    /// (the GPU's predictions, the same plan) shaded on the CPU (reported as "cpu") and report
-    /// psnr_db against the converged estimate
-    /// (--converged N samples per strategy, 256 by default) and, without anti-aliasing,
-    /// ceiling_db: the PSNR of the same plan with its shaded blocks given the converged values
-    /// (when psnr_db is near it, more --spp will not help; it is as exact as the converged
-    /// estimate, whose noise it carries into the up-sampled pixels).
+    /// and write OUT-difference.png. For the adaptive modes, frame by frame: count the pixels the
+    /// GPU predicted at another level than the CPU predicts (exit 1 over 2%), compare with the
+    /// same frames (the GPU's predictions, the same plans) shaded on the CPU (reported as "cpu")
+    /// and report psnr_db against the converged estimate (--converged N samples per strategy, 256
+    /// by default) and, without anti-aliasing, ceiling_db: the PSNR of the same plans with their
+    /// shaded blocks given the converged values, averaged (when psnr_db is near it, more --spp
+    /// or --frames will not help; it is as exact as the converged estimate, whose noise it
+    /// carries into the up-sampled pixels).
     #[arg(long)]
     validate: bool,
 
