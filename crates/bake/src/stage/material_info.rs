@@ -60,7 +60,7 @@ fn interp_name(interp: Interp) -> &'static str {
 }
 
 /// Why a table with `s` for its summary is not a material (values no measurement gives), in the
-/// words of [`problems`]; empty when it may be baked.
+/// words of the validation problems (`merl-info`'s); empty when it may be baked.
 pub fn unphysical(s: &Summary) -> Vec<String> {
     energy_problems(s, UNPHYSICAL_LIMIT)
 }
