@@ -189,6 +189,44 @@ fn a_rerun_is_up_to_date_and_writes_nothing() {
     assert!(snapshot(&dir) == before, "a rerun with --json changed the folder\n{r}");
 }
 
+/// The up-to-date check does only the work this bake's own files ask for: a manifest that also
+/// lists a file no stage writes (or a Phong layer under another spelling of its exponent), whole
+/// and matching its hash, is another bake's, so the rerun bakes again rather than hash it. The
+/// rebake then removes the extra file only where its name has a stage's pattern (`layer-n<N>.exr`,
+/// data-schema "Bake folders", step 5); a file of the user's stays.
+#[test]
+fn files_no_stage_writes_make_a_manifest_another_bakes() {
+    for extra in ["notes.bin", "layer-n016.exr"] {
+        let tmp = temp_dir();
+        let (_, dir) = copy_of_reference(&tmp);
+        let bytes = b"a file of the user's";
+        std::fs::write(dir.join(extra), bytes).unwrap();
+        let path = dir.join(MANIFEST);
+        let mut manifest: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let outputs = manifest["stages"][0]["outputs"].as_array_mut().unwrap();
+        let mut listed = outputs.iter().find(|o| o["format"] == "png").expect("a picture").clone();
+        listed["path"] = Value::from(extra);
+        listed["size_bytes"] = Value::from(bytes.len());
+        listed["sha256"] = Value::from(sha256_hex(bytes));
+        outputs.push(listed);
+        std::fs::write(&path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+        let r = run(bake_command(&dir, &[]), "").expect_code(0);
+        assert!(!r.stdout.contains("up to date"), "{extra}: {r}");
+        check_complete_but(&dir, extra);
+        let kept = std::fs::read(dir.join(extra)).ok();
+        assert_eq!(kept.as_deref(), (extra == "notes.bin").then_some(&bytes[..]), "{extra}");
+    }
+}
+
+/// [`check_complete`] with one more file in the folder, which the manifest does not list.
+fn check_complete_but(dir: &Path, extra: &str) {
+    let manifest = checked_manifest(dir);
+    let listed = output_paths(&manifest);
+    let present: BTreeSet<String> =
+        contents(dir).into_keys().filter(|n| n != MANIFEST && n != extra && !is_temporary(n)).collect();
+    assert_eq!(present, listed, "the files of {} are those its manifest lists", dir.display());
+}
+
 #[test]
 fn force_on_one_thread_gives_the_same_bytes() {
     let tmp = temp_dir();

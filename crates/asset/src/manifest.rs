@@ -148,6 +148,17 @@ impl StageOutput {
         })
     }
 
+    /// Whether the file at `path` in the manifest's folder has the size described: a regular file
+    /// (reached without following a link), its size from its metadata; nothing is read. A
+    /// missing file, a link, a FIFO or a device is `false`.
+    pub fn matches_size(&self, folder: &fsguard::Folder) -> std::io::Result<bool> {
+        match folder.open_file(&self.path) {
+            Ok(file) => Ok(file.metadata()?.len() == self.size_bytes),
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::InvalidInput) => Ok(false),
+            Err(e) => Err(e),
+        }
+    }
+
     /// Whether the file at `path` in the manifest's folder is still the one described: a regular
     /// file (reached without following a link, [`fsguard::Folder::open_file`]) of the same size,
     /// from its metadata, and hash, reading exactly that size. A missing file, a link, a FIFO or a

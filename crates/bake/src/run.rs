@@ -203,7 +203,7 @@ pub fn run_bake(
     if !config.force
         && let Some(previous) = &previous
         && is_same_bake(previous, &manifest)
-        && folder.all_files_match(previous)?
+        && folder.all_files_match(previous, &config.prefilter.exponents)?
     {
         // Only the temporary files a killed run of ours left (none the manifest names) go.
         folder.remove_temporaries()?;
@@ -410,8 +410,24 @@ impl BakeFolder {
     }
 
     /// Whether every file `manifest` names is the one it describes (a link, a FIFO or a device is
-    /// not; none is followed or read).
-    fn all_files_match(&self, manifest: &BakeManifest) -> Result<bool, Error> {
+    /// not; none is followed or read). The work is bounded by what this bake writes, whatever the
+    /// manifest lists: a path that is no stage's file name, or a Phong layer of an exponent this
+    /// bake does not make (`exponents`), means another bake, and so does any file of another
+    /// size; only then are the files hashed, at most one per name the stages write.
+    fn all_files_match(&self, manifest: &BakeManifest, exponents: &[u32]) -> Result<bool, Error> {
+        let ours = |path: &str| match path.strip_prefix("layer-n") {
+            Some(_) => exponents.iter().any(|&n| crate::stage::prefilter::layer_exr(n) == path),
+            None => crate::stage::is_output_name(path),
+        };
+        if !manifest.outputs().all(|output| ours(&output.path)) {
+            return Ok(false);
+        }
+        for output in manifest.outputs() {
+            let path = self.folder.join(&output.path);
+            if !output.matches_size(&self.folder).map_err(|e| Error::read(&path, e))? {
+                return Ok(false);
+            }
+        }
         for output in manifest.outputs() {
             let path = self.folder.join(&output.path);
             if !output.matches_file(&self.folder).map_err(|e| Error::read(&path, e))? {
