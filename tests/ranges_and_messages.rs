@@ -74,6 +74,15 @@ fn numeric_options_are_refused_outside_their_range() {
             command("brdf-wavelet", &[material, "--out-dir", out, "--threshold", "nan"]),
             "'--threshold <T>': expected a finite number from 0",
         ),
+        // A ratio past u32 said "out of range integral type conversion attempted".
+        (
+            command("brdf-wavelet", &[material, "--out-dir", out, "--ratio", "99999999999"]),
+            "--ratio 99999999999 is too large: use a power of two up to the grid's N x N coefficient positions",
+        ),
+        (
+            command("brdf-bake", &[material, "--out-dir", out, "--wavelet-brdf-ratio", "99999999999"]),
+            "--wavelet-brdf-ratio 99999999999 is too large: use a power of two",
+        ),
         // Exponents and widths whose tables overflow panicked.
         (
             command("merl-synth", &["phong", "-n", "1e308", "--out", out]),

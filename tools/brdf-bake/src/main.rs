@@ -146,7 +146,11 @@ fn run(args: Args) -> Result<ExitCode> {
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;
     if let Some(ratio) = args.wavelet_brdf_ratio {
-        let ratio = u32::try_from(ratio).map_err(|_| anyhow::anyhow!("--wavelet-brdf-ratio {ratio} is too large"))?;
+        let ratio = u32::try_from(ratio).map_err(|_| {
+            anyhow::anyhow!(
+                "--wavelet-brdf-ratio {ratio} is too large: use a power of two up to the grid's N x N coefficient positions"
+            )
+        })?;
         let config_w = wavelet_brdf::Config {
             keep: wavelet_brdf::Keep::Ratio(ratio),
             quantize: args.wavelet_brdf_quantize,

@@ -85,7 +85,9 @@ fn main() -> ExitCode {
 fn run(args: Args) -> Result<ExitCode> {
     let keep = match (args.ratio, args.threshold) {
         (_, Some(t)) => Keep::Threshold(t),
-        (Some(r), None) => Keep::Ratio(u32::try_from(r).context("--ratio is too large")?),
+        (Some(r), None) => Keep::Ratio(u32::try_from(r).map_err(|_| {
+            anyhow::anyhow!("--ratio {r} is too large: use a power of two up to the grid's N x N coefficient positions")
+        })?),
         (None, None) => Keep::Ratio(4),
     };
     let quantize = match args.quantize {
