@@ -4,7 +4,7 @@
 //! time of the process over the run (all threads; CPU / wall is the parallelism), and the peak
 //! resident memory of the process during the run (the kernel's high-water mark, reset before
 //! each run through `/proc/self/clear_refs`; what the earlier rows left allocated counts too).
-//! Goal (issue 33): the whole bake in at most 4 s on 2 cores.
+//! Goal: the whole bake in at most 4 s on 2 cores.
 //!
 //! Needs `target/merl/gold-paint.binary` (made by `make test-data`, or
 //! `python3 ../shared/tools/nbrdf2merl.py --out target/merl gold-paint`) and

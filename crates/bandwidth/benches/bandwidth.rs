@@ -6,7 +6,7 @@
 //!   for 1024 samples of db2) on the same array: written here as raw little-endian f64, read by
 //!   `numpy.fromfile`, timed by `timeit` inside Python so that the interpreter's start is not
 //!   counted. PyWavelets runs on one thread; the transform is timed on rayon's pool and on one
-//!   thread. Goal (issue 33): on one thread, at least 10x faster than PyWavelets (the ratio of the
+//!   thread. Goal: on one thread, at least 10x faster than PyWavelets (the ratio of the
 //!   medians; the ratio of the minima, less sensitive to other work on the machine, beside it).
 //! - The core of `envmap-bandwidth` on a real 1024 x 512 map (`log1p_luminance` and
 //!   `latlong_bandwidth`), without and with `envmap::load` (the file is in the page cache after

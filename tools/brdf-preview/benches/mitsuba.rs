@@ -1,4 +1,4 @@
-//! The outside referee (issue 31): the CPU renderer (crate `render`) against Mitsuba 3 on the
+//! The outside referee: the CPU renderer (crate `render`) against Mitsuba 3 on the
 //! same scene (a benchmark, not a test: it reports figures and asserts nothing).
 //!
 //! # What is compared
