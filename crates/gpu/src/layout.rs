@@ -86,7 +86,7 @@ fn shared_structs() -> Vec<Shared> {
             "brdf_marginal" => tables.brdf_marginal, "brdf_conditional" => tables.brdf_conditional,
             "env_marginal" => tables.env_marginal, "env_conditional" => tables.env_conditional,
             "peak_marginal" => tables.peak_marginal, "peak_conditional" => tables.peak_conditional,
-            "items" => items, "_pad0" => _pad0, "_pad1" => _pad1, "_pad2" => _pad2, "diffuse" => diffuse,
+            "items" => items, "filter_samples" => filter_samples, "_pad1" => _pad1, "_pad2" => _pad2, "diffuse" => diffuse,
         }),
         shared!(ADAPTIVE_PREDICT.source, "Predict", PredictUniform {
             "n_b" => n_b, "env_width" => env_width, "env_height" => env_height, "lobes_x" => lobes_x,

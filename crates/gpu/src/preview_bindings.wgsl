@@ -101,7 +101,9 @@ struct Shade {
     // The length of the list a pass over items reads (`predict_blocks`, `shade_blocks`): their
     // items arrive in `accumulation`.
     items: u32,
-    _pad0: u32,
+    // The samples the fis estimator's footprints are sized for: `spp` times the frames the
+    // picture averages.
+    filter_samples: u32,
     _pad1: u32,
     _pad2: u32,
     // `render::diffuse_split` (w unused): the BRDF's diffuse part `f_d`, which the filtered

@@ -62,8 +62,9 @@ fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
     return top * (1.0 - fy) + bottom * fy;
 }
 
-// `envmap::MipChain::lod_solid_angle` for one of `spp` samples of density `pdf` per unit solid
-// angle: max(log4(width height / (spp pdf 2 pi^2)), 0), as a difference of logarithms (the
+// `envmap::MipChain::lod_solid_angle` for one of `filter_samples` samples (the picture's, over
+// its frames) of density `pdf` per unit solid angle:
+// max(log4(width height / (filter_samples pdf 2 pi^2)), 0), as a difference of logarithms (the
 // quotient overflows f32 for tiny densities, where the CPU's f64 does not). A density that is not
 // positive stands for the CPU's infinite level: the last.
 fn mip_lod(pdf: f32) -> f32 {
@@ -72,7 +73,7 @@ fn mip_lod(pdf: f32) -> f32 {
     }
     let level0 = env_maps[shade.mips_first];
     let texels = f32(level0.x) * f32(level0.y);
-    return max(0.5 * (log2(texels) - log2(f32(shade.spp)) - log2(pdf * 2.0 * PI * PI)), 0.0);
+    return max(0.5 * (log2(texels) - log2(f32(shade.filter_samples)) - log2(pdf * 2.0 * PI * PI)), 0.0);
 }
 
 // `envmap::MipChain::lookup_uv` in the chain from `shade.mips_first`: bilinear in the two levels

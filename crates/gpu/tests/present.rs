@@ -74,7 +74,7 @@ fn bits(image: &Image) -> Vec<u32> {
 fn accumulating_frame_by_frame_is_one_render_of_as_many_frames() {
     let mut renderer = renderer();
     for expected in 1..=3 {
-        let frames = renderer.accumulate(&settings(1), View::Shaded).expect("accumulating");
+        let frames = renderer.accumulate(&settings(3), View::Shaded, 1).expect("accumulating");
         assert_eq!(frames, expected);
     }
     let progressive = renderer.accumulated_image().expect("reading back");
@@ -85,21 +85,22 @@ fn accumulating_frame_by_frame_is_one_render_of_as_many_frames() {
     let first = renderer.render_frames(&settings(1)).expect("rendering");
     assert!(bits(&first) != bits(&whole), "frames 1 and 2 added nothing new");
 
-    // render_frames leaves its frames to go on from.
+    // render_frames leaves its frames to go on from, for the same picture.
     assert_eq!(renderer.frames_accumulated(), 1);
-    assert_eq!(renderer.accumulate(&settings(2), View::Shaded).expect("accumulating"), 3);
-    let other_seed = Settings { seed: 4, ..settings(1) };
-    assert_eq!(renderer.accumulate(&other_seed, View::Shaded).expect("accumulating"), 1, "a new seed goes on");
-    assert_eq!(renderer.accumulate(&other_seed, View::Normal).expect("accumulating"), 1, "a new view goes on");
+    assert_eq!(renderer.accumulate(&settings(1), View::Shaded, 2).expect("accumulating"), 3);
+    assert_eq!(renderer.accumulate(&settings(2), View::Shaded, 1).expect("accumulating"), 1, "another picture goes on");
+    let other_seed = Settings { seed: 4, ..settings(2) };
+    assert_eq!(renderer.accumulate(&other_seed, View::Shaded, 1).expect("accumulating"), 1, "a new seed goes on");
+    assert_eq!(renderer.accumulate(&other_seed, View::Normal, 1).expect("accumulating"), 1, "a new view goes on");
     renderer.restart();
     assert_eq!(renderer.frames_accumulated(), 0);
     assert!(renderer.accumulated_image().is_err(), "an empty accumulation read back");
-    renderer.accumulate(&settings(2), View::Shaded).expect("accumulating");
+    renderer.accumulate(&settings(2), View::Shaded, 2).expect("accumulating");
     let camera = Camera::orbit(glam::Vec3::ZERO, 3.0, 0.5, 0.3, 45f32.to_radians()).expect("a valid camera");
     renderer.set_camera(&camera).expect("moving the camera");
     assert_eq!(renderer.frames_accumulated(), 0, "a camera change kept the accumulation");
     let invalid = Settings { spp: 3, ..settings(1) };
-    assert!(renderer.accumulate(&invalid, View::Shaded).is_err(), "spp 3 accepted");
+    assert!(renderer.accumulate(&invalid, View::Shaded, 1).is_err(), "spp 3 accepted");
 }
 
 /// The present pass at the image's size is `envmap::tonemap_rgb8` of the image
@@ -190,11 +191,11 @@ fn debug_views_show_what_the_estimators_read() {
     let material = material();
     let slices = material.samples.n_slices;
 
-    renderer.accumulate(&settings(1), View::Normal).expect("accumulating normals");
+    renderer.accumulate(&settings(1), View::Normal, 1).expect("accumulating normals");
     let normals = renderer.accumulated_image().expect("reading back");
-    renderer.accumulate(&settings(1), View::Layer).expect("accumulating layers");
+    renderer.accumulate(&settings(1), View::Layer, 1).expect("accumulating layers");
     let layers = renderer.accumulated_image().expect("reading back");
-    renderer.accumulate(&settings(1), View::Slice).expect("accumulating slices");
+    renderer.accumulate(&settings(1), View::Slice, 1).expect("accumulating slices");
     let slice_view = renderer.accumulated_image().expect("reading back");
 
     let (mut mismatches, mut covered, mut seen_layers, mut seen_slices) = (0, 0, Vec::new(), Vec::new());
@@ -243,7 +244,7 @@ fn debug_views_show_what_the_estimators_read() {
 fn debug_views_keep_the_environment_behind_the_mesh() {
     let mut renderer = renderer();
     let shaded = renderer.render_frames(&settings(1)).expect("rendering");
-    renderer.accumulate(&settings(1), View::Slice).expect("accumulating slices");
+    renderer.accumulate(&settings(1), View::Slice, 1).expect("accumulating slices");
     let slices = renderer.accumulated_image().expect("reading back");
     let mut background = 0;
     for (i, covered) in shaded.covered.iter().enumerate() {

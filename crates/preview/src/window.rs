@@ -356,9 +356,11 @@ impl State {
             return Ok(());
         }
         let frames = self.frames_per_redraw.min(target - done);
-        let settings = Settings { mode: self.mode, frames, ..*settings };
+        // The settings' frames size the fis estimator's footprints (`render::Settings::
+        // filter_samples`), as they do for `--out`; the window goes on averaging past them.
+        let settings = Settings { mode: self.mode, ..*settings };
         let start = Instant::now();
-        self.renderer.accumulate(&settings, self.view)?;
+        self.renderer.accumulate(&settings, self.view, frames)?;
         self.gpu.wait()?;
         let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(frames);
         self.ms_per_frame = Some(ms);

@@ -214,6 +214,7 @@ pub(crate) fn shade(
     let (n_vectors, n_samples, spp) = (s.n_vectors as u32, s.n_samples as u32, settings.spp);
     let table = &s.tables[slice_of(frame.theta_o(), s.n_slices)];
     let [brdf_points, env_points] = pixel_sequences(pixel, settings.seed);
+    let filter_samples = settings.filter_samples() as usize;
     // The light a filtered estimator reads (`Some` in fis and prefiltered) and the light that
     // multiple importance sampling of the BRDF's and a light's strategy takes: level 0 whole in
     // the reference mode, the peaks in the filtered modes (crate documentation).
@@ -275,7 +276,7 @@ pub(crate) fn shade(
                             add(rest, radiance, wi_local.z / sample.pdf);
                         }
                         Some(Source::Mips(mips)) => {
-                            let lod = mips.lod_solid_angle(spp as usize, sample.pdf);
+                            let lod = mips.lod_solid_angle(filter_samples, sample.pdf);
                             add(rest, mips.lookup_uv(u, v, lod), wi_local.z / sample.pdf);
                         }
                         None => {}

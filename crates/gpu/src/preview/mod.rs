@@ -122,9 +122,7 @@ impl View {
 /// What the accumulation buffer holds: the sum of frames `0 .. frames` of one render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Progress {
-    mode: Mode,
-    spp: u32,
-    seed: u32,
+    settings: Settings,
     view: View,
     frames: u32,
 }
@@ -261,34 +259,36 @@ impl Renderer {
     pub fn render_frames(&mut self, settings: &Settings) -> Result<Image, GpuError> {
         self.check_settings(settings)?;
         self.restart();
-        self.accumulate(settings, View::Shaded)?;
+        self.accumulate(settings, View::Shaded, settings.frames)?;
         self.accumulated_image()
     }
 
-    /// Adds `settings.frames` frames of `view` to the accumulation, continuing with the frame
-    /// after the last one added: calls of 1 frame each add frames 0, 1, 2, ... and their sum is
-    /// that of one render of as many frames. Starts again from frame 0 where the accumulation
-    /// holds another mode, spp, seed or view, or nothing (after [`Renderer::restart`] or a camera
-    /// change). Checks the settings as [`Renderer::render_frames`] does. Returns the frames now
-    /// accumulated. Submits the work without waiting for it (`wgpu::Device::poll` waits).
-    pub fn accumulate(&mut self, settings: &Settings, view: View) -> Result<u32, GpuError> {
+    /// Adds `frames` frames of the picture `settings` describes (`settings.frames` the frames it
+    /// averages when whole, which sets the fis estimator's footprints: `render`'s crate docs) and
+    /// of `view` to the accumulation, continuing with the frame after the last one added: calls
+    /// of 1 frame each add frames 0, 1, 2, ... and their sum is that of one render of as many
+    /// frames. Starts again from frame 0 where the accumulation holds other settings or another
+    /// view, or nothing (after [`Renderer::restart`] or a camera change). Checks the settings as
+    /// [`Renderer::render_frames`] does. Returns the frames now accumulated. Submits the work
+    /// without waiting for it (`wgpu::Device::poll` waits).
+    pub fn accumulate(&mut self, settings: &Settings, view: View, frames: u32) -> Result<u32, GpuError> {
         self.check_settings(settings)?;
         let progress = match self.progress.get() {
-            Some(p) if (p.mode, p.spp, p.seed, p.view) == (settings.mode, settings.spp, settings.seed, view) => p,
-            _ => Progress { mode: settings.mode, spp: settings.spp, seed: settings.seed, view, frames: 0 },
+            Some(p) if (p.settings, p.view) == (*settings, view) => p,
+            _ => Progress { settings: *settings, view, frames: 0 },
         };
-        let frames = progress.frames.checked_add(settings.frames).ok_or_else(|| {
+        let total = progress.frames.checked_add(frames).ok_or_else(|| {
             GpuError::Scene(render::Error::Invalid(format!(
-                "{} frames accumulated, {} more would overflow the frame index",
-                progress.frames, settings.frames
+                "{} frames accumulated, {frames} more would overflow the frame index",
+                progress.frames
             )))
         })?;
         // Nothing to continue is recorded before the work, so that a failure leaves none.
         self.progress.set(None);
         let shade = self.shade_uniform(view.mode_index(settings.mode), settings);
-        self.shade_frames(&shade, progress.frames, settings.frames, progress.frames == 0)?;
-        self.progress.set(Some(Progress { frames, ..progress }));
-        Ok(frames)
+        self.shade_frames(&shade, progress.frames, frames, progress.frames == 0)?;
+        self.progress.set(Some(Progress { frames: total, ..progress }));
+        Ok(total)
     }
 
     /// Frames in the accumulation: 0 after [`Renderer::restart`] or a camera change.
@@ -706,7 +706,7 @@ impl Renderer {
             maps: self.maps,
             tables: self.tables,
             items: 0,
-            _pad0: 0,
+            filter_samples: settings.filter_samples(),
             _pad1: 0,
             _pad2: 0,
             diffuse: [self.diffuse[0], self.diffuse[1], self.diffuse[2], 0.0],

@@ -67,7 +67,9 @@ pub(crate) struct ShadeUniform {
     /// The length of the list a pass over items reads (`Renderer::run_items`, an adaptive
     /// frame's parts); 0 for the passes over pixels.
     pub(crate) items: u32,
-    pub(crate) _pad0: u32,
+    /// The samples the fis estimator's footprints are sized for: `spp` times the frames the
+    /// picture averages (`render`'s crate docs, `Mode::Fis`).
+    pub(crate) filter_samples: u32,
     pub(crate) _pad1: u32,
     pub(crate) _pad2: u32,
     /// `render::diffuse_split` (w unused): the filtered estimators' diffuse part.
