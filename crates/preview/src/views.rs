@@ -77,9 +77,11 @@ pub fn debug_views(
          up-sampled (0: shaded on its own). Shaded blocks per level: {}. {} samples of a budget of {}; shaded fraction {}. Samples per \
          pixel: a shaded block's samples over its pixels. Bandwidth: cycles per pixel from the environment's and \
          the BRDF's bandwidth through the paper's reflection operators (001 eq. 3-6); the level is \
-         floor(log2(1 / (2 bandwidth))). Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). \
+         floor(log2(1 / ({} bandwidth))), {} samples per cycle. Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). \
          A shaded block's samples: {}. Black: background or silhouette.",
         per_level.join(", "),
+        render::adaptive::SAMPLES_PER_CYCLE,
+        render::adaptive::SAMPLES_PER_CYCLE,
         frame.samples,
         frame.budget,
         format_number((frame.shaded_fraction() * 1e4).round() / 1e4),

@@ -383,17 +383,22 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
         adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap()
     };
     let top = frame(4);
-    // Every shadeable pixel has a prediction, and blocks whose pixel is off the sphere share
-    // theirs by quarters rather than predicting every pixel.
+    // Every shadeable pixel has a prediction, and the blocks that hold pixels off the sphere
+    // share theirs by quarters rather than predicting every pixel: as many predictions as the
+    // recursion has sources, 150 for 444 pixels (3 x 2 blocks of 16 x 16, all split; the
+    // sphere is small, and its two outer rings predict pixel by pixel).
     let shadeable: Vec<&Prediction> = top.details().predictions.iter().filter(|p| p.level >= 0).collect();
     let mut distinct: Vec<(u64, u64)> =
         shadeable.iter().map(|p| (p.bandwidth.to_bits(), p.variance.to_bits())).collect();
     distinct.sort_unstable();
     distinct.dedup();
     assert_eq!(shadeable.len(), top.shadeable);
-    // 3 x 2 blocks, those off the sphere split: 8 predictions for 444 pixels (130 when every
-    // pixel of such a block predicted for itself).
-    assert!(distinct.len() <= 16, "{} predictions for {} pixels", distinct.len(), shadeable.len());
+    let covered: Vec<bool> = top.details().predictions.iter().map(|p| p.level >= 0).collect();
+    let mut sources: Vec<usize> = sources_by_recursion(&covered, (40, 30), 4).into_iter().flatten().collect();
+    sources.sort_unstable();
+    sources.dedup();
+    assert!(sources.len() < shadeable.len() / 2, "{} sources for {} pixels", sources.len(), shadeable.len());
+    assert_eq!(distinct.len(), sources.len(), "{} predictions for {} pixels", distinct.len(), shadeable.len());
     for predict_level in [5, 40, 64, usize::MAX] {
         let f = frame(predict_level);
         assert_eq!(f.details().predictions, top.details().predictions, "predict level {predict_level}");
@@ -421,7 +426,8 @@ fn the_settings_are_checked_before_the_scene() {
 }
 
 /// The recursion the module docs describe, written out: block `(bx, by)` of level `k` predicts
-/// at its pixel when that pixel is shadeable (or at level 0), else splits into its quarters.
+/// at its pixel when all its pixels are inner (shadeable, and so are their neighbours in the
+/// image), or at level 0, else splits into its quarters.
 fn sources_by_recursion(shadeable: &[bool], (w, h): (usize, usize), l: usize) -> Vec<Option<usize>> {
     fn visit(k: usize, (bx, by): (usize, usize), s: &[bool], (w, h): (usize, usize), out: &mut [Option<usize>]) {
         let (x0, y0) = (bx << k, by << k);
@@ -430,7 +436,12 @@ fn sources_by_recursion(shadeable: &[bool], (w, h): (usize, usize), l: usize) ->
         }
         let half = (1 << k) / 2;
         let (x, y) = ((x0 + half).min(w - 1), (y0 + half).min(h - 1));
-        if k > 0 && !s[y * w + x] {
+        let inner = |x: usize, y: usize| {
+            let neighbours = [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)];
+            s[y * w + x] && neighbours.iter().all(|&(nx, ny)| nx >= w || ny >= h || s[ny * w + nx])
+        };
+        let whole = (y0..(y0 + (1 << k)).min(h)).all(|py| (x0..(x0 + (1 << k)).min(w)).all(|px| inner(px, py)));
+        if k > 0 && !whole {
             for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 visit(k - 1, (2 * bx + dx, 2 * by + dy), s, (w, h), out);
             }

@@ -25,9 +25,9 @@
 //! # The bandwidth buffer (`001` eq. 3-6, 9-11)
 //!
 //! For each shadeable pixel (or, with [`Settings::predict_level`] `l`, once per block of `2^l x
-//! 2^l` output pixels, at the block's pixel, copied to its shadeable pixels, a block whose pixel
-//! is not shadeable split into its quarters: the prediction costs as much as shading `n_b`
-//! samples, and a block's pixels are alike), `n_b` incident
+//! 2^l` output pixels, at the block's pixel, copied to its pixels, a block that holds a pixel
+//! at or beside a silhouette split into its quarters ([`prediction_pixels`]): the prediction
+//! costs as much as shading `n_b` samples, and a block's pixels are alike), `n_b` incident
 //! directions (default 16): the first `n_b` samples of one baked vector of the pixel's slice
 //! (the vector `pcg_hash(pixel ^ pcg_hash(seed ^ 0x9e37_79b9)) % V`; the prefix of an
 //! Owen-scrambled Sobol' vector is stratified), each with its pdf. For each `wi`:
