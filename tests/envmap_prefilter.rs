@@ -38,7 +38,7 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
         cmd.arg(env_dir().join(name)).arg("--out-dir").arg(&out).arg("--verify");
         let r = run(cmd, "")
             .expect_code(0)
-            .expect_stdout("7 layers match the EXR layers within half-float rounding")
+            .expect_stdout("8 layers match the EXR layers within half-float rounding")
             .expect_stdout("10 mip levels match the source's mip chain within half-float rounding");
         assert!(!r.stdout.contains("problem"), "{r}");
 
@@ -46,9 +46,9 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
         assert_eq!(asset.provenance.source_name, name);
         assert_eq!(asset.provenance.source_sha256, asset::sha256_file(&env_dir().join(name)).unwrap());
         let Payload::PrefilteredEnvmap(p) = asset.payload else { panic!("{name}: not a prefiltered envmap") };
-        assert_eq!(p.exponents, [1, 4, 16, 64, 256, 1024, 4096]);
-        assert_eq!((p.source_size, p.layer_size, p.mip_levels), ([1024, 512], [256, 128], 10));
-        assert_eq!(p.lobe_bandwidth.len(), 7);
+        assert_eq!(p.exponents, [1, 4, 16, 64, 256, 1024, 4096, 16384]);
+        assert_eq!((p.source_size, p.layer_size, p.mip_levels), ([1024, 512], [512, 256], 10));
+        assert_eq!(p.lobe_bandwidth.len(), 8);
         for (k, nu) in p.lobe_bandwidth.iter().enumerate() {
             let n = f64::from(p.exponents[k]);
             assert!((nu - (n + 2.0).sqrt() / (2.0 * std::f64::consts::PI)).abs() < 1e-12);
@@ -90,13 +90,14 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
                 "layer-n64.exr",
                 "layer-n256.exr",
                 "layer-n1024.exr",
-                "layer-n4096.exr"
+                "layer-n4096.exr",
+                "layer-n16384.exr"
             ]
         );
-        // VK_FORMAT_R16G16B16A16_SFLOAT = 97; an array of 7 layers with one level, and a plain
+        // VK_FORMAT_R16G16B16A16_SFLOAT = 97; an array of 8 layers with one level, and a plain
         // 2D texture with 10 levels. Quarry's sun exceeds the largest half float: its mip chain is
         // stored as single floats (VK_FORMAT_R32G32B32A32_SFLOAT = 109), never at a hidden scale.
-        assert_eq!(ktx2_header(&out.join(&p.layers_ktx2.name)), (97, 256, 128, 7, 1));
+        assert_eq!(ktx2_header(&out.join(&p.layers_ktx2.name)), (97, 512, 256, 8, 1));
         let mips_format = if name.starts_with("quarry") { 109 } else { 97 };
         assert_eq!(ktx2_header(&out.join(&p.mips_ktx2.name)), (mips_format, 1024, 512, 0, 10));
         assert_eq!((p.layers_radiance_scale, p.mips_radiance_scale), (1.0, 1.0));
@@ -107,12 +108,12 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
             .expect_code(0)
             .expect_stdout("kind             prefiltered-envmap (3)")
             .expect_stdout("payload: prefiltered envmap")
-            .expect_stdout("layer exr        n = 4096: layer-n4096.exr");
+            .expect_stdout("layer exr        n = 16384: layer-n16384.exr");
         let mut cmd = tool("asset-info");
         cmd.arg(out.join("prefiltered.asset")).arg("--json");
         let json = run(cmd, "").expect_code(0).json();
         assert_eq!(json["payload"]["layers_ktx2"]["name"], "layers.ktx2");
-        assert_eq!(json["payload"]["exponents"][6], 4096);
+        assert_eq!(json["payload"]["exponents"][7], 16384);
     }
 }
 

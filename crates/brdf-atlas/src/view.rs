@@ -137,10 +137,10 @@ pub const KNOWN_LAYER_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.9
 
 /// [`layer_bandwidth`] of the default configuration under [`KNOWN_LAYER_REDUCTION`] for the
 /// default Phong exponents, `(n, bits of the f64)`: they depend on neither the material nor the
-/// map, so a bake reads them rather than measuring the seven lobes again. Printed by
+/// map, so a bake reads them rather than measuring the eight lobes again. Printed by
 /// `cargo run --release -p brdf-atlas --example layer-bandwidths`; a test holds them to the
 /// measurement.
-pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 7] = [
+pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 8] = [
     (1, 0x3fd3609ce95d2754),
     (4, 0x3fd42cf4b97e1f98),
     (16, 0x3fdcac9cf3d5b74d),
@@ -148,6 +148,7 @@ pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 7] = [
     (256, 0x3ffbb761706661e7),
     (1024, 0x400b86b5140489ea),
     (4096, 0x401b4b4672efc038),
+    (16384, 0x402ad28c75a5c1ba),
 ];
 
 /// The layer bandwidth of `n` from [`KNOWN_LAYER_BANDWIDTHS`] where `config` and `reduction` are

@@ -83,11 +83,11 @@ struct Args {
 
     /// Also write the Phong exponents as one mip chain, the layout engines read (cmft's):
     /// phong-chain.ktx2, level m the m-th sharpest exponent at (WIDTH >> m) x (HEIGHT >> m) (the
-    /// defaults give 4096, 1024, ..., 1 from 256 x 128 down), and phong-chain-cube.ktx2 with --cube.
+    /// defaults give 16384, 4096, ..., 1 from 512 x 256 down), and phong-chain-cube.ktx2 with --cube.
     #[arg(long, requires = "env")]
     chain: bool,
 
-    /// Also write the environment's GGX chain of M levels, from 2 to 7, and the split-sum DFG table
+    /// Also write the environment's GGX chain of M levels, from 2 to log2 of the layers' width less 1 (8 for the default 512 x 256), and the split-sum DFG table
     /// (ggx.ktx2, dfg.ktx2, dfg.png; see envmap-prefilter --help).
     #[arg(long, value_name = "M", value_parser = |s: &str| cli::parse_whole(s, 2), requires = "env")]
     ggx_levels: Option<usize>,

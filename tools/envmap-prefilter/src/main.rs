@@ -34,11 +34,11 @@ struct Args {
     out_dir: PathBuf,
 
     /// Phong exponents, one layer each, strictly increasing, each from 1 to 16777216.
-    #[arg(long, value_name = "N,N,...", value_delimiter = ',', default_value = "1,4,16,64,256,1024,4096")]
+    #[arg(long, value_name = "N,N,...", value_delimiter = ',', default_value = "1,4,16,64,256,1024,4096,16384")]
     exponents: Vec<u32>,
 
     /// Size of every layer, WIDTHxHEIGHT with WIDTH = 2 x HEIGHT, HEIGHT from 1 to 8192.
-    #[arg(long, value_name = "WxH", default_value = "256x128", value_parser = cli::parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "512x256", value_parser = cli::parse_size)]
     size: (usize, usize),
 
     /// Memory budget (4G, 512M, ...; from 1 byte to 16 EiB, more than the layers alone need): a map
@@ -60,14 +60,14 @@ struct Args {
 
     /// Also write the Phong exponents as one mip chain, the layout engines read (cmft's):
     /// phong-chain.ktx2, level m the m-th sharpest exponent at (WIDTH >> m) x (HEIGHT >> m) (the
-    /// defaults give 4096, 1024, ..., 1 from 256 x 128 down), and phong-chain-cube.ktx2 with --cube.
+    /// defaults give 16384, 4096, ..., 1 from 512 x 256 down), and phong-chain-cube.ktx2 with --cube.
     #[arg(long)]
     chain: bool,
 
     /// Also write the GGX chain engines read (split sum, n = v = r): ggx.ktx2, M mip levels from
     /// the --size grid down, level m at perceptual roughness m / (M - 1) (alpha = roughness^2;
     /// level 0 the mirror), ggx-cube.ktx2 with --cube, and the split-sum DFG table (dfg.ktx2: A
-    /// in red, B in green of F0 A + B; dfg.png). From 2 to log2(WIDTH) - 1 levels (7 for 256x128).
+    /// in red, B in green of F0 A + B; dfg.png). From 2 to log2(WIDTH) - 1 levels (8 for 512x256).
     #[arg(long, value_name = "M", value_parser = |s: &str| cli::parse_whole(s, 2))]
     ggx_levels: Option<usize>,
 
