@@ -59,9 +59,9 @@
 //! 99th-percentile per-texel relative error below `2e-7` on every layer (`f32` rounding), except
 //! the harmonics of `n = 1`: RMSE `1e-4`, 99th percentile `1e-3`, largest `6e-3` (quarry; its kink
 //! truncated at degree 256). A point source gives the lobe itself and a constant map itself
-//! (`tests/accuracy.rs`); the solid-angle-weighted mean of every 256 x 128 layer equals the
-//! source's within `3e-5`. The layers are `f32`; the KTX2 textures round them to half floats
-//! (relative error at most `2^-11`).
+//! (`tests/accuracy.rs`); the solid-angle-weighted mean of every default layer equals the
+//! source's within 0.5% (`layer_means_equal_the_source_mean`). The layers are `f32`; the KTX2
+//! textures round them to half floats (relative error at most `2^-11`).
 //!
 //! # Bandwidth to layer
 //!

@@ -11,9 +11,9 @@ fn the_default_exponents_make_cmfts_chain_and_match_the_brute_force() {
     let config = Config::default();
     let chain = phong_chain(&map, &config, &|_| {}).unwrap();
     let exponents: Vec<u32> = chain.iter().map(|(n, _)| *n).collect();
-    assert_eq!(exponents, [4096, 1024, 256, 64, 16, 4, 1]);
+    assert_eq!(exponents, [16384, 4096, 1024, 256, 64, 16, 4, 1]);
     let sizes: Vec<(usize, usize)> = chain.iter().map(|(_, l)| (l.width(), l.height())).collect();
-    assert_eq!(sizes, [(256, 128), (128, 64), (64, 32), (32, 16), (16, 8), (8, 4), (4, 2)]);
+    assert_eq!(sizes, [(512, 256), (256, 128), (128, 64), (64, 32), (32, 16), (16, 8), (8, 4), (4, 2)]);
     // Every level against the brute force at every texel from 32 x 16 down, every 8th texel
     // above. Relative RMSE below 1e-3 (the n = 1 lobe's harmonics, truncated at its kink, reach
     // 1e-4; the others are f32 rounding).
@@ -35,9 +35,9 @@ fn the_default_exponents_make_cmfts_chain_and_match_the_brute_force() {
         let error = (num / den).sqrt();
         assert!(error < 1e-3, "n {n} at {w} x {h}: relative rmse {error:.2e}");
     }
-    let too_long = Config { width: 128, height: 64, ..Config::default() };
+    let too_long = Config { width: 256, height: 128, ..Config::default() };
     let err = phong_chain(&map, &too_long, &|_| {}).unwrap_err().to_string();
-    assert!(err.contains("at most 6 levels"), "7 levels need a level 0 of 256 x 128 at least: {err}");
+    assert!(err.contains("at most 7 levels"), "8 levels need a level 0 of 512 x 256 at least: {err}");
 }
 
 #[test]

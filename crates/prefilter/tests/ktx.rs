@@ -113,9 +113,9 @@ fn the_layer_array_reads_back_and_matches_the_exr_layers() {
     check_common(&reader, &encoded);
     let header = reader.header();
     assert_eq!((header.pixel_width, header.pixel_height), (64, 32));
-    assert_eq!((header.layer_count, header.face_count, header.level_count), (7, 1, 1));
+    assert_eq!((header.layer_count, header.face_count, header.level_count), (8, 1, 1));
     let level = reader.levels().next().unwrap();
-    assert_eq!(level.data.len(), 7 * 64 * 32 * 8);
+    assert_eq!(level.data.len(), 8 * 64 * 32 * 8);
     let stored = values(level.data, encoded.format);
 
     let dir = tempfile::tempdir().unwrap();

@@ -172,8 +172,8 @@ fn layers_by_bandwidth() {
     let mapping = LayerMapping::new(&DEFAULT_EXPONENTS);
     let b = mapping.bandwidths().to_vec();
     let t = mapping.thresholds().to_vec();
-    assert_eq!((b.len(), t.len()), (7, 6));
-    for k in 0..6 {
+    assert_eq!((b.len(), t.len()), (8, 7));
+    for k in 0..7 {
         assert!(((t[k] * t[k]) / (b[k] * b[k + 1]) - 1.0).abs() < 1e-15, "threshold {k} is the geometric mean");
     }
     let check = |nu: f64, layer: usize| assert_eq!(mapping.layer(nu), layer, "bandwidth {nu}");
@@ -187,8 +187,8 @@ fn layers_by_bandwidth() {
         check(threshold, k);
         check(threshold * (1.0 + 1e-12), k + 1);
     }
-    check(b[6] * 100.0, 6);
-    check(f64::INFINITY, 6);
+    check(b[7] * 100.0, 7);
+    check(f64::INFINITY, 7);
 }
 
 #[test]
