@@ -128,8 +128,8 @@ target/merl/%.binary: | setup-python
 	@python3 ../shared/tools/nbrdf2merl.py --out target/merl $* >/dev/null
 
 ## bench: every benchmark (scripts/benchmarks.py lists them: timings against baselines measured in
-## the same run, issue 11's equal-quality benchmark of the adaptive modes on the GPU, lavapipe
-## without one, and issue 31's outside referee, the CPU renderer against Mitsuba 3), each report
+## the same run, the equal-quality benchmark of the adaptive modes on the GPU, lavapipe
+## without one, and the outside referee, the CPU renderer against Mitsuba 3), each report
 ## written into docs/benchmarks.md stamped with the commit and the machine; BENCH="stages atlas"
 ## runs some and keeps the other sections. About 90 minutes the first time on 2 cores (the
 ## adaptive and Mitsuba benchmarks keep their bakes, converged images and renders under

@@ -1,4 +1,4 @@
-//! Bake folders that cannot be turned against their user (issue 32): hostile folders (manifests
+//! Bake folders that cannot be turned against their user: hostile folders (manifests
 //! naming files outside, links, FIFOs) make no tool touch or read anything outside the folder and
 //! no tool block; two bakes of one folder at once leave a manifest that tells the truth; a rebake
 //! that fails keeps the previous bake listed; `brdf-wavelet` into a bake goes through the bake's

@@ -1,4 +1,4 @@
-//! `brdf-bandwidth` and `bandwidth-pca` end to end (issue 3): the outputs and their sizes, the
+//! `brdf-bandwidth` and `bandwidth-pca` end to end: the outputs and their sizes, the
 //! count of lobes at the analysis grid's limit on sharp and broad Phong lobes, a flat atlas for
 //! a Lambertian material, one-line errors on bad input, and the PCA table of the 20 shared
 //! real-derived materials.
@@ -140,7 +140,7 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
     assert_eq!(lobes_at_limit(&r), 0, "{r}");
 }
 
-/// Issue 10: with the defaults (1024 x 1024), no lobe of a `merl-synth` table of Phong n = 1000
+/// With the defaults (1024 x 1024), no lobe of a `merl-synth` table of Phong n = 1000
 /// reaches the analysis grid's limit (the `brdf-atlas` test `phong_1000_is_resolved_at_the_default_size`
 /// says what read it before: 192 lobes at 512, 64 at 1024 before the table's cells below the
 /// horizon were continued).

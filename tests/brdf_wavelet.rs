@@ -1,4 +1,4 @@
-//! `brdf-wavelet` end to end (issue 12): the paper's Lewis-like material through `merl-synth`
+//! `brdf-wavelet` end to end: the paper's Lewis-like material through `merl-synth`
 //! and the tool meets Table 1, the asset reads back in `asset-info`, bad settings and damaged
 //! assets are refused with the file and the problem, and `brdf-preview --brdf wavelet-brdf` renders
 //! from it and measures it against the table.

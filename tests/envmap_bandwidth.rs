@@ -230,7 +230,7 @@ fn spatial_maps_equal_the_library_estimate() {
     assert_equal(&run, 512, 768, custom.frequency(), "memorial, periodic, eps 0.05, 6 levels");
 }
 
-/// `--reading level-normalized` (issue 11): recorded in the JSON parameters, and never reads a
+/// `--reading level-normalized`: recorded in the JSON parameters, and never reads a
 /// coarser level than the paper's reading, so its median and 95th percentile are at least the
 /// paper's; on quarry it reads the fine texture the paper's reading masks (its median is higher).
 #[test]

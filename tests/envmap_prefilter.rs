@@ -221,8 +221,8 @@ fn damaged_inputs_are_refused_with_the_reason() {
 }
 
 /// `asset-info` checks the files a prefiltered asset names: a missing or replaced file is exit 1
-/// naming it (issue 9: a killed rerun could leave `prefiltered.asset` naming a `layers.ktx2`
-/// whose sha256 no longer matched, and `asset-info` said nothing).
+/// naming it (a killed rerun can leave `prefiltered.asset` naming a `layers.ktx2` whose sha256
+/// no longer matches, which `asset-info` must say).
 #[test]
 fn asset_info_names_a_stale_or_missing_linked_file() {
     let tmp = temp_dir();

@@ -1,5 +1,5 @@
 //! `merl-importance` and the `importance` crate on the 20 shared real-derived materials: the
-//! relative variance and albedo bars of issue 4, a chi-square test on peaked and broad
+//! bars on relative variance and albedo, a chi-square test on peaked and broad
 //! materials, and the tool end to end.
 
 use importance::quality::{albedo_estimate, chi2_against_density, slice_quality};
@@ -187,9 +187,8 @@ fn merl_importance_refuses_bad_settings() {
     assert!(!dir.path().join("x").exists(), "nothing is written for a bad setting\n{r}");
 }
 
-/// A tool's outputs land together or not at all (issue 9: `merl-importance` left the asset
-/// behind when the PNG could not be written, exit 2, and a build system saw a target that looked
-/// done). Here the PNG's name is taken by a folder: exit 2 naming the PNG (not a temporary file),
+/// A tool's outputs land together or not at all: an asset left behind when the PNG cannot be
+/// written (exit 2) is a target a build system takes for done. Here the PNG's name is taken by a folder: exit 2 naming the PNG (not a temporary file),
 /// no asset, no temporary file. Temporaries an interrupted run left for these names are removed
 /// by the next run.
 #[test]

@@ -217,8 +217,8 @@ fn eval_reads_stdin_and_reports_bad_lines() {
     cmd.arg(&path).arg("--eval");
     let r = run(cmd, "0.1 0 0.5 3.0\n0.1 0 nan 3\n").expect_code(2);
     assert!(r.stderr.contains("stdin line 2") && r.stderr.contains("theta_o nan is outside [0, pi]"), "{r}");
-    // An angle no direction has is a mistake, not a lookup that finds no data (issue 9: 1e308
-    // printed zeros); the message names the angle and the range.
+    // An angle no direction has is a mistake, not a lookup that finds no data (1e308 must not
+    // print zeros); the message names the angle and the range.
     for (line, says) in [
         ("1e308 0 0 0", "theta_i 1e308 is outside [0, pi]"),
         ("0.1 7 0.5 0", "phi_i 7 is outside [-2 pi, 2 pi]"),

@@ -1,6 +1,6 @@
 //! Numeric options with ranges, work with a ceiling, decoded values held to sane ranges, and the
-//! messages a newcomer meets (issue 32, points 4, 5, 7 and 8): every refusal is one line with
-//! exit 2 and comes at once, never a panic, a hang or a result that is not a number.
+//! messages a newcomer meets: every refusal is one line with exit 2 and comes at once, never a
+//! panic, a hang or a result that is not a number.
 
 use std::path::Path;
 use std::process::Command;

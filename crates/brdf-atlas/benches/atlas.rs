@@ -1,6 +1,6 @@
 //! Benchmark: `brdf-bandwidth`'s work on a real-derived material (the default 64 x 64 lobes,
 //! 1024 x 1024 analysis, 16 x 16 tiles), against a baseline measured in the same run (reading and
-//! validating the same MERL file). Goal (issue 33): at most 1.5 s on 2 cores. Needs
+//! validating the same MERL file). Goal: at most 1.5 s on 2 cores. Needs
 //! `target/merl/gold-paint.binary` (made by the tests, or
 //! `python3 ../shared/tools/nbrdf2merl.py --out target/merl gold-paint`).
 

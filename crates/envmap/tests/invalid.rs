@@ -96,8 +96,8 @@ fn limits_come_from_the_header() {
 }
 
 /// The memory a job needs is estimated from the header and refused over the budget, before any
-/// decoding (issue 9: a 98 KB old-RLE file declaring 16384 x 8192 made `envmap-prefilter`
-/// abort on a 1.4 GB allocation under a 4 GB address-space limit).
+/// decoding: a 98 KB old-RLE file declaring 16384 x 8192 would otherwise make `envmap-prefilter`
+/// abort on a 1.4 GB allocation under a 4 GB address-space limit.
 #[test]
 fn the_memory_budget_comes_from_the_header() {
     let path = crate::shared_env().join("potsdamer_platz_1k.hdr");
@@ -121,8 +121,8 @@ fn the_memory_budget_comes_from_the_header() {
 }
 
 /// An OpenEXR header that declares more pixels than the file can hold is truncated, found before
-/// the image is allocated (issue 9: an 808-byte header declaring the size limit reached 790 MB
-/// before "truncated"). Made from a small valid file by widening its data window to 16384 x
+/// the image is allocated: an 808-byte header declaring the size limit would otherwise reach
+/// 790 MB before "truncated". Made from a small valid file by widening its data window to 16384 x
 /// 8192 and cutting it after the header.
 #[test]
 fn an_exr_header_at_the_size_limit_is_truncated_before_allocating() {

@@ -542,7 +542,7 @@ fn inconsistent_settings_are_rejected_like_the_cpu_rejects_them() {
     assert!(matches!(error, GpuError::Scene(_)), "{error}");
 }
 
-/// Issue 11: the bandwidth buffer predicted on the GPU (`Renderer::predict_blocks`) equals the
+/// The bandwidth buffer predicted on the GPU (`Renderer::predict_blocks`) equals the
 /// CPU's (`render::adaptive`) to f32 rounding, for both estimators' variances, with and without
 /// anti-aliasing and per pixel or per block. Tolerance: the GPU works in f32 and reads the
 /// environment bandwidth and the atlas at the nearest texel, so a direction on a texel's edge

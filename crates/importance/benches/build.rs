@@ -1,7 +1,7 @@
 //! Benchmark: building one material's importance tables with the default settings (90 slices,
 //! 90 x 128 cells, 8 x 256 samples), against a baseline measured in the same run (a million
 //! nearest lookups of the same table), so the ratio means something on a shared, noisy machine.
-//! Goal (issue 4): at most 0.5 s on 2 cores. Run with `make bench` or
+//! Goal: at most 0.5 s on 2 cores. Run with `make bench` or
 //! `cargo bench -p importance --bench build`.
 
 use std::path::Path;

@@ -84,8 +84,8 @@ fn main() {
     engine_outputs(dir);
 }
 
-/// The engine outputs (issue 13) against the Phong array, measured in the same run on the same
-/// map: the GGX chain (default 7 levels from 256 x 128) with its accuracy against the brute force
+/// The engine outputs against the Phong array, measured in the same run on the same map: the
+/// GGX chain (default 7 levels from 256 x 128) with its accuracy against the brute force
 /// on every 8th texel of every level, the cube maps, the DFG table.
 fn engine_outputs(dir: &std::path::Path) {
     let config = measured();

@@ -94,7 +94,7 @@ fn by_directions(mu: f64, a: f64) -> [f64; 2] {
 
 #[test]
 fn the_table_matches_quadrature_over_half_vectors() {
-    // Issue 13: within 1e-3 absolute. Every texel centre of a 16 x 16 table.
+    // Within 1e-3 absolute. Every texel centre of a 16 x 16 table.
     let size = 16;
     let t = table(size);
     let worst = (0..size * size)

@@ -63,7 +63,7 @@ fn brute_force(map: &EnvMap, lobe: &Lobe, width: usize, height: usize) -> Vec<[f
 
 #[test]
 fn ggx_layers_match_the_brute_force_on_real_maps() {
-    // Issue 13: relative RMSE at most 1e-3 at 64 x 32 texel centres, roughness 0.05 to 1. The
+    // Relative RMSE at most 1e-3 at 64 x 32 texel centres, roughness 0.05 to 1. The
     // methods sum the same texels as the reference; what differs is the harmonics' truncation
     // (the kink at the horizon of the widest lobes) and f32 rounding.
     let roughness = [0.05, 0.25, 0.5, 1.0];

@@ -178,8 +178,8 @@
 //! and `prefilter::prefilter`, once per map when the lighting is made). A lower contrast moves
 //! more light into the unbiased part, with more noise at few samples; a higher one more into the
 //! filter: at 16, fis ended 3.5% dark on white-paint under
-//! `studio_small_03` with the light behind the sphere, at 4 within 2% on every case of issue 31
-//! (white-paint, gold-paint and chrome under `quarry_01` and `studio_small_03`, the light before
+//! `studio_small_03` with the light behind the sphere, at 4 within 2% on every case of the
+//! Mitsuba bench (white-paint, gold-paint and chrome under `quarry_01` and `studio_small_03`, the light before
 //! and behind the sphere; the peaks hold 54% of quarry's light, 83% of the studio's and 1% of
 //! `potsdamer_platz`'s).
 //!

@@ -1,9 +1,9 @@
-//! Issue 11's equal-quality benchmark of adaptive multi-resolution shading (a benchmark, not a
+//! The equal-quality benchmark of adaptive multi-resolution shading (a benchmark, not a
 //! test): 3 real-derived materials x 2 real maps x 2 meshes (a sphere, and a torus, whose
 //! curvature varies and changes sign), 512 x 512, the resolution of the paper's timings (`001`
 //! Fig. 11; `--size N` for another), on the CPU renderer (crate `render`; the GPU renderer
 //! equals it to rounding for the full-resolution modes) or with `--gpu` on the GPU (lavapipe on a
-//! machine without one), as issue 11 asks and `make bench` runs it.
+//! machine without one), as `make bench` runs it.
 //!
 //! For each case:
 //!
@@ -590,7 +590,7 @@ fn main() {
     out("## Speed-up at equal quality, per mode and reading (over cases and budgets)".into());
     out(String::new());
     out(format!(
-        "All rows, as issue 11 asks, then the rows off the brute force's plateau (`~` above: where its curve gains less than \
+        "All rows, then the rows off the brute force's plateau (`~` above: where its curve gains less than \
          {FLAT_DB_PER_DOUBLING} dB per doubling of its samples around the adaptive PSNR, or tops out less than {PLATEAU_DB} dB below it; \
          module docs, \"The sun's plateau\")."
     ));
