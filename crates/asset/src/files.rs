@@ -225,10 +225,7 @@ impl Step {
             keep(folder, self.target(), kept)?;
         }
         match self {
-            Step::Aside { target, .. } => match folder.unlink(target) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
-                _ => Ok(()),
-            },
+            Step::Aside { target, .. } => unlink_if_present(folder, target),
             Step::Replace { target, new, .. } => folder.rename(new, target),
         }
     }
@@ -255,10 +252,7 @@ impl Step {
                 // Landed: the old file back over the new one, unless that was done before.
                 if exists(kept)? { folder.rename(kept, target) } else { Ok(()) }
             }
-            Step::Replace { target, kept: None, .. } => match folder.unlink(target) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
-                _ => Ok(()),
-            },
+            Step::Replace { target, kept: None, .. } => unlink_if_present(folder, target),
         }
     }
 
@@ -444,6 +438,14 @@ impl Drop for Pending<'_> {
         if let Some(name) = &self.name {
             let _ = self.folder.unlink(name);
         }
+    }
+}
+
+/// Removes `name` from the folder; nothing there (a step taken or undone before) is nothing to do.
+fn unlink_if_present(folder: &fsguard::Folder, name: &str) -> std::io::Result<()> {
+    match folder.unlink(name) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
     }
 }
 

@@ -24,19 +24,8 @@ pub struct Loaded {
     pub bandwidths: Option<render::adaptive::Bandwidths>,
 }
 
-/// Reads the bake in `dir`. The MERL table is `material` when given, else the manifest's
-/// `source_path` (as given to the bake: absolute, or relative to the working folder or, failing
-/// that, to the bake's parent folder); either way its SHA-256 must be the manifest's.
-///
-/// Every file is read once, as the bytes that are checked and decoded: the manifest and the
-/// files it lists inside the folder without following a link, regular files only, each size
-/// checked from the file's metadata before it is read (the manifest's against
-/// [`asset::MANIFEST_LIMIT`], each output's against its `size_bytes`, then its SHA-256); the table
-/// (which may lie anywhere) as a regular file of at most [`merl::MAX_FILE_BYTES`], its SHA-256
-/// compared before anything in it is parsed or quoted.
-/// A switch a kill interrupted ([`asset::recover_switch`]) is finished or undone before the
-/// manifest is read, where no bake holds the folder (its lock, taken for the recovery alone): the
-/// folder then holds one whole bake. While a bake holds it, the reader goes on as it is.
+/// Finishes or undoes a switch a kill interrupted ([`asset::recover_switch`]) when no bake holds
+/// the folder: the lock is taken for the recovery alone.
 fn recover(folder: &fsguard::Folder, dir: &Path) -> Result<(), Error> {
     let journal = dir.join(asset::SWITCH_JOURNAL);
     if folder.entry(asset::SWITCH_JOURNAL).map_err(|e| Error::read(&journal, e))?.is_none() {
@@ -51,6 +40,20 @@ fn recover(folder: &fsguard::Folder, dir: &Path) -> Result<(), Error> {
     Ok(())
 }
 
+/// Reads the bake in `dir`. The MERL table is `material` when given, else the manifest's
+/// `source_path` (as given to the bake: absolute, or relative to the working folder or, failing
+/// that, to the bake's parent folder); either way its SHA-256 must be the manifest's.
+///
+/// Every file is read once, as the bytes that are checked and decoded: the manifest and the
+/// files it lists inside the folder without following a link, regular files only, each size
+/// checked from the file's metadata before it is read (the manifest's against
+/// [`asset::MANIFEST_LIMIT`], each output's against its `size_bytes`, then its SHA-256); the table
+/// (which may lie anywhere) as a regular file of at most [`merl::MAX_FILE_BYTES`], its SHA-256
+/// compared before anything in it is parsed or quoted.
+///
+/// A switch a kill interrupted ([`asset::recover_switch`]) is finished or undone before the
+/// manifest is read, where no bake holds the folder (its lock, taken for the recovery alone): the
+/// folder then holds one whole bake. While a bake holds it, the reader goes on as it is.
 pub fn load(dir: &Path, material: Option<&Path>) -> Result<Loaded, Error> {
     let folder = fsguard::Folder::open(dir).map_err(|e| Error::read(dir, e))?;
     recover(&folder, dir)?;

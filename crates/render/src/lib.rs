@@ -365,7 +365,8 @@ impl Settings {
     /// and frame (default 64 for the reference mode, 16 for the filtered ones) and `frames` frames
     /// (default: for the reference mode enough to use every point of a pixel's `V N` once,
     /// [`frames_to_exhaust`]; for the filtered modes 8, which average prefiltered's noise, not
-    /// its bias, and narrow fis's footprints, [`Settings::filter_samples`]). `spp` must not be 0 where `frames` is left to the default of the reference mode.
+    /// its bias, and narrow fis's footprints, [`Settings::filter_samples`]). `spp` must not be 0
+    /// where `frames` is left to the default of the reference mode.
     pub fn previewer(mode: Mode, samples: &SampleSet, spp: Option<u32>, frames: Option<u32>, seed: u32) -> Settings {
         let spp = spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
         let frames = frames.unwrap_or_else(|| match mode {

@@ -87,8 +87,9 @@ struct Args {
     #[arg(long, requires = "env")]
     chain: bool,
 
-    /// Also write the environment's GGX chain of M levels, from 2 to log2 of the layers' width less 1 (8 for the default 512 x 256), and the split-sum DFG table
-    /// (ggx.ktx2, dfg.ktx2, dfg.png; see envmap-prefilter --help).
+    /// Also write the environment's GGX chain of M levels, from 2 to log2 of the layers' width
+    /// less 1 (8 for the default 512 x 256), and the split-sum DFG table (ggx.ktx2, dfg.ktx2,
+    /// dfg.png; see envmap-prefilter --help).
     #[arg(long, value_name = "M", value_parser = |s: &str| cli::parse_whole(s, 2), requires = "env")]
     ggx_levels: Option<usize>,
 
