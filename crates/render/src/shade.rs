@@ -234,19 +234,7 @@ pub(crate) fn shade(
         (_, Some(peaks)) => Some((&peaks.sampling, &peaks.map)),
         (_, None) => None,
     };
-    // The diffuse part the filtered estimators take out of the BRDF, and its integral (crate
-    // documentation, "The estimators"); a diffuse part is never 0 without a cosine layer to read.
-    let diffuse = match settings.mode {
-        Mode::Reference => [0.0; 3],
-        Mode::Fis | Mode::Prefiltered => crate::diffuse_split(material, lighting).map(f64::from),
-    };
-    let diffuse_radiance: [f64; 3] = if diffuse == [0.0; 3] {
-        [0.0; 3]
-    } else {
-        let (u, v) = envmap::uv(frame.n);
-        let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
-        std::array::from_fn(|c| std::f64::consts::PI * diffuse[c] * f64::from(l_1[c]))
-    };
+    let (diffuse, diffuse_radiance) = diffuse_term(frame, material, lighting, settings.mode);
     let mut total = [0.0f64; 3];
     let mut add = |f: [f64; 3], radiance: [f32; 3], weight: f64| {
         for c in 0..3 {
@@ -303,6 +291,22 @@ pub(crate) fn shade(
     }
     let samples = f64::from(spp) * f64::from(settings.frames);
     std::array::from_fn(|c| total[c] / samples + diffuse_radiance[c])
+}
+
+/// The diffuse part the filtered estimators take out of the BRDF, and its integral against the
+/// smooth light, `pi f_d L_1(n)` (crate documentation, "The estimators"): `(f_d, radiance)`, both
+/// 0 in the reference mode. A diffuse part is never 0 without a cosine layer to read.
+fn diffuse_term(frame: &ShadingFrame, material: &Material, lighting: &Lighting, mode: Mode) -> ([f64; 3], [f64; 3]) {
+    let diffuse = match mode {
+        Mode::Reference => return ([0.0; 3], [0.0; 3]),
+        Mode::Fis | Mode::Prefiltered => crate::diffuse_split(material, lighting).map(f64::from),
+    };
+    if diffuse == [0.0; 3] {
+        return (diffuse, [0.0; 3]);
+    }
+    let (u, v) = envmap::uv(frame.n);
+    let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
+    (diffuse, std::array::from_fn(|c| std::f64::consts::PI * diffuse[c] * f64::from(l_1[c])))
 }
 
 /// `(1 - t) a + t b`.
