@@ -226,31 +226,41 @@ fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
 /// Values behind valid checksums: a bake whose importance samples, bandwidth
 /// rows or layer selection hold a value no bake writes, with the manifest's size and hash made to
 /// match, is refused by the previewer with one line naming the asset, the field and the value, and
-/// `asset-info` says the same of the asset (it used to report NaN samples as valid).
+/// `asset-info` says the same of the asset (it used to report NaN samples as valid). A pdf within
+/// its range but not the density the tables give its direction is refused as well: decoding
+/// accepts it (a payload check across fields, `ImportanceSamples::check_densities`), the previewer
+/// refuses it and `asset-info` reports it as a problem (exit 1).
 #[test]
 fn values_behind_valid_checksums_are_refused_by_every_reader() {
     let tmp = temp_dir();
-    /// The asset, what the message says, the edit.
-    type Case = (&'static str, &'static str, fn(&mut asset::Payload));
-    let cases: [Case; 4] = [
-        ("importance.asset", "wi (1e30, 1e30, 1e30) is not a unit direction", |p| {
+    /// The asset, what the message says, whether decoding refuses it (else only the densities'
+    /// check does), the edit.
+    type Case = (&'static str, &'static str, bool, fn(&mut asset::Payload));
+    let cases: [Case; 5] = [
+        ("importance.asset", "wi (1e30, 1e30, 1e30) is not a unit direction", true, |p| {
             let asset::Payload::ImportanceSamples(s) = p else { panic!("importance samples") };
             s.samples.iter_mut().for_each(|t| *t = [1e30; 4]);
         }),
-        ("importance.asset", "h density 0 is NaN, not a finite density", |p| {
+        ("importance.asset", "h density 0 is NaN, not a finite density", true, |p| {
             let asset::Payload::ImportanceSamples(s) = p else { panic!("importance samples") };
             s.h_density[0] = f32::NAN;
         }),
-        ("bandwidth-atlas.asset", "texel 0 is 1e30, outside [0, ", |p| {
+        ("importance.asset", "is not the density the tables give its direction", false, |p| {
+            let asset::Payload::ImportanceSamples(s) = p else { panic!("importance samples") };
+            // 1% off: five times the tolerance or more wherever wo . h > 1e-3.
+            let first = s.samples.iter_mut().find(|t| t[3] > 0.0).expect("a sample that reflects");
+            first[3] *= 1.01;
+        }),
+        ("bandwidth-atlas.asset", "texel 0 is 1e30, outside [0, ", true, |p| {
             let asset::Payload::BandwidthRows(r) = p else { panic!("bandwidth rows") };
             r.data.iter_mut().for_each(|b| *b = 1e30);
         }),
-        ("layer-selection.asset", "view bandwidth 0 is 1e300, outside [0, ", |p| {
+        ("layer-selection.asset", "view bandwidth 0 is 1e300, outside [0, ", true, |p| {
             let asset::Payload::LayerSelection(l) = p else { panic!("layer selection") };
             l.view_bandwidth[0] = 1e300;
         }),
     ];
-    for (i, (name, needle, edit)) in cases.into_iter().enumerate() {
+    for (i, (name, needle, decoding_refuses, edit)) in cases.into_iter().enumerate() {
         let dir = tmp.path().join(format!("case-{i}"));
         crate::support::copy_dir(&reference_bake().dir, &dir);
         let mut asset = asset::read_file(&dir.join(name)).unwrap();
@@ -272,11 +282,18 @@ fn values_behind_valid_checksums_are_refused_by_every_reader() {
         let mut cmd = tool("brdf-preview");
         cmd.arg(&dir).arg("--out").arg(tmp.path().join("p.png")).args(["--size", "16x16", "--spp", "16"]);
         let (r, _) = run_within(cmd, QUICK);
-        let r = r.expect_one_error_line(&format!("reading {}: invalid payload: ", path.display()));
+        let prefix = if decoding_refuses { "invalid payload: " } else { "importance samples: sample " };
+        let r = r.expect_one_error_line(&format!("reading {}: {prefix}", path.display()));
         assert!(r.stderr.contains(needle), "{r}");
         let mut cmd = tool("asset-info");
         cmd.arg(&path);
-        run(cmd, "").expect_error(&path, needle);
+        if decoding_refuses {
+            run(cmd, "").expect_error(&path, needle);
+        } else {
+            let r = run(cmd, "").expect_code(1);
+            assert!(r.stderr.starts_with(&format!("error: checking {}: {prefix}", path.display())), "{r}");
+            assert!(r.stderr.contains(needle) && r.stderr.lines().count() == 1, "{r}");
+        }
     }
 }
 

@@ -227,18 +227,15 @@ impl ImportanceSamples {
     /// half-vector densities finite and not negative. Samples of 1e30, -1 or 0 passed every
     /// checksum and changed the picture.
     fn check_values(&self) -> Result<(), String> {
-        let per_slice = self.n_vectors as usize * self.n_samples as usize;
         for (i, &[x, y, z, pdf]) in self.samples.iter().enumerate() {
             let length = (f64::from(x).powi(2) + f64::from(y).powi(2) + f64::from(z).powi(2)).sqrt();
-            let (slice, vector, sample) =
-                (i / per_slice, i % per_slice / self.n_samples as usize, i % self.n_samples as usize);
-            let at = format!("sample {i} (slice {slice}, vector {vector}, sample {sample})");
+            let at = || sample_at(i, self.n_vectors, self.n_samples);
             let off = (length - 1.0).abs();
             if off.is_nan() || off > UNIT_TOLERANCE {
-                return Err(format!("importance samples: {at}: wi ({x:e}, {y:e}, {z:e}) is not a unit direction"));
+                return Err(format!("importance samples: {}: wi ({x:e}, {y:e}, {z:e}) is not a unit direction", at()));
             }
             if !(pdf.is_finite() && pdf >= 0.0) {
-                return Err(format!("importance samples: {at}: pdf {pdf:e} is not a finite density of 0 or more"));
+                return Err(format!("importance samples: {}: pdf {pdf:e} is not a finite density of 0 or more", at()));
             }
         }
         for (what, cdf) in [("marginal cdf", &self.marginal_cdf), ("conditional cdf", &self.conditional_cdf)] {
@@ -251,6 +248,92 @@ impl ImportanceSamples {
         }
         Ok(())
     }
+
+    /// Whether every sample's pdf is the density the tables give its direction,
+    /// `h_density[cell of h] / (4 wo . h)` with `h` the half vector of `wo` (the slice's
+    /// outgoing direction at `phi_o = 0`) and the stored `wi`: a renderer weighs the samples'
+    /// pdfs against the tables' density of the same directions (multiple importance sampling),
+    /// so a pdf that passes [`ImportanceSamples`]' value check but not this one changes the
+    /// picture. Decoding does not ask for it (the golden file of version 1 is a synthetic payload
+    /// whose pdfs are twice its tables'); the renderers' reader and `asset-info` do.
+    ///
+    /// What a writer's rounding allows: the direction is stored in `f32`, which moves `h` by
+    /// about `1e-7 / (2 wo . h)` and `wo . h` (taken as `|wi + wo| / 2`) by `1e-7 / (wo . h)`
+    /// relatively; so `h` is taken to lie anywhere within `d = 1e-6 / (wo . h)` of where it is
+    /// found (a neighbouring row or sector where a cell's edge is that near, every sector where
+    /// `sin theta_h <= d`), and `wo . h` relatively as far. A pdf passes within
+    /// `1e-3 + d` of the density relatively (the pdf and the density are `f32`). A pdf of 0 (a
+    /// sample that reflects nowhere) passes where `h` is below the horizon or `wo . h <= 1e-3`,
+    /// or where a cell it may lie in has no density.
+    pub fn check_densities(&self) -> Result<(), String> {
+        use std::f64::consts::TAU;
+        let rows = self.theta_h_edges.len() - 1;
+        let cols = self.n_phi_h as usize;
+        let t_edges: Vec<f64> = self.theta_h_edges.iter().map(|&theta| 2.0 * (0.5 * theta).sin().powi(2)).collect();
+        let per_slice = self.n_vectors as usize * self.n_samples as usize;
+        for (i, &[x, y, z, pdf]) in self.samples.iter().enumerate() {
+            let slice = i / per_slice;
+            let (sin_o, cos_o) = self.theta_o[slice].sin_cos();
+            let pdf = f64::from(pdf);
+            let s = [f64::from(x) + sin_o, f64::from(y), f64::from(z) + cos_o];
+            let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+            let h = s.map(|c| c / len);
+            // For unit `wi` and `wo`, `wo . h = |wi + wo| / 2`: rounding `wi` moves it by about
+            // `1e-7` where `wo . normalize(wi + wo)` would move by `1e-7 / (2 wo . h)`.
+            let wo_h = 0.5 * len;
+            let at = || sample_at(i, self.n_vectors, self.n_samples);
+            if !(len > 0.0 && h[2] > 0.0) {
+                if pdf == 0.0 {
+                    continue;
+                }
+                return Err(format!(
+                    "importance samples: {}: pdf {pdf:e} for a direction no half vector above the surface reflects",
+                    at()
+                ));
+            }
+            let slack = 1e-6 / wo_h;
+            let t = (h[0] * h[0] + h[1] * h[1]) / (1.0 + h[2]);
+            let row = t_edges[1..].partition_point(|e| *e <= t).min(rows - 1);
+            let below = usize::from(row > 0 && t - t_edges[row] <= slack);
+            let above = usize::from(row + 1 < rows && t_edges[row + 1] - t <= slack);
+            let sector = TAU / cols as f64;
+            let phi = h[1].atan2(h[0]).rem_euclid(TAU);
+            let col = ((phi / sector) as usize).min(cols - 1);
+            let sin_h = (t * (2.0 - t)).max(0.0).sqrt();
+            let (before, after) = if sin_h <= slack {
+                (0, cols - 1)
+            } else {
+                let from_edge = phi - col as f64 * sector;
+                (usize::from(from_edge * sin_h <= slack), usize::from((sector - from_edge) * sin_h <= slack))
+            };
+            let density = |r: usize, c: usize| f64::from(self.h_density[(slice * rows + r) * cols + c]) / (4.0 * wo_h);
+            let tolerance = 1e-3 + slack;
+            let matches = |r: usize, c: usize| {
+                let expected = density(r, c);
+                (pdf - expected).abs() <= tolerance * expected || (pdf == 0.0 && (wo_h <= 1e-3 || expected == 0.0))
+            };
+            let found = (row - below..=row + above)
+                .any(|r| (0..=before + after).any(|k| matches(r, (col + cols - before + k) % cols)));
+            if !found {
+                return Err(format!(
+                    "importance samples: {}: pdf {pdf:e} is not the density the tables give its direction ({:e}: h \
+                     density {:e} of row {row}, sector {col}, over 4 wo . h = {:e})",
+                    at(),
+                    density(row, col),
+                    self.h_density[(slice * rows + row) * cols + col],
+                    4.0 * wo_h
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where sample texel `i` is: `sample i (slice k, vector v, sample s)`.
+fn sample_at(i: usize, n_vectors: u32, n_samples: u32) -> String {
+    let per_slice = n_vectors as usize * n_samples as usize;
+    let (slice, vector, sample) = (i / per_slice, i % per_slice / n_samples as usize, i % n_samples as usize);
+    format!("sample {i} (slice {slice}, vector {vector}, sample {sample})")
 }
 
 /// How far from 1 a stored direction's length may be: `f32` rounding makes about `1e-7`.

@@ -214,3 +214,47 @@ fn pca_and_material_info_values_outside_their_ranges_are_refused() {
         assert!(e.contains(needle), "{e}\nshould say {needle:?}");
     }
 }
+
+/// The check across fields that decoding leaves to the renderers' reader: each pdf is the density
+/// `h_density[cell of h] / (4 wo . h)` of its direction. A sample `wi = (0, 0.6, 0.8)` seen from
+/// the pole has `h = (0, 0.6, 1.8) / |.|` in the middle of sector 0 of the one row (`phi_h = pi /
+/// 2`; on an edge, at `phi_h = 0`, sector 1's density of 0 would be as near), `wo . h = 1.8 /
+/// sqrt(3.6)`.
+#[test]
+fn pdfs_that_are_not_their_tables_densities_are_found() {
+    let wo_h = 1.8 / 3.6f64.sqrt();
+    let density = 0.25 / (4.0 * wo_h);
+    let with_pdf = |pdf: f64| {
+        let mut p = importance();
+        p.samples[0] = [0.0, 0.6, 0.8, pdf as f32];
+        p
+    };
+    assert_eq!(with_pdf(density).check_densities(), Ok(()));
+    // Within the stated tolerance, 1e-3 + 1e-6 / (wo . h) relatively, and just past it.
+    assert_eq!(with_pdf(density * (1.0 + 0.9e-3)).check_densities(), Ok(()));
+    for (pdf, needle) in [
+        (density * 1.002, "is not the density the tables give its direction (6.588"),
+        (0.0, "pdf 0e0 is not the density"),
+        (1.5, "sample 0 (slice 0, vector 0, sample 0): pdf 1.5e0 is not the density"),
+    ] {
+        let e = with_pdf(pdf).check_densities().expect_err("a pdf off its tables");
+        assert!(e.contains(needle), "{pdf}: {e}");
+        // Decoding takes it: its values are within their ranges.
+        assert_eq!(refusal(with_pdf(pdf).into()), None);
+    }
+    // Sector 1 has no density: a direction there may only have pdf 0, and a pdf for a direction
+    // whose half vector is below the horizon is refused.
+    let mut p = with_pdf(density);
+    p.samples[1] = [0.0, -0.6, 0.8, 0.0];
+    assert_eq!(p.check_densities(), Ok(()));
+    p.samples[1][3] = 0.1;
+    assert!(p.check_densities().unwrap_err().contains("sample 1 "), "{p:?}");
+    p.samples[1] = [0.0, 0.0, -1.0, 0.1];
+    assert!(p.check_densities().unwrap_err().contains("no half vector above the surface reflects"));
+
+    // The golden file of version 1 decodes (the format's promise) and its pdfs are twice its
+    // tables' densities: asset-info reports it, the previewer would refuse it.
+    let golden = asset::read_file(&crate::fixtures_dir().join("assets/golden-v1-importance-samples.asset")).unwrap();
+    let Payload::ImportanceSamples(golden) = golden.payload else { panic!("importance samples") };
+    assert!(golden.check_densities().unwrap_err().contains("is not the density"));
+}

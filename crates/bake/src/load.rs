@@ -243,6 +243,8 @@ fn read_payload(path: &Path, bytes: &[u8]) -> Result<Payload, Error> {
 /// The samples as the renderers read them; the slices must be the uniform ones
 /// `merl-importance` writes (`theta_o[k] = k / S * pi / 2`).
 fn sample_set(s: asset::ImportanceSamples) -> Result<render::SampleSet, String> {
+    // The estimators weigh each sample's pdf against the tables' density of its direction.
+    s.check_densities()?;
     let n_slices = s.theta_o.len();
     for (k, theta) in s.theta_o.iter().enumerate() {
         let expected = k as f64 / n_slices as f64 * std::f64::consts::FRAC_PI_2;

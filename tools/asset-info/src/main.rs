@@ -1,8 +1,8 @@
 //! `asset-info`: shows what a baked asset file holds (header, provenance, checksum status and a
 //! summary of the payload) as text or JSON, and checks the files it names beside it. The exit
 //! status tells a script whether the file is valid (0), readable but damaged or stale (1: the
-//! checksum does not match, or a file it names is missing or does not have the recorded
-//! SHA-256), or unreadable (2).
+//! checksum does not match, a file it names is missing or does not have the recorded SHA-256,
+//! or its importance samples disagree with their tables), or unreadable (2).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,8 +17,9 @@ use serde_json::{Value, json};
 ///
 /// Exit status: 0 the asset is valid; 1 its checksum does not match its contents (the header is
 /// still shown), or a file it names beside it (the KTX2, EXR and PNG files of a prefiltered
-/// envmap) is missing or does not have the SHA-256 it records; 2 the file cannot be read, is not an asset, or is of a version or kind this
-/// build does not know.
+/// envmap) is missing or does not have the SHA-256 it records, or importance samples whose pdfs
+/// are not the densities their tables give (what the previewer refuses); 2 the file cannot be
+/// read, is not an asset, or is of a version or kind this build does not know.
 #[derive(Debug, Parser)]
 #[command(version, allow_negative_numbers = true)]
 struct Args {
@@ -86,7 +87,14 @@ fn run() -> anyhow::Result<ExitCode> {
         eprintln!("error: checking {}: linked file {stale}", cli::printable_path(&args.file));
         return Ok(ExitCode::from(1));
     }
-    if report.asset.is_some() {
+    if let Some(asset) = &report.asset {
+        // The one check across a payload's fields that decoding leaves to the renderers' reader.
+        if let asset::Payload::ImportanceSamples(samples) = &asset.payload
+            && let Err(e) = samples.check_densities()
+        {
+            eprintln!("error: checking {}: {}", cli::printable_path(&args.file), cli::printable(&e));
+            return Ok(ExitCode::from(1));
+        }
         return Ok(ExitCode::SUCCESS);
     }
     let mismatch = Error::ChecksumMismatch { header: report.header, computed: report.computed };
