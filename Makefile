@@ -9,7 +9,7 @@ PREFIX ?= /usr/local
 # wgpu warns when XDG_RUNTIME_DIR is unset; give it a private folder.
 export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && chmod 700 $$d && echo $$d)
 
-.PHONY: setup setup-gpu setup-python setup-node setup-chromium setup-ktx setup-mitsuba three-cases build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
+.PHONY: setup setup-gpu setup-python setup-node setup-chromium setup-ktx setup-mitsuba three-cases three-example build install test test-data demo bake lint bench clean-demo fuzz fuzz-regressions
 
 ## setup: everything the tests need (setup-gpu, setup-python, setup-node, setup-chromium,
 ## setup-ktx). Idempotent.
@@ -44,8 +44,8 @@ setup-mitsuba: setup-python
 	fi
 
 ## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
-## tests run on the KTX2 files with node, and engines/three's packages (three and puppeteer-core,
-## pinned by its lock file). Installs node and npm from Debian when missing.
+## tests run on the KTX2 files with node, and engines/three's packages (three, ktx-parse and
+## puppeteer-core, pinned by its lock file). Installs node and npm from Debian when missing.
 setup-node:
 	@if ! command -v npm >/dev/null 2>&1; then \
 	  echo "installing nodejs and npm (to read the KTX2 outputs with ktx-parse in the tests)"; \
@@ -54,7 +54,7 @@ setup-node:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
 	fi
 	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
-	@test -d engines/three/node_modules/puppeteer-core || npm ci --silent --prefix engines/three
+	@test -d engines/three/node_modules/puppeteer-core -a -d engines/three/node_modules/ktx-parse || npm ci --silent --prefix engines/three
 
 ## setup-chromium: Debian's Chromium, the real browser tests/three.rs renders the three.js material
 ## in (headless, WebGL 2 on SwiftShader, driven by puppeteer-core from engines/three; no browser
@@ -156,6 +156,12 @@ demo: setup-gpu build
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview.png --mode prefiltered --size 384x384 --camera 200,15 --sheet $(DEMO)/sheet.png
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview-reference.png --size 384x384 --camera 200,15 --validate
 	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png (reference mode), preview-reference-difference.png (GPU against CPU, with its scale), sheet.png"
+
+## three-example: the demo's bake again with the engine textures (brdf-bake --engine-textures),
+## and engines/three's packages: what the three.js example page (engines/three/index.html) reads.
+three-example: demo setup-node
+	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --engine-textures --out-dir $(DEMO)/bake
+	@echo "serve the repository root (python3 -m http.server) and open http://localhost:8000/engines/three/index.html?bake=/target/demo/bake/"
 
 ## bake: every MERL table in IN (*.binary) into OUT/<name>/, in parallel with -j; ENV=map.hdr adds
 ## the environment stages. E.g. make -j4 bake IN=target/merl OUT=target/bakes ENV=../shared/data/env/quarry_01_1k.hdr

@@ -236,6 +236,46 @@ fn engine_textures_need_an_environment() {
     assert!(!tmp.path().join("bake").exists(), "{r}");
 }
 
+/// The material in a three.js scene as its users build one (`engines/three/test/scene.mjs`:
+/// +y up, the bake's map as `scene.environment` and `scene.background`, the material's default
+/// orientation), chrome under quarry_01 at 128 x 128; the pictures are written to
+/// target/test-tmp/three-scene, three.js's drawing beside the bake's.
+/// - The bake's background equals three's `scene.background` of the same map, unturned and under a
+///   `backgroundRotation` about every axis: at least 45 dB (measured 51.9 and 48.8: three turns the
+///   map into a cube map and filters it, the bake reads it bilinearly; the map mirrored, as the
+///   material read it before, or turned the wrong way scores 14.7).
+/// - A `MeshStandardMaterial` mirror ball lit by `scene.environment` and the bake's near-mirror
+///   material reflect the horizon on the same row of the ball's centre column, within one pixel
+///   (measured: the same row).
+/// - A sphere squashed by its mesh's scale is drawn as the same shape made in its geometry: at
+///   least 60 dB (measured 63.0; with normals turned by the model matrix instead of its inverse
+///   transpose, 22.6).
+#[test]
+fn the_material_is_at_home_in_a_y_up_three_js_scene() {
+    let dir = bake("chrome", "quarry_01_1k");
+    let out = root().join("target/test-tmp/three-scene");
+    assert!(
+        root().join("engines/three/node_modules/puppeteer-core").is_dir(),
+        "puppeteer-core is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"
+    );
+    let mut node = Command::new("node");
+    node.arg(root().join("engines/three/test/scene.mjs")).arg("--bake").arg(&dir).arg("--out-dir").arg(&out);
+    let r = run(node, "");
+    assert_eq!(r.code, Some(0), "the scenes failed (Chromium: apt-get install chromium, or set CHROMIUM)\n{r}");
+    let figures: serde_json::Value = serde_json::from_str(r.stdout.trim()).unwrap();
+    println!("{figures}");
+    let where_ = format!("pictures in {}", out.display());
+    for (i, psnr) in figures["background_psnr_db"].as_array().unwrap().iter().enumerate() {
+        let psnr = psnr.as_f64().unwrap();
+        assert!(psnr >= 45.0, "background {i}: {psnr:.2} dB against three's scene.background; {where_}");
+    }
+    let rows = &figures["mirror_horizon_rows"];
+    let (three, ours) = (rows["three"].as_i64().unwrap(), rows["bake"].as_i64().unwrap());
+    assert!(three > 0 && (three - ours).abs() <= 1, "reflected horizon on row {ours}, three's on {three}; {where_}");
+    let scale = figures["scale_psnr_db"].as_f64().unwrap();
+    assert!(scale >= 60.0, "mesh scale against geometry scale: {scale:.2} dB; {where_}");
+}
+
 /// The loader refuses every manifest path that would leave the bake folder (`node --test` on
 /// `engines/three/test/loader.test.mjs`).
 #[test]

@@ -10,7 +10,7 @@
 //     scene.add(bake.createBackground(), mesh);
 
 import * as THREE from 'three';
-import { read as readKtx2 } from 'three/addons/libs/ktx-parse.module.js';
+import { read as readKtx2 } from 'ktx-parse';
 
 import {
     BACKGROUND_FRAGMENT,
@@ -23,6 +23,15 @@ import {
 
 /** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
 export const MODES = { reference: 0, prefiltered: 2 };
+
+/**
+ * How the world's axes meet the environment map's. `three`: three.js's (+y up; the map read as
+ * `equirectUv` reads it for `scene.environment` and `scene.background`, after the scene's
+ * `environmentRotation` or `backgroundRotation`), so that the same HDR lights the bake and three's
+ * own materials alike. `brdf-preview`: brdf-preview's (+z up, `phi` from +x towards +y; what
+ * `orbitCamera` and `previewSphere` assume), where the pictures equal brdf-preview's.
+ */
+export const ORIENTATIONS = ['three', 'brdf-preview'];
 
 /** The stage of the manifest that lists the engine textures. */
 export const STAGE = 'engine-textures';
@@ -194,16 +203,23 @@ export class Bake {
      * top of the drawing buffer, whose size the material reads from the renderer at each draw.
      */
     createMaterial(options = {}) {
+        const turned = orientationDefines(options.orientation);
         const material = new THREE.RawShaderMaterial({
             name: `brdf-bake ${options.mode ?? 'reference'}`,
             glslVersion: THREE.GLSL3,
+            defines: turned,
             vertexShader: SURFACE_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             // render::raster culls no back face: at a silhouette a pixel may see one.
             side: THREE.DoubleSide,
-            uniforms: this.shadingUniforms(options),
+            uniforms: { ...this.shadingUniforms(options), uWorldNormalMatrix: { value: new THREE.Matrix3() } },
         });
-        material.onBeforeRender = (renderer) => resolution(renderer, material.uniforms.uResolution.value);
+        material.onBeforeRender = (renderer, scene, camera, geometry, object) => {
+            const u = material.uniforms;
+            resolution(renderer, u.uResolution.value);
+            u.uWorldNormalMatrix.value.getNormalMatrix(object.matrixWorld);
+            if (turned.TURNED) envFromWorld(scene.environmentRotation, u.uEnvFromWorld.value);
+        };
         return material;
     }
 
@@ -213,10 +229,11 @@ export class Bake {
      * pixels show the environment. `options` as for `createMaterial`.
      */
     createDeferred(gbuffer, options = {}) {
+        const turned = orientationDefines(options.orientation);
         const material = new THREE.RawShaderMaterial({
             name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
             glslVersion: THREE.GLSL3,
-            defines: { DEFERRED: 1 },
+            defines: { DEFERRED: 1, ...turned },
             vertexShader: QUAD_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             depthTest: false,
@@ -228,10 +245,7 @@ export class Bake {
                 uGScale: { value: gbuffer.scale },
             },
         });
-        const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
-        mesh.frustumCulled = false;
-        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
-        return mesh;
+        return fullScreen(material, turned, 'environmentRotation');
     }
 
     shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0, exposureEv, toneMap = true }) {
@@ -270,18 +284,22 @@ export class Bake {
             uFrameCount: { value: frames },
             uDivisor: { value: divisor ?? frames },
             ...rayUniforms(),
+            uEnvFromWorld: { value: new THREE.Matrix3() },
         };
     }
 
     /**
      * The environment behind everything: level 0 along each pixel's camera ray
-     * (render::Camera::ray), tone mapped like the material. A full-screen quad drawn first, not
+     * (render::Camera::ray), tone mapped like the material, turned as the material is (in three's
+     * orientation after the scene's `backgroundRotation`). A full-screen quad drawn first, not
      * tested against or written to depth.
      */
-    createBackground({ exposureEv, toneMap = true } = {}) {
+    createBackground({ exposureEv, toneMap = true, orientation } = {}) {
+        const turned = orientationDefines(orientation);
         const material = new THREE.RawShaderMaterial({
             name: 'brdf-bake background',
             glslVersion: THREE.GLSL3,
+            defines: turned,
             vertexShader: BACKGROUND_VERTEX,
             fragmentShader: BACKGROUND_FRAGMENT,
             depthTest: false,
@@ -290,12 +308,11 @@ export class Bake {
                 uEnvironment: { value: this.textures.uEnvironment },
                 ...this.toneUniforms(exposureEv, toneMap),
                 ...rayUniforms(),
+                uEnvFromWorld: { value: new THREE.Matrix3() },
             },
         });
-        const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
-        mesh.frustumCulled = false;
+        const mesh = fullScreen(material, turned, 'backgroundRotation');
         mesh.renderOrder = -Infinity;
-        mesh.onBeforeRender = (renderer, scene, camera) => setRay(material.uniforms, renderer, camera);
         return mesh;
     }
 
@@ -314,6 +331,57 @@ export class Bake {
         Object.values(this.textures).forEach((t) => t.dispose());
     }
 }
+
+/** The shaders' defines for `orientation` (default three's): TURNED where the frames differ. */
+function orientationDefines(orientation = 'three') {
+    if (!ORIENTATIONS.includes(orientation)) {
+        throw new BakeError(`error: unknown orientation ${orientation}: ${ORIENTATIONS.join(' or ')}`);
+    }
+    return orientation === 'three' ? { TURNED: 1 } : {};
+}
+
+// three's world (+y up) into brdf-preview's environment frame (+z up): the direction whose
+// equirectUv is the texel env_uv finds. equirectUv reads u = atan(d.z, d.x) / 2 pi + 1/2 and
+// v from asin(d.y) with the top row up; env_uv reads u = atan(e.y, e.x) / 2 pi from +x towards
+// +y and theta from +z, the top row up. So e = (-d.x, -d.z, d.y): a turn and a mirror (the two
+// run phi opposite ways around the up axis). A MERL table is isotropic, so the material's
+// reflection in a mirror is the material itself: only the environment is turned.
+const THREE_TO_ENV = new THREE.Matrix3().set(-1, 0, 0, 0, 0, -1, 0, 1, 0);
+const rotation4 = new THREE.Matrix4();
+const rotation3 = new THREE.Matrix3();
+const turn = new THREE.Euler();
+
+/**
+ * `out` set to the environment frame from three's world under `euler` (a scene's
+ * environmentRotation or backgroundRotation), as three's renderer turns the directions it looks
+ * up in an equirect map or a PMREM (WebGLMaterials, WebGLBackground: by the rotation's inverse,
+ * its transpose).
+ */
+function envFromWorld(euler, out) {
+    turn.copy(euler ?? IDENTITY_TURN);
+    rotation3.setFromMatrix4(rotation4.makeRotationFromEuler(turn)).transpose();
+    return out.copy(THREE_TO_ENV).multiply(rotation3);
+}
+
+const IDENTITY_TURN = new THREE.Euler();
+
+/**
+ * A full-screen quad drawing `material` (the background or the deferred pass): at each draw, the
+ * image size and the pixel rays from the camera, and with `turned` the environment frame from
+ * the scene's `rotation` (its name on THREE.Scene).
+ */
+function fullScreen(material, turned, rotation) {
+    const mesh = new THREE.Mesh(QUAD, material);
+    mesh.frustumCulled = false;
+    mesh.onBeforeRender = (renderer, scene, camera) => {
+        setRay(material.uniforms, renderer, camera);
+        if (turned.TURNED) envFromWorld(scene[rotation], material.uniforms.uEnvFromWorld.value);
+    };
+    return mesh;
+}
+
+/** The full-screen quad's geometry, shared by every background and deferred pass (never disposed). */
+const QUAD = new THREE.PlaneGeometry(2, 2);
 
 function rayUniforms() {
     return {
@@ -363,7 +431,7 @@ export function exactCoverage(renderer, geometry, camera, width, height, scale =
         vertexShader: SURFACE_VERTEX,
         fragmentShader: GBUFFER_FRAGMENT,
         side: THREE.DoubleSide,
-        uniforms: { uGScale: { value: scale } },
+        uniforms: { uGScale: { value: scale }, uWorldNormalMatrix: { value: new THREE.Matrix3() } },
     });
     const scene = new THREE.Scene();
     scene.add(new THREE.Mesh(geometry, material));

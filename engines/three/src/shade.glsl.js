@@ -23,6 +23,10 @@ const float ONE_BELOW = 0.99999994;
 
 // engine-environment.ktx2: layer 0 the environment's level 0, layer 1 its peaks.
 uniform sampler2DArray uEnvironment;
+// The environment's frame (brdf-preview's: +z up, phi from +x towards +y) from the world's:
+// identity in brdf-preview's orientation; in three's, the turn and mirror that make env_uv read
+// the texel three's equirectUv reads, after the scene's environment (or background) rotation.
+uniform mat3 uEnvFromWorld;
 // 2^EV, and whether to tone map (0: the linear average, for a float target).
 uniform float uExposure;
 uniform bool uToneMap;
@@ -107,7 +111,11 @@ vec3 camera_ray(uint x, uint y) {
 
 // render::shade::background (shade_backdrop): level 0 along the pixel's ray.
 vec3 background(uint x, uint y) {
-    return env_bilinear(uEnvironment, 0, env_uv(camera_ray(x, y)));
+    vec3 ray = camera_ray(x, y);
+#ifdef TURNED
+    ray = uEnvFromWorld * ray;
+#endif
+    return env_bilinear(uEnvironment, 0, env_uv(ray));
 }
 `;
 
@@ -137,13 +145,15 @@ in vec3 normal;
 uniform mat4 modelMatrix;
 uniform mat4 viewMatrix;
 uniform mat4 projectionMatrix;
+// The inverse transpose of mat3(modelMatrix) (THREE.Matrix3.getNormalMatrix), set per object.
+uniform mat3 uWorldNormalMatrix;
 out vec3 vPosition;
 out vec3 vNormal;
 void main() {
     vec4 world = modelMatrix * vec4(position, 1.0);
     vPosition = world.xyz;
-    // World-space normals: a rotation and uniform scale keep them; normalized per pixel.
-    vNormal = mat3(modelMatrix) * normal;
+    // World-space normals, normalized per pixel.
+    vNormal = uWorldNormalMatrix * normal;
     gl_Position = projectionMatrix * viewMatrix * world;
 }
 `;
@@ -653,6 +663,12 @@ void main() {
     // glam's normalize_or_zero.
     float length_squared = dot(normal, normal);
     vec3 n = length_squared > 0.0 ? normal / sqrt(length_squared) : vec3(0.0);
+#ifdef TURNED
+    // Shaded in the environment's frame: the normal and the eye ray turned by uEnvFromWorld
+    // (left out in brdf-preview's orientation, where it is the identity).
+    position = cameraPosition + uEnvFromWorld * (position - cameraPosition);
+    n = uEnvFromWorld * n;
+#endif
     ShadingFrame frame;
     vec3 radiance = vec3(0.0);
     if (shading_frame(position, n, frame)) {

@@ -16,9 +16,8 @@
 // Errors: one line `error: ...` on stderr, exit 2.
 import { existsSync, realpathSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { deflateSync } from 'node:zlib';
 
-import { launch, serve } from './serve.mjs';
+import { launch, png, serve } from './serve.mjs';
 
 
 function fail(message) {
@@ -48,44 +47,6 @@ function parseArgs(argv) {
         if (args[k] !== undefined) args[k] = Number(args[k]);
     }
     return args;
-}
-
-const CRC_TABLE = Array.from({ length: 256 }, (_, n) => {
-    let c = n;
-    for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
-    return c >>> 0;
-});
-
-function crc32(bytes) {
-    let c = 0xffffffff;
-    for (const b of bytes) c = CRC_TABLE[(c ^ b) & 0xff] ^ (c >>> 8);
-    return (c ^ 0xffffffff) >>> 0;
-}
-
-// An 8-bit RGB PNG, no interlace, filter 0 on every row.
-function png(rgb, width, height) {
-    const chunk = (type, data) => {
-        const body = Buffer.concat([Buffer.from(type, 'latin1'), data]);
-        const out = Buffer.alloc(12 + data.length);
-        out.writeUInt32BE(data.length, 0);
-        body.copy(out, 4);
-        out.writeUInt32BE(crc32(body), 8 + data.length);
-        return out;
-    };
-    const header = Buffer.alloc(13);
-    header.writeUInt32BE(width, 0);
-    header.writeUInt32BE(height, 4);
-    header.set([8, 2, 0, 0, 0], 8);
-    const raw = Buffer.alloc((3 * width + 1) * height);
-    for (let y = 0; y < height; y++) {
-        Buffer.from(rgb.slice(3 * width * y, 3 * width * (y + 1))).copy(raw, y * (3 * width + 1) + 1);
-    }
-    return Buffer.concat([
-        Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]),
-        chunk('IHDR', header),
-        chunk('IDAT', deflateSync(raw)),
-        chunk('IEND', Buffer.alloc(0)),
-    ]);
 }
 
 const args = parseArgs(process.argv.slice(2));

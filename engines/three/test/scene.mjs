@@ -1,0 +1,127 @@
+// The material in a y-up three.js scene, beside three's own drawings of it (test/scene.html), in
+// headless Chromium: prints one JSON line of figures and writes, for a person to look at, one PNG
+// per check in OUT (three.js's drawing on the left, the bake's on the right, tone mapped as
+// brdf-preview tone maps).
+//
+//   node test/scene.mjs --bake DIR --out-dir OUT [--size WxH] [--chromium PATH]
+//
+// Figures:
+// - background_psnr_db: three's scene.background from the bake's map against the bake's
+//   createBackground, per scene rotation (none, then a turn about every axis): the orientation;
+// - mirror_horizon_rows: where the reflected horizon crosses the centre column of a mirror ball
+//   seen from 30 degrees above (the row of the steepest change of log luminance), three's
+//   MeshStandardMaterial lit by scene.environment and the bake's material;
+// - scale_psnr_db: a sphere squashed by its mesh's scale against the same shape made in its
+//   geometry, both drawn by the bake's material: the normal matrix.
+// Errors: one line `error: ...` on stderr, exit 2.
+import { existsSync, mkdirSync, realpathSync, writeFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+
+import { launch, png, serve } from './serve.mjs';
+
+function fail(message) {
+    console.error(`error: ${message}`);
+    process.exit(2);
+}
+
+const args = { size: '128x128', chromium: process.env.CHROMIUM ?? '/usr/bin/chromium' };
+for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
+if (!args.bake || !args['out-dir']) fail('usage: node test/scene.mjs --bake DIR --out-dir OUT [--size WxH]');
+const size = /^(\d+)x(\d+)$/.exec(args.size);
+if (!size) fail(`--size ${args.size}: expected WIDTHxHEIGHT`);
+const [width, height] = [Number(size[1]), Number(size[2])];
+if (!existsSync(resolve(args.bake, 'manifest.json'))) fail(`${args.bake}: not a bake folder (it has no manifest.json)`);
+
+// envmap::tonemap_rgb8: exposure, Reinhard per channel, sRGB, rounded to 8 bits.
+function tonemap(rgb, exposure) {
+    return Uint8Array.from(rgb, (v) => {
+        const x = Math.min(Math.max(v * exposure, 0), 3e38);
+        const r = x / (1 + x);
+        const s = r <= 0.0031308 ? 12.92 * r : 1.055 * r ** (1 / 2.4) - 0.055;
+        return Math.round(Math.min(Math.max(s, 0), 1) * 255);
+    });
+}
+
+function psnrDb(a, b) {
+    let sum = 0;
+    for (let i = 0; i < a.length; i++) sum += (a[i] - b[i]) ** 2;
+    const mse = sum / a.length;
+    return mse === 0 ? Infinity : 10 * Math.log10((255 * 255) / mse);
+}
+
+// The row where log luminance changes most steeply down the centre column, within the rows the
+// ball covers in both pictures (a pixel of the ball is not black).
+function horizonRow(rgb) {
+    const x = Math.floor(width / 2);
+    const luminance = (y) => {
+        const i = 3 * (y * width + x);
+        return 0.2126 * rgb[i] + 0.7152 * rgb[i + 1] + 0.0722 * rgb[i + 2];
+    };
+    let best = { row: -1, step: 0 };
+    for (let y = 1; y < height; y++) {
+        const [a, b] = [luminance(y - 1), luminance(y)];
+        if (a <= 0 || b <= 0) continue;
+        const step = Math.abs(Math.log(b) - Math.log(a));
+        if (step > best.step) best = { row: y, step };
+    }
+    return best.row;
+}
+
+// Two pictures side by side with a 4-pixel grey gap.
+function sideBySide(a, b) {
+    const gap = 4;
+    const w = 2 * width + gap;
+    const out = new Uint8Array(3 * w * height).fill(96);
+    for (let y = 0; y < height; y++) {
+        out.set(a.subarray(3 * width * y, 3 * width * (y + 1)), 3 * w * y);
+        out.set(b.subarray(3 * width * y, 3 * width * (y + 1)), 3 * (w * y + width + gap));
+    }
+    return { rgb: out, width: w };
+}
+
+const server = await serve(realpathSync(resolve(args.bake)));
+const origin = `http://127.0.0.1:${server.address().port}`;
+const browser = await launch(args.chromium).catch((e) => fail(e.message));
+try {
+    const page = await browser.newPage();
+    const errors = [];
+    page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(`${origin}/engines/three/test/scene.html`);
+    await page.waitForFunction('window.ready === true', { timeout: 60000 }).catch(() => {
+        fail(`the test page did not load: ${errors.join('; ')}`);
+    });
+    const result = await page
+        .evaluate((options) => window.renderScenes(options), { bake: `${origin}/bake/`, width, height })
+        .catch((e) => fail(`rendering the scenes of ${args.bake}: ${e.message}; ${errors.join('; ')}`));
+    if (errors.length > 0) fail(`the page reported errors: ${errors.join('; ')}`);
+    const exposure = 2 ** result.exposureEv;
+    const pictures = Object.fromEntries(Object.entries(result.pictures).map(([k, v]) => [k, tonemap(v, exposure)]));
+    const outDir = args['out-dir'];
+    mkdirSync(outDir, { recursive: true });
+    const pair = (name, left, right) => {
+        const sheet = sideBySide(pictures[left], pictures[right]);
+        const file = join(outDir, `${name}.png`);
+        writeFileSync(file, png(sheet.rgb, sheet.width, height));
+        return file;
+    };
+    const files = [];
+    const backgroundPsnr = [0, 1].map((i) => {
+        files.push(pair(`background-${i}`, `background-${i}-three`, `background-${i}-bake`));
+        return psnrDb(pictures[`background-${i}-three`], pictures[`background-${i}-bake`]);
+    });
+    files.push(pair('mirror', 'mirror-three', 'mirror-bake'));
+    files.push(pair('scale', 'scale-mesh', 'scale-geometry'));
+    console.log(JSON.stringify({
+        renderer: result.renderer,
+        width,
+        height,
+        background_psnr_db: backgroundPsnr,
+        mirror_horizon_rows: { three: horizonRow(result.pictures['mirror-three']), bake: horizonRow(result.pictures['mirror-bake']) },
+        scale_psnr_db: psnrDb(pictures['scale-mesh'], pictures['scale-geometry']),
+        files,
+    }));
+} finally {
+    await browser.close();
+    server.close();
+}
