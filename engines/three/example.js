@@ -11,7 +11,7 @@ renderer.setSize(canvas.width, canvas.height, false);
 const camera = orbitCamera(canvas.width / canvas.height);
 const view = { azimuth: 0, elevation: 0 };
 let current = null;
-const orientation = 'brdf-preview';
+const look = { orientation: 'brdf-preview', output: 'brdf-preview' };
 
 const params = new URLSearchParams(location.search);
 document.getElementById('bake').value = params.get('bake') ?? '/target/demo/bake/';
@@ -29,9 +29,9 @@ async function load() {
         const bake = await loadBake(url);
         current?.bake.dispose();
         const scene = new THREE.Scene();
-        // brdf-preview's sphere and camera, so brdf-preview's axes (+z up).
-        scene.add(bake.createBackground({ orientation }));
-        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), orientation }));
+        // brdf-preview's sphere and camera, so brdf-preview's axes (+z up) and picture.
+        scene.add(bake.createBackground(look));
+        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), ...look }));
         scene.add(mesh);
         current = { bake, scene, mesh };
         draw();
@@ -49,7 +49,7 @@ function draw() {
     const defaults = bake.defaults(m);
     const frames = document.getElementById('frames').value === '1' ? 1 : defaults.frames;
     mesh.material.dispose();
-    mesh.material = bake.createMaterial({ mode: m, frames, orientation });
+    mesh.material = bake.createMaterial({ mode: m, frames, ...look });
     setOrbit(camera, view.azimuth, view.elevation);
     const gl = renderer.getContext();
     const start = performance.now();

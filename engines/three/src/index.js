@@ -1,12 +1,13 @@
 // A bake of the BRDF toolchain (`brdf-bake --engine-textures`) as three.js materials: the
-// reference and prefiltered estimators of `brdf-preview`, with the same samples, the same
-// per-pixel sample choice and the same tone mapping, in GLSL ES 3.0 (`shade.glsl.js`). The
-// engine textures are described in `data-schema/engine-textures.md`; this file reads them and
-// sets the shader's inputs.
+// reference and prefiltered estimators of `brdf-preview`, with the same samples and the same
+// per-pixel sample choice, in GLSL ES 3.0 (`shade.glsl.js`) on three's shader chunks, in three's
+// world and colour pipeline (or brdf-preview's: ORIENTATIONS, OUTPUTS). The engine textures are
+// described in `data-schema/engine-textures.md`; this file reads them and sets the shader's
+// inputs.
 //
-//     import { loadBake, previewSphere, orbitCamera } from '@brdf-toolchain/three';
+//     import { loadBake } from '@brdf-toolchain/three';
 //     const bake = await loadBake('bakes/gold-paint/');
-//     const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: 'prefiltered' }));
+//     const mesh = new THREE.Mesh(new THREE.TorusKnotGeometry(), bake.createMaterial({ mode: 'prefiltered' }));
 //     scene.add(bake.createBackground(), mesh);
 
 import * as THREE from 'three';
@@ -16,6 +17,7 @@ import {
     BACKGROUND_FRAGMENT,
     BACKGROUND_VERTEX,
     GBUFFER_FRAGMENT,
+    GBUFFER_VERTEX,
     QUAD_VERTEX,
     SURFACE_FRAGMENT,
     SURFACE_VERTEX,
@@ -32,6 +34,15 @@ export const MODES = { reference: 0, prefiltered: 2 };
  * `orbitCamera` and `previewSphere` assume), where the pictures equal brdf-preview's.
  */
 export const ORIENTATIONS = ['three', 'brdf-preview'];
+
+/**
+ * What a pixel writes. `three`: the linear radiance (times 2^exposureEv), which the renderer's
+ * tone mapping (`renderer.toneMapping`, `toneMappingExposure`) and output colour space take as
+ * for its own materials where it draws to the canvas (on a render target: linear, as three's
+ * own). `brdf-preview`: brdf-preview's picture (the environment's automatic exposure or
+ * exposureEv, Reinhard per channel, sRGB), nothing of three's added.
+ */
+export const OUTPUTS = ['three', 'brdf-preview'];
 
 /** The stage of the manifest that lists the engine textures. */
 export const STAGE = 'engine-textures';
@@ -196,29 +207,29 @@ export class Bake {
     /**
      * A material that shades a mesh with the bake's `mode` ('reference' or 'prefiltered'): per
      * pixel, frames `firstFrame .. firstFrame + frames` of `spp` samples each, their sum divided
-     * by `divisor` (default `frames`: their average), tone mapped with `exposureEv` (default the
-     * environment's automatic exposure, as brdf-preview's) unless `toneMap` is false (then linear
-     * radiance, for a float target). `spp` and `frames` default to brdf-preview's; `seed` is
-     * brdf-preview's --seed. The pixel index (which samples a pixel takes) counts rows from the
-     * top of the drawing buffer, whose size the material reads from the renderer at each draw.
+     * by `divisor` (default `frames`: their average). `spp` and `frames` default to
+     * brdf-preview's; `seed` is brdf-preview's --seed. The pixel index (which samples a pixel
+     * takes) counts rows from the top of the drawing buffer, whose size the material reads from
+     * the renderer at each draw. Built on three's shader chunks: instanced, batched, skinned and
+     * morphed meshes, clipping planes and a logarithmic depth buffer work as with three's own
+     * materials. `orientation` (ORIENTATIONS) and `output` (OUTPUTS) say how it meets the scene;
+     * `exposureEv` scales the radiance by 2^EV (default: none in three's output, the environment's
+     * automatic exposure in brdf-preview's).
      */
     createMaterial(options = {}) {
-        const turned = orientationDefines(options.orientation);
-        const material = new THREE.RawShaderMaterial({
+        const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'}`,
-            glslVersion: THREE.GLSL3,
-            defines: turned,
             vertexShader: SURFACE_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             // render::raster culls no back face: at a silhouette a pixel may see one.
             side: THREE.DoubleSide,
-            uniforms: { ...this.shadingUniforms(options), uWorldNormalMatrix: { value: new THREE.Matrix3() } },
+            clipping: true,
+            uniforms: this.shadingUniforms(options),
         });
-        material.onBeforeRender = (renderer, scene, camera, geometry, object) => {
+        material.onBeforeRender = (renderer, scene) => {
             const u = material.uniforms;
             resolution(renderer, u.uResolution.value);
-            u.uWorldNormalMatrix.value.getNormalMatrix(object.matrixWorld);
-            if (turned.TURNED) envFromWorld(scene.environmentRotation, u.uEnvFromWorld.value);
+            if (material.defines.TURNED) envFromWorld(scene.environmentRotation, u.uEnvFromWorld.value);
         };
         return material;
     }
@@ -229,11 +240,9 @@ export class Bake {
      * pixels show the environment. `options` as for `createMaterial`.
      */
     createDeferred(gbuffer, options = {}) {
-        const turned = orientationDefines(options.orientation);
-        const material = new THREE.RawShaderMaterial({
+        const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
-            glslVersion: THREE.GLSL3,
-            defines: { DEFERRED: 1, ...turned },
+            defines: { DEFERRED: 1 },
             vertexShader: QUAD_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             depthTest: false,
@@ -245,10 +254,10 @@ export class Bake {
                 uGScale: { value: gbuffer.scale },
             },
         });
-        return fullScreen(material, turned, 'environmentRotation');
+        return fullScreen(material, 'environmentRotation');
     }
 
-    shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0, exposureEv, toneMap = true }) {
+    shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0 }) {
         if (!(mode in MODES)) {
             throw new BakeError(`error: unknown mode ${mode}: reference or prefiltered`);
         }
@@ -268,7 +277,6 @@ export class Bake {
         }
         return {
             ...this.textureUniforms(),
-            ...this.toneUniforms(exposureEv, toneMap),
             uPhiDRange: { value: f.phi_d_range },
             uMode: { value: MODES[mode] },
             uSeed: { value: seed >>> 0 },
@@ -284,60 +292,62 @@ export class Bake {
             uFrameCount: { value: frames },
             uDivisor: { value: divisor ?? frames },
             ...rayUniforms(),
-            uEnvFromWorld: { value: new THREE.Matrix3() },
         };
     }
 
     /**
      * The environment behind everything: level 0 along each pixel's camera ray
-     * (render::Camera::ray), tone mapped like the material, turned as the material is (in three's
-     * orientation after the scene's `backgroundRotation`). A full-screen quad drawn first, not
-     * tested against or written to depth.
+     * (render::Camera::ray), turned and written as the material is (`orientation`, `output`,
+     * `exposureEv`; in three's orientation after the scene's `backgroundRotation`). A full-screen
+     * quad drawn first, not tested against or written to depth.
      */
-    createBackground({ exposureEv, toneMap = true, orientation } = {}) {
-        const turned = orientationDefines(orientation);
-        const material = new THREE.RawShaderMaterial({
+    createBackground(options = {}) {
+        const material = this.shaderMaterial(options, {
             name: 'brdf-bake background',
-            glslVersion: THREE.GLSL3,
-            defines: turned,
             vertexShader: BACKGROUND_VERTEX,
             fragmentShader: BACKGROUND_FRAGMENT,
             depthTest: false,
             depthWrite: false,
+            uniforms: { uEnvironment: { value: this.textures.uEnvironment }, ...rayUniforms() },
+        });
+        const mesh = fullScreen(material, 'backgroundRotation');
+        mesh.renderOrder = -Infinity;
+        return mesh;
+    }
+
+    /**
+     * A THREE.ShaderMaterial (GLSL ES 3.0) of `params` drawing in `orientation` and writing
+     * `output`: their defines, the exposure and the environment's frame as uniforms.
+     */
+    shaderMaterial({ orientation = 'three', output = 'three', exposureEv }, params) {
+        if (!ORIENTATIONS.includes(orientation)) {
+            throw new BakeError(`error: unknown orientation ${orientation}: ${ORIENTATIONS.join(' or ')}`);
+        }
+        if (!OUTPUTS.includes(output)) {
+            throw new BakeError(`error: unknown output ${output}: ${OUTPUTS.join(' or ')}`);
+        }
+        const preview = output === 'brdf-preview';
+        return new THREE.ShaderMaterial({
+            glslVersion: THREE.GLSL3,
+            ...params,
+            defines: { ...params.defines, ...(orientation === 'three' && { TURNED: 1 }), ...(preview && { PREVIEW_OUTPUT: 1 }) },
+            // brdf-preview's output maps its own tones; three's goes through the renderer's.
+            toneMapped: !preview,
             uniforms: {
-                uEnvironment: { value: this.textures.uEnvironment },
-                ...this.toneUniforms(exposureEv, toneMap),
-                ...rayUniforms(),
+                ...params.uniforms,
+                uExposure: { value: 2 ** (exposureEv ?? (preview ? this.figures.exposure_ev : 0)) },
                 uEnvFromWorld: { value: new THREE.Matrix3() },
             },
         });
-        const mesh = fullScreen(material, turned, 'backgroundRotation');
-        mesh.renderOrder = -Infinity;
-        return mesh;
     }
 
     textureUniforms() {
         return Object.fromEntries(Object.entries(this.textures).map(([name, texture]) => [name, { value: texture }]));
     }
 
-    toneUniforms(exposureEv, toneMap) {
-        return {
-            uExposure: { value: 2 ** (exposureEv ?? this.figures.exposure_ev) },
-            uToneMap: { value: toneMap },
-        };
-    }
-
     dispose() {
         Object.values(this.textures).forEach((t) => t.dispose());
     }
-}
-
-/** The shaders' defines for `orientation` (default three's): TURNED where the frames differ. */
-function orientationDefines(orientation = 'three') {
-    if (!ORIENTATIONS.includes(orientation)) {
-        throw new BakeError(`error: unknown orientation ${orientation}: ${ORIENTATIONS.join(' or ')}`);
-    }
-    return orientation === 'three' ? { TURNED: 1 } : {};
 }
 
 // three's world (+y up) into brdf-preview's environment frame (+z up): the direction whose
@@ -367,15 +377,15 @@ const IDENTITY_TURN = new THREE.Euler();
 
 /**
  * A full-screen quad drawing `material` (the background or the deferred pass): at each draw, the
- * image size and the pixel rays from the camera, and with `turned` the environment frame from
- * the scene's `rotation` (its name on THREE.Scene).
+ * image size and the pixel rays from the camera, and in three's orientation the environment frame
+ * from the scene's `rotation` (its name on THREE.Scene).
  */
-function fullScreen(material, turned, rotation) {
+function fullScreen(material, rotation) {
     const mesh = new THREE.Mesh(QUAD, material);
     mesh.frustumCulled = false;
     mesh.onBeforeRender = (renderer, scene, camera) => {
         setRay(material.uniforms, renderer, camera);
-        if (turned.TURNED) envFromWorld(scene[rotation], material.uniforms.uEnvFromWorld.value);
+        if (material.defines.TURNED) envFromWorld(scene[rotation], material.uniforms.uEnvFromWorld.value);
     };
     return mesh;
 }
@@ -428,10 +438,10 @@ export function exactCoverage(renderer, geometry, camera, width, height, scale =
     const material = new THREE.RawShaderMaterial({
         name: 'brdf-bake g-buffer',
         glslVersion: THREE.GLSL3,
-        vertexShader: SURFACE_VERTEX,
+        vertexShader: GBUFFER_VERTEX,
         fragmentShader: GBUFFER_FRAGMENT,
         side: THREE.DoubleSide,
-        uniforms: { uGScale: { value: scale }, uWorldNormalMatrix: { value: new THREE.Matrix3() } },
+        uniforms: { uGScale: { value: scale } },
     });
     const scene = new THREE.Scene();
     scene.add(new THREE.Mesh(geometry, material));

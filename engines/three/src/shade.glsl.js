@@ -16,6 +16,10 @@ precision highp sampler2D;
 precision highp sampler3D;
 precision highp sampler2DArray;
 
+// The output, under the name three's chunks write (it declares it only for GLSL ES 1.0 shaders).
+layout(location = 0) out highp vec4 pc_fragColor;
+#define gl_FragColor pc_fragColor
+
 const float PI = 3.14159265358979;
 const float HALF_PI = 1.5707963267948966;
 // The largest f32 below 1 (sampling::ONE_MINUS_EPSILON in f32).
@@ -27,9 +31,8 @@ uniform sampler2DArray uEnvironment;
 // identity in brdf-preview's orientation; in three's, the turn and mirror that make env_uv read
 // the texel three's equirectUv reads, after the scene's environment (or background) rotation.
 uniform mat3 uEnvFromWorld;
-// 2^EV, and whether to tone map (0: the linear average, for a float target).
+// 2^EV: brdf-preview's exposure (PREVIEW_OUTPUT), or a scale of the linear radiance.
 uniform float uExposure;
-uniform bool uToneMap;
 
 // merl_lookup.wgsl's merl_atan2: atan2(0, 0) is 0, as Rust's.
 float merl_atan2(float y, float x) {
@@ -91,8 +94,15 @@ vec3 tonemap(vec3 radiance) {
     return srgb_encode(finite / (1.0 + finite));
 }
 
+// What a pixel writes to gl_FragColor: brdf-preview's exposure, Reinhard and sRGB
+// (PREVIEW_OUTPUT), or the linear radiance times uExposure, which three's tone mapping and output
+// colour space take next (OUTPUT below, after the write).
 vec4 present(vec3 value) {
-    return vec4(uToneMap ? tonemap(value) : value, 1.0);
+#ifdef PREVIEW_OUTPUT
+    return vec4(tonemap(value), 1.0);
+#else
+    return vec4(value * uExposure, 1.0);
+#endif
 }
 
 // The image size, and the pixel ray's basis as render::Camera::ray builds it: forward,
@@ -119,9 +129,18 @@ vec3 background(uint x, uint y) {
 }
 `;
 
+// After the write of present(): three's tone mapping and output colour space (its shader chunks:
+// the renderer's toneMapping where it draws to the canvas, its outputColorSpace there, nothing on
+// a render target), unless PREVIEW_OUTPUT.
+const OUTPUT = /* glsl */ `
+#ifndef PREVIEW_OUTPUT
+    #include <tonemapping_fragment>
+    #include <colorspace_fragment>
+#endif
+`;
+
 // The background: level 0 along each pixel's camera ray (render::Camera::ray).
 export const BACKGROUND_VERTEX = /* glsl */ `
-in vec3 position;
 void main() {
     // A full-screen quad at the far plane.
     gl_Position = vec4(position.xy, 1.0, 1.0);
@@ -130,31 +149,69 @@ void main() {
 
 export const BACKGROUND_FRAGMENT = /* glsl */ `
 ${COMMON}
-out vec4 outColor;
 
 void main() {
     uvec2 p = uvec2(gl_FragCoord.xy);
     uint y = uResolution.y - 1u - p.y;
-    outColor = present(background(p.x, y));
+    gl_FragColor = present(background(p.x, y));
+    ${OUTPUT}
 }
 `;
 
+// A mesh as three's own materials move it (its shader chunks: batching, instancing, morph
+// targets, skinning, logarithmic depth, clipping planes), handing the fragment shader the world
+// position and normal (the normal through three's normal matrix and back from view space).
 export const SURFACE_VERTEX = /* glsl */ `
-in vec3 position;
-in vec3 normal;
-uniform mat4 modelMatrix;
-uniform mat4 viewMatrix;
-uniform mat4 projectionMatrix;
-// The inverse transpose of mat3(modelMatrix) (THREE.Matrix3.getNormalMatrix), set per object.
-uniform mat3 uWorldNormalMatrix;
+#include <common>
+#include <batching_pars_vertex>
+#include <morphtarget_pars_vertex>
+#include <skinning_pars_vertex>
+#include <logdepthbuf_pars_vertex>
+#include <clipping_planes_pars_vertex>
 out vec3 vPosition;
 out vec3 vNormal;
 void main() {
-    vec4 world = modelMatrix * vec4(position, 1.0);
+    #include <morphinstance_vertex>
+    #include <batching_vertex>
+    #include <beginnormal_vertex>
+    #include <morphnormal_vertex>
+    #include <skinbase_vertex>
+    #include <skinnormal_vertex>
+    #include <defaultnormal_vertex>
+    #include <begin_vertex>
+    #include <morphtarget_vertex>
+    #include <skinning_vertex>
+    #include <project_vertex>
+    #include <logdepthbuf_vertex>
+    #include <clipping_planes_vertex>
+    // worldpos_vertex's steps, which three takes only for its own lights and maps.
+    vec4 world = vec4(transformed, 1.0);
+#ifdef USE_BATCHING
+    world = batchingMatrix * world;
+#endif
+#ifdef USE_INSTANCING
+    world = instanceMatrix * world;
+#endif
+    world = modelMatrix * world;
     vPosition = world.xyz;
     // World-space normals, normalized per pixel.
-    vNormal = uWorldNormalMatrix * normal;
-    gl_Position = projectionMatrix * viewMatrix * world;
+    vNormal = transformNormalByInverseViewMatrix(transformedNormal, viewMatrix);
+}
+`;
+
+// exactCoverage's G-buffer pass (a RawShaderMaterial: it writes two targets): the geometry's
+// positions and normals as they are, in world space.
+export const GBUFFER_VERTEX = /* glsl */ `
+in vec3 position;
+in vec3 normal;
+uniform mat4 viewMatrix;
+uniform mat4 projectionMatrix;
+out vec3 vPosition;
+out vec3 vNormal;
+void main() {
+    vPosition = position;
+    vNormal = normal;
+    gl_Position = projectionMatrix * viewMatrix * vec4(position, 1.0);
 }
 `;
 
@@ -194,8 +251,7 @@ uniform vec3 uDiffuse;
 uniform uint uFirstFrame;
 uniform uint uFrameCount;
 uniform float uDivisor;
-// The eye (three.js sets it from the camera).
-uniform vec3 cameraPosition;
+// The eye: cameraPosition, which three.js declares and sets from the camera.
 
 #ifdef DEFERRED
 // The G-buffer of exactCoverage (index.js): the interpolated position, and the interpolated
@@ -207,8 +263,9 @@ uniform int uGScale;
 #else
 in vec3 vPosition;
 in vec3 vNormal;
+#include <logdepthbuf_pars_fragment>
+#include <clipping_planes_pars_fragment>
 #endif
-out vec4 outColor;
 
 // ---- merl_lookup.wgsl: merl::half_diff, merl::Dims::nearest_cell, merl::MerlTable::cell_value.
 
@@ -642,8 +699,9 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     return sum;
 }
 
-void main() {
-    uvec2 p = uvec2(gl_FragCoord.xy);
+// The radiance at pixel p (rows from the bottom), or where the G-buffer has no triangle the
+// environment behind.
+vec3 shade_pixel(uvec2 p) {
     // Row 0 at the top, as render's pixel index counts.
     uint pixel = (uResolution.y - 1u - p.y) * uResolution.x + p.x;
 #ifdef DEFERRED
@@ -651,8 +709,7 @@ void main() {
     vec4 gn = texelFetch(uGNormal, g, 0);
     if (gn.w == 0.0) {
         // No triangle covers the pixel: the environment behind.
-        outColor = present(background(p.x, uResolution.y - 1u - p.y));
-        return;
+        return background(p.x, uResolution.y - 1u - p.y);
     }
     vec3 position = texelFetch(uGPosition, g, 0).xyz;
     vec3 normal = gn.xyz;
@@ -678,7 +735,18 @@ void main() {
         }
         radiance = sum / uDivisor;
     }
-    outColor = present(radiance);
+    return radiance;
+}
+
+void main() {
+#ifndef DEFERRED
+    #include <clipping_planes_fragment>
+#endif
+    gl_FragColor = present(shade_pixel(uvec2(gl_FragCoord.xy)));
+    ${OUTPUT}
+#ifndef DEFERRED
+    #include <logdepthbuf_fragment>
+#endif
 }
 `;
 
@@ -704,7 +772,6 @@ void main() {
 
 // exactCoverage's shading pass: a full-screen quad.
 export const QUAD_VERTEX = /* glsl */ `
-in vec3 position;
 void main() {
     gl_Position = vec4(position.xy, 0.0, 1.0);
 }

@@ -12,7 +12,12 @@
 //   seen from 30 degrees above (the row of the steepest change of log luminance), three's
 //   MeshStandardMaterial lit by scene.environment and the bake's material;
 // - scale_psnr_db: a sphere squashed by its mesh's scale against the same shape made in its
-//   geometry, both drawn by the bake's material: the normal matrix.
+//   geometry, both drawn by the bake's material: the normal matrix;
+// - instances_psnr_db, skinning_psnr_db: an InstancedMesh of 100 against 100 meshes, a sphere
+//   skinned to a bone against a mesh moved as the bone (three's chunks in the vertex shader);
+// - tone_mapping_levels: the material drawn to the canvas under ACES filmic (exposure 1.7) and no
+//   tone mapping, against three's formulas applied to its linear radiance read back as floats:
+//   the largest difference in 8-bit levels and how many values differ by more than one.
 // Errors: one line `error: ...` on stderr, exit 2.
 import { existsSync, mkdirSync, realpathSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
@@ -67,6 +72,40 @@ function horizonRow(rgb) {
     return best.row;
 }
 
+// three's pipeline on linear RGB (its ShaderChunk tonemapping_pars_fragment and
+// colorspace_pars_fragment, r187): ACES filmic (Narkowicz's fit as three writes it) or none, then
+// the sRGB transfer function, clamped and rounded to 8 bits as the canvas stores them.
+function threePipeline(rgb, toneMapping, exposure) {
+    const out = new Uint8Array(rgb.length);
+    const input = [[0.59719, 0.35458, 0.04823], [0.076, 0.90834, 0.01566], [0.0284, 0.13383, 0.83777]];
+    const output = [[1.60475, -0.53108, -0.07367], [-0.10208, 1.10813, -0.00605], [-0.00327, -0.07276, 1.07602]];
+    const times = (m, v) => m.map((row) => row[0] * v[0] + row[1] * v[1] + row[2] * v[2]);
+    const fit = (v) => (v * (v + 0.0245786) - 0.000090537) / (v * (0.983729 * v + 0.432951) + 0.238081);
+    for (let i = 0; i < rgb.length; i += 3) {
+        let c = [rgb[i], rgb[i + 1], rgb[i + 2]];
+        if (toneMapping === 'aces') {
+            c = times(output, times(input, c.map((v) => (v * exposure) / 0.6)).map(fit));
+        }
+        for (let k = 0; k < 3; k++) {
+            const v = Math.min(Math.max(c[k], 0), 1);
+            const s = v <= 0.0031308 ? v * 12.92 : 1.055 * v ** 0.41666 - 0.055;
+            out[i + k] = Math.round(Math.min(Math.max(s, 0), 1) * 255);
+        }
+    }
+    return out;
+}
+
+// The largest difference in 8-bit levels and how many values differ by more than one.
+function levels(a, b) {
+    let [max, beyondOne] = [0, 0];
+    for (let i = 0; i < a.length; i++) {
+        const d = Math.abs(a[i] - b[i]);
+        max = Math.max(max, d);
+        if (d > 1) beyondOne++;
+    }
+    return { max, beyond_one: beyondOne };
+}
+
 // Two pictures side by side with a 4-pixel grey gap.
 function sideBySide(a, b) {
     const gap = 4;
@@ -112,6 +151,20 @@ try {
     });
     files.push(pair('mirror', 'mirror-three', 'mirror-bake'));
     files.push(pair('scale', 'scale-mesh', 'scale-geometry'));
+    files.push(pair('instances', 'instances-instanced', 'instances-separate'));
+    files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
+    const linear = result.pictures['mirror-bake'];
+    const canvases = Object.fromEntries(
+        ['aces', 'none'].map((t) => {
+            const expected = threePipeline(linear, t, result.toneMappingExposure);
+            const canvas = Uint8Array.from(result.canvases[t]);
+            const sheet = sideBySide(canvas, expected);
+            const file = join(outDir, `tone-mapping-${t}.png`);
+            writeFileSync(file, png(sheet.rgb, sheet.width, height));
+            files.push(file);
+            return [t, levels(canvas, expected)];
+        }),
+    );
     console.log(JSON.stringify({
         renderer: result.renderer,
         width,
@@ -119,6 +172,9 @@ try {
         background_psnr_db: backgroundPsnr,
         mirror_horizon_rows: { three: horizonRow(result.pictures['mirror-three']), bake: horizonRow(result.pictures['mirror-bake']) },
         scale_psnr_db: psnrDb(pictures['scale-mesh'], pictures['scale-geometry']),
+        instances_psnr_db: psnrDb(pictures['instances-instanced'], pictures['instances-separate']),
+        skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
+        tone_mapping_levels: canvases,
         files,
     }));
 } finally {
