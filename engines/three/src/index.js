@@ -402,17 +402,25 @@ function rayUniforms() {
     };
 }
 
-// The image size and the pixel rays' basis (render::Camera::basis: the columns of the camera's
-// world matrix are right, up and back) for the draw about to run.
+// The image size and the pixel rays' basis (render::Camera::ray) for the draw about to run, from
+// the camera's projection, so that zoom, a view offset and an orthographic camera (whose rays are
+// parallel: no change across the image) are drawn as three draws them: the rays through the image's
+// centre and through the middle of its right and top edges, in view space at z = -1, turned to
+// the world.
 function setRay(u, renderer, camera) {
     resolution(renderer, u.uResolution.value);
-    const e = camera.matrixWorld.elements;
-    const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
-    const aspect = u.uResolution.value.x / u.uResolution.value.y;
-    u.uRayForward.value.set(-e[8], -e[9], -e[10]).normalize();
-    u.uRayRight.value.set(e[0], e[1], e[2]).normalize().multiplyScalar(tanHalf * aspect);
-    u.uRayUp.value.set(e[4], e[5], e[6]).normalize().multiplyScalar(tanHalf);
+    const toWorld = worldTurn.setFromMatrix4(camera.matrixWorld);
+    const at = (x, y, out) => {
+        out.set(x, y, 0.5).applyMatrix4(camera.projectionMatrixInverse);
+        return camera.isOrthographicCamera ? out.set(0, 0, -1) : out.divideScalar(-out.z);
+    };
+    at(0, 0, u.uRayForward.value);
+    at(1, 0, u.uRayRight.value).sub(u.uRayForward.value).applyMatrix3(toWorld);
+    at(0, 1, u.uRayUp.value).sub(u.uRayForward.value).applyMatrix3(toWorld);
+    u.uRayForward.value.applyMatrix3(toWorld);
 }
+
+const worldTurn = new THREE.Matrix3();
 
 /**
  * The G-buffer of `geometry` seen by `camera` at `width x height` with brdf-preview's coverage:

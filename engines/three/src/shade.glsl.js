@@ -105,8 +105,10 @@ vec4 present(vec3 value) {
 #endif
 }
 
-// The image size, and the pixel ray's basis as render::Camera::ray builds it: forward,
-// right tan(fov_y / 2) aspect, up tan(fov_y / 2).
+// The image size, and the pixel ray's basis as render::Camera::ray builds it: the ray through
+// the image's centre, and its change across half the image to the right and up (for three's
+// perspective camera without zoom or view offset: forward, right tan(fov_y / 2) aspect, up
+// tan(fov_y / 2); for an orthographic camera: forward, and no change).
 uniform uvec2 uResolution;
 uniform vec3 uRayForward;
 uniform vec3 uRayRight;
@@ -567,11 +569,11 @@ vec3 bend_towards(vec3 n, vec3 wo, float cos_o) {
 
 // render::shade::ShadingFrame::new (shading_frame); false where the pixel is black (a normal
 // interpolated to zero).
-bool shading_frame(vec3 position, vec3 n, out ShadingFrame frame) {
+bool shading_frame(vec3 position, vec3 n, vec3 eye, out ShadingFrame frame) {
     if (all(equal(n, vec3(0.0)))) {
         return false;
     }
-    vec3 wo = normalize(cameraPosition - position);
+    vec3 wo = normalize(eye - position);
     float cos_o = dot(n, wo);
     if (isnan(cos_o)) {
         return false;
@@ -720,15 +722,18 @@ vec3 shade_pixel(uvec2 p) {
     // glam's normalize_or_zero.
     float length_squared = dot(normal, normal);
     vec3 n = length_squared > 0.0 ? normal / sqrt(length_squared) : vec3(0.0);
+    // An orthographic camera looks along its axis everywhere: the eye a unit back along it (the
+    // view matrix's third row).
+    vec3 eye = isOrthographic ? position + vec3(viewMatrix[0][2], viewMatrix[1][2], viewMatrix[2][2]) : cameraPosition;
 #ifdef TURNED
     // Shaded in the environment's frame: the normal and the eye ray turned by uEnvFromWorld
     // (left out in brdf-preview's orientation, where it is the identity).
-    position = cameraPosition + uEnvFromWorld * (position - cameraPosition);
+    eye = position + uEnvFromWorld * (eye - position);
     n = uEnvFromWorld * n;
 #endif
     ShadingFrame frame;
     vec3 radiance = vec3(0.0);
-    if (shading_frame(position, n, frame)) {
+    if (shading_frame(position, n, eye, frame)) {
         vec3 sum = vec3(0.0);
         for (uint f = uFirstFrame; f < uFirstFrame + uFrameCount; f++) {
             sum += estimate_sum(frame, pixel, f, uSpp) / float(uSpp);

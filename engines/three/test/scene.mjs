@@ -15,6 +15,8 @@
 //   geometry, both drawn by the bake's material: the normal matrix;
 // - instances_psnr_db, skinning_psnr_db: an InstancedMesh of 100 against 100 meshes, a sphere
 //   skinned to a bone against a mesh moved as the bone (three's chunks in the vertex shader);
+// - orthographic_psnr_db: the material seen by an orthographic camera against a perspective one
+//   4000 units away (rays parallel within 3e-4 radians);
 // - tone_mapping_levels: the material drawn to the canvas under ACES filmic (exposure 1.7) and no
 //   tone mapping, against three's formulas applied to its linear radiance read back as floats:
 //   the largest difference in 8-bit levels and how many values differ by more than one.
@@ -153,6 +155,7 @@ try {
     files.push(pair('scale', 'scale-mesh', 'scale-geometry'));
     files.push(pair('instances', 'instances-instanced', 'instances-separate'));
     files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
+    files.push(pair('orthographic', 'orthographic-orthographic', 'orthographic-distant'));
     const linear = result.pictures['mirror-bake'];
     const canvases = Object.fromEntries(
         ['aces', 'none'].map((t) => {
@@ -174,6 +177,7 @@ try {
         scale_psnr_db: psnrDb(pictures['scale-mesh'], pictures['scale-geometry']),
         instances_psnr_db: psnrDb(pictures['instances-instanced'], pictures['instances-separate']),
         skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
+        orthographic_psnr_db: psnrDb(pictures['orthographic-orthographic'], pictures['orthographic-distant']),
         tone_mapping_levels: canvases,
         files,
     }));
