@@ -44,8 +44,8 @@ setup-mitsuba: setup-python
 	fi
 
 ## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
-## tests run on the KTX2 files with node, and engines/three's packages (three, ktx-parse and
-## puppeteer-core, pinned by its lock file). Installs node and npm from Debian when missing.
+## tests run on the KTX2 files with node, and engines/three's packages (three, ktx-parse,
+## @noble/hashes and puppeteer-core, pinned by its lock file). Installs node and npm from Debian when missing.
 setup-node:
 	@if ! command -v npm >/dev/null 2>&1; then \
 	  echo "installing nodejs and npm (to read the KTX2 outputs with ktx-parse in the tests)"; \
@@ -54,7 +54,7 @@ setup-node:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
 	fi
 	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
-	@test -d engines/three/node_modules/puppeteer-core -a -d engines/three/node_modules/ktx-parse || npm ci --silent --prefix engines/three
+	@test -d engines/three/node_modules/puppeteer-core -a -d engines/three/node_modules/ktx-parse -a -d engines/three/node_modules/@noble/hashes || npm ci --silent --prefix engines/three
 
 ## setup-chromium: Debian's Chromium, the real browser tests/three.rs renders the three.js material
 ## in (headless, WebGL 2 on SwiftShader, driven by puppeteer-core from engines/three; no browser

@@ -295,10 +295,15 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
     }
 }
 
-/// The loader refuses every manifest path that would leave the bake folder (`node --test` on
-/// `engines/three/test/loader.test.mjs`).
+/// The loader refuses what a hostile bake can give (`node --test` on
+/// `engines/three/test/loader.test.mjs`, a synthetic bake behind a fake fetch): manifest paths
+/// that leave the folder, figures of the wrong type or out of range, textures of the wrong format
+/// or shape or with values outside their role's range, outputs missing, listed twice or with
+/// sizes and hashes that are no file's, bodies longer than listed (an endless one stops at the
+/// limit), a file that is not the one listed, with WebCrypto or without: each a BakeError
+/// naming the file.
 #[test]
-fn the_loader_keeps_manifest_paths_inside_the_bake() {
+fn the_loader_refuses_what_a_hostile_bake_gives() {
     assert!(
         root().join("engines/three/node_modules/three").is_dir(),
         "three is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"

@@ -11,7 +11,8 @@
 //     scene.add(bake.createBackground(), mesh);
 
 import * as THREE from 'three';
-import { read as readKtx2 } from 'ktx-parse';
+
+import { BakeError, readBake } from './loader.js';
 
 import {
     BACKGROUND_FRAGMENT,
@@ -22,6 +23,8 @@ import {
     SURFACE_FRAGMENT,
     SURFACE_VERTEX,
 } from './shade.glsl.js';
+
+export { BakeError, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
 
 /** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
 export const MODES = { reference: 0, prefiltered: 2 };
@@ -44,147 +47,14 @@ export const ORIENTATIONS = ['three', 'brdf-preview'];
  */
 export const OUTPUTS = ['three', 'brdf-preview'];
 
-/** The stage of the manifest that lists the engine textures. */
-export const STAGE = 'engine-textures';
-
-/** The roles of the engine textures and the uniforms they bind. */
-const TEXTURES = {
-    'engine-merl': 'uMerl',
-    'engine-brdf-tables': 'uBrdfTables',
-    'engine-light-tables': 'uLightTables',
-    'engine-view-layers': 'uViewLayers',
-    'engine-environment': 'uEnvironment',
-    'engine-layers': 'uLayers',
-};
-
-// KTX2 vkFormat codes of the data textures.
-const VK_FORMAT_R32_SFLOAT = 100;
-const VK_FORMAT_R32G32B32A32_SFLOAT = 109;
-
-/** An error in a bake's files, naming the file. */
-export class BakeError extends Error {}
-
 /**
- * Resolves a path a manifest names inside the bake folder `base` (a URL ending in `/`): a
- * relative path of `/`-separated components, none empty, `.` or `..`, without `\`, `:`, `?` or
- * `#` (the manifest's own rule, data-schema/README.md "Paths", and no scheme or query that
- * would take a fetch elsewhere). Anything else is refused.
+ * Reads the bake at `url` (a folder served over HTTP, with or without the trailing `/`) with the
+ * checks of `readBake` (loader.js): the manifest, the engine textures' figures and every engine
+ * texture by role. `options.fetch` replaces the page's fetch.
  */
-export function resolveInside(base, path) {
-    const components = typeof path === 'string' ? path.split('/') : [''];
-    const bad = components.some((c) => c === '' || c === '.' || c === '..' || /[\\:?#\0%]/.test(c));
-    if (bad) {
-        throw new BakeError(`error: manifest.json: the output path ${JSON.stringify(path)} leaves the bake folder`);
-    }
-    const url = new URL(components.map(encodeURIComponent).join('/'), base);
-    if (url.origin !== base.origin || !url.pathname.startsWith(base.pathname)) {
-        throw new BakeError(`error: manifest.json: the output path ${JSON.stringify(path)} leaves the bake folder`);
-    }
-    return url;
-}
-
-async function fetchBytes(url, what) {
-    const response = await fetch(url);
-    if (!response.ok) {
-        throw new BakeError(`error: ${what}: HTTP ${response.status} fetching ${url}`);
-    }
-    return new Uint8Array(await response.arrayBuffer());
-}
-
-async function sha256Hex(bytes) {
-    if (!globalThis.crypto?.subtle) {
-        return null;
-    }
-    const digest = new Uint8Array(await crypto.subtle.digest('SHA-256', bytes));
-    return Array.from(digest, (b) => b.toString(16).padStart(2, '0')).join('');
-}
-
-/**
- * A data texture of the bake (KTX2, one level, R32_SFLOAT or R32G32B32A32_SFLOAT, 2D, 2D array or
- * 3D) as a three.js texture read with texelFetch: nearest filtering, no mipmaps, no flip (row 0
- * of the file is row 0 of the texture).
- */
-export function dataTexture(bytes, name) {
-    let container;
-    try {
-        container = readKtx2(bytes);
-    } catch (e) {
-        throw new BakeError(`error: ${name}: not a ktx2 file: ${e.message}`);
-    }
-    const { vkFormat, pixelWidth: w, pixelHeight: h, pixelDepth: d, layerCount: layers, levels } = container;
-    const channels = { [VK_FORMAT_R32_SFLOAT]: 1, [VK_FORMAT_R32G32B32A32_SFLOAT]: 4 }[vkFormat];
-    if (!channels || container.supercompressionScheme !== 0 || levels.length !== 1 || container.faceCount !== 1) {
-        throw new BakeError(`error: ${name}: expected one level of r32f or rgba32f texels, found vkFormat ${vkFormat}`);
-    }
-    const level = levels[0].levelData;
-    const expected = 4 * channels * w * Math.max(h, 1) * Math.max(d, 1) * Math.max(layers, 1);
-    if (level.byteLength !== expected) {
-        throw new BakeError(`error: ${name}: level 0 holds ${level.byteLength} bytes, expected ${expected}`);
-    }
-    // Copied so that the floats are aligned whatever the level's offset in the file.
-    const data = new Float32Array(level.slice().buffer);
-    const format = channels === 1 ? THREE.RedFormat : THREE.RGBAFormat;
-    let texture;
-    if (d > 0) {
-        texture = new THREE.Data3DTexture(data, w, h, d);
-    } else if (layers > 0) {
-        texture = new THREE.DataArrayTexture(data, w, h, layers);
-    } else {
-        texture = new THREE.DataTexture(data, w, h);
-    }
-    texture.format = format;
-    texture.type = THREE.FloatType;
-    texture.minFilter = THREE.NearestFilter;
-    texture.magFilter = THREE.NearestFilter;
-    texture.generateMipmaps = false;
-    texture.flipY = false;
-    texture.unpackAlignment = 4;
-    texture.needsUpdate = true;
-    return texture;
-}
-
-/**
- * Reads the bake at `url` (a folder served over HTTP, with or without the trailing `/`): its
- * `manifest.json`, then every engine texture the manifest lists (by role, resolved inside the
- * folder, its size and, where the page has WebCrypto, its SHA-256 checked against the manifest).
- */
-export async function loadBake(url) {
-    const base = new URL(String(url).endsWith('/') ? String(url) : `${url}/`, globalThis.location?.href);
-    const manifestBytes = await fetchBytes(new URL('manifest.json', base), 'manifest.json');
-    let manifest;
-    try {
-        manifest = JSON.parse(new TextDecoder().decode(manifestBytes));
-    } catch (e) {
-        throw new BakeError(`error: ${base}manifest.json: not json: ${e.message}`);
-    }
-    const stage = (manifest.stages ?? []).find((s) => s.name === STAGE);
-    if (!stage) {
-        throw new BakeError(
-            `error: ${base}manifest.json: the bake has no engine textures: bake it with brdf-bake --engine-textures`,
-        );
-    }
-    const textures = {};
-    await Promise.all(
-        Object.entries(TEXTURES).map(async ([role, uniform]) => {
-            const output = stage.outputs.find((o) => o.role === role);
-            if (!output) {
-                throw new BakeError(`error: ${base}manifest.json: the engine textures have no ${role} output`);
-            }
-            const fileUrl = resolveInside(base, output.path);
-            const bytes = await fetchBytes(fileUrl, output.path);
-            if (bytes.byteLength !== output.size_bytes) {
-                throw new BakeError(
-                    `error: ${fileUrl}: ${bytes.byteLength} bytes, the manifest says ${output.size_bytes}`,
-                );
-            }
-            const hash = await sha256Hex(bytes);
-            if (hash !== null && hash !== output.sha256) {
-                throw new BakeError(`error: ${fileUrl}: not the file the manifest describes (its sha256 differs)`);
-            }
-            textures[uniform] = dataTexture(bytes, String(fileUrl));
-        }),
-    );
-    return new Bake(manifest, stage.figures, textures);
+export async function loadBake(url, options = {}) {
+    const { manifest, figures, textures } = await readBake(url, options);
+    return new Bake(manifest, figures, textures);
 }
 
 /** A loaded bake: its manifest, the engine textures' figures and the textures. */
@@ -265,13 +135,6 @@ export class Bake {
         const defaults = this.defaults(mode);
         spp = spp ?? defaults.spp;
         frames = frames ?? defaults.frames;
-        const diffuse = f.diffuse;
-        if (!(Array.isArray(diffuse) && diffuse.length === 3 && diffuse.every((v) => Number.isFinite(v) && v >= 0))) {
-            throw new BakeError(
-                `error: manifest.json: the engine textures' diffuse is ${JSON.stringify(diffuse)}, expected three ` +
-                    'finite values of at least 0 (a bake older than this loader: bake it again)',
-            );
-        }
         if (!(spp > 0 && (spp & (spp - 1)) === 0 && f.samples % spp === 0)) {
             throw new BakeError(`error: spp ${spp} must be a power of two dividing the bake's ${f.samples} samples`);
         }
@@ -287,7 +150,7 @@ export class Bake {
             uRows: { value: f.rows },
             uSectors: { value: f.sectors },
             uPeaks: { value: Boolean(f.peaks) },
-            uDiffuse: { value: new THREE.Vector3(...diffuse) },
+            uDiffuse: { value: new THREE.Vector3(...f.diffuse) },
             uFirstFrame: { value: firstFrame },
             uFrameCount: { value: frames },
             uDivisor: { value: divisor ?? frames },
