@@ -24,6 +24,7 @@ import {
     SURFACE_VERTEX,
 } from './shade.glsl.js';
 
+export { Accumulator } from './live.js';
 export { BakeError, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
 
 /** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
@@ -96,6 +97,8 @@ export class Bake {
             clipping: true,
             uniforms: this.shadingUniforms(options),
         });
+        // What the live mode (Accumulator) looks for, and the frame it counts from.
+        material.userData.brdfBake = { firstFrame: options.firstFrame ?? 0 };
         material.onBeforeRender = (renderer, scene) => {
             const u = material.uniforms;
             resolution(renderer, u.uResolution.value);

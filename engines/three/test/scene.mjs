@@ -17,6 +17,9 @@
 //   skinned to a bone against a mesh moved as the bone (three's chunks in the vertex shader);
 // - orthographic_psnr_db: the material seen by an orthographic camera against a perspective one
 //   4000 units away (rays parallel within 3e-4 radians);
+// - live_largest_relative_difference, live_frames, live_frames_after_moving: the live mode
+//   (Accumulator): the mean of 8 calls against one draw of the same 8 frames (linear values), the
+//   frames it holds, and after the camera moved;
 // - tone_mapping_levels: the material drawn to the canvas under ACES filmic (exposure 1.7) and no
 //   tone mapping, against three's formulas applied to its linear radiance read back as floats:
 //   the largest difference in 8-bit levels and how many values differ by more than one.
@@ -108,6 +111,13 @@ function levels(a, b) {
     return { max, beyond_one: beyondOne };
 }
 
+// The largest |a - b| / max(|b|, 1e-6) over the linear values of two pictures.
+function largestRelativeDifference(a, b) {
+    let largest = 0;
+    for (let i = 0; i < a.length; i++) largest = Math.max(largest, Math.abs(a[i] - b[i]) / Math.max(Math.abs(b[i]), 1e-6));
+    return largest;
+}
+
 // Two pictures side by side with a 4-pixel grey gap.
 function sideBySide(a, b) {
     const gap = 4;
@@ -156,6 +166,7 @@ try {
     files.push(pair('instances', 'instances-instanced', 'instances-separate'));
     files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
     files.push(pair('orthographic', 'orthographic-orthographic', 'orthographic-distant'));
+    files.push(pair('live', 'live-accumulated', 'live-drawn'));
     const linear = result.pictures['mirror-bake'];
     const canvases = Object.fromEntries(
         ['aces', 'none'].map((t) => {
@@ -178,6 +189,9 @@ try {
         instances_psnr_db: psnrDb(pictures['instances-instanced'], pictures['instances-separate']),
         skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
         orthographic_psnr_db: psnrDb(pictures['orthographic-orthographic'], pictures['orthographic-distant']),
+        live_largest_relative_difference: largestRelativeDifference(result.pictures['live-accumulated'], result.pictures['live-drawn']),
+        live_frames: result.live.frames,
+        live_frames_after_moving: result.live.framesAfterMoving,
         tone_mapping_levels: canvases,
         files,
     }));
