@@ -1,22 +1,27 @@
-// The example page (index.html): a bake on brdf-preview's sphere, the environment behind it,
-// orbit by dragging, the mode switch, and the milliseconds per frame of each picture.
+// The example page (index.html): a bake on brdf-preview's sphere, the environment behind it, in
+// the live mode (Accumulator): one frame of the mode's samples per animation frame, averaged
+// while the view is still, up to `?frames=N` (default 256). Drag to orbit (the average starts
+// again), switch modes; the status line gives the frames averaged and the milliseconds of the
+// last one. brdf-preview's axes (+z up) and look: three's Reinhard tone mapping at the bake's
+// automatic exposure and sRGB output are brdf-preview's tone map.
 import * as THREE from 'three';
-import { loadBake, orbitCamera, previewSphere, setOrbit } from './src/index.js';
+import { Accumulator, loadBake, orbitCamera, previewSphere, setOrbit } from './src/index.js';
 
 const canvas = document.getElementById('view');
 const status = document.getElementById('status');
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
 renderer.setSize(canvas.width, canvas.height, false);
+renderer.toneMapping = THREE.ReinhardToneMapping;
 const camera = orbitCamera(canvas.width / canvas.height);
 const view = { azimuth: 0, elevation: 0 };
+const orientation = 'brdf-preview';
 let current = null;
-const look = { orientation: 'brdf-preview', output: 'brdf-preview' };
 
 const params = new URLSearchParams(location.search);
 document.getElementById('bake').value = params.get('bake') ?? '/target/demo/bake/';
 if (params.get('mode')) document.querySelector(`input[name=mode][value=${CSS.escape(params.get('mode'))}]`).checked = true;
-if (params.get('frames')) document.getElementById('frames').value = params.get('frames');
+const live = new Accumulator(renderer, { maxFrames: Number(params.get('frames') ?? 256) });
 
 function mode() {
     return document.querySelector('input[name=mode]:checked').value;
@@ -28,39 +33,44 @@ async function load() {
     try {
         const bake = await loadBake(url);
         current?.bake.dispose();
+        renderer.toneMappingExposure = 2 ** bake.figures.exposure_ev;
         const scene = new THREE.Scene();
-        // brdf-preview's sphere and camera, so brdf-preview's axes (+z up) and picture.
-        scene.add(bake.createBackground(look));
-        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), ...look }));
+        scene.add(bake.createBackground({ orientation }));
+        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), orientation }));
         scene.add(mesh);
         current = { bake, scene, mesh };
-        draw();
+        live.reset();
     } catch (e) {
         status.textContent = e.message;
     }
 }
 
-// One picture: the frames of the chosen mode, timed to the end of the draw (a one-pixel read
-// waits for it).
-function draw() {
+function setMode(m) {
+    document.querySelector(`input[name=mode][value=${CSS.escape(m)}]`).checked = true;
     if (!current) return;
-    const { bake, scene, mesh } = current;
-    const m = mode();
-    const defaults = bake.defaults(m);
-    const frames = document.getElementById('frames').value === '1' ? 1 : defaults.frames;
-    mesh.material.dispose();
-    mesh.material = bake.createMaterial({ mode: m, frames, ...look });
+    current.mesh.material.dispose();
+    current.mesh.material = current.bake.createMaterial({ mode: m, orientation });
+    live.reset();
+}
+
+// One animation frame: the next frame of samples added (until maxFrames), timed to the end of
+// the draw (a one-pixel read waits for it).
+function tick() {
+    if (!current) return;
+    const { bake, scene } = current;
     setOrbit(camera, view.azimuth, view.elevation);
-    const gl = renderer.getContext();
+    const adding = live.frames < live.maxFrames;
     const start = performance.now();
-    renderer.render(scene, camera);
-    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+    live.render(scene, camera);
+    renderer.getContext().readPixels(0, 0, 1, 1, WebGL2RenderingContext.RGBA, WebGL2RenderingContext.UNSIGNED_BYTE, new Uint8Array(4));
+    if (!adding) return;
     const ms = performance.now() - start;
+    const m = mode();
     const names = `${bake.manifest.material.name} under ${bake.manifest.environment?.name}`;
     status.textContent =
-        `${names} | ${m} | ${defaults.spp} spp x ${frames} frames\n` +
+        `${names} | ${m} | ${bake.defaults(m).spp} spp x ${live.frames} frames (live, up to ${live.maxFrames})\n` +
         `${canvas.width}x${canvas.height} | exposure ${bake.figures.exposure_ev.toFixed(2)} EV\n` +
-        `${(ms / frames).toFixed(1)} ms per frame (${ms.toFixed(0)} ms for the picture) | camera ${view.azimuth.toFixed(0)},${view.elevation.toFixed(0)}`;
+        `${ms.toFixed(1)} ms per frame | camera ${view.azimuth.toFixed(0)},${view.elevation.toFixed(0)}`;
 }
 
 let drag = null;
@@ -68,15 +78,16 @@ canvas.addEventListener('pointerdown', (e) => {
     drag = { x: e.clientX, y: e.clientY, azimuth: view.azimuth, elevation: view.elevation };
     canvas.setPointerCapture(e.pointerId);
 });
-canvas.addEventListener('pointerup', (e) => {
+canvas.addEventListener('pointermove', (e) => {
     if (!drag) return;
     view.azimuth = drag.azimuth - (e.clientX - drag.x) * 0.5;
     view.elevation = Math.max(-89, Math.min(89, drag.elevation + (e.clientY - drag.y) * 0.5));
+});
+canvas.addEventListener('pointerup', () => {
     drag = null;
-    draw();
 });
 document.getElementById('load').addEventListener('click', load);
-document.querySelectorAll('input[name=mode]').forEach((r) => r.addEventListener('change', draw));
-document.getElementById('frames').addEventListener('change', draw);
-window.brdfExample = { draw, view, setMode: (m) => { document.querySelector(`input[value=${m}]`).checked = true; draw(); } };
+document.querySelectorAll('input[name=mode]').forEach((r) => r.addEventListener('change', () => setMode(mode())));
+window.brdfExample = { view, setMode, live };
+renderer.setAnimationLoop(tick);
 load();

@@ -2,7 +2,7 @@
 // the environment behind it, the mode switch and the milliseconds per frame.
 //
 //   node test/screenshot.mjs --bake DIR --out FILE.png [--mode reference|prefiltered]
-//        [--camera AZ,EL] [--chromium PATH]
+//        [--camera AZ,EL] [--frames N] [--chromium PATH]
 import { existsSync, realpathSync } from 'node:fs';
 import { resolve } from 'node:path';
 
@@ -27,15 +27,21 @@ try {
     await page.setViewport({ width: 760, height: 640 });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(`${origin}/engines/three/index.html?bake=/bake/&mode=${args.mode}&frames=1`);
-    await page.waitForFunction(() => /ms per frame/.test(document.getElementById('status').textContent), { timeout: 0 });
+    // The live average stopped after --frames frames (default 2), at the camera asked for.
+    const frames = Number(args.frames ?? 2);
+    await page.goto(`${origin}/engines/three/index.html?bake=/bake/&mode=${args.mode}&frames=${frames}`);
+    await page.waitForFunction(() => window.brdfExample !== undefined, { timeout: 0 });
     const [azimuth, elevation] = args.camera.split(',').map(Number);
-    await page.evaluate((m, az, el) => {
-        document.getElementById('frames').value = '1';
+    await page.evaluate((az, el) => {
         window.brdfExample.view.azimuth = az;
         window.brdfExample.view.elevation = el;
-        window.brdfExample.setMode(m);
-    }, args.mode, azimuth, elevation);
+    }, azimuth, elevation);
+    await page.waitForFunction(
+        (az, n) => window.brdfExample.live.frames >= n && document.getElementById('status').textContent.includes(`camera ${az},`),
+        { timeout: 0 },
+        azimuth.toFixed(0),
+        frames,
+    );
     await page.screenshot({ path: args.out });
     console.log(await page.evaluate(() => document.getElementById('status').textContent));
     if (errors.length > 0) throw new Error(errors.join('; '));
