@@ -249,8 +249,8 @@ fn engine_textures_need_an_environment() {
 ///   (measured: the same row).
 /// - A sphere squashed by its mesh's scale is drawn as the same shape made in its geometry: at
 ///   least 60 dB (measured 92.0; with normals turned by the model matrix instead of its inverse
-///   transpose, 22.6). Likewise an `InstancedMesh` of 100 against 100 meshes (measured 90.3) and
-///   a sphere skinned to a bone against a mesh moved as the bone (89.0).
+///   transpose, 22.6). Likewise an `InstancedMesh` of 100 against 100 meshes (measured 90.3-92.0)
+///   and a sphere skinned to a bone against a mesh moved as the bone (88.1-89.0).
 /// - An orthographic camera draws as a perspective one 4000 units away (rays parallel within
 ///   3e-4 radians): at least 50 dB (measured 58.4; with the eye at the camera's position, as for
 ///   a perspective camera, 30.0).

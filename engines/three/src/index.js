@@ -12,6 +12,7 @@
 
 import * as THREE from 'three';
 
+import { floatTarget } from './live.js';
 import { BakeError, readBake } from './loader.js';
 
 import {
@@ -300,15 +301,7 @@ const worldTurn = new THREE.Matrix3();
  * frames. `createDeferred` shades from it.
  */
 export function exactCoverage(renderer, geometry, camera, width, height, scale = 16) {
-    const target = new THREE.WebGLRenderTarget(scale * width, scale * height, {
-        count: 2,
-        type: THREE.FloatType,
-        format: THREE.RGBAFormat,
-        depthBuffer: true,
-        minFilter: THREE.NearestFilter,
-        magFilter: THREE.NearestFilter,
-        generateMipmaps: false,
-    });
+    const target = floatTarget(scale * width, scale * height, 2);
     const material = new THREE.RawShaderMaterial({
         name: 'brdf-bake g-buffer',
         glslVersion: THREE.GLSL3,

@@ -36,8 +36,10 @@ void main() {
 }
 `;
 
-function floatTarget(width, height) {
+/** A float RGBA render target read texel by texel (nearest, no mipmaps), with `count` textures. */
+export function floatTarget(width, height, count = 1) {
     return new THREE.WebGLRenderTarget(width, height, {
+        count,
         type: THREE.FloatType,
         format: THREE.RGBAFormat,
         depthBuffer: true,

@@ -17,7 +17,7 @@
 import { existsSync, realpathSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 
-import { launch, png, serve } from './serve.mjs';
+import { launch, openPage, png, serve } from './serve.mjs';
 
 
 function fail(message) {
@@ -59,14 +59,7 @@ const server = await serve(bakeDir);
 const origin = `http://127.0.0.1:${server.address().port}`;
 const browser = await launch(args.chromium).catch((e) => fail(e.message));
 try {
-    const page = await browser.newPage();
-    const errors = [];
-    page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
-    page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(`${origin}/engines/three/test/render.html`);
-    await page.waitForFunction('window.ready === true', { timeout: 60000 }).catch(() => {
-        fail(`the test page did not load: ${errors.join('; ')}`);
-    });
+    const { page, errors } = await openPage(browser, `${origin}/engines/three/test/render.html`).catch((e) => fail(e.message));
     const result = await page.evaluate((options) => window.renderBake(options), {
         bake: `${origin}/bake/`,
         mode: args.mode,

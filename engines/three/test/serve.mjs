@@ -59,6 +59,23 @@ export async function launch(executable) {
     });
 }
 
+/**
+ * A new page of `browser` at `url` (one of this package's test pages), once it has set
+ * `window.ready`; the errors it reports (console errors and uncaught exceptions) collect in
+ * `errors`. Rejects with them if it does not get ready within a minute.
+ */
+export async function openPage(browser, url) {
+    const page = await browser.newPage();
+    const errors = [];
+    page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(url);
+    await page.waitForFunction('window.ready === true', { timeout: 60000 }).catch(() => {
+        throw new Error(`the test page did not load: ${errors.join('; ')}`);
+    });
+    return { page, errors };
+}
+
 const CRC_TABLE = Array.from({ length: 256 }, (_, n) => {
     let c = n;
     for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
