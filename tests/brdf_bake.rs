@@ -403,9 +403,9 @@ fn validation_problems_survive_an_up_to_date_rerun() {
 }
 
 /// A table whose values no material has (one cell reflecting hundreds of times the light it
-/// receives, which the albedo at merl-info's four elevations misses; every cell at 1e30) is a
-/// validation problem: exit 1, the problem with its figures, nothing written, the previous bake
-/// kept.
+/// receives, which the albedo at merl-info's four elevations misses; every cell at 1e30; every
+/// cell at an albedo of 31) is a validation problem: exit 1, the problem with its figures, nothing
+/// written, the previous bake kept.
 #[test]
 fn an_unphysical_table_is_refused_before_anything_is_baked() {
     let tmp = temp_dir();
@@ -422,8 +422,17 @@ fn an_unphysical_table_is_refused_before_anything_is_baked() {
     let cell = dims.index(merl::Cell { theta_h: 0, theta_d: 68, phi_d: 105 });
     let mut one_cell = table.raw().to_vec();
     (0..3).for_each(|c| one_cell[c * dims.cells() + cell] = 1e15);
+    // Every cell at 1e30: each reflects more than it receives, found by the cells' pass. Every
+    // cell at 10 / sr: an albedo of about 31, each cell's share 0.013 (a Lambertian's 4.2e-4 per
+    // unit albedo), found by the importance stage's quadrature, before anything is written.
     let all = vec![1e30; table.raw().len()];
-    for (name, raw, expect) in [("one-cell", one_cell, "on its own it reflects"), ("all", all, "albedo above 2")] {
+    let bright: Vec<f64> = (0..table.raw().len()).map(|i| 10.0 / merl::SCALE[i / dims.cells()]).collect();
+    let cases = [
+        ("one-cell", one_cell, "on its own it reflects"),
+        ("all", all, "on its own it reflects"),
+        ("bright", bright, "albedo above 2 at theta_o 0 deg"),
+    ];
+    for (name, raw, expect) in cases {
         let path = tmp.path().join(format!("{name}.binary"));
         std::fs::write(&path, merl::MerlTable::from_raw(dims, raw).unwrap().to_bytes()).unwrap();
         let mut cmd = command(&path);

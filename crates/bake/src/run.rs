@@ -215,8 +215,9 @@ pub fn run_bake(
     // previous one as it was.
     let table = merl::MerlTable::parse(&material_bytes).map_err(|e| Error::read(&config.material, e))?;
     drop(material_bytes);
-    let summary = merl::summary::summarize(&table, merl::Interp::Trilinear, merl::albedo::Quadrature::default());
-    let problems = crate::stage::material_info::unphysical(&summary);
+    // The cells' pass finds a value no material has; the albedo waits for the importance stage's
+    // quadrature, below (a refusal then drops what was staged: the folder is left as it was).
+    let problems = crate::stage::material_info::unphysical(&merl::summary::summarize_cells(&table));
     if !problems.is_empty() {
         return Err(Error::Unphysical { path: config.material.clone(), problems });
     }
@@ -258,7 +259,12 @@ pub fn run_bake(
     let work = |done: u64, total: u64| progress(Progress::Work { done, total });
 
     begin("importance samples");
-    record(importance::run(&table, &material_source, program, &config.importance, true)?, &mut manifest)?;
+    let (staged, albedo) = importance::run_measured(&table, &material_source, program, &config.importance, true)?;
+    let unphysical = crate::stage::material_info::unphysical_albedo(&albedo);
+    if !unphysical.is_empty() {
+        return Err(Error::Unphysical { path: config.material.clone(), problems: unphysical });
+    }
+    record(staged, &mut manifest)?;
     begin("bandwidth atlas");
     let lobes = (config.atlas.lobes * config.atlas.lobes) as u64;
     let done = std::sync::atomic::AtomicU64::new(0);

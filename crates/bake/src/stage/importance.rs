@@ -29,6 +29,21 @@ pub fn run(
     config: &Config,
     measure: bool,
 ) -> Result<Staged, Error> {
+    run_measured(table, source, program, config, measure).map(|(staged, _)| staged)
+}
+
+/// The directional albedo at measured slices: `theta_o` in degrees, RGB.
+pub type Albedos = Vec<(f64, [f64; 3])>;
+
+/// [`run`], and with `measure` the directional albedo its quadrature found at each measured slice
+/// (nearest lookups): what a bake holds to `UNPHYSICAL_LIMIT`.
+pub fn run_measured(
+    table: &MerlTable,
+    source: &Source,
+    program: &Program,
+    config: &Config,
+    measure: bool,
+) -> Result<(Staged, Albedos), Error> {
     let tables = importance::build(table, config).map_err(|e| Error::stage("importance", e))?;
     let payload = payload(config, &tables);
     let provenance = source.provenance(program, &provenance_parameters(config));
@@ -49,8 +64,10 @@ pub fn run(
         config.n_theta_o, config.n_theta_o, config.n_vectors, config.n_samples
     )];
     let mut problems = Vec::new();
+    let mut albedo = Vec::new();
     if measure {
         let measured = measure_slices(table, &tables, &shown);
+        albedo.extend(measured.iter().map(|m| (m.theta_o_deg, m.albedo)));
         report.extend(report_lines(&measured));
         for m in &measured {
             if m.rv > RV_LIMIT {
@@ -62,7 +79,7 @@ pub fn run(
         }
         figures.insert("measured".into(), json!(measured.iter().map(Measured::json).collect::<Vec<_>>()));
     }
-    Ok(Staged {
+    let staged = Staged {
         name: "importance",
         parameters: object([
             ("theta_o", json!(config.n_theta_o)),
@@ -81,7 +98,8 @@ pub fn run(
         ],
         report,
         problems,
-    })
+    };
+    Ok((staged, albedo))
 }
 
 /// The slices nearest to [`SHOWN_DEG`], without repeats.

@@ -60,22 +60,35 @@ fn interp_name(interp: Interp) -> &'static str {
 }
 
 /// Why a table with `s` for its summary is not a material (values no measurement gives), in the
-/// words of the validation problems (`merl-info`'s); empty when it may be baked.
+/// words of the validation problems (`merl-info`'s); empty when it may be baked. A bake takes the
+/// summary of the cells alone (`merl::summary::summarize_cells`: the cell share) before anything
+/// else, and the albedo from the importance stage's quadrature ([`unphysical_albedo`]), which
+/// computes it anyway.
 pub fn unphysical(s: &Summary) -> Vec<String> {
     energy_problems(s, UNPHYSICAL_LIMIT)
 }
 
+/// Why directional albedos `(theta_o in degrees, RGB)` are not a material's: each above
+/// [`UNPHYSICAL_LIMIT`] (or NaN), in the words of [`unphysical`].
+pub fn unphysical_albedo(albedo: &[(f64, [f64; 3])]) -> Vec<String> {
+    albedo_problems(albedo.iter().copied(), UNPHYSICAL_LIMIT)
+}
+
+fn albedo_problems(albedo: impl Iterator<Item = (f64, [f64; 3])>, limit: f64) -> Vec<String> {
+    albedo
+        .filter(|(_, rgb)| rgb.iter().any(|v| v.is_nan() || *v > limit))
+        .map(|(deg, rgb)| {
+            format!(
+                "albedo above {limit} at theta_o {deg} deg ({:.4e} {:.4e} {:.4e}): the table reflects more than it receives",
+                rgb[0], rgb[1], rgb[2]
+            )
+        })
+        .collect()
+}
+
 /// The albedos and the cell share above `limit`.
 fn energy_problems(s: &Summary, limit: f64) -> Vec<String> {
-    let mut out = Vec::new();
-    for (deg, a) in &s.albedo {
-        if a.rgb.iter().any(|v| v.is_nan() || *v > limit) {
-            out.push(format!(
-                "albedo above {limit} at theta_o {deg} deg ({:.4e} {:.4e} {:.4e}): the table reflects more than it receives",
-                a.rgb[0], a.rgb[1], a.rgb[2]
-            ));
-        }
-    }
+    let mut out = albedo_problems(s.albedo.iter().map(|(deg, a)| (*deg, a.rgb)), limit);
     if let Some(c) = s.largest_share.filter(|c| c.share.is_nan() || c.share > limit) {
         out.push(format!(
             "cell ({}, {}, {}) (theta_i {:.1} deg, theta_o {:.1} deg) holds {:.4e} {:.4e} {:.4e} 1/sr: on its own it \
