@@ -129,12 +129,13 @@ target/merl/%.binary: | setup-python
 
 ## bench: every benchmark (scripts/benchmarks.py lists them: timings against baselines measured in
 ## the same run, the equal-quality benchmark of the adaptive modes on the GPU, lavapipe
-## without one, and the outside referee, the CPU renderer against Mitsuba 3), each report
-## written into docs/benchmarks.md stamped with the commit and the machine; BENCH="stages atlas"
-## runs some and keeps the other sections. About 90 minutes the first time on 2 cores (the
-## adaptive and Mitsuba benchmarks keep their bakes, converged images and renders under
-## target/bench-adaptive/ and target/bench-mitsuba/), 30 after.
-bench: setup-gpu setup-mitsuba test-data
+## without one, the outside referee, the CPU renderer against Mitsuba 3, and the three.js
+## material against three.js's own in Chromium), each report written into docs/benchmarks.md
+## stamped with the commit and the machine; BENCH="stages atlas" runs some and keeps the other
+## sections. About 100 minutes the first time on 2 cores (the adaptive and Mitsuba benchmarks
+## keep their bakes, converged images and renders under target/bench-adaptive/ and
+## target/bench-mitsuba/), 40 after.
+bench: setup-gpu setup-mitsuba setup-node setup-chromium test-data
 	python3 scripts/benchmarks.py $(BENCH)
 
 ## three-cases: the three.js material in headless Chromium against brdf-preview on the issue's six

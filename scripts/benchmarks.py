@@ -47,6 +47,7 @@ BENCHMARKS = [
         "markdown",
     ),
     ("mitsuba", "The CPU renderer against Mitsuba 3", "cargo bench -p brdf-preview --bench mitsuba", "markdown"),
+    ("frontier", "The three.js material against three.js's own", "node engines/three/bench/frontier.mjs", "markdown"),
 ]
 
 HEADER = """# Benchmarks

@@ -208,6 +208,29 @@ export class Bake {
         });
     }
 
+    /**
+     * The bake's environment (level 0 of engine-environment.ktx2) as the equirectangular texture
+     * a three.js user loads from the HDR for `scene.environment` or `scene.background`: rows from
+     * the bottom (three's v runs up), linear, filtered; what the material's default orientation
+     * lines up with. The caller disposes it.
+     */
+    environmentTexture() {
+        const image = this.textures.uEnvironment.image;
+        const { width, height } = image;
+        const rowLength = 4 * width;
+        const data = new Float32Array(rowLength * height);
+        for (let y = 0; y < height; y++) {
+            data.set(image.data.subarray(y * rowLength, (y + 1) * rowLength), (height - 1 - y) * rowLength);
+        }
+        const texture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+        texture.mapping = THREE.EquirectangularReflectionMapping;
+        texture.colorSpace = THREE.LinearSRGBColorSpace;
+        texture.minFilter = THREE.LinearFilter;
+        texture.magFilter = THREE.LinearFilter;
+        texture.needsUpdate = true;
+        return texture;
+    }
+
     textureUniforms() {
         return Object.fromEntries(Object.entries(this.textures).map(([name, texture]) => [name, { value: texture }]));
     }

@@ -1,0 +1,118 @@
+// The frontier benchmark: what the bake's three.js material costs and gains against three.js's
+// own materials, in headless Chromium (WebGL 2 on SwiftShader, the same software GPU on every
+// machine: costs are ratios to MeshStandardMaterial's frame in the same run).
+//
+//   node bench/frontier.mjs [--size N] [--timing-size N] [--truth-frames N] [--chromium PATH]
+//
+// About a minute and a half per case on 2 cores.
+//
+// Cases: a plastic (gray-plastic), a metal (steel) and a felt-like diffuse (pink-fabric) of the
+// shared real-derived tables, under quarry_01 (a sun) and studio_small_03 (indoor); each baked
+// with `brdf-bake --engine-textures` (release build, into target/bench-frontier/) and drawn on a
+// sphere in a y-up three.js scene lit by the bake's map (engines/three/bench/frontier.html):
+// - the truth: the bake's reference estimator, 64 samples per strategy x --truth-frames frames;
+// - MeshStandardMaterial and MeshPhysicalMaterial (scene.environment: three's PMREM of the same
+//   map) at parameters fitted to the truth's picture (the page says how);
+// - the bake's prefiltered estimator, one frame of 1, 4 and 16 samples, and the live mode after
+//   the time of 8 standard frames.
+// PSNR over the sphere's pixels at --size (128), tone mapped as brdf-preview maps them (Reinhard
+// at the bake's automatic exposure, sRGB); milliseconds per frame at --timing-size (512).
+// Prints the report as markdown. Needs target/merl (make test-data), Chromium and engines/three's
+// packages (make setup).
+import { execFileSync } from 'node:child_process';
+import { existsSync, mkdirSync, realpathSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+import { launch, openPage, serve } from '../test/serve.mjs';
+
+const ROOT = resolve(fileURLToPath(new URL('.', import.meta.url)), '../../..');
+const MATERIALS = [['gray-plastic', 'a plastic'], ['steel', 'a metal'], ['pink-fabric', 'a felt-like diffuse']];
+const MAPS = ['quarry_01_1k', 'studio_small_03_1k'];
+
+function fail(message) {
+    console.error(`error: ${message}`);
+    process.exit(2);
+}
+
+const args = { size: 128, 'timing-size': 512, 'truth-frames': 16, chromium: process.env.CHROMIUM ?? '/usr/bin/chromium' };
+for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
+for (const k of ['size', 'timing-size', 'truth-frames']) args[k] = Number(args[k]);
+
+const out = join(ROOT, 'target/bench-frontier');
+mkdirSync(out, { recursive: true });
+console.error('building brdf-bake (release)');
+execFileSync('cargo', ['build', '--quiet', '--release', '-p', 'brdf-bake'], { cwd: ROOT, stdio: 'inherit' });
+const bakes = [];
+for (const [material, what] of MATERIALS) {
+    const table = join(ROOT, 'target/merl', `${material}.binary`);
+    if (!existsSync(table)) fail(`${table} does not exist: make test-data makes it`);
+    for (const map of MAPS) {
+        const dir = join(out, `${material}-${map}`);
+        console.error(`baking ${material} under ${map}`);
+        const env = join(ROOT, '../shared/data/env', `${map}.hdr`);
+        try {
+            execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', '--quiet'], { stdio: ['ignore', 'ignore', 'inherit'] });
+        } catch (e) {
+            // Exit 1 is a validation problem (the bake is written); anything else is an error.
+            if (e.status !== 1) fail(`baking ${material} under ${map}: exit ${e.status}`);
+        }
+        bakes.push({ material, what, map: map.replace(/_1k$/, ''), dir: realpathSync(dir) });
+    }
+}
+
+const browser = await launch(args.chromium).catch((e) => fail(e.message));
+const rows = [];
+let renderer = '';
+try {
+    for (const bake of bakes) {
+        console.error(`drawing ${bake.material} under ${bake.map}`);
+        const server = await serve(bake.dir);
+        const origin = `http://127.0.0.1:${server.address().port}`;
+        try {
+            const { page, errors } = await openPage(browser, `${origin}/engines/three/bench/frontier.html`).catch((e) => fail(e.message));
+            const r = await page
+                .evaluate((o) => window.frontier(o), {
+                    bake: `${origin}/bake/`,
+                    size: args.size,
+                    timingSize: args['timing-size'],
+                    truthFrames: args['truth-frames'],
+                    timingDraws: 3,
+                })
+                .catch((e) => fail(`${bake.material} under ${bake.map}: ${e.message}; ${errors.join('; ')}`));
+            renderer ||= await page.evaluate(() => {
+                const gl = document.createElement('canvas').getContext('webgl2');
+                const debug = gl.getExtension('WEBGL_debug_renderer_info');
+                return gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER);
+            });
+            await page.close();
+            rows.push({ ...bake, r });
+        } finally {
+            server.close();
+        }
+    }
+} finally {
+    await browser.close();
+}
+
+const f = (v, d = 1) => v.toFixed(d);
+console.log(`### The three.js material against three's own (Chromium, ${renderer})\n`);
+console.log(
+    `PSNR in dB over the sphere's pixels at ${args.size} x ${args.size} against the bake's reference estimator at 64 samples per ` +
+        `strategy x ${args['truth-frames']} frames, tone mapped as brdf-preview maps them; cost: milliseconds per frame at ` +
+        `${args['timing-size']} x ${args['timing-size']} over MeshStandardMaterial's (its ms in brackets). Three's materials are ` +
+        `fitted to the truth's picture (engines/three/bench/frontier.html: metalness and roughness on a grid, the colour by least ` +
+        `squares, clearcoat for MeshPhysicalMaterial); live: the mean of the 1-sample frames drawn in the time of 8 standard frames.\n`,
+);
+console.log('| material | map | standard dB (metalness, roughness) | physical dB (clearcoat, its roughness) | measured 1 / 4 / 16 spp dB | cost 1 / 4 / 16 spp | physical cost | live: frames, dB |');
+console.log('|---|---|---:|---:|---:|---:|---:|---:|');
+for (const { material, what, map, r } of rows) {
+    const s = r.ms.standard;
+    console.log(
+        `| ${material} (${what}) | ${map} | ${f(r.standard.psnr)} (${r.standard.params.metalness}, ${f(r.standard.params.roughness, 2)}) ` +
+            `| ${f(r.physical.psnr)} (${r.physical.params.clearcoat}, ${r.physical.params.clearcoatRoughness}) ` +
+            `| ${f(r.measured[1])} / ${f(r.measured[4])} / ${f(r.measured[16])} ` +
+            `| ${f(r.ms.measured[1] / s)} / ${f(r.ms.measured[4] / s)} / ${f(r.ms.measured[16] / s)} (${f(s)} ms) ` +
+            `| ${f(r.ms.physical / s, 2)} | ${r.live.frames}, ${f(r.live.psnr)} |`,
+    );
+}
