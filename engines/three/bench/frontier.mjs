@@ -9,7 +9,7 @@
 // Cases: a plastic (gray-plastic), a metal (steel) and a felt-like diffuse (pink-fabric) of the
 // shared real-derived tables, under quarry_01 (a sun) and studio_small_03 (indoor); each baked
 // with `brdf-bake --engine-textures` (release build, into target/bench-frontier/) and drawn on a
-// sphere in a y-up three.js scene lit by the bake's map (engines/three/bench/frontier.html):
+// sphere in a y-up three.js scene lit by the bake's map (engines/three/bench/frontier-page.js):
 // - the truth: the bake's reference estimator, 64 samples per strategy x --truth-frames frames;
 // - MeshStandardMaterial and MeshPhysicalMaterial (scene.environment: three's PMREM of the same
 //   map) at parameters fitted to the truth's picture (the page says how);
@@ -70,7 +70,7 @@ try {
         const server = await serve(bake.dir);
         const origin = `http://127.0.0.1:${server.address().port}`;
         try {
-            const { page, errors } = await openPage(browser, `${origin}/engines/three/bench/frontier.html`).catch((e) => fail(e.message));
+            const { page, errors } = await openPage(browser, `${origin}/engines/three/test/page.html`).catch((e) => fail(e.message));
             const r = await page
                 .evaluate((o) => window.frontier(o), {
                     bake: `${origin}/bake/`,
@@ -101,8 +101,8 @@ console.log(
     `PSNR in dB over the sphere's pixels at ${args.size} x ${args.size} against the bake's reference estimator at 64 samples per ` +
         `strategy x ${args['truth-frames']} frames, tone mapped as brdf-preview maps them; cost: milliseconds per frame at ` +
         `${args['timing-size']} x ${args['timing-size']} over MeshStandardMaterial's (its ms in brackets). Three's materials are ` +
-        `fitted to the truth's picture (engines/three/bench/frontier.html: metalness and roughness on a grid, the colour by least ` +
-        `squares, clearcoat for MeshPhysicalMaterial); live: the mean of the 1-sample frames drawn in the time of 8 standard frames.\n`,
+        `fitted to the truth's picture (engines/three/bench/frontier-page.js: metalness, roughness and for MeshPhysicalMaterial ` +
+        `clearcoat on a grid, each channel's colour by a search on the tone-mapped error); live: the mean of the 1-sample frames drawn in the time of 8 standard frames.\n`,
 );
 console.log('| material | map | standard dB (metalness, roughness) | physical dB (clearcoat, its roughness) | measured 1 / 4 / 16 spp dB | cost 1 / 4 / 16 spp | physical cost | live: frames, dB |');
 console.log('|---|---|---:|---:|---:|---:|---:|---:|');

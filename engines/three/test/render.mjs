@@ -59,7 +59,7 @@ const server = await serve(bakeDir);
 const origin = `http://127.0.0.1:${server.address().port}`;
 const browser = await launch(args.chromium).catch((e) => fail(e.message));
 try {
-    const { page, errors } = await openPage(browser, `${origin}/engines/three/test/render.html`).catch((e) => fail(e.message));
+    const { page, errors } = await openPage(browser, `${origin}/engines/three/test/page.html`).catch((e) => fail(e.message));
     const result = await page.evaluate((options) => window.renderBake(options), {
         bake: `${origin}/bake/`,
         mode: args.mode,

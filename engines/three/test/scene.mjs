@@ -1,4 +1,4 @@
-// The material in a y-up three.js scene, beside three's own drawings of it (test/scene.html), in
+// The material in a y-up three.js scene, beside three's own drawings of it (test/scene-page.js), in
 // headless Chromium: prints one JSON line of figures and writes, for a person to look at, one PNG
 // per check in OUT (three.js's drawing on the left, the bake's on the right, tone mapped as
 // brdf-preview tone maps).
@@ -134,7 +134,7 @@ const server = await serve(realpathSync(resolve(args.bake)));
 const origin = `http://127.0.0.1:${server.address().port}`;
 const browser = await launch(args.chromium).catch((e) => fail(e.message));
 try {
-    const { page, errors } = await openPage(browser, `${origin}/engines/three/test/scene.html`).catch((e) => fail(e.message));
+    const { page, errors } = await openPage(browser, `${origin}/engines/three/test/page.html`).catch((e) => fail(e.message));
     const result = await page
         .evaluate((options) => window.renderScenes(options), { bake: `${origin}/bake/`, width, height })
         .catch((e) => fail(`rendering the scenes of ${args.bake}: ${e.message}; ${errors.join('; ')}`));

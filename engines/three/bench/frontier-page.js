@@ -1,25 +1,10 @@
-<!doctype html>
-<!-- The page engines/three/bench/frontier.mjs drives: one bake in a y-up three.js scene, drawn by
-     three's MeshStandardMaterial and MeshPhysicalMaterial at fitted parameters and by the bake's
-     material at a few sample counts, timed and compared with the converged estimate
-     (window.frontier). -->
-<html>
-<head>
-<meta charset="utf-8">
-<link rel="icon" href="data:,">
-<title>brdf-bake in three.js: the frontier</title>
-<script type="importmap">
-{ "imports": {
-    "three": "/engines/three/node_modules/three/build/three.module.js",
-    "ktx-parse": "/engines/three/node_modules/ktx-parse/dist/index.mjs",
-    "@noble/hashes/": "/engines/three/node_modules/@noble/hashes/"
-} }
-</script>
-</head>
-<body style="margin:0">
-<script type="module">
+// What engines/three/bench/frontier.mjs calls in the test page (test/page.html): one bake in a
+// y-up three.js scene, drawn by three's MeshStandardMaterial and MeshPhysicalMaterial at fitted
+// parameters and by the bake's material at a few sample counts, timed and compared with the
+// converged estimate (window.frontier).
 import * as THREE from 'three';
-import { loadBake } from '/engines/three/src/index.js';
+import { loadBake } from '../src/index.js';
+import { drawFloats, pageRenderer } from '../test/page-tools.js';
 
 // The sphere at the origin, the camera 3.2 away, 15 degrees above the horizon, 45 degrees of
 // field of view: the same picture for every material.
@@ -42,12 +27,7 @@ function level(v, exposure) {
 }
 
 window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws }) => {
-    const canvas = document.createElement('canvas');
-    canvas.width = timingSize;
-    canvas.height = timingSize;
-    document.body.appendChild(canvas);
-    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
-    renderer.setPixelRatio(1);
+    const renderer = pageRenderer(timingSize, timingSize);
     renderer.toneMapping = THREE.NoToneMapping;
     const bake = await loadBake(url);
     const exposure = 2 ** bake.figures.exposure_ev;
@@ -67,13 +47,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     // Linear RGB of `material` on the sphere at size x size, black around it.
     const linear = (material) => {
         mesh.material = material;
-        renderer.setRenderTarget(target);
-        renderer.setClearColor(0x000000, 0);
-        renderer.clear();
-        renderer.render(scene, view);
-        const values = new Float32Array(4 * size * size);
-        renderer.readRenderTargetPixels(target, 0, 0, size, size, values);
-        return values;
+        return drawFloats(renderer, target, scene, view);
     };
     // The sphere's pixels: where a drawing writes alpha 1.
     const white = new THREE.MeshBasicMaterial({ color: 0xffffff });
@@ -215,7 +189,3 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     renderer.dispose();
     return result;
 };
-window.ready = true;
-</script>
-</body>
-</html>

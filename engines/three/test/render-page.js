@@ -1,23 +1,9 @@
-<!doctype html>
-<!-- The page engines/three/test/render.mjs drives: renders a bake on brdf-preview's sphere at
-     brdf-preview's camera and size, and hands the picture back (window.renderBake). -->
-<html>
-<head>
-<meta charset="utf-8">
-<link rel="icon" href="data:,">
-<title>brdf-bake in three.js: test render</title>
-<script type="importmap">
-{ "imports": {
-    "three": "/engines/three/node_modules/three/build/three.module.js",
-    "ktx-parse": "/engines/three/node_modules/ktx-parse/dist/index.mjs",
-    "@noble/hashes/": "/engines/three/node_modules/@noble/hashes/"
-} }
-</script>
-</head>
-<body style="margin:0">
-<script type="module">
+// What engines/three/test/render.mjs calls in the test page (page.html): renders a bake on
+// brdf-preview's sphere at brdf-preview's camera and size, and hands the picture back
+// (window.renderBake).
 import * as THREE from 'three';
-import { exactCoverage, loadBake, previewSphere, orbitCamera } from '/engines/three/src/index.js';
+import { exactCoverage, loadBake, previewSphere, orbitCamera } from '../src/index.js';
+import { pageRenderer } from './page-tools.js';
 
 // Renders `bake` with `mode` at width x height into a float target, in tiles of `tile` pixels
 // (each one draw of every frame: no draw runs for long), and returns the tone-mapped picture as
@@ -26,13 +12,7 @@ import { exactCoverage, loadBake, previewSphere, orbitCamera } from '/engines/th
 // deferred pass; with 'forward' the material draws the mesh as any scene would. With `timing`,
 // also the milliseconds per frame of whole-image draws of one frame each (forward).
 window.renderBake = async ({ bake: url, mode, width, height, spp, frames, seed = 0, azimuth = 0, elevation = 0, tile = 64, timing = 0, picture = true, coverage = 'exact' }) => {
-    const canvas = document.createElement('canvas');
-    canvas.width = width;
-    canvas.height = height;
-    document.body.appendChild(canvas);
-    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
-    renderer.setPixelRatio(1);
-    renderer.setSize(width, height, false);
+    const renderer = pageRenderer(width, height);
     const bake = await loadBake(url);
     // brdf-preview's world and picture.
     const look = { orientation: 'brdf-preview', output: 'brdf-preview' };
@@ -116,7 +96,3 @@ window.renderBake = async ({ bake: url, mode, width, height, spp, frames, seed =
     renderer.dispose();
     return result;
 };
-window.ready = true;
-</script>
-</body>
-</html>

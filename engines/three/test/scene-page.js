@@ -1,24 +1,10 @@
-<!doctype html>
-<!-- The page engines/three/test/scene.mjs drives: the material in a three.js scene as a three.js
-     user builds one (+y up, the bake's map as three's scene.environment and scene.background),
-     beside three's own drawings of the same scene (window.renderScenes). -->
-<html>
-<head>
-<meta charset="utf-8">
-<link rel="icon" href="data:,">
-<title>brdf-bake in three.js: a y-up scene</title>
-<script type="importmap">
-{ "imports": {
-    "three": "/engines/three/node_modules/three/build/three.module.js",
-    "ktx-parse": "/engines/three/node_modules/ktx-parse/dist/index.mjs",
-    "@noble/hashes/": "/engines/three/node_modules/@noble/hashes/"
-} }
-</script>
-</head>
-<body style="margin:0">
-<script type="module">
+// What engines/three/test/scene.mjs calls in the test page (page.html): the material in a
+// three.js scene as a three.js user builds one (+y up, the bake's map as three's
+// scene.environment and scene.background), beside three's own drawings of the same scene
+// (window.renderScenes).
 import * as THREE from 'three';
-import { Accumulator, loadBake } from '/engines/three/src/index.js';
+import { Accumulator, loadBake } from '../src/index.js';
+import { drawFloats, pageRenderer } from './page-tools.js';
 
 // Each scene drawn into a float target (linear radiance, no tone mapping), returned as RGB floats,
 // rows from the top. Three checks, each a pair drawn by three.js alone and with the bake:
@@ -35,13 +21,7 @@ import { Accumulator, loadBake } from '/engines/three/src/index.js';
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
 //   (8 bits; against three's formulas applied to pictures['mirror-bake'] by scene.mjs).
 window.renderScenes = async ({ bake: url, width, height }) => {
-    const canvas = document.createElement('canvas');
-    canvas.width = width;
-    canvas.height = height;
-    document.body.appendChild(canvas);
-    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
-    renderer.setPixelRatio(1);
-    renderer.setSize(width, height, false);
+    const renderer = pageRenderer(width, height, { preserveDrawingBuffer: true });
     renderer.toneMapping = THREE.NoToneMapping;
     const bake = await loadBake(url);
     const map = bake.environmentTexture();
@@ -52,13 +32,7 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const disposables = [map, target];
     const pictures = {};
     const draw = (name, scene, camera) => {
-        renderer.setRenderTarget(target);
-        renderer.setClearColor(0x000000, 1);
-        renderer.clear();
-        renderer.render(scene, camera);
-        const values = new Float32Array(4 * width * height);
-        renderer.readRenderTargetPixels(target, 0, 0, width, height, values);
-        pictures[name] = topDownRgb(values);
+        pictures[name] = topDownRgb(drawFloats(renderer, target, scene, camera));
     };
     // RGBA values read back (rows from the bottom) as RGB, rows from the top, each divided by `d`.
     const topDownRgb = (values, d = 1) => {
@@ -247,7 +221,3 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     renderer.dispose();
     return result;
 };
-window.ready = true;
-</script>
-</body>
-</html>
