@@ -71,8 +71,9 @@ async function fetchCapped(fetch, url, what, limit, exact) {
     }
     const chunks = [];
     let total = 0;
-    const reader = response.body.getReader();
-    for (;;) {
+    // A response without a body (an empty file, as some servers send it) reads as no bytes.
+    const reader = response.body?.getReader();
+    while (reader) {
         const { done, value } = await reader.read();
         if (done) break;
         total += value.byteLength;

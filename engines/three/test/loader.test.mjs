@@ -169,6 +169,9 @@ test('responses are read as streams up to the listed size, and checked by sha256
     await refused(load(() => {}, () => {}, (m, b) => ({ ...b, 'engine-merl.ktx2': b['engine-merl.ktx2'].map((v, i) => (i === 100 ? v ^ 1 : v)) })), 'engine-merl.ktx2: not the file the manifest describes');
     await refused(load(() => {}, () => {}, (m, b) => ({ ...b, 'engine-view-layers.ktx2': undefined })), 'engine-view-layers.ktx2: HTTP 404');
     await refused(load(() => {}, () => {}, (m, b) => ({ ...b, 'manifest.json': new Uint8Array([0xff, 0xfe]) })), 'manifest.json: not json');
+    // A response with no body at all: no bytes, so not json, or shorter than listed.
+    await refused(load(() => {}, () => {}, (m, b) => ({ ...b, 'manifest.json': new Response(null) })), 'manifest.json: not json');
+    await refused(load(() => {}, () => {}, (m, b) => ({ ...b, 'engine-merl.ktx2': new Response(null) })), 'engine-merl.ktx2: 0 bytes, the manifest says');
 });
 
 test('without WebCrypto the sha256 is still checked', async () => {
