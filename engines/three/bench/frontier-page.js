@@ -4,7 +4,9 @@
 // converged estimate (window.frontier).
 import * as THREE from 'three';
 import { loadBake } from '../src/index.js';
+import { floatTarget } from '../src/live.js';
 import { drawFloats, pageRenderer } from '../test/page-tools.js';
+import { previewLevel as level } from '../test/tonemap.js';
 
 // The sphere at the origin, the camera 3.2 away, 15 degrees above the horizon, 45 degrees of
 // field of view: the same picture for every material.
@@ -17,14 +19,6 @@ function camera(aspect) {
     return c;
 }
 
-// Reinhard at the bake's exposure and sRGB, as three maps tones with ReinhardToneMapping and
-// brdf-preview maps them: the 8-bit value of linear radiance v.
-function level(v, exposure) {
-    const x = Math.max(v * exposure, 0);
-    const r = x / (1 + x);
-    const s = r <= 0.0031308 ? 12.92 * r : 1.055 * r ** (1 / 2.4) - 0.055;
-    return Math.round(Math.min(Math.max(s, 0), 1) * 255);
-}
 
 window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws }) => {
     const renderer = pageRenderer(timingSize, timingSize);
@@ -37,10 +31,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     const scene = new THREE.Scene();
     scene.environment = map;
     scene.add(mesh);
-    const target = new THREE.WebGLRenderTarget(size, size, {
-        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true,
-        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, generateMipmaps: false,
-    });
+    const target = floatTarget(size, size);
     const view = camera(1);
     const disposables = [map, sphere, target];
 
@@ -55,14 +46,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     const coverage = linear(white);
     const covered = [];
     for (let i = 0; i < size * size; i++) if (coverage[4 * i + 3] > 0.5) covered.push(i);
-    const psnr = (values, truth) => {
-        let sum = 0;
-        for (const i of covered) {
-            for (let c = 0; c < 3; c++) sum += (level(values[4 * i + c], exposure) - level(truth[4 * i + c], exposure)) ** 2;
-        }
-        return 10 * Math.log10((255 * 255) / (sum / (3 * covered.length)));
-    };
-    // Squared error of the tone-mapped values (what the picture shows), in levels.
+    // Squared error of the tone-mapped values (what the picture shows), in levels, and as PSNR.
     const toneError = (values, truth) => {
         let sum = 0;
         for (const i of covered) {
@@ -70,68 +54,27 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
         }
         return sum;
     };
+    const psnr = (values, truth) => 10 * Math.log10((255 * 255) / (toneError(values, truth) / (3 * covered.length)));
 
     // The truth: the bake's reference estimator at 64 samples per strategy and truthFrames frames.
     const truthMaterial = bake.createMaterial({ mode: 'reference', spp: 64, frames: truthFrames });
     disposables.push(truthMaterial);
     const truth = linear(truthMaterial);
 
-    // Three's materials at fitted parameters, fitted to what the picture shows: the squared
-    // error of the tone-mapped values over the sphere's pixels (a fit of linear radiance is ruled
-    // by the sun's few pixels, which three's PMREM spreads). Their radiance is affine in the base
-    // colour, per channel (the diffuse part scales with it, the split-sum specular with F0 =
-    // mix(0.04, colour, metalness)), so for each point of a grid of the other parameters two
-    // drawings (colour 0 and 1) give every colour's picture: each channel's colour in [0, 1] is
-    // found by a golden-section search on it, and the grid point with the least error wins.
-    const fit = (make, grid) => {
-        let best = null;
-        for (const params of grid) {
-            const m0 = make(params, 0);
-            const m1 = make(params, 1);
-            const [c0, c1] = [linear(m0), linear(m1)];
-            m0.dispose();
-            m1.dispose();
-            const colour = [0, 1, 2].map((c) => {
-                const error = (k) => {
-                    let sum = 0;
-                    for (const i of covered) {
-                        const v = c0[4 * i + c] + k * (c1[4 * i + c] - c0[4 * i + c]);
-                        sum += (level(v, exposure) - level(truth[4 * i + c], exposure)) ** 2;
-                    }
-                    return sum;
-                };
-                let [a, b] = [0, 1];
-                const g = (Math.sqrt(5) - 1) / 2;
-                for (let step = 0; step < 24; step++) {
-                    const [x1, x2] = [b - g * (b - a), a + g * (b - a)];
-                    if (error(x1) <= error(x2)) b = x2;
-                    else a = x1;
-                }
-                return (a + b) / 2;
-            });
-            const material = make(params, colour);
-            const values = linear(material);
-            const error = toneError(values, truth);
-            if (!best || error < best.error) {
-                best?.material.dispose();
-                best = { params, colour, error, values, material };
-            } else {
-                material.dispose();
-            }
-        }
-        return best;
-    };
+    const fitting = { linear, truth, covered, exposure, toneError };
     const colourOf = (c) => (Array.isArray(c) ? new THREE.Color(...c) : new THREE.Color(c, c, c));
     const roughnesses = Array.from({ length: 16 }, (_, i) => 0.02 + (0.98 * i) / 15);
     const standardGrid = [0, 0.25, 0.5, 0.75, 1].flatMap((metalness) => roughnesses.map((roughness) => ({ metalness, roughness })));
     const standard = fit(
         (p, c) => new THREE.MeshStandardMaterial({ color: colourOf(c), metalness: p.metalness, roughness: p.roughness }),
         standardGrid,
+        fitting,
     );
     const physicalGrid = [0, 0.5, 1].flatMap((clearcoat) => [0.03, 0.15, 0.4].map((clearcoatRoughness) => ({ ...standard.params, clearcoat, clearcoatRoughness })));
     const physical = fit(
         (p, c) => new THREE.MeshPhysicalMaterial({ color: colourOf(c), ...p }),
         physicalGrid,
+        fitting,
     );
     disposables.push(standard.material, physical.material);
 
@@ -148,19 +91,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     // then timingDraws draws, each waited for by a one-pixel read.
     renderer.setRenderTarget(null);
     renderer.setSize(timingSize, timingSize, false);
-    const gl = renderer.getContext();
-    const pixel = new Uint8Array(4);
-    const time = (material) => {
-        mesh.material = material;
-        renderer.render(scene, view);
-        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
-        const start = performance.now();
-        for (let i = 0; i < timingDraws; i++) {
-            renderer.render(scene, view);
-            gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
-        }
-        return (performance.now() - start) / timingDraws;
-    };
+    const time = (material) => msPerFrame(renderer, scene, view, mesh, material, timingDraws);
     const ms = {
         standard: time(standard.material),
         physical: time(physical.material),
@@ -189,3 +120,67 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     renderer.dispose();
     return result;
 };
+
+// Three's materials at fitted parameters, fitted to what the picture shows: the squared
+// error of the tone-mapped values over the sphere's pixels (a fit of linear radiance is ruled
+// by the sun's few pixels, which three's PMREM spreads). Their radiance is affine in the base
+// colour, per channel (the diffuse part scales with it, the split-sum specular with F0 =
+// mix(0.04, colour, metalness)), so for each point of a grid of the other parameters two
+// drawings (colour 0 and 1) give every colour's picture: each channel's colour in [0, 1] is
+// found by a golden-section search on it, and the grid point with the least error wins.
+function fit(make, grid, { linear, truth, covered, exposure, toneError }) {
+    let best = null;
+    for (const params of grid) {
+        const m0 = make(params, 0);
+        const m1 = make(params, 1);
+        const [c0, c1] = [linear(m0), linear(m1)];
+        m0.dispose();
+        m1.dispose();
+        const colour = [0, 1, 2].map((c) => {
+            const error = (k) => {
+                let sum = 0;
+                for (const i of covered) {
+                    const v = c0[4 * i + c] + k * (c1[4 * i + c] - c0[4 * i + c]);
+                    sum += (level(v, exposure) - level(truth[4 * i + c], exposure)) ** 2;
+                }
+                return sum;
+            };
+            let [a, b] = [0, 1];
+            const g = (Math.sqrt(5) - 1) / 2;
+            for (let step = 0; step < 24; step++) {
+                const [x1, x2] = [b - g * (b - a), a + g * (b - a)];
+                if (error(x1) <= error(x2)) b = x2;
+                else a = x1;
+            }
+            return (a + b) / 2;
+        });
+        const material = make(params, colour);
+        const values = linear(material);
+        const error = toneError(values, truth);
+        if (!best || error < best.error) {
+            best?.material.dispose();
+            best = { params, colour, error, values, material };
+        } else {
+            material.dispose();
+        }
+    }
+    return best;
+}
+
+/**
+ * Milliseconds per frame of `mesh` drawn with `material` in `scene`: one untimed draw, then
+ * `draws` timed ones, each waited for by a one-pixel read.
+ */
+function msPerFrame(renderer, scene, view, mesh, material, draws) {
+    const gl = renderer.getContext();
+    const pixel = new Uint8Array(4);
+    mesh.material = material;
+    renderer.render(scene, view);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    const start = performance.now();
+    for (let i = 0; i < draws; i++) {
+        renderer.render(scene, view);
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    }
+    return (performance.now() - start) / draws;
+}

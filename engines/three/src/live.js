@@ -4,11 +4,8 @@
 
 import * as THREE from 'three';
 
-const QUAD_VERTEX = /* glsl */ `
-void main() {
-    gl_Position = vec4(position.xy, 0.0, 1.0);
-}
-`;
+import { QUAD_VERTEX } from './shade.glsl.js';
+
 
 // The running sum: the previous sum (none for the first frame) plus this frame, texel by texel.
 const ADD_FRAGMENT = /* glsl */ `

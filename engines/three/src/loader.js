@@ -123,11 +123,13 @@ function counts(figures, name, length) {
 }
 
 /**
- * The stage's figures, typed and bounded (data-schema/engine-textures.md, "The stage's figures"):
- * what the shader takes as constants and what the textures' shapes are checked against.
+ * The stage's figures once each is typed and bounded (data-schema/engine-textures.md, "The
+ * stage's figures"): what the shader takes as constants and what the textures' shapes are checked
+ * against, under the manifest's names.
  */
 export function checkFigures(f) {
     if (typeof f !== 'object' || f === null || Array.isArray(f)) throw figureError('figures', f, 'an object');
+    ['slices', 'vectors', 'rows', 'sectors', 'view_rows'].forEach((name) => count(f, name));
     const merlSize = counts(f, 'merl_size', 3);
     const phi = f.phi_d_range;
     const phiCells = { 180: Math.PI, 360: 2 * Math.PI }[merlSize[0]];
@@ -136,9 +138,8 @@ export function checkFigures(f) {
     }
     const samples = count(f, 'samples');
     if ((samples & (samples - 1)) !== 0) throw figureError('samples', samples, 'a power of two');
-    const environmentSize = counts(f, 'environment_size', 2);
-    const layersSize = counts(f, 'layers_size', 2);
-    for (const [name, [w, h]] of [['environment_size', environmentSize], ['layers_size', layersSize]]) {
+    for (const name of ['environment_size', 'layers_size']) {
+        const [w, h] = counts(f, name, 2);
         if (w !== 2 * h) throw figureError(name, [w, h], 'a lat-long size, width twice the height');
     }
     const exponents = f.exponents;
@@ -159,23 +160,7 @@ export function checkFigures(f) {
             && Number.isInteger(d.frames) && d.frames >= 1 && d.frames <= 65536;
         if (!ok) throw figureError(`previewer.${mode}`, d, `{ spp, frames }: spp a power of two dividing the ${samples} samples, frames from 1 to 65536`);
     }
-    return {
-        merlSize,
-        phi_d_range: phi,
-        slices: count(f, 'slices'),
-        vectors: count(f, 'vectors'),
-        samples,
-        rows: count(f, 'rows'),
-        sectors: count(f, 'sectors'),
-        viewRows: count(f, 'view_rows'),
-        environmentSize,
-        layersSize,
-        exponents,
-        peaks: f.peaks,
-        diffuse,
-        exposure_ev: f.exposure_ev,
-        previewer: f.previewer,
-    };
+    return f;
 }
 
 /**
@@ -184,14 +169,14 @@ export function checkFigures(f) {
  * depth, and the range of its values.
  */
 function roles(f) {
-    const [W, H] = f.environmentSize;
-    const [Wl, Hl] = f.layersSize;
+    const [W, H] = f.environment_size;
+    const [Wl, Hl] = f.layers_size;
     const R = f.rows;
     const C = f.sectors;
     return {
-        'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: f.merlSize, range: [0, Infinity] },
+        'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: f.merl_size, range: [0, Infinity] },
         'engine-brdf-tables': { uniform: 'uBrdfTables', channels: 1, kind: 'array', shape: [Math.max(R, C) + 1, R + 2, f.slices], range: [0, 1] },
-        'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [f.viewRows, 1, 1], range: [0, f.exponents.length - 1] },
+        'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [f.view_rows, 1, 1], range: [0, f.exponents.length - 1] },
         'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [W, H, 2], range: [0, Infinity] },
         'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [Math.max(W, H) + 1, H + 1, 2], range: [0, 1] },
         'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, Infinity] },

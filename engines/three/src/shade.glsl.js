@@ -775,7 +775,7 @@ void main() {
 }
 `;
 
-// exactCoverage's shading pass: a full-screen quad.
+// A full-screen quad: exactCoverage's shading pass and the live mode's sums (live.js).
 export const QUAD_VERTEX = /* glsl */ `
 void main() {
     gl_Position = vec4(position.xy, 0.0, 1.0);

@@ -4,10 +4,11 @@
 // (window.renderScenes).
 import * as THREE from 'three';
 import { Accumulator, loadBake } from '../src/index.js';
+import { floatTarget } from '../src/live.js';
 import { drawFloats, pageRenderer } from './page-tools.js';
 
 // Each scene drawn into a float target (linear radiance, no tone mapping), returned as RGB floats,
-// rows from the top. Three checks, each a pair drawn by three.js alone and with the bake:
+// rows from the top. The checks, each a pair (three.js alone and with the bake, or two ways):
 // - background-N: three's scene.background from the map against the bake's createBackground,
 //   under scene rotations N (none, then a turn about every axis);
 // - mirror: a MeshStandardMaterial mirror ball lit by scene.environment against the bake's
@@ -21,19 +22,49 @@ import { drawFloats, pageRenderer } from './page-tools.js';
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
 //   (8 bits; against three's formulas applied to pictures['mirror-bake'] by scene.mjs).
 window.renderScenes = async ({ bake: url, width, height }) => {
+    const s = await setUp(url, width, height);
+    backgrounds(s);
+    const mirrorScene = mirror(s);
+    scale(s);
+    instances(s);
+    skinning(s);
+    orthographic(s, mirrorScene);
+    const live = liveMode(s);
+    const canvases = toneMapped(s, mirrorScene);
+    const gl = s.renderer.getContext();
+    const debug = gl.getExtension('WEBGL_debug_renderer_info');
+    const result = {
+        renderer: gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER),
+        exposureEv: s.bake.figures.exposure_ev,
+        pictures: s.pictures,
+        canvases,
+        toneMappingExposure: TONE_MAPPING_EXPOSURE,
+        live,
+    };
+    s.disposables.forEach((d) => d.dispose());
+    s.bake.dispose();
+    s.renderer.dispose();
+    return result;
+};
+
+/** The exposure of the canvas drawings under three's tone mapping. */
+const TONE_MAPPING_EXPOSURE = 1.7;
+
+/**
+ * What every check draws with: the renderer, the bake and its map, the sphere and the bake's
+ * prefiltered material on brdf-preview's defaults, `draw(name, scene, camera)` into
+ * `pictures[name]`, a camera 3.2 away at an elevation, and what is disposed at the end.
+ */
+async function setUp(url, width, height) {
     const renderer = pageRenderer(width, height, { preserveDrawingBuffer: true });
     renderer.toneMapping = THREE.NoToneMapping;
     const bake = await loadBake(url);
     const map = bake.environmentTexture();
-    const target = new THREE.WebGLRenderTarget(width, height, {
-        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true,
-        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, generateMipmaps: false,
-    });
-    const disposables = [map, target];
+    const target = floatTarget(width, height);
+    const sphere = new THREE.SphereGeometry(1, 128, 64);
+    const material = bake.createMaterial({ mode: 'prefiltered' });
+    const disposables = [map, target, sphere, material];
     const pictures = {};
-    const draw = (name, scene, camera) => {
-        pictures[name] = topDownRgb(drawFloats(renderer, target, scene, camera));
-    };
     // RGBA values read back (rows from the bottom) as RGB, rows from the top, each divided by `d`.
     const topDownRgb = (values, d = 1) => {
         const rgb = new Array(3 * width * height);
@@ -45,6 +76,9 @@ window.renderScenes = async ({ bake: url, width, height }) => {
         }
         return rgb;
     };
+    const draw = (name, scene, camera) => {
+        pictures[name] = topDownRgb(drawFloats(renderer, target, scene, camera));
+    };
     const camera = (elevationDeg) => {
         const c = new THREE.PerspectiveCamera(45, width / height, 0.032, 320);
         const el = (elevationDeg * Math.PI) / 180;
@@ -53,11 +87,11 @@ window.renderScenes = async ({ bake: url, width, height }) => {
         c.updateMatrixWorld();
         return c;
     };
-    const sphere = new THREE.SphereGeometry(1, 128, 64);
-    disposables.push(sphere);
-    const material = bake.createMaterial({ mode: 'prefiltered' });
-    disposables.push(material);
+    return { renderer, bake, map, sphere, material, disposables, pictures, draw, camera, topDownRgb, width, height };
+}
 
+/** three's scene.background against the bake's createBackground, unturned and turned. */
+function backgrounds({ bake, map, disposables, draw, camera }) {
     const rotations = [new THREE.Euler(0, 0, 0), new THREE.Euler(0.3, 1.1, -0.4, 'YXZ')];
     rotations.forEach((rotation, i) => {
         const three = new THREE.Scene();
@@ -71,7 +105,13 @@ window.renderScenes = async ({ bake: url, width, height }) => {
         draw(`background-${i}-three`, three, camera(10));
         draw(`background-${i}-bake`, ours, camera(10));
     });
+}
 
+/**
+ * A MeshStandardMaterial mirror ball lit by scene.environment against the bake's material on the
+ * same sphere, from 30 degrees above; returns the bake's scene.
+ */
+function mirror({ bake, map, sphere, material, disposables, draw, camera }) {
     const mirror = new THREE.MeshStandardMaterial({ color: 0xffffff, metalness: 1, roughness: 0 });
     disposables.push(mirror);
     const three = new THREE.Scene();
@@ -81,7 +121,11 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const ours = new THREE.Scene();
     ours.add(new THREE.Mesh(sphere, material));
     draw('mirror-bake', ours, camera(30));
+    return ours;
+}
 
+/** A sphere squashed by its mesh's scale against the same shape made in its geometry. */
+function scale({ bake, sphere, disposables, draw, camera }) {
     // Four times brdf-preview's frames: the two drawings' normals differ by rounding, which moves
     // their samples a little; with less noise that moves the picture less.
     const converged = bake.createMaterial({ mode: 'prefiltered', frames: 32 });
@@ -100,10 +144,13 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const byGeometry = new THREE.Scene();
     byGeometry.add(new THREE.Mesh(shape, converged));
     draw('scale-geometry', byGeometry, camera(20));
+}
 
-    // A 10 x 10 InstancedMesh of small spheres, turned and scaled each its own way, against 100
-    // meshes with the same matrices; and a sphere skinned to one bone, turned and moved, against a
-    // mesh moved as the bone.
+/**
+ * A 10 x 10 InstancedMesh of small spheres, turned and scaled each its own way, against 100
+ * meshes with the same matrices.
+ */
+function instances({ material, disposables, draw, camera }) {
     const small = new THREE.SphereGeometry(0.14, 32, 16);
     disposables.push(small);
     const instanced = new THREE.InstancedMesh(small, material, 100);
@@ -124,7 +171,10 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     draw('instances-instanced', instances, camera(0));
     draw('instances-separate', separate, camera(0));
     instanced.dispose();
+}
 
+/** A sphere skinned to one bone, turned and moved, against a mesh moved as the bone. */
+function skinning({ sphere, material, disposables, draw, camera }) {
     const skinned = sphere.clone();
     const count = skinned.attributes.position.count;
     skinned.setAttribute('skinIndex', new THREE.Uint16BufferAttribute(new Uint16Array(4 * count), 4));
@@ -153,9 +203,13 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     movedScene.add(moved);
     draw('skinning-moved', movedScene, camera(20));
     body.skeleton.dispose();
+}
 
-    // An orthographic camera against a perspective one so far away that its rays are parallel
-    // within 3e-4 radians (the same view: 2.4 units across, looking down 20 degrees).
+/**
+ * An orthographic camera against a perspective one so far away that its rays are parallel
+ * within 3e-4 radians (the same view: 2.4 units across, looking down 20 degrees), on `ours`.
+ */
+function orthographic({ draw }, ours) {
     const view = (c, distance) => {
         const el = (20 * Math.PI) / 180;
         c.position.set(0, distance * Math.sin(el), distance * Math.cos(el));
@@ -168,9 +222,13 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const distant = view(new THREE.PerspectiveCamera((2 * Math.atan(1.2 / far) * 180) / Math.PI, 1, far - 2, far + 2), far);
     draw('orthographic-orthographic', ours, orthographic);
     draw('orthographic-distant', ours, distant);
+}
 
-    // The live mode: eight calls of the accumulator, one frame each, against one draw of the
-    // same eight frames; then the camera moves and the average starts again.
+/**
+ * The live mode: eight calls of the accumulator, one frame each, against one draw of the same
+ * eight frames; then the camera moves and the average starts again. Returns its frame counts.
+ */
+function liveMode({ renderer, bake, sphere, disposables, pictures, draw, camera, topDownRgb, width, height }) {
     const live = new Accumulator(renderer);
     const liveScene = new THREE.Scene();
     const liveMaterial = bake.createMaterial({ mode: 'prefiltered', frames: 8 });
@@ -190,14 +248,19 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     renderer.setRenderTarget(null);
     live.render(liveScene, camera(31));
     const liveRestart = live.frames;
+    return { frames: liveFrames, framesAfterMoving: liveRestart };
+}
 
-    // three's colour pipeline: the material on the canvas under ACES filmic tone mapping (and
-    // none), 8 bits as three writes them, beside its linear radiance on the float target above.
+/**
+ * three's colour pipeline: `ours` drawn to the canvas under ACES filmic tone mapping (and none),
+ * 8 bits as three writes them, beside its linear radiance on the float target.
+ */
+function toneMapped({ renderer, camera, topDownRgb, width, height }, ours) {
     const canvases = {};
     const drawCanvas = (name, toneMapping) => {
         renderer.setRenderTarget(null);
         renderer.toneMapping = toneMapping;
-        renderer.toneMappingExposure = 1.7;
+        renderer.toneMappingExposure = TONE_MAPPING_EXPOSURE;
         renderer.render(ours, camera(30));
         const pixels = new Uint8Array(4 * width * height);
         gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
@@ -206,18 +269,5 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const gl = renderer.getContext();
     drawCanvas('aces', THREE.ACESFilmicToneMapping);
     drawCanvas('none', THREE.NoToneMapping);
-
-    const debug = gl.getExtension('WEBGL_debug_renderer_info');
-    const result = {
-        renderer: gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER),
-        exposureEv: bake.figures.exposure_ev,
-        pictures,
-        canvases,
-        toneMappingExposure: 1.7,
-        live: { frames: liveFrames, framesAfterMoving: liveRestart },
-    };
-    disposables.forEach((d) => d.dispose());
-    bake.dispose();
-    renderer.dispose();
-    return result;
-};
+    return canvases;
+}

@@ -28,6 +28,7 @@ import { existsSync, mkdirSync, realpathSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 
 import { launch, openPage, png, serve } from './serve.mjs';
+import { previewLevel } from './tonemap.js';
 
 function fail(message) {
     console.error(`error: ${message}`);
@@ -44,12 +45,7 @@ if (!existsSync(resolve(args.bake, 'manifest.json'))) fail(`${args.bake}: not a 
 
 // envmap::tonemap_rgb8: exposure, Reinhard per channel, sRGB, rounded to 8 bits.
 function tonemap(rgb, exposure) {
-    return Uint8Array.from(rgb, (v) => {
-        const x = Math.min(Math.max(v * exposure, 0), 3e38);
-        const r = x / (1 + x);
-        const s = r <= 0.0031308 ? 12.92 * r : 1.055 * r ** (1 / 2.4) - 0.055;
-        return Math.round(Math.min(Math.max(s, 0), 1) * 255);
-    });
+    return Uint8Array.from(rgb, (v) => previewLevel(v, exposure));
 }
 
 function psnrDb(a, b) {
