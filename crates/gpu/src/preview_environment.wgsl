@@ -62,18 +62,21 @@ fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
     return top * (1.0 - fy) + bottom * fy;
 }
 
+// `render::FIS_LOD_BIAS`.
+const FIS_LOD_BIAS: f32 = -1.0;
+
 // `envmap::MipChain::lod_solid_angle` for one of `filter_samples` samples (the picture's, over
-// its frames) of density `pdf` per unit solid angle:
-// max(log4(width height / (filter_samples pdf 2 pi^2)), 0), as a difference of logarithms (the
-// quotient overflows f32 for tiny densities, where the CPU's f64 does not). A density that is not
-// positive stands for the CPU's infinite level: the last.
+// its frames) of density `pdf` per unit solid angle, plus `FIS_LOD_BIAS` (`render::shade::shade`):
+// max(log4(width height / (filter_samples pdf 2 pi^2)) + FIS_LOD_BIAS, 0), as a difference of
+// logarithms (the quotient overflows f32 for tiny densities, where the CPU's f64 does not). A
+// density that is not positive stands for the CPU's infinite level: the last.
 fn mip_lod(pdf: f32) -> f32 {
     if (!(pdf > 0.0)) {
         return f32(shade.n_levels - 1u);
     }
     let level0 = env_maps[shade.mips_first];
     let texels = f32(level0.x) * f32(level0.y);
-    return max(0.5 * (log2(texels) - log2(f32(shade.filter_samples)) - log2(pdf * 2.0 * PI * PI)), 0.0);
+    return max(0.5 * (log2(texels) - log2(f32(shade.filter_samples)) - log2(pdf * 2.0 * PI * PI)) + FIS_LOD_BIAS, 0.0);
 }
 
 // `envmap::MipChain::lookup_uv` in the chain from `shade.mips_first`: bilinear in the two levels

@@ -123,10 +123,11 @@
 //!   by the luminance of their bilinear reconstruction times `sin theta`). Unbiased: it estimates
 //!   `int f L cos` with level 0 as the renderers read it, the converged estimate's integral.
 //! - [`Mode::Fis`] (filtered importance sampling, `002`): `F` the mip chain of the environment's
-//!   smooth part ([`Lighting::smooth_mips`]), trilinear at `lod = max(log4(w h / (N p_b 2 pi^2)),
-//!   0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the level a footprint of
-//!   solid angle `1 / (N p_b)` gets at the equator, wherever it lies; "Small bright sources"
-//!   says why); `N` the samples the picture averages, `spp` times the frames
+//!   smooth part ([`Lighting::smooth_mips`]), trilinear at `lod = max(log4(w h / (N p_b 2 pi^2))
+//!   + FIS_LOD_BIAS, 0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the
+//!   level a footprint of solid angle `1 / (N p_b)` gets at the equator, wherever it lies;
+//!   "Small bright sources" says why; [`FIS_LOD_BIAS`] says why a level finer than the
+//!   footprint's); `N` the samples the picture averages, `spp` times the frames
 //!   ([`Settings::filter_samples`]): the frames draw other points of the sample set, so each
 //!   sample stands for `1 / N` of the integral, not `1 / spp`. A frame alone is then filtered
 //!   for more samples than it holds, and only the average is free of aliasing. Sized by `spp`
@@ -169,19 +170,30 @@
 //! bright source it was large: the sun's light spread over a footprint reaches directions below a
 //! surface's horizon and beyond a lobe (mean luminance -7% to +31% against the converged estimate
 //! under quarry's sun, +64% in a band with the sun behind the sphere). So level 0 is split in two
-//! ([`Peaks`]): a texel whose luminance `Y` exceeds [`PEAK_CONTRAST`] (4) times the map's mean
+//! ([`Peaks`]): a texel whose luminance `Y` exceeds [`PEAK_CONTRAST`] (1) times the map's mean
 //! luminance (by solid angle) keeps `T / Y` of itself, `T` that threshold, and gives the rest to
 //! the peaks. The peaks' light is integrated without a filter, by multiple importance sampling of
 //! the BRDF's directions and the peaks' own importance sampling; the filters read the smooth rest,
-//! at most 4 times the mean. Filtering is linear, so the smooth part's chain and layers are the
+//! the map clamped at its mean. Filtering is linear, so the smooth part's chain and layers are the
 //! bake's minus the peaks' own (made with the code that made the bake's, `envmap::MipChain::new`
 //! and `prefilter::prefilter`, once per map when the lighting is made). A lower contrast moves
 //! more light into the unbiased part, with more noise at few samples; a higher one more into the
-//! filter: at 16, fis ended 3.5% dark on white-paint under
-//! `studio_small_03` with the light behind the sphere, at 4 within 2% on every case of the
-//! Mitsuba bench (white-paint, gold-paint and chrome under `quarry_01` and `studio_small_03`, the light before
-//! and behind the sphere; the peaks hold 54% of quarry's light, 83% of the studio's and 1% of
-//! `potsdamer_platz`'s).
+//! filter, whose bias shows on a narrow lobe: a studio's lit walls, below 4 times its mean,
+//! blurred into chrome's reflection of the dark ones. Against the converged estimate (128 x 128,
+//! brdf-preview's defaults, the Mitsuba bench's cases and cameras), 7x7 bias p99 of fis (with a
+//! level-of-detail bias of 0) and prefiltered on chrome under `studio_small_03`, the light before
+//! and behind the sphere:
+//!
+//! | contrast | fis | prefiltered | Lambertian / quarry / sun, prefiltered PSNR (sphere) |
+//! |---:|---|---|---:|
+//! | 4 | 4.45, 2.54 | 2.13, 4.98 | 46.30 dB |
+//! | 2 | 2.77, 1.77 | 1.66, 2.73 | 45.92 dB |
+//! | 1 | 1.70, 1.41 | 1.30, 1.58 | 45.50 dB |
+//! | 0.5 | 1.13, 1.29 | 1.07, 1.15 | 44.61 dB |
+//!
+//! The other materials' bias moved by at most 0.2 levels; what a lower contrast costs is noise
+//! under a sun, where a broad lobe takes ever more of the light by sampling. 1 keeps the
+//! Lambertian's prefiltered picture above 48 dB against Mitsuba 3.
 //!
 //! A second bias was fis's own on a lat-long chain: a footprint of a given solid angle covers ever
 //! more of `u` towards the poles and no more of `v`, and a square level matched to its area there
@@ -436,6 +448,18 @@ pub fn pixel_sequences(pixel: u32, seed: u32) -> [OwenSobol2D; 2] {
     let w3 = pcg_hash(w2);
     [OwenSobol2D::from_words([w0, w1]), OwenSobol2D::from_words([w2, w3])]
 }
+
+/// Levels added to fis's level of detail (crate documentation, "The estimators"): the footprint
+/// of solid angle `1 / (N p_b)` is read one level finer than its size. A trilinear read's
+/// bilinear tent at level `l` spans two texels of that level along each axis, twice the width of
+/// the footprint that chose `l`; one level finer, its support is the footprint. What the wider
+/// read costs is bias where the smooth light changes within it: against the converged estimate
+/// (the Mitsuba bench's cases, 128 x 128, brdf-preview's defaults), chrome under
+/// `studio_small_03` had a 7x7 bias p99 of 1.70 and 1.41 levels (light before and behind the
+/// sphere) at 0, 0.92 and 1.01 at -1, for 0.1 and 1.6 dB more noise; no other case moved by more
+/// than 0.05 levels. Colbert and Krivanek's +1 hides the aliasing of a few samples; the picture's
+/// `N` is `spp` times the frames, 128 by default.
+pub const FIS_LOD_BIAS: f64 = -1.0;
 
 /// Mixed into the seed of [`pixel_sequences`], so that its words are not [`sample_range`]'s.
 pub const SEQUENCE_SALT: u32 = 0x6a09_e667;

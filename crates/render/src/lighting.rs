@@ -27,7 +27,7 @@ pub struct Lighting {
 
 /// A texel of level 0 whose luminance exceeds this multiple of the map's mean luminance (by solid
 /// angle) belongs to the peaks (crate documentation, "Small bright sources").
-pub const PEAK_CONTRAST: f64 = 4.0;
+pub const PEAK_CONTRAST: f64 = 1.0;
 
 /// The split `L = L_smooth + L_peak` of level 0: a texel of luminance `Y` above the threshold
 /// `T` gives `L (1 - T / Y)` to the peaks and keeps `L T / Y`, so the smooth part's luminance is

@@ -264,7 +264,7 @@ pub(crate) fn shade(
                             add(rest, radiance, wi_local.z / sample.pdf);
                         }
                         Some(Source::Mips(mips)) => {
-                            let lod = mips.lod_solid_angle(filter_samples, sample.pdf);
+                            let lod = mips.lod_solid_angle(filter_samples, sample.pdf) + crate::FIS_LOD_BIAS;
                             add(rest, mips.lookup_uv(u, v, lod), wi_local.z / sample.pdf);
                         }
                         None => {}

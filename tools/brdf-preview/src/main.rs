@@ -33,14 +33,12 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///   adaptive-prefiltered
 ///                the same with the prefiltered estimator and eq. 10's variance (001 ASFPCS)
 ///
-/// Small bright sources: fis and prefiltered filter only the environment's smooth part. Texels
-/// brighter than 4 times its mean luminance (a sun, a softbox) are its peaks, sampled from the
-/// unfiltered map by multiple importance sampling, so a small bright source keeps its light.
-/// What the filter does to the smooth part is an approximation: within 2.5% of the converged
-/// estimate's mean luminance on white-paint, gold-paint and chrome under quarry_01 and
-/// studio_small_03 at the default settings (cargo bench -p brdf-preview --bench mitsuba); more
-/// for a broad lobe under a sharp horizon (a Lambertian's broadest layer is read at
-/// cosine-distributed directions: twice blurred).
+/// Small bright sources: fis and prefiltered filter only the environment's smooth part, the map
+/// clamped at its mean luminance. The light above it (a sun, a softbox, a lit wall) is the
+/// map's peaks, sampled from the unfiltered map by multiple importance sampling, so a small
+/// bright source keeps its light and no filter spreads it. What the filter does to the smooth
+/// part is an approximation, measured against Mitsuba 3 by cargo bench -p brdf-preview --bench
+/// mitsuba (docs/benchmarks.md).
 ///
 /// Pictures: the environment is drawn behind the mesh, so its orientation can be checked.
 /// Pictures are tone mapped: exposure 2^EV (by default the one that maps the environment's

@@ -145,7 +145,7 @@ pub(crate) const MODE_DEBUG_SLICE: u32 = 7;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::{PREVIEW_BINDINGS, PREVIEW_SAMPLING};
+    use crate::wgsl::{PREVIEW_BINDINGS, PREVIEW_ENVIRONMENT, PREVIEW_SAMPLING};
 
     #[test]
     fn workgroup_size_matches_the_shader() {
@@ -166,7 +166,8 @@ mod tests {
     fn sampling_constants_match_the_cpu() {
         let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
         let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
-        for (wgsl, decl) in [(&PREVIEW_SAMPLING, salt), (&PREVIEW_BINDINGS, no_map)] {
+        let lod_bias = format!("const FIS_LOD_BIAS: f32 = {:?};", render::FIS_LOD_BIAS as f32);
+        for (wgsl, decl) in [(&PREVIEW_SAMPLING, salt), (&PREVIEW_BINDINGS, no_map), (&PREVIEW_ENVIRONMENT, lod_bias)] {
             assert!(wgsl.source.contains(&decl), "{} does not declare `{decl}`", wgsl.file);
         }
     }
