@@ -44,7 +44,8 @@ setup-mitsuba: setup-python
 	fi
 
 ## setup-node: ktx-parse (the KTX2 parser three.js uses) in tests/ktx-parse, which the end-to-end
-## tests run on the KTX2 files with node, and engines/three's packages (three, ktx-parse,
+## tests run on the KTX2 files with node, the Khronos glTF validator in tests/gltf-validator (on
+## brdf-fit's material.gltf), and engines/three's packages (three, ktx-parse,
 ## @noble/hashes and puppeteer-core, pinned by its lock file). Installs node and npm from Debian when missing.
 setup-node:
 	@if ! command -v npm >/dev/null 2>&1; then \
@@ -54,6 +55,7 @@ setup-node:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; \
 	fi
 	@test -d tests/ktx-parse/node_modules/ktx-parse || npm ci --silent --prefix tests/ktx-parse
+	@test -d tests/gltf-validator/node_modules/gltf-validator || npm ci --silent --prefix tests/gltf-validator
 	@test -d engines/three/node_modules/puppeteer-core -a -d engines/three/node_modules/ktx-parse -a -d engines/three/node_modules/@noble/hashes || npm ci --silent --prefix engines/three
 
 ## setup-chromium: Debian's Chromium, the real browser tests/three.rs renders the three.js material

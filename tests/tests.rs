@@ -8,6 +8,7 @@ mod asset_info;
 mod bake_folders;
 mod brdf_bake;
 mod brdf_bandwidth;
+mod brdf_fit;
 mod brdf_wavelet;
 mod envmap_bandwidth;
 mod envmap_prefilter;
