@@ -36,7 +36,7 @@ pub(crate) fn render(
         lobe_weight: request.lobe_weight,
         layer_shift: request.layer_shift,
         seed: request.seed,
-        ..render::adaptive::Settings::new(mode, request.spp.unwrap_or(if mode == Estimator::Reference { 8 } else { 4 }))
+        ..render::adaptive::Settings::new(mode, request.spp.unwrap_or(render::adaptive::SPP))
     };
     let frames = request.frames.unwrap_or(render::adaptive::FRAMES);
     let scene = scene(request)?;

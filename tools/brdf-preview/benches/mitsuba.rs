@@ -220,11 +220,11 @@ fn ours(
             .unwrap_or_else(|e| panic!("rendering {}: {e}", mode.name()));
         images.push((mode.name(), image, start.elapsed().as_secs_f64()));
     }
-    for (name, mode, spp) in [("adaptive", Mode::Reference, 8), ("adaptive-prefiltered", Mode::Prefiltered, 4)] {
+    for (name, mode) in [("adaptive", Mode::Reference), ("adaptive-prefiltered", Mode::Prefiltered)] {
         let settings = adaptive::Settings {
             predict_level: 2,
             allocation: adaptive::Allocation::Area,
-            ..adaptive::Settings::new(mode, spp)
+            ..adaptive::Settings::new(mode, adaptive::SPP)
         };
         let start = Instant::now();
         let image = adaptive::render_frames(scene, material, lighting, bandwidths, &settings, adaptive::FRAMES)
@@ -617,7 +617,8 @@ fn main() {
                     .collect::<Vec<_>>()
                     .join(", ")
                     + &format!(
-                        ", adaptive 8 spp and adaptive-prefiltered 4 spp ({} frames each, predict level 2, area allocation)",
+                        ", adaptive and adaptive-prefiltered {} spp x {} frames (predict level 2, area allocation)",
+                        adaptive::SPP,
                         adaptive::FRAMES
                     );
                 let ours_s = start.elapsed().as_secs_f64();

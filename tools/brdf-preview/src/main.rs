@@ -107,8 +107,8 @@ struct Args {
     /// by default); in reference, fis and prefiltered each sample is a direction drawn from the
     /// material's tables and, where the mode samples a light, one drawn from the light. Default:
     /// 64 for reference, 16 for fis and prefiltered. For the adaptive modes, the frame's budget in
-    /// mean samples per covered pixel (any number from 1; default 8 for adaptive, 4 for
-    /// adaptive-prefiltered). Within --max-samples.
+    /// mean samples per covered pixel (any number from 1; default 16, as fis and prefiltered).
+    /// Within --max-samples.
     #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     spp: Option<u32>,
 

@@ -170,7 +170,8 @@
 //! seed ([`frame_seed`]): other prediction directions, so a slightly different plan, and other
 //! samples. Against Mitsuba 3 (`cargo bench -p brdf-preview --bench mitsuba`, 7x7 bias p99 at
 //! brdf-preview's defaults, at the Nyquist rate): a Lambertian under quarry's sun 2.45 levels
-//! with one frame, 1.74 with 8; gold-paint 3.61 and 2.06.
+//! with one frame, 1.74 with 8; gold-paint 3.61 and 2.06. Each frame's budget is [`SPP`]
+//! samples per covered pixel by default, the filtered modes' 16.
 //!
 //! # Anti-aliasing (`001` section 4.3)
 //!
