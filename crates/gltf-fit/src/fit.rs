@@ -175,19 +175,18 @@ fn samples(table: &MerlTable, objective: Objective, stride: usize) -> Vec<Sample
     let dims = table.dims();
     (0..dims.cells())
         .into_par_iter()
-        .filter(|&i| dims.cell(i).phi_d % stride == 0)
+        .filter(|&i| dims.cell(i).phi_d.is_multiple_of(stride))
         .filter_map(|i| sample(table, i, objective, stride))
         .collect()
 }
 
-/// A sample's squared error, weighted, and the weight it stands for (six terms: three channels,
-/// two cosines).
+/// A sample's squared error, weighted (six terms: three channels, two cosines).
 fn sample_cost(s: &Sample, m: &Material, settings: &Settings) -> f64 {
     let f = brdf(m, settings.masking, &s.g);
     let mut sum = 0.0;
-    for (k, cos) in s.cos.iter().enumerate() {
-        for c in 0..3 {
-            sum += (settings.objective.transform(f[c], *cos) - s.target[k][c]).powi(2);
+    for (cos, target) in s.cos.iter().zip(&s.target) {
+        for (f, t) in f.iter().zip(target) {
+            sum += (settings.objective.transform(*f, *cos) - t).powi(2);
         }
     }
     s.weight * sum
@@ -551,8 +550,8 @@ mod tests {
         let fit = fit(&table, &Settings::default());
         let m = fit.chosen().material;
         assert!((m.alpha() - 0.05).abs() < 0.05 * 0.05, "{}", summary(&fit));
-        for c in 0..3 {
-            assert!((m.base_color[c] - kd[c]).abs() < 0.05, "{}", summary(&fit));
+        for (got, want) in m.base_color.iter().zip(kd) {
+            assert!((got - want).abs() < 0.05, "{}", summary(&fit));
         }
     }
 }

@@ -108,7 +108,12 @@ fn run(args: Args) -> Result<ExitCode> {
     let name = path.file_stem().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "material".into());
     let generator = format!("{} {}", env!("CARGO_PKG_NAME"), env!("CARGO_PKG_VERSION"));
     let gltf = gltf_fit::gltf::gltf_files(&material, &name, BIN, &generator);
-    let record = fit_json(&fit, &albedo, source);
+    // The kept material under every objective, so that fits by one can be judged by the other.
+    let by_kind: Vec<(Objective, f64)> = [Objective::LogCosine, Objective::LinearCosine]
+        .into_iter()
+        .map(|objective| (objective, gltf_fit::objective(&table, &material, &Settings { objective, ..settings })))
+        .collect();
+    let record = fit_json(&fit, &albedo, &by_kind, source);
     let record_text = serde_json::to_string_pretty(&record).expect("json values serialize") + "\n";
     let table_bytes = fitted.to_bytes();
     let files: [(&str, &[u8]); 4] =
@@ -136,7 +141,7 @@ fn material_json(m: &Material) -> Value {
 }
 
 /// fit.json (data-schema/brdf-fit.md).
-fn fit_json(fit: &Fit, albedo: &[AlbedoRow], source: Value) -> Value {
+fn fit_json(fit: &Fit, albedo: &[AlbedoRow], by_kind: &[(Objective, f64)], source: Value) -> Value {
     let chosen = fit.chosen();
     let extensions: Vec<&str> =
         if chosen.material.uses_specular_extension() { vec!["KHR_materials_specular"] } else { vec![] };
@@ -152,6 +157,7 @@ fn fit_json(fit: &Fit, albedo: &[AlbedoRow], source: Value) -> Value {
             "core": fit.core.objective,
             "specular": fit.specular.objective,
             "specular_margin": fit.settings.margin,
+            "by_kind": by_kind.iter().map(|(o, v)| (o.name().to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
         },
         "initial_estimate": {
             "alpha": fit.estimate.alpha,
