@@ -147,8 +147,14 @@ fn brdf_fit_uses_the_specular_extension_for_a_lambertian() {
     assert!(reports[1]["errors"].as_u64().unwrap() > 0, "{:#}", reports[1]);
 }
 
+/// A small valid table for the refusals that are not about the table.
+fn table_of(dir: &Path) -> PathBuf {
+    synth(dir, "lambert.binary", &["lambertian"])
+}
+
 /// Refusals: a file that is not a MERL table and a missing one name the file (exit 2, one line,
-/// nothing written); a bake folder is refused as the output.
+/// nothing written); a bake folder is refused as the output, and an output folder whose parent
+/// is missing before the fit runs.
 #[test]
 fn brdf_fit_refuses_bad_inputs() {
     let dir = temp_dir();
@@ -171,6 +177,11 @@ fn brdf_fit_refuses_bad_inputs() {
     let mut cmd = tool("brdf-fit");
     cmd.arg(&text).arg("--out-dir").arg(&bake);
     run(cmd, "").expect_one_error_line("is a bake folder");
+
+    let orphan = dir.path().join("no-such-folder").join("out");
+    let mut cmd = tool("brdf-fit");
+    cmd.arg(&table_of(dir.path())).arg("--out-dir").arg(&orphan);
+    run(cmd, "").expect_one_error_line("does not exist");
 
     let mut cmd = tool("brdf-fit");
     cmd.arg(&text).arg("--out-dir").arg(&out).args(["--masking", "ggx"]);

@@ -470,7 +470,11 @@ mod tests {
     }
 
     fn check(table: &MerlTable, expected: &Material, variant: Variant, tolerance: f64) -> Fit {
-        let fit = fit(table, &Settings::default());
+        check_with(table, &Settings::default(), expected, variant, tolerance)
+    }
+
+    fn check_with(table: &MerlTable, settings: &Settings, expected: &Material, variant: Variant, tolerance: f64) -> Fit {
+        let fit = fit(table, settings);
         let m = fit.chosen().material;
         assert_eq!(fit.chosen, variant, "{}", summary(&fit));
         let pairs = [
@@ -514,6 +518,16 @@ mod tests {
         let expected = Material::core([0.6, 0.3, 0.2], 0.0, 0.5);
         let table = fitted_table(&expected, Masking::HeightCorrelated, Dims::MERL);
         check(&table, &expected, Variant::Core, 2e-3);
+    }
+
+    /// With Appendix B.3.2's separable masking, a table of that model comes back the same way,
+    /// metallic factor included (a mix of dielectric and metal).
+    #[test]
+    fn recovers_a_separable_mix() {
+        let expected = Material::core([0.8, 0.5, 0.3], 0.4, 0.3);
+        let table = fitted_table(&expected, Masking::Separable, Dims::MERL);
+        let settings = Settings { masking: Masking::Separable, ..Settings::default() };
+        check_with(&table, &settings, &expected, Variant::Core, 2e-3);
     }
 
     /// A Lambertian is the dielectric with `specularFactor` 0 (the core material always

@@ -100,6 +100,8 @@ fn run(args: Args) -> Result<ExitCode> {
     });
     let table = MerlTable::parse(&bytes).with_context(|| format!("reading {}", path.display()))?;
     drop(bytes);
+    // Before the fit: a folder that cannot be made costs nothing.
+    asset::create_folder(dir).map_err(|e| anyhow::anyhow!("writing {}: {e}", dir.display()))?;
 
     let fit = gltf_fit::fit(&table, &settings);
     let material = fit.chosen().material;
