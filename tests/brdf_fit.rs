@@ -54,9 +54,12 @@ fn fit(table: &Path, out: &Path) -> Value {
     assert_eq!(record, object["fit"], "stdout's fit is fit.json\n{r}");
     let errors: Vec<String> = schema().iter_errors(&record).map(|e| format!("{e} at {}", e.instance_path())).collect();
     assert!(errors.is_empty(), "fit.json fails the schema:\n{}", errors.join("\n"));
-    let names: Vec<String> = object["files"].as_array().unwrap().iter().map(|f| f["path"].as_str().unwrap().to_string()).collect();
-    let expected: Vec<String> =
-        ["material.bin", "fit.binary", "material.gltf", "fit.json"].iter().map(|n| out.join(n).display().to_string()).collect();
+    let names: Vec<String> =
+        object["files"].as_array().unwrap().iter().map(|f| f["path"].as_str().unwrap().to_string()).collect();
+    let expected: Vec<String> = ["material.bin", "fit.binary", "material.gltf", "fit.json"]
+        .iter()
+        .map(|n| out.join(n).display().to_string())
+        .collect();
     assert_eq!(names, expected, "{r}");
     for file in object["files"].as_array().unwrap() {
         let bytes = std::fs::read(file["path"].as_str().unwrap()).unwrap();
@@ -116,7 +119,11 @@ fn brdf_fit_recovers_a_ggx_metal_and_writes_a_valid_gltf() {
 
     let reports = validate_gltf(&[out.join("material.gltf")]);
     let report = &reports[0];
-    assert_eq!((report["errors"].as_u64(), report["warnings"].as_u64(), report["infos"].as_u64()), (Some(0), Some(0), Some(0)), "{report:#}");
+    assert_eq!(
+        (report["errors"].as_u64(), report["warnings"].as_u64(), report["infos"].as_u64()),
+        (Some(0), Some(0), Some(0)),
+        "{report:#}"
+    );
     assert_eq!(report["resources"], serde_json::json!(["material.bin"]), "{report:#}");
 }
 
@@ -180,7 +187,7 @@ fn brdf_fit_refuses_bad_inputs() {
 
     let orphan = dir.path().join("no-such-folder").join("out");
     let mut cmd = tool("brdf-fit");
-    cmd.arg(&table_of(dir.path())).arg("--out-dir").arg(&orphan);
+    cmd.arg(table_of(dir.path())).arg("--out-dir").arg(&orphan);
     run(cmd, "").expect_one_error_line("does not exist");
 
     let mut cmd = tool("brdf-fit");

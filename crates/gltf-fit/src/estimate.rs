@@ -186,7 +186,8 @@ mod tests {
     fn nodes_integrate_a_ggx_distribution() {
         let (theta, w) = nodes();
         for alpha in [0.02, 0.1, 0.5, 1.0] {
-            let total: f64 = theta.iter().zip(&w).map(|(t, w)| ggx_d(alpha, t.cos()) * t.cos() * w).sum::<f64>() * 2.0 * PI;
+            let total: f64 =
+                theta.iter().zip(&w).map(|(t, w)| ggx_d(alpha, t.cos()) * t.cos() * w).sum::<f64>() * 2.0 * PI;
             assert!((total - 1.0).abs() < 1e-4, "alpha {alpha}: {total}");
         }
     }
@@ -201,7 +202,12 @@ mod tests {
                 let metal = crate::Material::core([0.9, 0.6, 0.3], 1.0, alpha.sqrt());
                 let table = crate::fitted_table(&metal, masking, Dims::MERL);
                 let e = estimate_ndf(&table, masking);
-                assert!((e.alpha - alpha).abs() < 0.03 * alpha, "{masking:?} alpha {alpha}: {} after {}", e.alpha, e.iterations);
+                assert!(
+                    (e.alpha - alpha).abs() < 0.03 * alpha,
+                    "{masking:?} alpha {alpha}: {} after {}",
+                    e.alpha,
+                    e.iterations
+                );
             }
         }
         // The merl crate's own table (height-correlated): the same.

@@ -289,16 +289,26 @@ fn parameters(variant: Variant, m: &Material) -> (Vec<f64>, Vec<(f64, f64)>) {
 fn material(variant: Variant, p: &[f64]) -> Material {
     match variant {
         Variant::Core => Material::core([p[0], p[1], p[2]], p[3], p[4]),
-        Variant::Specular => {
-            Material { base_color: [p[0], p[1], p[2]], metallic: 0.0, roughness: p[3], specular: p[4], specular_color: [p[5], p[6], p[7]] }
-        }
+        Variant::Specular => Material {
+            base_color: [p[0], p[1], p[2]],
+            metallic: 0.0,
+            roughness: p[3],
+            specular: p[4],
+            specular_color: [p[5], p[6], p[7]],
+        },
     }
 }
 
 /// Levenberg-Marquardt (Marquardt's scaling: the damping multiplies the normal matrix's
 /// diagonal) with forward-difference derivatives, steps projected onto the bounds. The normal
 /// equations are accumulated cell by cell (the Jacobian, cells x parameters, is never stored).
-fn refine(table: &MerlTable, samples: &[Sample], settings: &Settings, variant: Variant, start: &Material) -> VariantFit {
+fn refine(
+    table: &MerlTable,
+    samples: &[Sample],
+    settings: &Settings,
+    variant: Variant,
+    start: &Material,
+) -> VariantFit {
     let (mut p, bounds) = parameters(variant, start);
     let n = p.len();
     let cost = |p: &[f64]| ordered_sum(samples, |s| [sample_cost(s, &material(variant, p), settings), 0.0])[0];
@@ -318,7 +328,8 @@ fn refine(table: &MerlTable, samples: &[Sample], settings: &Settings, variant: V
                 lambda *= 4.0;
                 continue;
             };
-            let candidate: Vec<f64> = p.iter().zip(&delta).zip(&bounds).map(|((p, d), (lo, hi))| (p + d).clamp(*lo, *hi)).collect();
+            let candidate: Vec<f64> =
+                p.iter().zip(&delta).zip(&bounds).map(|((p, d), (lo, hi))| (p + d).clamp(*lo, *hi)).collect();
             let c = cost(&candidate);
             if c < current {
                 let decrease = (current - c) / current.max(f64::MIN_POSITIVE);
@@ -338,7 +349,13 @@ fn refine(table: &MerlTable, samples: &[Sample], settings: &Settings, variant: V
 
 /// `J^T J` (row-major, `n x n`) and `J^T r` of the weighted residuals at `p`, by forward
 /// differences (backward at an upper bound).
-fn normal_equations(samples: &[Sample], settings: &Settings, variant: Variant, p: &[f64], bounds: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
+fn normal_equations(
+    samples: &[Sample],
+    settings: &Settings,
+    variant: Variant,
+    p: &[f64],
+    bounds: &[(f64, f64)],
+) -> (Vec<f64>, Vec<f64>) {
     let n = p.len();
     let steps: Vec<f64> = p.iter().zip(bounds).map(|(p, (_, hi))| if p + 1e-6 > *hi { -1e-6 } else { 1e-6 }).collect();
     let base = material(variant, p);
@@ -473,7 +490,13 @@ mod tests {
         check_with(table, &Settings::default(), expected, variant, tolerance)
     }
 
-    fn check_with(table: &MerlTable, settings: &Settings, expected: &Material, variant: Variant, tolerance: f64) -> Fit {
+    fn check_with(
+        table: &MerlTable,
+        settings: &Settings,
+        expected: &Material,
+        variant: Variant,
+        tolerance: f64,
+    ) -> Fit {
         let fit = fit(table, settings);
         let m = fit.chosen().material;
         assert_eq!(fit.chosen, variant, "{}", summary(&fit));

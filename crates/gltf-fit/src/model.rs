@@ -139,8 +139,10 @@ pub fn brdf(m: &Material, masking: Masking, g: &Geometry) -> [f64; 3] {
     let alpha = m.alpha();
     let specular_brdf = visibility(masking, alpha, g.n_l, g.n_v) * ggx_d(alpha, g.n_h);
     let fresnel_w = (1.0 - g.v_h.abs()).powi(5);
-    let dielectric_fresnel =
-        m.specular_color.map(|c| (DIELECTRIC_F0 * c).min(1.0) * m.specular).map(|f0| f0 + (m.specular - f0) * fresnel_w);
+    let dielectric_fresnel = m
+        .specular_color
+        .map(|c| (DIELECTRIC_F0 * c).min(1.0) * m.specular)
+        .map(|f0| f0 + (m.specular - f0) * fresnel_w);
     let fresnel_max = dielectric_fresnel.iter().copied().fold(f64::MIN, f64::max);
     let mut out = [0.0; 3];
     for c in 0..3 {
@@ -216,7 +218,13 @@ mod tests {
     /// `baseColor` exactly (the extension's "pure diffuse material").
     #[test]
     fn specular_zero_is_lambertian() {
-        let m = Material { base_color: [0.8, 0.4, 0.1], metallic: 0.0, roughness: 0.3, specular: 0.0, specular_color: [1.0; 3] };
+        let m = Material {
+            base_color: [0.8, 0.4, 0.1],
+            metallic: 0.0,
+            roughness: 0.3,
+            specular: 0.0,
+            specular_color: [1.0; 3],
+        };
         for (wi, wo) in pairs() {
             let f = eval(&m, Masking::HeightCorrelated, wi, wo);
             let expected = Analytic::Lambertian { albedo: m.base_color }.eval(wi, wo);
@@ -268,7 +276,13 @@ mod tests {
 
     #[test]
     fn reciprocity() {
-        let m = Material { base_color: [0.3, 0.6, 0.9], metallic: 0.4, roughness: 0.35, specular: 0.7, specular_color: [1.5, 0.5, 3.0] };
+        let m = Material {
+            base_color: [0.3, 0.6, 0.9],
+            metallic: 0.4,
+            roughness: 0.35,
+            specular: 0.7,
+            specular_color: [1.5, 0.5, 3.0],
+        };
         for masking in [Masking::HeightCorrelated, Masking::Separable] {
             for (wi, wo) in pairs() {
                 let (a, b) = (eval(&m, masking, wi, wo), eval(&m, masking, wo, wi));

@@ -77,7 +77,11 @@ fn main() -> ExitCode {
 fn run(args: Args) -> Result<ExitCode> {
     let dir = &args.out_dir;
     if dir.join(asset::MANIFEST_FILE).exists() {
-        bail!("{} is a bake folder (it holds {}): brdf-fit writes a folder of its own", dir.display(), asset::MANIFEST_FILE);
+        bail!(
+            "{} is a bake folder (it holds {}): brdf-fit writes a folder of its own",
+            dir.display(),
+            asset::MANIFEST_FILE
+        );
     }
     let settings = Settings {
         masking: match args.masking {
@@ -209,7 +213,10 @@ fn report(fit: &Fit, albedo: &[AlbedoRow]) -> Vec<String> {
         format!("initial estimate: alpha {:.5} after {} power iterations", fit.estimate.alpha, fit.estimate.iterations),
     ];
     if m.uses_specular_extension() {
-        lines.insert(1, format!("KHR_materials_specular: specular {:.4}, specularColor {}", m.specular, rgb(m.specular_color)));
+        lines.insert(
+            1,
+            format!("KHR_materials_specular: specular {:.4}, specularColor {}", m.specular, rgb(m.specular_color)),
+        );
     }
     lines.push("directional albedo (nearest lookup), measured -> fit, luminance error:".into());
     for row in albedo {
