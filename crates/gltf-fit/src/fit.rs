@@ -218,11 +218,28 @@ pub fn objective(table: &MerlTable, m: &Material, settings: &Settings) -> f64 {
 
 /// Fits the glTF material to the table: the stages in order.
 pub fn fit(table: &MerlTable, settings: &Settings) -> Fit {
+    fit_reporting(table, settings, &|_, _| {})
+}
+
+/// The stages of [`fit`], as [`fit_reporting`] reports them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The power iteration and the initial colours.
+    Estimate,
+    /// Levenberg-Marquardt on one variant; its iterations so far, of at most
+    /// [`Settings::max_iterations`].
+    Refine(Variant, usize),
+}
+
+/// [`fit`], calling `progress(stage, settings)` as each stage begins and after each iteration of
+/// the refinements (a tool's progress bar).
+pub fn fit_reporting(table: &MerlTable, settings: &Settings, progress: &dyn Fn(Stage, &Settings)) -> Fit {
+    progress(Stage::Estimate, settings);
     let samples = samples(table, settings.objective, settings.phi_d_stride.max(1));
     let estimate = estimate_ndf(table, settings.masking);
     let initial = initial_material(&samples, settings, estimate.alpha.sqrt().max(MIN_ROUGHNESS));
-    let core = refine(table, &samples, settings, Variant::Core, &initial);
-    let specular = refine(table, &samples, settings, Variant::Specular, &core.material);
+    let core = refine(table, &samples, settings, Variant::Core, &initial, progress);
+    let specular = refine(table, &samples, settings, Variant::Specular, &core.material, progress);
     let gain = core.objective - specular.objective;
     let chosen = if gain > settings.margin * core.objective && gain > NEGLIGIBLE_OBJECTIVE {
         Variant::Specular
@@ -308,6 +325,7 @@ fn refine(
     settings: &Settings,
     variant: Variant,
     start: &Material,
+    progress: &dyn Fn(Stage, &Settings),
 ) -> VariantFit {
     let (mut p, bounds) = parameters(variant, start);
     let n = p.len();
@@ -316,6 +334,7 @@ fn refine(
     let mut lambda = 1e-3;
     let mut iterations = 0;
     while iterations < settings.max_iterations {
+        progress(Stage::Refine(variant, iterations), settings);
         iterations += 1;
         let (jtj, jtr) = normal_equations(samples, settings, variant, &p, &bounds);
         let mut improved = false;

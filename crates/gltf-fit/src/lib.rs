@@ -49,5 +49,8 @@ pub mod fit;
 pub mod gltf;
 pub mod model;
 
-pub use fit::{AlbedoRow, Fit, Objective, Settings, Variant, VariantFit, albedo_rows, fit, fitted_table, objective};
+pub use fit::{
+    AlbedoRow, Fit, Objective, Settings, Stage, Variant, VariantFit, albedo_rows, fit, fit_reporting, fitted_table,
+    objective,
+};
 pub use model::{Masking, Material};

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
-use gltf_fit::{AlbedoRow, Fit, Masking, Material, Objective, Settings};
+use gltf_fit::{AlbedoRow, Fit, Masking, Material, Objective, Settings, Stage, Variant};
 use merl::MerlTable;
 use serde_json::{Value, json};
 
@@ -49,6 +49,10 @@ struct Args {
     /// goes to stderr.
     #[arg(long)]
     json: bool,
+
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -107,7 +111,18 @@ fn run(args: Args) -> Result<ExitCode> {
     // Before the fit: a folder that cannot be made costs nothing.
     asset::create_folder(dir).map_err(|e| anyhow::anyhow!("writing {}: {e}", dir.display()))?;
 
-    let fit = gltf_fit::fit(&table, &settings);
+    let progress = cli::Progress::new(args.quiet);
+    let fit = gltf_fit::fit_reporting(&table, &settings, &|stage, settings| match stage {
+        Stage::Estimate => progress.step("1/3 initial estimate (power iteration)".into()),
+        Stage::Refine(variant, done) => {
+            if done == 0 {
+                let step = if variant == Variant::Core { "2/3 core material" } else { "3/3 specular variant" };
+                progress.step(format!("{step} (Levenberg-Marquardt)"));
+            }
+            progress.work(done as u64, settings.max_iterations as u64);
+        }
+    });
+    progress.finish();
     let material = fit.chosen().material;
     let fitted = gltf_fit::fitted_table(&material, settings.masking, table.dims());
     let albedo = gltf_fit::albedo_rows(&table, &fitted);
