@@ -129,7 +129,10 @@ struct Args {
 
     /// Adaptive modes: one prediction per block of 2^L x 2^L pixels, L from 0 (every pixel, as the
     /// paper; 2, the default, costs a sixteenth: cargo bench -p brdf-preview --bench adaptive); a
-    /// level above the pyramid's top predicts at the top.
+    /// level above the pyramid's top predicts at the top. A finer prediction catches a sun-lit
+    /// rim's narrow ramp: gold-paint under quarry_01 at 512 x 512 (default camera), 14 pixels more
+    /// than 20 levels from a converged estimate at 2, 2 at 1, 0 at 0, for 7% and 25% more time
+    /// per frame on lavapipe.
     #[arg(long, value_name = "L", default_value_t = 2)]
     predict_level: usize,
 
