@@ -24,7 +24,7 @@
 //! `ln alpha` in `[1e-3, 1]`). The diffuse part of a material adds a constant to `f(k, k)` and so
 //! widens the estimate; the least squares afterwards corrects it.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 use merl::{HalfDiff, Interp, MerlTable};
 
@@ -63,14 +63,7 @@ pub fn azimuthal_projection(theta_a: f64, theta_b: f64) -> f64 {
 /// The nodes' `theta` and their weights `w` such that `integral g(theta) sin theta dtheta
 /// ~= sum g(theta_j) w_j` (one azimuthal turn not included).
 fn nodes() -> (Vec<f64>, Vec<f64>) {
-    let du = 1.0 / NODES as f64;
-    (0..NODES)
-        .map(|j| {
-            let u = (j as f64 + 0.5) * du;
-            let theta = u * u * FRAC_PI_2;
-            (theta, theta.sin() * PI * u * du)
-        })
-        .unzip()
+    (0..NODES).map(|j| merl::albedo::sqrt_spaced_node(j, NODES)).unzip()
 }
 
 /// The luminance of the table's backscattering `f(k, k)` at elevation `theta` (`None` where
@@ -158,6 +151,7 @@ mod tests {
     use super::*;
     use merl::Dims;
     use merl::analytic::Analytic;
+    use std::f64::consts::FRAC_PI_2;
 
     #[test]
     fn azimuthal_projection_known_values() {

@@ -2,8 +2,6 @@
 //! squares over the table's cells, for the core material and for one with
 //! `KHR_materials_specular`, the second kept when it lowers the objective by [`Settings::margin`].
 
-use std::f64::consts::FRAC_PI_2;
-
 use merl::albedo::{Quadrature, directional_albedo};
 use merl::analytic::HORIZON_EPS;
 use merl::{Dims, Interp, MerlTable};
@@ -160,8 +158,8 @@ fn sample(table: &MerlTable, index: usize, objective: Objective, stride: usize) 
     if wi.z <= HORIZON_EPS || wo.z <= HORIZON_EPS {
         return None;
     }
-    let theta_h = |i: usize| (i as f64 / dims.n_theta_h as f64).powi(2) * FRAC_PI_2;
-    let theta_d = |j: usize| j as f64 / dims.n_theta_d as f64 * FRAC_PI_2;
+    let theta_h = |i: usize| dims.theta_h_at(i as f64);
+    let theta_d = |j: usize| dims.theta_d_at(j as f64);
     let measure_h = theta_h(cell.theta_h).cos() - theta_h(cell.theta_h + 1).cos();
     let measure_d = 2.0 * (theta_d(cell.theta_d + 1).sin().powi(2) - theta_d(cell.theta_d).sin().powi(2));
     let measure_p = dims.phi_d_range() / dims.n_phi_d as f64 * stride as f64;

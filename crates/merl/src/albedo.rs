@@ -63,20 +63,29 @@ pub fn directional_albedo(
     Albedo { rgb: [r, g, b], no_data_fraction: no_data / PI }
 }
 
+/// Node `i` of `n` of the quadrature in `theta` over `[0, pi / 2]` at MERL's square-root spacing
+/// (`theta = u^2 pi / 2`, `u` the node's midpoint in `[0, 1]`): `(theta, w)` such that
+/// `integral g(theta) sin theta dtheta ~= sum g(theta_i) w_i` (`dtheta = pi u du`), dense near
+/// 0 where peaked lobes are. The rows of [`hemisphere_integral`]'s half vectors.
+pub fn sqrt_spaced_node(i: usize, n: usize) -> (f64, f64) {
+    let du = 1.0 / n as f64;
+    let u = (i as f64 + 0.5) * du;
+    let theta = u * u * FRAC_PI_2;
+    (theta, theta.sin() * PI * u * du)
+}
+
 /// `integral g(wi) dwi` over the upper hemisphere (`wi.z > 0`), by the half-vector quadrature
 /// about `wo` described in the module docs: the nodes are dense where `wi` is near the mirror
 /// direction of `wo`, so peaked integrands (BRDF lobes, importance-sampling densities) converge.
 /// Deterministic: the same bits whatever the number of threads.
 pub fn hemisphere_integral<const N: usize>(g: impl Fn(DVec3) -> [f64; N] + Sync, wo: DVec3, q: Quadrature) -> [f64; N] {
     let n_u = 90 * q.nodes_per_cell;
-    let du = 1.0 / n_u as f64;
     let dphi = 2.0 * PI / q.n_phi_h as f64;
     (0..n_u)
         .into_par_iter()
         .map(|iu| {
-            let u = (iu as f64 + 0.5) * du;
-            let theta_h = u * u * FRAC_PI_2;
-            let row_weight = theta_h.sin() * PI * u * du * dphi;
+            let (theta_h, weight) = sqrt_spaced_node(iu, n_u);
+            let row_weight = weight * dphi;
             let mut sum = [0.0; N];
             for ip in 0..q.n_phi_h {
                 let h = spherical_dir(theta_h, (ip as f64 + 0.5) * dphi);

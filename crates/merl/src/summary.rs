@@ -3,7 +3,7 @@
 use crate::albedo::{Albedo, Quadrature, directional_albedo};
 use crate::coords::HalfDiff;
 use crate::table::{Cell, Dims, Interp, MerlTable};
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::TAU;
 
 /// The outgoing elevations (degrees) at which the summary reports the directional albedo.
 pub const SUMMARY_THETA_O_DEG: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
@@ -67,13 +67,11 @@ pub struct Summary {
 /// at most 3.6e-4, teflon's; a Lambertian's 4.2e-4), and a share above 1 is a value no material
 /// has. A cell below the horizon on either side has no share.
 pub fn cell_share(dims: Dims, c: Cell, value: f64) -> CellShare {
-    let (n_h, n_d) = (dims.n_theta_h as f64, dims.n_theta_d as f64);
-    let theta_h_at = |u: f64| (u / n_h).powi(2) * FRAC_PI_2;
-    let (theta_a, theta_b) = (theta_h_at(c.theta_h as f64), theta_h_at(c.theta_h as f64 + 1.0));
+    let (theta_a, theta_b) = (dims.theta_h_at(c.theta_h as f64), dims.theta_h_at(c.theta_h as f64 + 1.0));
     let centre = HalfDiff {
-        theta_h: theta_h_at(c.theta_h as f64 + 0.5),
+        theta_h: dims.theta_h_at(c.theta_h as f64 + 0.5),
         phi_h: 0.0,
-        theta_d: (c.theta_d as f64 + 0.5) / n_d * FRAC_PI_2,
+        theta_d: dims.theta_d_at(c.theta_d as f64 + 0.5),
         phi_d: (c.phi_d as f64 + 0.5) / dims.n_phi_d as f64 * dims.phi_d_range(),
     };
     let (wi, wo) = centre.to_dirs();

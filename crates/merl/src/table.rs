@@ -101,13 +101,24 @@ impl Dims {
         }
     }
 
+    /// `theta_h` at grid coordinate `x` along its axis (the inverse of [`Dims::grid_coords`]'s
+    /// square-root spacing): `(x / n_theta_h)^2 pi / 2`; cell `i` spans `[i, i + 1)`.
+    pub fn theta_h_at(&self, x: f64) -> f64 {
+        let u = x / self.n_theta_h as f64;
+        u * u * FRAC_PI_2
+    }
+
+    /// `theta_d` at grid coordinate `x` along its axis: `x / n_theta_d pi / 2`.
+    pub fn theta_d_at(&self, x: f64) -> f64 {
+        x / self.n_theta_d as f64 * FRAC_PI_2
+    }
+
     /// The configuration at which cell `c` is sampled: its lower edge.
     pub fn sample_point(&self, c: Cell) -> HalfDiff {
-        let u = c.theta_h as f64 / self.n_theta_h as f64;
         HalfDiff {
-            theta_h: u * u * FRAC_PI_2,
+            theta_h: self.theta_h_at(c.theta_h as f64),
             phi_h: 0.0,
-            theta_d: c.theta_d as f64 / self.n_theta_d as f64 * FRAC_PI_2,
+            theta_d: self.theta_d_at(c.theta_d as f64),
             phi_d: c.phi_d as f64 / self.n_phi_d as f64 * self.phi_d_range(),
         }
     }
