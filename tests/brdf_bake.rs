@@ -446,3 +446,40 @@ fn an_unphysical_table_is_refused_before_anything_is_baked() {
         assert_eq!(snapshot(&dir), before, "{name}: the previous bake changed ({good})");
     }
 }
+
+/// `--env-reading auto` (the default) reads the environment's bandwidth level-normalized exactly
+/// when the layer selection's figures say every view's lobe is at least as sharp as the sharpest
+/// layer's, and a fixed reading is kept; either way `env-bandwidth.exr` is what `envmap-bandwidth
+/// --reading` of that reading writes for the map.
+#[test]
+fn the_environment_bandwidth_reading_follows_the_material() {
+    let reference = reference_bake();
+    let stage = |manifest: &Value, name: &str| -> Value {
+        manifest["stages"].as_array().unwrap().iter().find(|s| s["name"] == name).cloned().expect(name)
+    };
+    let manifest = checked_manifest(&reference.dir);
+    assert_eq!(manifest["parameters"]["environment_bandwidth"]["reading"], "auto", "{manifest:#}");
+    let selection = stage(&manifest, "layer-selection");
+    let numbers = |key: &str| -> Vec<f64> {
+        selection["figures"][key].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    let sharpest = *numbers("layer_bandwidth").last().unwrap();
+    let mirror_like = numbers("view_bandwidth").iter().all(|&b| b >= sharpest);
+    let (chosen, other) = if mirror_like { ("level-normalized", "paper") } else { ("paper", "level-normalized") };
+    assert_eq!(stage(&manifest, "environment-bandwidth")["parameters"]["reading"], chosen, "{manifest:#}");
+
+    let tmp = temp_dir();
+    let fixed = tmp.path().join("fixed");
+    run(bake_command(&fixed, &["--env-reading", other]), "").expect_code(0);
+    let fixed_manifest = checked_manifest(&fixed);
+    assert_eq!(fixed_manifest["parameters"]["environment_bandwidth"]["reading"], other);
+    assert_eq!(stage(&fixed_manifest, "environment-bandwidth")["parameters"]["reading"], other);
+    for (reading, dir) in [(chosen, &reference.dir), (other, &fixed)] {
+        let alone = tmp.path().join(reading);
+        let mut cmd = tool("envmap-bandwidth");
+        cmd.arg(bake_env()).arg("--out-dir").arg(&alone).args(["--reading", reading]);
+        run(cmd, "").expect_code(0);
+        let read = |d: &Path| std::fs::read(d.join("env-bandwidth.exr")).expect("env-bandwidth.exr");
+        assert!(read(dir) == read(&alone), "{reading}: the bake's env-bandwidth.exr differs from envmap-bandwidth's");
+    }
+}

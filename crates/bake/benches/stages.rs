@@ -138,7 +138,8 @@ fn main() {
     print(
         "layer selection",
         &measure(|| {
-            layers::run(&build, &config.atlas, exponents, config.layer_reduction, &source, &PROGRAM).expect("layers")
+            let selection = layers::select(&build, &config.atlas, exponents, config.layer_reduction).expect("layers");
+            layers::run(&selection, &config.atlas, &build, &source, &PROGRAM).expect("layers")
         }),
     );
     drop((table, build, map));

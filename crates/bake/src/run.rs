@@ -27,7 +27,11 @@ pub struct BakeConfig {
     pub pca_max_error: Option<f64>,
     /// Encode the material in Haar wavelets (`brdf-wavelet`) with these settings.
     pub wavelet_brdf: Option<wavelet_brdf::Settings>,
+    /// The environment bandwidth's settings; its reading is [`BakeConfig::env_reading`]'s, resolved
+    /// for the material (the reading of `config` here is not read).
     pub env_bandwidth: env_bandwidth::Settings,
+    /// Which reading the environment's bandwidth takes ([`env_bandwidth::ReadingChoice`]).
+    pub env_reading: env_bandwidth::ReadingChoice,
     pub prefilter: ::prefilter::Config,
     /// How a view's lobe and a layer's lobe become the numbers the layer selection compares.
     pub layer_reduction: brdf_atlas::view::ViewReduction,
@@ -50,6 +54,7 @@ impl BakeConfig {
             pca_max_error: None,
             wavelet_brdf: None,
             env_bandwidth: env_bandwidth::Settings::default(),
+            env_reading: env_bandwidth::ReadingChoice::Auto,
             prefilter: ::prefilter::Config::default(),
             layer_reduction: layers::DEFAULT_REDUCTION,
             engine_textures: false,
@@ -119,7 +124,7 @@ impl BakeConfig {
                 "environment_bandwidth",
                 json!({
                     "mode": e.mode.name(), "eps": e.config.eps, "c": e.config.c, "levels": e.config.levels,
-                    "reading": e.config.reading.name(), "fft_diagnostic": e.fft_diagnostic,
+                    "reading": self.env_reading.name(), "fft_diagnostic": e.fft_diagnostic,
                 }),
             ),
             (
@@ -290,16 +295,24 @@ pub fn run_bake(
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
         begin("environment bandwidth");
-        record(env_bandwidth::run_on_map(path, map, &config.env_bandwidth).map_err(of_map(path))?, &mut manifest)?;
+        // The layer selection is made first: the reading of the environment's bandwidth follows
+        // the material's lobes (`env_bandwidth::ReadingChoice`).
+        let selection =
+            layers::select(&atlas_build, &config.atlas, &config.prefilter.exponents, config.layer_reduction)?;
+        let settings = env_bandwidth::Settings {
+            config: bandwidth::Config {
+                reading: config.env_reading.resolve(&selection),
+                ..config.env_bandwidth.config
+            },
+            ..config.env_bandwidth.clone()
+        };
+        record(env_bandwidth::run_on_map(path, map, &settings).map_err(of_map(path))?, &mut manifest)?;
         begin("phong layers and mip chain");
         let (staged, _prefiltered) =
             prefilter::run(map, source, program, &config.prefilter, &work).map_err(of_map(path))?;
         record(staged, &mut manifest)?;
         begin("layer selection");
-        let exponents = &config.prefilter.exponents;
-        let (staged, _) =
-            layers::run(&atlas_build, &config.atlas, exponents, config.layer_reduction, &material_source, program)?;
-        record(staged, &mut manifest)?;
+        record(layers::run(&selection, &config.atlas, &atlas_build, &material_source, program)?, &mut manifest)?;
         if config.engine_textures {
             begin("engine textures");
             let file = |role: &str| -> Result<(PathBuf, Vec<u8>), Error> {

@@ -94,9 +94,12 @@ struct Args {
     ggx_levels: Option<usize>,
 
     /// How the environment's bandwidth compares wavelet levels (see envmap-bandwidth --help):
-    /// paper (the default) or level-normalized.
-    #[arg(long, value_name = "paper|level-normalized", default_value = "paper", requires = "env")]
-    env_reading: bandwidth::Reading,
+    /// paper, level-normalized, or auto (the default): level-normalized for a mirror-like
+    /// material (its lobe at every view as sharp as the sharpest Phong layer, as chrome's), whose
+    /// pictures show the fine detail the paper's reading lets strong edges mask, paper otherwise.
+    /// brdf-preview's adaptive modes plan their frames from it.
+    #[arg(long, value_name = "auto|paper|level-normalized", default_value = "auto", requires = "env")]
+    env_reading: bake::stage::env_bandwidth::ReadingChoice,
 
     /// Also write the engine textures (engine-*.ktx2): everything brdf-preview's reference and
     /// prefiltered estimators read (the MERL table as a 3D texture, the importance tables, the
@@ -171,7 +174,7 @@ fn run(args: Args) -> Result<ExitCode> {
     config.prefilter.chain = args.chain;
     config.engine_textures = args.engine_textures;
     config.env_bandwidth.max_memory = args.max_memory;
-    config.env_bandwidth.config.reading = args.env_reading;
+    config.env_reading = args.env_reading;
     let progress = cli::Progress::new(args.quiet);
     let outcome = bake::run_bake(&config, &PROGRAM, &|p| match p {
         Progress::Stage { index, count, name } => progress.step(format!("{}/{count} {name}", index + 1)),

@@ -68,6 +68,10 @@ use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings, metrics};
 const MATERIALS: [&str; 3] = ["gold-paint", "white-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
 const MESHES: [&str; 2] = ["sphere", "torus"];
+/// The summary's rows of the reading each bake chose (`brdf-bake --env-reading auto`, the
+/// default: level-normalized for chrome, paper for the two paints).
+const BAKE_CHOICE: &str = "the bake's (auto)";
+
 /// The default render size (`--size N`): the paper's (`001` Fig. 11). The speed-ups depend on it:
 /// a frame's fixed costs (prediction, plan, up-sampling) grow with the pixels as the brute
 /// force's do, but the shaded pixels do not, as an image's bandwidth in cycles per pixel halves
@@ -326,7 +330,7 @@ fn main() {
     out(String::new());
     out("| case | mode | env reading | budget spp | PSNR dB | ceiling dB | ms | shaded | samples | brute ms | speed-up |".into());
     out("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|".into());
-    let mut speedups: Vec<(String, &'static str, &'static str, f64, Match)> = Vec::new();
+    let mut speedups: Vec<(String, &'static str, &'static str, f64, Match, bool)> = Vec::new();
     let mut correlations = Vec::new();
     let mut aa_rows = Vec::new();
     let mut stages = Vec::new();
@@ -348,6 +352,13 @@ fn main() {
             let loaded = bake(material, env);
             let lighting = loaded.lighting.as_ref().expect("an environment");
             let atlas = loaded.bandwidths.as_ref().expect("bandwidths").brdf.clone();
+            // The reading the bake chose for the material (`brdf-bake --env-reading auto`): its
+            // rows make the summary's "bake's choice".
+            let bake_reading = match &loaded.bandwidths.as_ref().expect("bandwidths").environment {
+                e if e == paper => "paper",
+                e if e == normalized => "level-normalized",
+                _ => panic!("{material} / {env}: the bake's environment bandwidth is neither reading's"),
+            };
             let preview = metrics::auto_tone_mapping(lighting.mips.level(0));
             for mesh in MESHES {
                 let name = format!("{material} / {env} / {mesh}");
@@ -488,7 +499,14 @@ fn main() {
                                 millis(brute.ms()),
                                 brute.mark()
                             ));
-                            speedups.push((name.clone(), label, variant.name, speedup, brute));
+                            speedups.push((
+                                name.clone(),
+                                label,
+                                variant.name,
+                                speedup,
+                                brute,
+                                variant.name == bake_reading,
+                            ));
                             if variant.name == "paper" {
                                 stages.push((name.clone(), label, spp, frame.timings, ms, brute.ms()));
                             }
@@ -598,10 +616,14 @@ fn main() {
     out("| mode | env reading | rows | min | median | max | rows >= goal |".into());
     out("|---|---|---|---:|---:|---:|---:|".into());
     for label in ["adaptive", "adaptive-prefiltered"] {
-        for reading in ["paper", "level-normalized", "oracle (FFT)", "paper + lobe weight"] {
+        for reading in [BAKE_CHOICE, "paper", "level-normalized", "oracle (FFT)", "paper + lobe weight"] {
             for (rows, off_plateau) in [("all", false), ("off the plateau", true)] {
+                let of_reading = |s: &(String, &str, &str, f64, Match, bool)| match reading {
+                    BAKE_CHOICE => s.5,
+                    _ => s.2 == reading,
+                };
                 let mut v: Vec<f64> = (speedups.iter())
-                    .filter(|s| s.1 == label && s.2 == reading && !(off_plateau && matches!(s.4, Match::Plateau(_))))
+                    .filter(|s| s.1 == label && of_reading(s) && !(off_plateau && matches!(s.4, Match::Plateau(_))))
                     .map(|s| s.3)
                     .collect();
                 v.sort_by(f64::total_cmp);

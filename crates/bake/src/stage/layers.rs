@@ -39,17 +39,26 @@ pub const ASSET: &str = "layer-selection.asset";
 pub const DEFAULT_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.99);
 
 /// Selects the layers of `exponents` for the material whose atlas build (made with `config`) is
-/// `build`; `source` is the material.
-pub fn run(
+/// `build`.
+pub fn select(
     build: &AtlasBuild,
     config: &Config,
     exponents: &[u32],
     reduction: ViewReduction,
+) -> Result<LayerSelection, Error> {
+    select_layers(build, config, exponents, reduction).map_err(|e| Error::stage("layer selection", e))
+}
+
+/// The stage of `selection` ([`select`] of the atlas build `build`, made with `config`); `source`
+/// is the material.
+pub fn run(
+    selection: &LayerSelection,
+    config: &Config,
+    build: &AtlasBuild,
     source: &Source,
     program: &Program,
-) -> Result<(Staged, LayerSelection), Error> {
-    let selection =
-        select_layers(build, config, exponents, reduction).map_err(|e| Error::stage("layer selection", e))?;
+) -> Result<Staged, Error> {
+    let (exponents, reduction) = (&selection.exponents, selection.reduction);
     let payload = asset::LayerSelection {
         analysis: analysis_of(&build.atlas),
         rows: selection.view_layer.len() as u32,
@@ -98,5 +107,5 @@ pub fn run(
         report,
         problems: Vec::new(),
     };
-    Ok((staged, selection))
+    Ok(staged)
 }

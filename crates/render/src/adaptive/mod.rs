@@ -33,7 +33,9 @@
 //! Owen-scrambled Sobol' vector is stratified), each with its pdf. For each `wi`:
 //!
 //! - the light's bandwidth `nu_l = [0, nu_env(wi)]`, `nu_env` the bake's environment bandwidth
-//!   (cycles per radian, nearest texel; [`EnvBandwidth`]); a distant light has no spatial
+//!   (cycles per radian, nearest texel; [`EnvBandwidth`]; read level-normalized for a
+//!   mirror-like material, whose pictures show the fine detail the paper's reading lets a strong
+//!   edge mask: crate `bake`, `stage::env_bandwidth::ReadingChoice`); a distant light has no spatial
 //!   bandwidth, so the transport from it (`T_d`) and `P_i` leave it unchanged;
 //! - the reflection operator of eq. 3, `R = P_x C_-c S B_{t,rho} C_c P_i`, with the matrices of
 //!   Fig. 4 exactly as printed: `C_c` shears `[0, nu_a]` to `[c nu_a, nu_a]`; `B` keeps the
