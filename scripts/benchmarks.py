@@ -47,6 +47,12 @@ BENCHMARKS = [
         "markdown",
     ),
     ("mitsuba", "The CPU renderer against Mitsuba 3", "cargo bench -p brdf-preview --bench mitsuba", "markdown"),
+    (
+        "fits",
+        "brdf-fit's glTF materials against the 20 measured tables, in pictures",
+        "cargo bench -p brdf-preview --bench fits",
+        "markdown",
+    ),
     ("frontier", "The three.js material against three.js's own", "node engines/three/bench/frontier.mjs", "markdown"),
 ]
 

@@ -1,0 +1,258 @@
+//! How close `brdf-fit`'s glTF material comes to each measured table, in pictures (a benchmark,
+//! not a test): for each of the 20 real-derived materials, the fit at its defaults
+//! (`gltf_fit::fit`), its parameters, objective and directional albedo error, and the PSNR of
+//! the fit's exact render (its MERL table, `gltf_fit::fitted_table`) against the measured
+//! table's, both by the converged estimator (`render::converged`: no baked table, 256 samples per
+//! strategy, the same seed, so the two pictures share their noise) on a 128 x 128 sphere under
+//! two maps, each with the camera of the Mitsuba benchmark that looks at its brightest light's
+//! reflection: quarry_01 (a sun) and studio_small_03 (lamps). PSNR on the 8-bit pictures after
+//! the previewer's tone mapping of the map, over the sphere's pixels only.
+//!
+//! The report (markdown) is printed and written to target/bench-fits/report.md; the sorted plot
+//! of the PSNRs to docs/brdf-fit-psnr.png, which the report shows.
+//!
+//! `cargo bench -p brdf-preview --bench fits [-- --only NAME]`. Needs `../shared` (the maps, and
+//! nbrdf2merl.py with numpy for the materials, made once under target/merl/). About 25 s per
+//! material on 2 cores.
+
+use std::path::PathBuf;
+
+mod common;
+
+use common::{Stamp, material_path, root, shared};
+use envmap::MipChain;
+use gltf_fit::Settings;
+use merl::MerlTable;
+use picture::layout::{Axis, caption, heat_map, stack};
+use picture::{BACKGROUND, Canvas, INK, TEXT_SCALE};
+use render::{Camera, Image, Lighting, Material, SampleSet, Scene, metrics};
+
+/// The 20 real-derived materials (the Makefile's test data).
+const MATERIALS: [&str; 20] = [
+    "alum-bronze",
+    "black-obsidian",
+    "blue-acrylic",
+    "blue-rubber",
+    "brass",
+    "cherry-235",
+    "chrome",
+    "color-changing-paint3",
+    "gold-paint",
+    "gray-plastic",
+    "green-metallic-paint",
+    "nickel",
+    "pink-fabric",
+    "red-metallic-paint",
+    "silver-metallic-paint",
+    "steel",
+    "teflon",
+    "white-marble",
+    "white-paint",
+    "yellow-paint",
+];
+
+/// The maps, each with the Mitsuba benchmark's camera on its brightest light's reflection
+/// (azimuth, elevation in degrees) and the colour of its dots in the plot.
+const MAPS: [(&str, f32, f32, [u8; 3]); 2] =
+    [("quarry_01_1k", -144.0, 10.0, [250, 160, 40]), ("studio_small_03_1k", 82.8, 43.1, [90, 170, 250])];
+
+const SIZE: usize = 128;
+const SAMPLES_PER_STRATEGY: u32 = 256;
+const SEED: u64 = 7;
+
+fn work() -> PathBuf {
+    root().join("target/bench-fits")
+}
+
+/// A map's lighting (level 0 and its importance sampling are all the converged estimator reads)
+/// and the previewer's tone mapping of it.
+fn lighting(name: &str) -> (Lighting, envmap::ToneMapping) {
+    let map = envmap::load(&shared().join(format!("data/env/{name}.hdr"))).expect("the map");
+    let tone = metrics::auto_tone_mapping(&map);
+    (Lighting::new(MipChain::new(&map), Vec::new(), Vec::new()).expect("the lighting"), tone)
+}
+
+/// The converged estimator reads the table alone: no samples, no layers.
+fn material(table: MerlTable) -> Material {
+    let samples = SampleSet { n_slices: 0, n_vectors: 0, n_samples: 0, texels: Vec::new(), tables: Vec::new() };
+    Material::new(table, samples, Vec::new())
+}
+
+/// PSNR of `a` against `b` (8-bit RGB) over the covered pixels.
+fn sphere_psnr(a: &[u8], b: &[u8], covered: &[bool]) -> f64 {
+    let pick = |p: &[u8]| -> Vec<u8> {
+        p.chunks_exact(3).zip(covered).filter(|(_, c)| **c).flat_map(|(rgb, _)| rgb.iter().copied()).collect()
+    };
+    metrics::psnr_db(&pick(a), &pick(b))
+}
+
+struct Row {
+    name: &'static str,
+    fit: gltf_fit::Fit,
+    albedo: Vec<gltf_fit::AlbedoRow>,
+    psnr: Vec<f64>,
+}
+
+fn main() {
+    let only = std::env::args().skip_while(|a| a != "--only").nth(1);
+    std::fs::create_dir_all(work()).expect("creating target/bench-fits");
+    let settings = Settings::default();
+    let maps: Vec<_> = MAPS.iter().map(|(name, az, el, _)| (lighting(name), *az, *el)).collect();
+    let scene = |az: f32, el: f32| Scene {
+        mesh: preview::mesh("sphere").expect("the sphere"),
+        camera: Camera::orbit(glam::Vec3::ZERO, 3.2, az.to_radians(), el.to_radians(), 45f32.to_radians())
+            .expect("the camera"),
+        width: SIZE,
+        height: SIZE,
+    };
+    let scenes: Vec<Scene> = maps.iter().map(|(_, az, el)| scene(*az, *el)).collect();
+    let mut rows = Vec::new();
+    for name in MATERIALS.into_iter().filter(|n| only.as_ref().is_none_or(|o| n.contains(o.as_str()))) {
+        let start = std::time::Instant::now();
+        let bytes = merl::read_bytes(&material_path(name)).expect("the table");
+        let table = MerlTable::parse(&bytes).expect("the table");
+        let fit = gltf_fit::fit(&table, &settings);
+        let fitted = gltf_fit::fitted_table(&fit.chosen().material, settings.masking, table.dims());
+        let albedo = gltf_fit::albedo_rows(&table, &fitted);
+        let (measured, fitted) = (material(table), material(fitted));
+        let psnr: Vec<f64> = maps
+            .iter()
+            .zip(&scenes)
+            .map(|(((lighting, tone), _, _), scene)| {
+                let render = |m: &Material| -> Image {
+                    render::converged::converged(scene, m, lighting, SAMPLES_PER_STRATEGY, SEED)
+                        .expect("the converged estimate")
+                };
+                let (truth, fit) = (render(&measured), render(&fitted));
+                sphere_psnr(&metrics::tonemap(&fit, tone), &metrics::tonemap(&truth, tone), &truth.covered)
+            })
+            .collect();
+        eprintln!(
+            "{name}: {} ({:.1} s)",
+            psnr.iter().map(|p| format!("{p:.2} dB")).collect::<Vec<_>>().join(", "),
+            start.elapsed().as_secs_f64()
+        );
+        rows.push(Row { name, fit, albedo, psnr });
+    }
+
+    let mut report = String::new();
+    let mut out = |line: String| {
+        println!("{line}");
+        report.push_str(&line);
+        report.push('\n');
+    };
+    out("# brdf-fit: the glTF material against the measured table".into());
+    out(String::new());
+    out(format!("Measured at {}.", Stamp::now()));
+    out(String::new());
+    out(format!(
+        "Fits at brdf-fit's defaults (objective {}, masking {}, the specular variant kept when {}% lower). \
+         PSNR: the fit's MERL table against the measured one, both by the converged estimator ({SAMPLES_PER_STRATEGY} samples \
+         per strategy, one seed), {SIZE} x {SIZE} sphere, the sphere's pixels, 8-bit after the map's tone mapping; cameras on \
+         the brightest light's reflection. Albedo error: the fit's directional albedo (luminance) against the table's at \
+         theta_o 0 / 30 / 60 / 80 degrees.",
+        settings.objective.name(),
+        settings.masking.name(),
+        settings.margin * 100.0
+    ));
+    out(String::new());
+    let map_names: Vec<&str> = MAPS.iter().map(|m| m.0).collect();
+    out(format!(
+        "| material | variant | baseColor | metallic | roughness | specular | specularColor | objective | albedo error % | {} |",
+        map_names.iter().map(|m| format!("{m} dB")).collect::<Vec<_>>().join(" | ")
+    ));
+    out(format!("|---|---|---|---:|---:|---:|---|---:|---|{}", "---:|".repeat(MAPS.len())));
+    let triple = |v: [f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
+    for r in &rows {
+        let chosen = r.fit.chosen();
+        let m = &chosen.material;
+        let variant = chosen.variant.name();
+        let albedo: Vec<String> = r.albedo.iter().map(|a| format!("{:+.1}", 100.0 * a.relative_error())).collect();
+        out(format!(
+            "| {} | {variant} | {} | {:.3} | {:.3} | {:.3} | {} | {:.2e} | {} | {} |",
+            r.name,
+            triple(m.base_color),
+            m.metallic,
+            m.roughness,
+            m.specular,
+            triple(m.specular_color),
+            chosen.objective,
+            albedo.join(" / "),
+            r.psnr.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join(" | ")
+        ));
+    }
+    out(String::new());
+    for (k, map) in map_names.iter().enumerate() {
+        let mut v: Vec<f64> = rows.iter().map(|r| r.psnr[k]).collect();
+        v.sort_by(f64::total_cmp);
+        if let (Some(lo), Some(hi)) = (v.first(), v.last()) {
+            out(format!(
+                "{map}: min {lo:.2} dB, median {:.2} dB, max {hi:.2} dB over {} materials.",
+                median(&v),
+                v.len()
+            ));
+        }
+    }
+    if rows.len() == MATERIALS.len() {
+        let png = plot(&rows, &map_names);
+        let path = root().join("docs/brdf-fit-psnr.png");
+        std::fs::write(&path, envmap::encode_png_rgb8(png.width, png.height, &png.rgb).expect("encoding the plot"))
+            .expect("writing docs/brdf-fit-psnr.png");
+        out(String::new());
+        out("![The fit's PSNR per material and map, sorted](brdf-fit-psnr.png)".into());
+    }
+    std::fs::write(work().join("report.md"), &report).expect("writing the report");
+}
+
+/// The median of sorted values (of an even count, the mean of the two middle ones).
+fn median(sorted: &[f64]) -> f64 {
+    let m = sorted.len() / 2;
+    if sorted.len() % 2 == 1 { sorted[m] } else { (sorted[m - 1] + sorted[m]) / 2.0 }
+}
+
+/// One row per material, sorted by its lowest PSNR (worst at the top), a dot per map on a PSNR
+/// axis, the material's name as the row's tick label; a legend of the maps below.
+fn plot(rows: &[Row], maps: &[&str]) -> Canvas {
+    // A row holds a label (14 pixels) and the gap heat_map keeps between labels.
+    const ROW: usize = 20;
+    const WIDTH: usize = 360;
+    let mut order: Vec<&Row> = rows.iter().collect();
+    let worst = |r: &Row| r.psnr.iter().copied().fold(f64::INFINITY, f64::min);
+    order.sort_by(|a, b| worst(a).total_cmp(&worst(b)));
+    let all = rows.iter().flat_map(|r| r.psnr.iter().copied());
+    let lo = (all.clone().fold(f64::INFINITY, f64::min) / 5.0).floor() * 5.0;
+    let hi = (all.fold(f64::NEG_INFINITY, f64::max) / 5.0).ceil() * 5.0;
+    let x_of = |p: f64| (((p - lo) / (hi - lo)) * (WIDTH - 1) as f64).round() as isize;
+    let mut image = Canvas::new(WIDTH, ROW * order.len(), BACKGROUND);
+    for (i, r) in order.iter().enumerate() {
+        let y = (i * ROW + ROW / 2) as isize;
+        let xs: Vec<isize> = r.psnr.iter().map(|&p| x_of(p)).collect();
+        let (a, b) = (*xs.iter().min().unwrap_or(&0), *xs.iter().max().unwrap_or(&0));
+        image.hline(a, y, (b - a) as usize + 1, [110, 110, 110]);
+        for (x, map) in xs.iter().zip(MAPS) {
+            image.fill_rect(x - 3, y - 3, 7, 7, map.3);
+        }
+    }
+    // Row i's centre is (i + 1/2) rows from the top, where heat_map counts a vertical axis from.
+    let n = order.len() as f64;
+    let ticks = order.iter().enumerate().map(|(i, r)| (i as f64 + 0.5, r.name.to_string())).collect();
+    let y = Axis::new("material (worst first)", 0.0, n).with_ticks(ticks);
+    let x = Axis::new("PSNR of the fit against the measured table, dB", lo, hi);
+    let chart = heat_map(&image, 1, &x, &y);
+    let width = chart.width;
+    let title = caption(
+        &format!(
+            "brdf-fit's glTF material against the measured table: the converged estimate of each, {SIZE} x {SIZE} sphere, \
+             camera on the brightest light's reflection"
+        ),
+        width,
+    );
+    let mut legend = Canvas::new(width, 14 * TEXT_SCALE, BACKGROUND);
+    let mut x0 = 10;
+    for (map, (_, _, _, colour)) in maps.iter().zip(MAPS) {
+        legend.fill_rect(x0, 4, 10, 10, colour);
+        legend.text(x0 + 16, 2, map, TEXT_SCALE, INK);
+        x0 += 16 + picture::font::text_width(map, TEXT_SCALE) as isize + 24;
+    }
+    stack(&[title, chart, legend])
+}
