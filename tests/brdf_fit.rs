@@ -78,13 +78,27 @@ fn fit(table: &Path, out: &Path) -> Value {
     assert_eq!(f64s(&pbr["baseColorFactor"]), base);
     assert_eq!(pbr["metallicFactor"], m["metallicFactor"]);
     assert_eq!(pbr["roughnessFactor"], m["roughnessFactor"]);
-    let extension = &gltf["materials"][0]["extensions"]["KHR_materials_specular"];
-    if record["model"]["extensions"].as_array().unwrap().is_empty() {
-        assert!(extension.is_null() && gltf.get("extensionsUsed").is_none(), "{gltf:#}");
+    let listed = &record["model"]["extensions"];
+    let uses = |name: &str| listed.as_array().unwrap().iter().any(|e| e == name);
+    let extensions = &gltf["materials"][0]["extensions"];
+    if listed.as_array().unwrap().is_empty() {
+        assert!(extensions.is_null() && gltf.get("extensionsUsed").is_none(), "{gltf:#}");
     } else {
-        assert_eq!(extension["specularFactor"], m["specularFactor"]);
-        assert_eq!(extension["specularColorFactor"], m["specularColorFactor"]);
-        assert_eq!(gltf["extensionsUsed"], serde_json::json!(["KHR_materials_specular"]));
+        assert_eq!(&gltf["extensionsUsed"], listed, "{gltf:#}");
+    }
+    let specular = &extensions["KHR_materials_specular"];
+    if uses("KHR_materials_specular") {
+        assert_eq!(specular["specularFactor"], m["specularFactor"]);
+        assert_eq!(specular["specularColorFactor"], m["specularColorFactor"]);
+    } else {
+        assert!(specular.is_null(), "{gltf:#}");
+    }
+    let coat = &extensions["KHR_materials_clearcoat"];
+    if uses("KHR_materials_clearcoat") {
+        assert_eq!(coat["clearcoatFactor"], m["clearcoatFactor"]);
+        assert_eq!(coat["clearcoatRoughnessFactor"], m["clearcoatRoughnessFactor"]);
+    } else {
+        assert!(coat.is_null() && m["clearcoatFactor"] == 0.0, "{gltf:#}");
     }
     merl::read_file(&out.join("fit.binary")).unwrap_or_else(|e| panic!("fit.binary: {e}"));
     record
@@ -152,6 +166,34 @@ fn brdf_fit_uses_the_specular_extension_for_a_lambertian() {
     assert_eq!(reports[0]["warnings"].as_u64(), Some(0), "{:#}", reports[0]);
     assert_eq!(reports[0]["extensionsUsed"], serde_json::json!(["KHR_materials_specular"]));
     assert!(reports[1]["errors"].as_u64().unwrap() > 0, "{:#}", reports[1]);
+}
+
+/// A coated metal's table (a sharp colourless lobe over a broad dark metal: the library's
+/// `recovers_a_coated_metal`, whose tolerances these are) comes back with
+/// `KHR_materials_clearcoat`, which the validator passes with no error or warning.
+#[test]
+fn brdf_fit_uses_the_clearcoat_extension_for_a_coated_metal() {
+    let dir = temp_dir();
+    let coated = gltf_fit::Material {
+        clearcoat: 0.9,
+        clearcoat_roughness: 0.1,
+        ..gltf_fit::Material::core([0.1, 0.06, 0.03], 1.0, 0.6)
+    };
+    let table = dir.path().join("coated.binary");
+    let bytes = gltf_fit::fitted_table(&coated, gltf_fit::Masking::HeightCorrelated, merl::Dims::MERL).to_bytes();
+    std::fs::write(&table, bytes).unwrap();
+    let out = dir.path().join("fit");
+    let record = fit(&table, &out);
+    assert_eq!(record["variant"], "clearcoat", "{record:#}");
+    assert_eq!(record["model"]["extensions"], serde_json::json!(["KHR_materials_clearcoat"]));
+    let m = &record["material"];
+    let factor = |k: &str| m[k].as_f64().unwrap();
+    assert!((factor("clearcoatRoughnessFactor") - 0.1).abs() <= 1e-2, "{record:#}");
+    assert!((factor("roughnessFactor") - 0.6).abs() <= 1e-2, "{record:#}");
+    assert!((factor("clearcoatFactor") - 0.9).abs() <= 0.1, "{record:#}");
+    let report = &validate_gltf(&[out.join("material.gltf")])[0];
+    assert_eq!((report["errors"].as_u64(), report["warnings"].as_u64()), (Some(0), Some(0)), "{report:#}");
+    assert_eq!(report["extensionsUsed"], serde_json::json!(["KHR_materials_clearcoat"]), "{report:#}");
 }
 
 /// A small valid table for the refusals that are not about the table.

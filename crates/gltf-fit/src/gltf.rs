@@ -1,6 +1,6 @@
 //! The fitted material as a glTF 2.0 asset: a UV sphere (positions and normals, `+Y` up as glTF
-//! requires) with one material, `KHR_materials_specular` in `extensionsUsed` when the material
-//! needs it. In memory: the caller writes the two files together.
+//! requires) with one material, `KHR_materials_specular` and `KHR_materials_clearcoat` in
+//! `extensionsUsed` when the material needs them. In memory: the caller writes the two files together.
 
 use std::f64::consts::PI;
 
@@ -101,11 +101,22 @@ pub fn gltf_files(material: &Material, name: &str, bin_name: &str, generator: &s
             { "bufferView": 2, "componentType": 5123, "count": indices.len(), "type": "SCALAR" },
         ],
     });
+    let mut extensions = serde_json::Map::new();
     if material.uses_specular_extension() {
-        gltf_material["extensions"] = json!({
-            "KHR_materials_specular": { "specularFactor": material.specular, "specularColorFactor": material.specular_color }
-        });
-        document["extensionsUsed"] = json!(["KHR_materials_specular"]);
+        extensions.insert(
+            "KHR_materials_specular".into(),
+            json!({ "specularFactor": material.specular, "specularColorFactor": material.specular_color }),
+        );
+    }
+    if material.uses_clearcoat_extension() {
+        extensions.insert(
+            "KHR_materials_clearcoat".into(),
+            json!({ "clearcoatFactor": material.clearcoat, "clearcoatRoughnessFactor": material.clearcoat_roughness }),
+        );
+    }
+    if !extensions.is_empty() {
+        gltf_material["extensions"] = serde_json::Value::Object(extensions);
+        document["extensionsUsed"] = json!(material.extensions());
     }
     document["materials"] = json!([gltf_material]);
     let gltf = serde_json::to_string_pretty(&document).expect("json values serialize") + "\n";
@@ -160,5 +171,13 @@ mod tests {
         let doc: serde_json::Value = serde_json::from_str(&gltf_files(&specular, "m", "m.bin", "test").gltf).unwrap();
         assert_eq!(doc["extensionsUsed"], json!(["KHR_materials_specular"]));
         assert_eq!(doc["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"], 0.5);
+        let coated = Material { clearcoat: 0.7, clearcoat_roughness: 0.1, ..specular };
+        let doc: serde_json::Value = serde_json::from_str(&gltf_files(&coated, "m", "m.bin", "test").gltf).unwrap();
+        assert_eq!(doc["extensionsUsed"], json!(["KHR_materials_specular", "KHR_materials_clearcoat"]));
+        let coat = &doc["materials"][0]["extensions"]["KHR_materials_clearcoat"];
+        assert_eq!(
+            (coat["clearcoatFactor"].as_f64(), coat["clearcoatRoughnessFactor"].as_f64()),
+            (Some(0.7), Some(0.1))
+        );
     }
 }

@@ -1,5 +1,5 @@
 //! The BRDF of glTF 2.0's metallic-roughness material (the specification's Appendix B) with
-//! `KHR_materials_specular`, as one function: [`brdf`].
+//! `KHR_materials_specular` and `KHR_materials_clearcoat`, as one function: [`brdf`].
 
 use std::f64::consts::PI;
 
@@ -18,18 +18,48 @@ pub struct Material {
     pub specular: f64,
     /// `KHR_materials_specular.specularColorFactor`, each `>= 0` (1 without the extension).
     pub specular_color: [f64; 3],
+    /// `KHR_materials_clearcoat.clearcoatFactor`, in `[0, 1]` (0 without the extension: no coat).
+    pub clearcoat: f64,
+    /// `KHR_materials_clearcoat.clearcoatRoughnessFactor`, in `[0, 1]`; the coat's GGX width is
+    /// its square. Read only where `clearcoat > 0`.
+    pub clearcoat_roughness: f64,
 }
 
 impl Material {
     /// The core material: `KHR_materials_specular` at its defaults, which leave the BRDF as the
     /// core specification defines it.
     pub fn core(base_color: [f64; 3], metallic: f64, roughness: f64) -> Material {
-        Material { base_color, metallic, roughness, specular: 1.0, specular_color: [1.0; 3] }
+        Material {
+            base_color,
+            metallic,
+            roughness,
+            specular: 1.0,
+            specular_color: [1.0; 3],
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+        }
     }
 
     /// Whether the material needs `KHR_materials_specular` (its factors are not the defaults).
     pub fn uses_specular_extension(&self) -> bool {
         self.specular != 1.0 || self.specular_color != [1.0; 3]
+    }
+
+    /// Whether the material needs `KHR_materials_clearcoat` (it has a coat).
+    pub fn uses_clearcoat_extension(&self) -> bool {
+        self.clearcoat != 0.0
+    }
+
+    /// The glTF extensions the material needs, in the order `fit.json` and the glTF list them.
+    pub fn extensions(&self) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if self.uses_specular_extension() {
+            out.push("KHR_materials_specular");
+        }
+        if self.uses_clearcoat_extension() {
+            out.push("KHR_materials_clearcoat");
+        }
+        out
     }
 
     /// The GGX width `alpha = roughness^2`.
@@ -103,6 +133,11 @@ impl Geometry {
         let h = (wi + wo).normalize();
         Geometry { n_l: wi.z, n_v: wo.z, n_h: h.z, v_h: wo.dot(h) }
     }
+
+    /// The pair the other way round: the light at `wo`, the viewer at `wi` (`v.h = l.h`).
+    pub fn swapped(&self) -> Geometry {
+        Geometry { n_l: self.n_v, n_v: self.n_l, ..*self }
+    }
 }
 
 /// The BRDF of glTF 2.0's metallic-roughness material (Appendix B.2 and B.3) with
@@ -132,6 +167,17 @@ impl Geometry {
 ///
 /// With the extension's defaults (`specular = 1`, `specularColor = 1`) this is the core
 /// specification's `mix(diffuse, specular, 0.04 + 0.96 (1 - |v.h|)^5)`.
+///
+/// `KHR_materials_clearcoat` (its Layering section) lays a colourless GGX lobe over the result,
+/// weighted by a Fresnel term of the viewing angle:
+///
+/// ```text
+/// coated = mix(material, specular_brdf(clearcoatRoughness^2), clearcoat fr)
+/// fr     = 0.04 + 0.96 (1 - |v.n|)^5
+/// ```
+///
+/// `fr` reads the viewer's direction alone, so a coated material is not reciprocal: `g` is the
+/// light `l` and the viewer `v` in that order ([`Geometry::swapped`] gives the other reading).
 pub fn brdf(m: &Material, masking: Masking, g: &Geometry) -> [f64; 3] {
     if g.n_l <= 0.0 || g.n_v <= 0.0 {
         return [0.0; 3];
@@ -150,6 +196,12 @@ pub fn brdf(m: &Material, masking: Masking, g: &Geometry) -> [f64; 3] {
         let dielectric = dielectric_fresnel[c] * specular_brdf + (1.0 - fresnel_max) * diffuse_brdf;
         let metal = (m.base_color[c] + (1.0 - m.base_color[c]) * fresnel_w) * specular_brdf;
         out[c] = (1.0 - m.metallic) * dielectric + m.metallic * metal;
+    }
+    if m.clearcoat > 0.0 {
+        let alpha_c = m.clearcoat_roughness * m.clearcoat_roughness;
+        let coat = visibility(masking, alpha_c, g.n_l, g.n_v) * ggx_d(alpha_c, g.n_h);
+        let weight = m.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * (1.0 - g.n_v.abs()).powi(5));
+        out = out.map(|base| base * (1.0 - weight) + coat * weight);
     }
     out
 }
@@ -224,6 +276,8 @@ mod tests {
             roughness: 0.3,
             specular: 0.0,
             specular_color: [1.0; 3],
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
         };
         for (wi, wo) in pairs() {
             let f = eval(&m, Masking::HeightCorrelated, wi, wo);
@@ -282,6 +336,8 @@ mod tests {
             roughness: 0.35,
             specular: 0.7,
             specular_color: [1.5, 0.5, 3.0],
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
         };
         for masking in [Masking::HeightCorrelated, Masking::Separable] {
             for (wi, wo) in pairs() {
@@ -291,5 +347,33 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `KHR_materials_clearcoat` over a Lambertian base (`specular = 0`): the base weighed by
+    /// `1 - clearcoat fr` plus the coat, a GGX lobe with `F = 1` (`merl::analytic`'s, from Lambda)
+    /// weighed by `clearcoat fr`, `fr = 0.04 + 0.96 (1 - cos theta_o)^5` of the viewer's angle.
+    /// Not reciprocal: the two readings of a pair differ where the two angles do.
+    #[test]
+    fn clearcoat_is_a_colourless_lobe_weighed_by_the_viewing_fresnel() {
+        let base = [0.5, 0.25, 0.125];
+        let m = Material { specular: 0.0, clearcoat: 0.8, clearcoat_roughness: 0.3, ..Material::core(base, 0.0, 0.6) };
+        let coat = Analytic::Ggx { alpha: 0.09, f0: [1.0; 3] };
+        let mut asymmetric = 0;
+        for (wi, wo) in pairs() {
+            let weight = 0.8 * (0.04 + 0.96 * (1.0 - wo.z).powi(5));
+            let lobe = coat.eval(wi, wo)[0];
+            let f = eval(&m, Masking::HeightCorrelated, wi, wo);
+            for c in 0..3 {
+                let expected = base[c] / PI * (1.0 - weight) + lobe * weight;
+                assert!((f[c] - expected).abs() <= 1e-12 * expected, "{wi} {wo}: {f:?} {expected}");
+            }
+            let back = eval(&m, Masking::HeightCorrelated, wo, wi);
+            if (back[0] - f[0]).abs() > 1e-6 * f[0] {
+                asymmetric += 1;
+                assert!((wi.z - wo.z).abs() > 1e-9, "{wi} {wo}");
+            }
+        }
+        assert!(asymmetric > 0, "a coat's readings never differed");
+        assert_eq!(m.extensions(), ["KHR_materials_specular", "KHR_materials_clearcoat"]);
     }
 }

@@ -12,7 +12,8 @@ use serde_json::{Value, json};
 
 /// Fit glTF 2.0's metallic-roughness material (the specification's Appendix B BRDF: GGX with
 /// alpha = roughness^2, Smith masking, Schlick Fresnel, Lambertian diffuse), with
-/// KHR_materials_specular where it lowers the error by 5%, to a MERL table. The initial roughness
+/// KHR_materials_specular or KHR_materials_clearcoat (a second, colourless lobe) where one lowers
+/// the error by 5%, to a MERL table. The initial roughness
 /// comes from the table's backscattering by Dupuy et al. 2015's power iteration; the factors are
 /// then refined by Levenberg-Marquardt on the error of ln(1 + f cos theta) over the table's
 /// cells, each weighted by its solid angle (the crate gltf-fit documents the choice).
@@ -113,10 +114,14 @@ fn run(args: Args) -> Result<ExitCode> {
 
     let progress = cli::Progress::new(args.quiet);
     let fit = gltf_fit::fit_reporting(&table, &settings, &|stage, settings| match stage {
-        Stage::Estimate => progress.step("1/3 initial estimate (power iteration)".into()),
+        Stage::Estimate => progress.step("1/4 initial estimate (power iteration)".into()),
         Stage::Refine(variant, done) => {
             if done == 0 {
-                let step = if variant == Variant::Core { "2/3 core material" } else { "3/3 specular variant" };
+                let step = match variant {
+                    Variant::Core => "2/4 core material",
+                    Variant::Specular => "3/4 specular variant",
+                    Variant::Clearcoat => "4/4 clearcoat variant",
+                };
                 progress.step(format!("{step} (Levenberg-Marquardt)"));
             }
             progress.work(done as u64, settings.max_iterations as u64);
@@ -158,17 +163,18 @@ fn material_json(m: &Material) -> Value {
         "alpha": m.alpha(),
         "specularFactor": m.specular,
         "specularColorFactor": m.specular_color,
+        "clearcoatFactor": m.clearcoat,
+        "clearcoatRoughnessFactor": m.clearcoat_roughness,
     })
 }
 
 /// fit.json (data-schema/brdf-fit.md).
 fn fit_json(fit: &Fit, albedo: &[AlbedoRow], by_kind: &[(Objective, f64)], source: Value) -> Value {
     let chosen = fit.chosen();
-    let extensions: Vec<&str> =
-        if chosen.material.uses_specular_extension() { vec!["KHR_materials_specular"] } else { vec![] };
+    let extensions = chosen.material.extensions();
     json!({
         "format": "brdf-fit",
-        "version": 1,
+        "version": 2,
         "model": { "brdf": "gltf-2.0-metallic-roughness", "masking": fit.settings.masking.name(), "extensions": extensions },
         "variant": chosen.variant.name(),
         "material": material_json(&chosen.material),
@@ -177,7 +183,8 @@ fn fit_json(fit: &Fit, albedo: &[AlbedoRow], by_kind: &[(Objective, f64)], sourc
             "value": chosen.objective,
             "core": fit.core.objective,
             "specular": fit.specular.objective,
-            "specular_margin": fit.settings.margin,
+            "clearcoat": fit.clearcoat.objective,
+            "margin": fit.settings.margin,
             "by_kind": by_kind.iter().map(|(o, v)| (o.name().to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
         },
         "initial_estimate": {
@@ -190,6 +197,7 @@ fn fit_json(fit: &Fit, albedo: &[AlbedoRow], by_kind: &[(Objective, f64)], sourc
             "phi_d_stride": fit.settings.phi_d_stride,
             "core_iterations": fit.core.iterations,
             "specular_iterations": fit.specular.iterations,
+            "clearcoat_iterations": fit.clearcoat.iterations,
         },
         "albedo": albedo.iter().map(|row| json!({
             "theta_o_deg": row.theta_o_deg,
@@ -218,15 +226,26 @@ fn report(fit: &Fit, albedo: &[AlbedoRow]) -> Vec<String> {
             m.alpha()
         ),
         format!(
-            "objective ({}, {} masking): {:.6e} (core {:.6e}, with KHR_materials_specular {:.6e})",
+            "objective ({}, {} masking): {:.6e} (core {:.6e}, with KHR_materials_specular {:.6e}, with \
+             KHR_materials_clearcoat {:.6e})",
             fit.settings.objective.name(),
             fit.settings.masking.name(),
             fit.chosen().objective,
             fit.core.objective,
-            fit.specular.objective
+            fit.specular.objective,
+            fit.clearcoat.objective
         ),
         format!("initial estimate: alpha {:.5} after {} power iterations", fit.estimate.alpha, fit.estimate.iterations),
     ];
+    if m.uses_clearcoat_extension() {
+        lines.insert(
+            1,
+            format!(
+                "KHR_materials_clearcoat: clearcoat {:.4}, clearcoatRoughness {:.4}",
+                m.clearcoat, m.clearcoat_roughness
+            ),
+        );
+    }
     if m.uses_specular_extension() {
         lines.insert(
             1,

@@ -1,15 +1,18 @@
 //! How close `brdf-fit`'s glTF material comes to each measured table, in pictures (a benchmark,
 //! not a test): for each of the 20 real-derived materials, the fit at its defaults
-//! (`gltf_fit::fit`), its parameters, objective and directional albedo error, and the PSNR of
-//! the fit's exact render (its MERL table, `gltf_fit::fitted_table`) against the measured
+//! (`gltf_fit::fit`), the kept variant's parameters, objective and directional albedo error, and
+//! for every variant (core, `KHR_materials_specular`, `KHR_materials_clearcoat`) its objective and
+//! the PSNR of its exact render (its MERL table, `gltf_fit::fitted_table`) against the measured
 //! table's, both by the converged estimator (`render::converged`: no baked table, 256 samples per
 //! strategy, the same seed, so the two pictures share their noise) on a 128 x 128 sphere under
 //! two maps, each with the camera of the Mitsuba benchmark that looks at its brightest light's
 //! reflection: quarry_01 (a sun) and studio_small_03 (lamps). PSNR on the 8-bit pictures after
 //! the previewer's tone mapping of the map, over the sphere's pixels only.
 //!
-//! The report (markdown) is printed and written to target/bench-fits/report.md; the sorted plot
-//! of the PSNRs to docs/brdf-fit-psnr.png, which the report shows.
+//! Whether the objective predicts the pictures: per map, how often the variant of least objective
+//! is the one of best PSNR, and what the kept variant loses against the best. The report
+//! (markdown) is printed and written to target/bench-fits/report.md; the sorted plot of the kept
+//! variants' PSNRs to docs/brdf-fit-psnr.png, which the report shows.
 //!
 //! `cargo bench -p brdf-preview --bench fits [-- --only NAME]`. Needs `../shared` (the maps, and
 //! nbrdf2merl.py with numpy for the materials, made once under target/merl/). About 25 s per
@@ -21,7 +24,7 @@ mod common;
 
 use common::{Stamp, material_path, root, shared};
 use envmap::MipChain;
-use gltf_fit::Settings;
+use gltf_fit::{Settings, Variant};
 use merl::MerlTable;
 use picture::layout::{Axis, caption, heat_map, stack};
 use picture::{BACKGROUND, Canvas, INK, TEXT_SCALE};
@@ -86,11 +89,17 @@ fn sphere_psnr(a: &[u8], b: &[u8], covered: &[bool]) -> f64 {
     metrics::psnr_db(&pick(a), &pick(b))
 }
 
+/// The variants in the order of the report's columns.
+const VARIANTS: [Variant; 3] = [Variant::Core, Variant::Specular, Variant::Clearcoat];
+
 struct Row {
     name: &'static str,
     fit: gltf_fit::Fit,
     albedo: Vec<gltf_fit::AlbedoRow>,
+    /// The kept variant's PSNR per map.
     psnr: Vec<f64>,
+    /// Per variant ([`VARIANTS`]), its PSNR per map.
+    by_variant: Vec<Vec<f64>>,
 }
 
 fn main() {
@@ -112,10 +121,16 @@ fn main() {
         let bytes = merl::read_bytes(&material_path(name)).expect("the table");
         let table = MerlTable::parse(&bytes).expect("the table");
         let fit = gltf_fit::fit(&table, &settings);
-        let fitted = gltf_fit::fitted_table(&fit.chosen().material, settings.masking, table.dims());
-        let albedo = gltf_fit::albedo_rows(&table, &fitted);
-        let (measured, fitted) = (material(table), material(fitted));
-        let psnr: Vec<f64> = maps
+        let tables: Vec<MerlTable> = VARIANTS
+            .iter()
+            .map(|&v| gltf_fit::fitted_table(&fit.variant(v).material, settings.masking, table.dims()))
+            .collect();
+        let chosen = VARIANTS.iter().position(|&v| v == fit.chosen).expect("a variant");
+        let albedo = gltf_fit::albedo_rows(&table, &tables[chosen]);
+        let measured = material(table);
+        let fitted: Vec<Material> = tables.into_iter().map(material).collect();
+        // Per map, each variant's PSNR.
+        let per_map: Vec<Vec<f64>> = maps
             .iter()
             .zip(&scenes)
             .map(|(((lighting, tone), _, _), scene)| {
@@ -123,16 +138,23 @@ fn main() {
                     render::converged::converged(scene, m, lighting, SAMPLES_PER_STRATEGY, SEED)
                         .expect("the converged estimate")
                 };
-                let (truth, fit) = (render(&measured), render(&fitted));
-                sphere_psnr(&metrics::tonemap(&fit, tone), &metrics::tonemap(&truth, tone), &truth.covered)
+                let truth = render(&measured);
+                let truth_picture = metrics::tonemap(&truth, tone);
+                fitted
+                    .iter()
+                    .map(|m| sphere_psnr(&metrics::tonemap(&render(m), tone), &truth_picture, &truth.covered))
+                    .collect()
             })
             .collect();
+        let by_variant: Vec<Vec<f64>> = (0..VARIANTS.len()).map(|v| per_map.iter().map(|p| p[v]).collect()).collect();
+        let psnr = by_variant[chosen].clone();
         eprintln!(
-            "{name}: {} ({:.1} s)",
+            "{name}: {} {} ({:.1} s)",
+            fit.chosen.name(),
             psnr.iter().map(|p| format!("{p:.2} dB")).collect::<Vec<_>>().join(", "),
             start.elapsed().as_secs_f64()
         );
-        rows.push(Row { name, fit, albedo, psnr });
+        rows.push(Row { name, fit, albedo, psnr, by_variant });
     }
 
     let mut report = String::new();
@@ -146,7 +168,7 @@ fn main() {
     out(format!("Measured at {}.", Stamp::now()));
     out(String::new());
     out(format!(
-        "Fits at brdf-fit's defaults (objective {}, masking {}, the specular variant kept when {}% lower). \
+        "Fits at brdf-fit's defaults (objective {}, masking {}, a variant with an extension kept when {}% lower). \
          PSNR: the fit's MERL table against the measured one, both by the converged estimator ({SAMPLES_PER_STRATEGY} samples \
          per strategy, one seed), {SIZE} x {SIZE} sphere, the sphere's pixels, 8-bit after the map's tone mapping; cameras on \
          the brightest light's reflection. Albedo error: the fit's directional albedo (luminance) against the table's at \
@@ -156,12 +178,15 @@ fn main() {
         settings.margin * 100.0
     ));
     out(String::new());
+    out("## The kept material".into());
+    out(String::new());
     let map_names: Vec<&str> = MAPS.iter().map(|m| m.0).collect();
     out(format!(
-        "| material | variant | baseColor | metallic | roughness | specular | specularColor | objective | albedo error % | {} |",
+        "| material | variant | baseColor | metallic | roughness | specular | specularColor | clearcoat | clearcoatRoughness | \
+         objective | albedo error % | {} |",
         map_names.iter().map(|m| format!("{m} dB")).collect::<Vec<_>>().join(" | ")
     ));
-    out(format!("|---|---|---|---:|---:|---:|---|---:|---|{}", "---:|".repeat(MAPS.len())));
+    out(format!("|---|---|---|---:|---:|---:|---|---:|---:|---:|---|{}", "---:|".repeat(MAPS.len())));
     let triple = |v: [f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
     for r in &rows {
         let chosen = r.fit.chosen();
@@ -169,17 +194,61 @@ fn main() {
         let variant = chosen.variant.name();
         let albedo: Vec<String> = r.albedo.iter().map(|a| format!("{:+.1}", 100.0 * a.relative_error())).collect();
         out(format!(
-            "| {} | {variant} | {} | {:.3} | {:.3} | {:.3} | {} | {:.2e} | {} | {} |",
+            "| {} | {variant} | {} | {:.3} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.2e} | {} | {} |",
             r.name,
             triple(m.base_color),
             m.metallic,
             m.roughness,
             m.specular,
             triple(m.specular_color),
+            m.clearcoat,
+            m.clearcoat_roughness,
             chosen.objective,
             albedo.join(" / "),
             r.psnr.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join(" | ")
         ));
+    }
+    out(String::new());
+    out("## Every variant: objective and PSNR (`*` the kept one)".into());
+    out(String::new());
+    let header: Vec<String> = VARIANTS
+        .iter()
+        .flat_map(|v| {
+            std::iter::once(format!("{} objective", v.name()))
+                .chain(map_names.iter().map(move |m| format!("{} {m} dB", v.name())))
+        })
+        .collect();
+    out(format!("| material | {} |", header.join(" | ")));
+    out(format!("|---|{}", "---:|".repeat(header.len())));
+    for r in &rows {
+        let cells: Vec<String> = VARIANTS
+            .iter()
+            .zip(&r.by_variant)
+            .flat_map(|(&v, psnr)| {
+                let mark = if v == r.fit.chosen { "*" } else { "" };
+                std::iter::once(format!("{:.2e}{mark}", r.fit.variant(v).objective))
+                    .chain(psnr.iter().map(|p| format!("{p:.2}")))
+            })
+            .collect();
+        out(format!("| {} | {} |", r.name, cells.join(" | ")));
+    }
+    out(String::new());
+    for (k, map) in map_names.iter().enumerate() {
+        // The variant of least objective against the variant of best picture.
+        let objective = |r: &Row, v: usize| r.fit.variant(VARIANTS[v]).objective;
+        let least = |r: &Row| (0..VARIANTS.len()).min_by(|&a, &b| objective(r, a).total_cmp(&objective(r, b)));
+        let best = |r: &Row| (0..VARIANTS.len()).max_by(|&a, &b| r.by_variant[a][k].total_cmp(&r.by_variant[b][k]));
+        let agree = rows.iter().filter(|r| least(r) == best(r)).count();
+        let mut loss: Vec<f64> = rows.iter().filter_map(|r| Some(r.by_variant[best(r)?][k] - r.psnr[k])).collect();
+        loss.sort_by(f64::total_cmp);
+        if let Some(worst) = loss.last() {
+            out(format!(
+                "{map}: the variant of least objective draws the best picture for {agree} of {} materials; the kept \
+                 variant's picture is {:.2} dB below the best variant's at the median, {worst:.2} dB at most.",
+                rows.len(),
+                median(&loss)
+            ));
+        }
     }
     out(String::new());
     for (k, map) in map_names.iter().enumerate() {
@@ -215,7 +284,7 @@ fn median(sorted: &[f64]) -> f64 {
 fn plot(rows: &[Row], maps: &[&str]) -> Canvas {
     // A row holds a label (14 pixels) and the gap heat_map keeps between labels.
     const ROW: usize = 20;
-    const WIDTH: usize = 360;
+    const WIDTH: usize = 480;
     let mut order: Vec<&Row> = rows.iter().collect();
     let worst = |r: &Row| r.psnr.iter().copied().fold(f64::INFINITY, f64::min);
     order.sort_by(|a, b| worst(a).total_cmp(&worst(b)));
@@ -237,7 +306,10 @@ fn plot(rows: &[Row], maps: &[&str]) -> Canvas {
     let n = order.len() as f64;
     let ticks = order.iter().enumerate().map(|(i, r)| (i as f64 + 0.5, r.name.to_string())).collect();
     let y = Axis::new("material (worst first)", 0.0, n).with_ticks(ticks);
-    let x = Axis::new("PSNR of the fit against the measured table, dB", lo, hi);
+    // A tick every 5 dB (the axis's ends are multiples of 5).
+    let steps = ((hi - lo) / 5.0).round() as usize;
+    let x_ticks = (0..=steps).map(|k| lo + 5.0 * k as f64).map(|v| (v, format!("{v}"))).collect();
+    let x = Axis::new("PSNR of the fit against the measured table, dB", lo, hi).with_ticks(x_ticks);
     let chart = heat_map(&image, 1, &x, &y);
     let width = chart.width;
     let title = caption(
