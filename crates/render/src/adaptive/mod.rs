@@ -63,7 +63,8 @@
 //! (`cargo bench -p brdf-preview --bench mitsuba`, 7x7 bias p99, [`FRAMES`] frames):
 //! gold-paint under quarry's sun 2.06 levels at the Nyquist rate, 1.18 at twice it, 1.47 at
 //! four times (the budget then spreads over more blocks: noise); chrome, whose predicted
-//! bandwidth is low, 5.6, 3.0 and 1.0.
+//! bandwidth the paper's reading of the environment made low, 5.6, 3.0 and 1.0 (the bakes now
+//! read chrome's environment level-normalized: see "The bandwidth buffer").
 //!
 //! The predicted variance (eq. 9) is `sum_i (nu_env(wi) + rho_i) g_i^2 / pdf_i / n_b` with
 //! `g_i = L(wi) f(wi, wo) cos theta_i` the integrand, the angular bandwidths of the light and
