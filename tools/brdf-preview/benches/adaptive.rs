@@ -20,7 +20,8 @@
 //!    log time) over the adaptive time: the speed-up at equal quality (`>` when the brute force
 //!    never reaches the PSNR: a lower bound from its 256 spp; `~` when the PSNR is on the brute
 //!    force's plateau, where the speed-up is the samples' luck: "The sun's plateau" below),
-//!    summarized over all rows and over the rows off the plateau;
+//!    summarized over all rows and over the rows off the plateau, per reading and for the rows of
+//!    the reading each bake chose (`brdf-bake --env-reading auto`: level-normalized for chrome);
 //! 3. Spearman's rank correlation of the predicted image bandwidth with the windowed FFT of the
 //!    converged picture (windows wholly on the mesh), and of the predicted variance with the
 //!    measured variance of the one-sample estimator (16 independent renders), per reading;
