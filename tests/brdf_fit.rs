@@ -1,12 +1,13 @@
 //! `brdf-fit` end to end: on tables `merl-synth` writes, the files, the JSON, the known answers,
-//! the Khronos glTF validator's verdict, and the refusals.
+//! the Khronos glTF validator's verdict, and the refusals; and `brdf-bake --fit`, which writes
+//! the same files as a stage of the bake.
 
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
 use crate::brdf_bake::sha256_hex;
-use crate::support::{root, run, temp_dir, tool};
+use crate::support::{bake_command, ggx_copper, root, run, temp_dir, tool};
 
 fn synth(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
     let out = dir.join(name);
@@ -194,6 +195,55 @@ fn brdf_fit_uses_the_clearcoat_extension_for_a_coated_metal() {
     let report = &validate_gltf(&[out.join("material.gltf")])[0];
     assert_eq!((report["errors"].as_u64(), report["warnings"].as_u64()), (Some(0), Some(0)), "{report:#}");
     assert_eq!(report["extensionsUsed"], serde_json::json!(["KHR_materials_clearcoat"]), "{report:#}");
+}
+
+/// `brdf-bake --fit` writes brdf-fit's four files as its stage `fit`, each listed by role and
+/// format with its hash, and they are brdf-fit's bytes on the same table but for the name of the
+/// tool that wrote them (fit.json's provenance, the glTF's generator).
+#[test]
+fn brdf_bake_fit_writes_brdf_fits_files_as_a_stage() {
+    let dir = temp_dir();
+    let bake = dir.path().join("bake");
+    run(bake_command(&bake, &["--fit"]), "").expect_code(0);
+    let manifest: Value = serde_json::from_str(&std::fs::read_to_string(bake.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["parameters"]["fit"]["objective"], "log-cosine", "{manifest:#}");
+    let stage = manifest["stages"].as_array().unwrap().iter().find(|s| s["name"] == "fit").expect("a fit stage");
+    let listed: Vec<(String, String, String)> = stage["outputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            let bytes = std::fs::read(bake.join(o["path"].as_str().unwrap())).unwrap();
+            assert_eq!(o["sha256"].as_str(), Some(sha256_hex(&bytes).as_str()), "{o}");
+            [&o["path"], &o["role"], &o["format"]].map(|v| v.as_str().unwrap().to_string()).into()
+        })
+        .collect();
+    let expected = [
+        ("material.bin", "fit-gltf-buffer", "bin"),
+        ("fit.binary", "fit-table", "merl"),
+        ("material.gltf", "fit-gltf", "gltf"),
+        ("fit.json", "fit-record", "json"),
+    ]
+    .map(|(a, b, c)| (a.to_string(), b.to_string(), c.to_string()));
+    assert_eq!(listed, expected);
+
+    let alone = dir.path().join("alone");
+    fit(ggx_copper(), &alone);
+    let read = |d: &Path, n: &str| std::fs::read(d.join(n)).unwrap();
+    for name in ["material.bin", "fit.binary"] {
+        assert!(read(&bake, name) == read(&alone, name), "{name} differs between brdf-bake and brdf-fit");
+    }
+    let json = |d: &Path, n: &str| -> Value { serde_json::from_slice(&read(d, n)).unwrap() };
+    let (mut baked, alone_record) = (json(&bake, "fit.json"), json(&alone, "fit.json"));
+    let errors: Vec<String> = schema().iter_errors(&baked).map(|e| format!("{e} at {}", e.instance_path())).collect();
+    assert!(errors.is_empty(), "the bake's fit.json fails the schema:\n{}", errors.join("\n"));
+    assert_eq!(baked["provenance"]["tool"]["name"], "brdf-bake");
+    baked["provenance"]["tool"] = alone_record["provenance"]["tool"].clone();
+    assert_eq!(baked, alone_record);
+    let (mut baked, alone_gltf) = (json(&bake, "material.gltf"), json(&alone, "material.gltf"));
+    assert!(baked["asset"]["generator"].as_str().unwrap().starts_with("brdf-bake "), "{baked:#}");
+    baked["asset"]["generator"] = alone_gltf["asset"]["generator"].clone();
+    assert_eq!(baked, alone_gltf);
 }
 
 /// A small valid table for the refusals that are not about the table.

@@ -89,11 +89,25 @@ pub enum FileFormat {
     Png,
     /// JSON document.
     Json,
+    /// glTF 2.0 JSON document.
+    Gltf,
+    /// A glTF buffer (`.bin`), named by a glTF document beside it.
+    Bin,
+    /// MERL BRDF table (`data-schema/merl.md`).
+    Merl,
 }
 
 impl FileFormat {
-    pub const ALL: [FileFormat; 5] =
-        [FileFormat::Asset, FileFormat::Ktx2, FileFormat::Exr, FileFormat::Png, FileFormat::Json];
+    pub const ALL: [FileFormat; 8] = [
+        FileFormat::Asset,
+        FileFormat::Ktx2,
+        FileFormat::Exr,
+        FileFormat::Png,
+        FileFormat::Json,
+        FileFormat::Gltf,
+        FileFormat::Bin,
+        FileFormat::Merl,
+    ];
 
     /// The name in the manifest.
     pub fn name(self) -> &'static str {
@@ -103,6 +117,9 @@ impl FileFormat {
             FileFormat::Exr => "exr",
             FileFormat::Png => "png",
             FileFormat::Json => "json",
+            FileFormat::Gltf => "gltf",
+            FileFormat::Bin => "bin",
+            FileFormat::Merl => "merl",
         }
     }
 }

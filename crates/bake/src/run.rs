@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use asset::{BakeManifest, SourceFile, Tool};
 use serde_json::json;
 
-use crate::stage::{atlas, engine, env_bandwidth, importance, layers, pca, prefilter, wavelet_brdf};
+use crate::stage::{atlas, engine, env_bandwidth, fit, importance, layers, pca, prefilter, wavelet_brdf};
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
@@ -27,6 +27,8 @@ pub struct BakeConfig {
     pub pca_max_error: Option<f64>,
     /// Encode the material in Haar wavelets (`brdf-wavelet`) with these settings.
     pub wavelet_brdf: Option<wavelet_brdf::Settings>,
+    /// Fit the closest glTF material (`brdf-fit`) with these settings.
+    pub fit: Option<gltf_fit::Settings>,
     /// The environment bandwidth's settings; its reading is [`BakeConfig::env_reading`]'s, resolved
     /// for the material (the reading of `config` here is not read).
     pub env_bandwidth: env_bandwidth::Settings,
@@ -53,6 +55,7 @@ impl BakeConfig {
             atlas: brdf_atlas::Config::default(),
             pca_max_error: None,
             wavelet_brdf: None,
+            fit: None,
             env_bandwidth: env_bandwidth::Settings::default(),
             env_reading: env_bandwidth::ReadingChoice::Auto,
             prefilter: ::prefilter::Config::default(),
@@ -119,6 +122,13 @@ impl BakeConfig {
                 self.wavelet_brdf
                     .as_ref()
                     .map_or(serde_json::Value::Null, |w| serde_json::Value::Object(w.parameters())),
+            ),
+            (
+                "fit",
+                self.fit.as_ref().map_or(
+                    serde_json::Value::Null,
+                    |f| json!({ "masking": f.masking.name(), "objective": f.objective.name(), "margin": f.margin }),
+                ),
             ),
             (
                 "environment_bandwidth",
@@ -219,6 +229,7 @@ pub fn run_bake(
     // Both inputs are decoded before anything is written: a bake that cannot run leaves the
     // previous one as it was.
     let table = merl::MerlTable::parse(&material_bytes).map_err(|e| Error::read(&config.material, e))?;
+    let material_size = material_bytes.len() as u64;
     drop(material_bytes);
     // The cells' pass finds a value no material has; the albedo waits for the importance stage's
     // quadrature, below (a refusal then drops what was staged: the folder is left as it was).
@@ -291,6 +302,16 @@ pub fn run_bake(
     if let Some(settings) = config.wavelet_brdf {
         begin("wavelet encoding");
         record(wavelet_brdf::run(&table, &material_source, program, settings)?, &mut manifest)?;
+    }
+    if let Some(settings) = &config.fit {
+        begin("glTF fit");
+        let report = |stage: gltf_fit::Stage, s: &gltf_fit::Settings| {
+            if let gltf_fit::Stage::Refine(_, done) = stage {
+                work(done as u64, s.max_iterations as u64);
+            }
+        };
+        let staged = fit::run(&table, &material_source, material_size, program, settings, &report).staged;
+        record(staged, &mut manifest)?;
     }
 
     if let (Some(path), Some(source), Some(map)) = (&config.environment, &environment_source, &map) {
@@ -388,11 +409,12 @@ pub fn write_stage(
 }
 
 /// The stages' names (`Staged::name`) in the order `run_bake` runs them.
-const STAGE_ORDER: [&str; 8] = [
+const STAGE_ORDER: [&str; 9] = [
     "importance",
     "bandwidth-atlas",
     "bandwidth-pca",
     "wavelet-brdf",
+    "fit",
     "environment-bandwidth",
     "prefilter",
     "layer-selection",
@@ -533,6 +555,9 @@ fn stage_names(config: &BakeConfig) -> Vec<&'static str> {
     }
     if config.wavelet_brdf.is_some() {
         names.push("wavelet encoding");
+    }
+    if config.fit.is_some() {
+        names.push("glTF fit");
     }
     if config.environment.is_some() {
         names.extend(["environment bandwidth", "phong layers and mip chain", "layer selection"]);

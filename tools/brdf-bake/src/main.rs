@@ -15,7 +15,8 @@ use serde_json::json;
 /// (bandwidth-atlas.asset: once per row for an isotropic table, kind bandwidth-rows; .exr: the full
 /// 1024 x 1024 texture; .png), with --pca-max-error its PCA model (bandwidth-pca.asset, .png), with
 /// --wavelet-brdf-ratio its Haar wavelet encoding (wavelet-brdf.asset, .png; what brdf-preview
-/// --brdf wavelet-brdf reads), and with --env the environment's bandwidth (env-bandwidth.exr/.png),
+/// --brdf wavelet-brdf reads), with --fit the closest glTF material (fit.json, material.gltf,
+/// material.bin, fit.binary), and with --env the environment's bandwidth (env-bandwidth.exr/.png),
 /// its Phong-lobe layers and mip chain (prefiltered.asset, layers.ktx2, layer-n<N>.exr, mips.ktx2,
 /// layers.png), the layer selection (layer-selection.asset) and with --engine-textures the engine
 /// textures (engine-*.ktx2); then manifest.json (data-schema/README.md: every file with its sha256,
@@ -59,6 +60,12 @@ struct Args {
     /// With --wavelet-brdf-ratio, store the kept coefficients as 8-bit codes.
     #[arg(long, requires = "wavelet_brdf_ratio")]
     wavelet_brdf_quantize: bool,
+
+    /// Also fit the closest glTF 2.0 material (as brdf-fit does, at its defaults: fit.json,
+    /// material.gltf + material.bin, fit.binary; data-schema/brdf-fit.md). About 10 to 30 s on 2
+    /// cores.
+    #[arg(long)]
+    fit: bool,
 
     /// Vectors of importance samples per view elevation (each of --samples samples): the
     /// reference mode's accuracy grows with them (a bright sun seen in a mirror-like material
@@ -149,6 +156,7 @@ fn run(args: Args) -> Result<ExitCode> {
     }
     let mut config = BakeConfig::new(args.material.clone(), args.env.clone(), args.out_dir.clone());
     config.pca_max_error = args.pca_max_error;
+    config.fit = args.fit.then(gltf_fit::Settings::default);
     if let Some(ratio) = args.wavelet_brdf_ratio {
         let ratio = u32::try_from(ratio).map_err(|_| {
             anyhow::anyhow!(

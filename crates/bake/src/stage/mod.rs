@@ -4,6 +4,7 @@
 pub mod atlas;
 pub mod engine;
 pub mod env_bandwidth;
+pub mod fit;
 pub mod importance;
 pub mod layers;
 pub mod material_info;
@@ -15,7 +16,7 @@ pub mod wavelet_brdf;
 /// ...; `data-schema/README.md` lists them by role): a rebake removes a file of the previous
 /// manifest only under such a name, so that no manifest can make it remove anything else.
 pub fn is_output_name(name: &str) -> bool {
-    const NAMES: [&str; 30] = [
+    const NAMES: [&str; 34] = [
         importance::ASSET,
         importance::PICTURE,
         atlas::ASSET,
@@ -46,6 +47,10 @@ pub fn is_output_name(name: &str) -> bool {
         engine::ENVIRONMENT_KTX2,
         engine::LIGHT_TABLES_KTX2,
         engine::LAYERS_KTX2,
+        fit::RECORD,
+        fit::GLTF,
+        fit::BIN,
+        fit::TABLE,
     ];
     let layer_exr = name
         .strip_prefix("layer-n")
