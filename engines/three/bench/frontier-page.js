@@ -1,8 +1,10 @@
 // What engines/three/bench/frontier.mjs calls in the test page (test/page.html): one bake in a
 // y-up three.js scene, drawn by three's MeshStandardMaterial and MeshPhysicalMaterial at fitted
-// parameters and by the bake's material at a few sample counts, timed and compared with the
-// converged estimate (window.frontier).
+// parameters, by the glTF material brdf-fit fitted to the table (the bake's material.gltf, read
+// by three's GLTFLoader) and by the bake's material at a few sample counts, timed and compared
+// with the converged estimate (window.frontier).
 import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { loadBake } from '../src/index.js';
 import { floatTarget } from '../src/live.js';
 import { drawFloats, pageRenderer } from '../test/page-tools.js';
@@ -78,6 +80,19 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     );
     disposables.push(standard.material, physical.material);
 
+    // brdf-fit's material as a glTF viewer reads it: three's GLTFLoader turns the bake's
+    // material.gltf (brdf-bake --fit) into a MeshStandardMaterial, or a MeshPhysicalMaterial with
+    // KHR_materials_specular or KHR_materials_clearcoat; drawn on the same sphere.
+    const gltf = await new GLTFLoader().loadAsync(`${url}material.gltf`);
+    let fitted = null;
+    gltf.scene.traverse((o) => {
+        if (o.isMesh && !fitted) fitted = o.material;
+    });
+    if (!fitted) throw new Error(`${url}material.gltf holds no mesh`);
+    gltf.scene.traverse((o) => o.isMesh && o.geometry.dispose());
+    disposables.push(fitted);
+    const fittedPsnr = psnr(linear(fitted), truth);
+
     // The bake's material, one frame at 1, 4 and 16 samples.
     const measured = {};
     for (const spp of [1, 4, 16]) {
@@ -95,6 +110,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     const ms = {
         standard: time(standard.material),
         physical: time(physical.material),
+        gltf: time(fitted),
         measured: Object.fromEntries([1, 4, 16].map((spp) => [spp, time(measured[spp].material)])),
     };
 
@@ -111,6 +127,7 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
         pixels: covered.length,
         standard: { params: standard.params, colour: standard.colour, psnr: psnr(standard.values, truth) },
         physical: { params: physical.params, colour: physical.colour, psnr: psnr(physical.values, truth) },
+        gltf: { type: fitted.type, psnr: fittedPsnr },
         measured: Object.fromEntries(Object.entries(measured).map(([spp, m]) => [spp, m.psnr])),
         live,
         ms,

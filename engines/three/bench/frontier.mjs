@@ -13,6 +13,8 @@
 // - the truth: the bake's reference estimator, 64 samples per strategy x --truth-frames frames;
 // - MeshStandardMaterial and MeshPhysicalMaterial (scene.environment: three's PMREM of the same
 //   map) at parameters fitted to the truth's picture (the page says how);
+// - the glTF material brdf-fit fitted to the table (`brdf-bake --fit`: material.gltf), read by
+//   three's GLTFLoader: what a glTF viewer shows of the fit, fitted to the BRDF, not the picture;
 // - the bake's prefiltered estimator, one frame of 1, 4 and 16 samples, and the live mode after
 //   the time of 8 standard frames.
 // PSNR over the sphere's pixels at --size (128), tone mapped as brdf-preview maps them (Reinhard
@@ -52,7 +54,9 @@ for (const [material, what] of MATERIALS) {
         console.error(`baking ${material} under ${map}`);
         const env = join(ROOT, '../shared/data/env', `${map}.hdr`);
         try {
-            execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', '--quiet'], { stdio: ['ignore', 'ignore', 'inherit'] });
+            execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', '--fit', '--quiet'], {
+                stdio: ['ignore', 'ignore', 'inherit'],
+            });
         } catch (e) {
             // Exit 1 is a validation problem (the bake is written); anything else is an error.
             if (e.status !== 1) fail(`baking ${material} under ${map}: exit ${e.status}`);
@@ -102,17 +106,18 @@ console.log(
         `strategy x ${args['truth-frames']} frames, tone mapped as brdf-preview maps them; cost: milliseconds per frame at ` +
         `${args['timing-size']} x ${args['timing-size']} over MeshStandardMaterial's (its ms in brackets). Three's materials are ` +
         `fitted to the truth's picture (engines/three/bench/frontier-page.js: metalness, roughness and for MeshPhysicalMaterial ` +
-        `clearcoat on a grid, each channel's colour by a search on the tone-mapped error); live: the mean of the 1-sample frames drawn in the time of 8 standard frames.\n`,
+        `clearcoat on a grid, each channel's colour by a search on the tone-mapped error); glTF: brdf-fit's material (fitted to the table, not to this picture) as three's GLTFLoader reads the bake's material.gltf; live: the mean of the 1-sample frames drawn in the time of 8 standard frames.\n`,
 );
-console.log('| material | map | standard dB (metalness, roughness) | physical dB (clearcoat, its roughness) | measured 1 / 4 / 16 spp dB | cost 1 / 4 / 16 spp | physical cost | live: frames, dB |');
-console.log('|---|---|---:|---:|---:|---:|---:|---:|');
+console.log('| material | map | standard dB (metalness, roughness) | physical dB (clearcoat, its roughness) | glTF dB (material type) | measured 1 / 4 / 16 spp dB | cost 1 / 4 / 16 spp | physical cost | glTF cost | live: frames, dB |');
+console.log('|---|---|---:|---:|---:|---:|---:|---:|---:|---:|');
 for (const { material, what, map, r } of rows) {
     const s = r.ms.standard;
     console.log(
         `| ${material} (${what}) | ${map} | ${f(r.standard.psnr)} (${r.standard.params.metalness}, ${f(r.standard.params.roughness, 2)}) ` +
             `| ${f(r.physical.psnr)} (${r.physical.params.clearcoat}, ${r.physical.params.clearcoatRoughness}) ` +
+            `| ${f(r.gltf.psnr)} (${r.gltf.type}) ` +
             `| ${f(r.measured[1])} / ${f(r.measured[4])} / ${f(r.measured[16])} ` +
             `| ${f(r.ms.measured[1] / s)} / ${f(r.ms.measured[4] / s)} / ${f(r.ms.measured[16] / s)} (${f(s)} ms) ` +
-            `| ${f(r.ms.physical / s, 2)} | ${r.live.frames}, ${f(r.live.psnr)} |`,
+            `| ${f(r.ms.physical / s, 2)} | ${f(r.ms.gltf / s, 2)} | ${r.live.frames}, ${f(r.live.psnr)} |`,
     );
 }
