@@ -33,7 +33,7 @@ struct Args {
     material: PathBuf,
 
     /// The folder to write into (created if missing: the folder itself, its parent must exist);
-    /// never a bake's folder.
+    /// never a bake's folder (brdf-bake --fit writes the same files into a bake).
     #[arg(long, short, value_name = "DIR")]
     out_dir: PathBuf,
 
