@@ -1,14 +1,13 @@
 //! `brdf-fit`: the glTF material closest to a MERL table. Argument parsing, reading, writing and
-//! reporting around `gltf_fit::fit`.
+//! reporting around `bake::stage::fit` (which runs `gltf_fit::fit`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
 use gltf_fit::{Masking, Objective, Settings, Stage, Variant};
 use merl::MerlTable;
-use serde_json::{Value, json};
 
 /// Fit glTF 2.0's metallic-roughness material (the specification's Appendix B BRDF: GGX with
 /// alpha = roughness^2, Smith masking, Schlick Fresnel, Lambertian diffuse), with
@@ -123,11 +122,8 @@ fn run(args: Args) -> Result<ExitCode> {
     progress.finish();
     let staged = &fitted.staged;
     staged.write(dir)?;
-    let files: Vec<Value> = staged.files.iter().map(|f| file_entry(dir, &f.name, &f.bytes)).collect();
-    let value = json!({ "fit": fitted.record, "files": files });
-    Ok(cli::finish(args.json, &value, &staged.report, &[], &staged.written(dir)))
-}
-
-fn file_entry(dir: &Path, name: &str, bytes: &[u8]) -> Value {
-    json!({ "path": dir.join(name).display().to_string(), "size_bytes": bytes.len(), "sha256": asset::hex(&asset::sha256(bytes)) })
+    // What every single-stage tool prints (the stage and its files), and fit.json's record.
+    let mut value = staged.json(dir)?;
+    value["fit"] = fitted.record;
+    Ok(cli::finish(args.json, &value, &staged.report, &staged.problems, &staged.written(dir)))
 }
