@@ -67,12 +67,26 @@ fn work() -> PathBuf {
     root().join("target/bench-fits")
 }
 
-/// A map's lighting (level 0 and its importance sampling are all the converged estimator reads)
-/// and the previewer's tone mapping of it.
-fn lighting(name: &str) -> (Lighting, envmap::ToneMapping) {
-    let map = envmap::load(&shared().join(format!("data/env/{name}.hdr"))).expect("the map");
-    let tone = metrics::auto_tone_mapping(&map);
-    (Lighting::new(MipChain::new(&map), Vec::new(), Vec::new()).expect("the lighting"), tone)
+/// One map of [`MAPS`]: its lighting (level 0 and its importance sampling are all the converged
+/// estimator reads), the previewer's tone mapping of it, and the sphere seen from its camera.
+struct Case {
+    lighting: Lighting,
+    tone: envmap::ToneMapping,
+    scene: Scene,
+}
+
+impl Case {
+    fn new(name: &str, azimuth: f32, elevation: f32) -> Case {
+        let map = envmap::load(&shared().join(format!("data/env/{name}.hdr"))).expect("the map");
+        let camera =
+            Camera::orbit(glam::Vec3::ZERO, 3.2, azimuth.to_radians(), elevation.to_radians(), 45f32.to_radians())
+                .expect("the camera");
+        Case {
+            lighting: Lighting::new(MipChain::new(&map), Vec::new(), Vec::new()).expect("the lighting"),
+            tone: metrics::auto_tone_mapping(&map),
+            scene: Scene { mesh: preview::mesh("sphere").expect("the sphere"), camera, width: SIZE, height: SIZE },
+        }
+    }
 }
 
 /// The converged estimator reads the table alone: no samples, no layers.
@@ -106,94 +120,122 @@ fn main() {
     let only = std::env::args().skip_while(|a| a != "--only").nth(1);
     std::fs::create_dir_all(work()).expect("creating target/bench-fits");
     let settings = Settings::default();
-    let maps: Vec<_> = MAPS.iter().map(|(name, az, el, _)| (lighting(name), *az, *el)).collect();
-    let scene = |az: f32, el: f32| Scene {
-        mesh: preview::mesh("sphere").expect("the sphere"),
-        camera: Camera::orbit(glam::Vec3::ZERO, 3.2, az.to_radians(), el.to_radians(), 45f32.to_radians())
-            .expect("the camera"),
-        width: SIZE,
-        height: SIZE,
-    };
-    let scenes: Vec<Scene> = maps.iter().map(|(_, az, el)| scene(*az, *el)).collect();
-    let mut rows = Vec::new();
-    for name in MATERIALS.into_iter().filter(|n| only.as_ref().is_none_or(|o| n.contains(o.as_str()))) {
-        let start = std::time::Instant::now();
-        let bytes = merl::read_bytes(&material_path(name)).expect("the table");
-        let table = MerlTable::parse(&bytes).expect("the table");
-        let fit = gltf_fit::fit(&table, &settings);
-        let tables: Vec<MerlTable> = VARIANTS
-            .iter()
-            .map(|&v| gltf_fit::fitted_table(&fit.variant(v).material, settings.masking, table.dims()))
-            .collect();
-        let chosen = VARIANTS.iter().position(|&v| v == fit.chosen).expect("a variant");
-        let albedo = gltf_fit::albedo_rows(&table, &tables[chosen]);
-        let measured = material(table);
-        let fitted: Vec<Material> = tables.into_iter().map(material).collect();
-        // Per map, each variant's PSNR.
-        let per_map: Vec<Vec<f64>> = maps
-            .iter()
-            .zip(&scenes)
-            .map(|(((lighting, tone), _, _), scene)| {
-                let render = |m: &Material| -> Image {
-                    render::converged::converged(scene, m, lighting, SAMPLES_PER_STRATEGY, SEED)
-                        .expect("the converged estimate")
-                };
-                let truth = render(&measured);
-                let truth_picture = metrics::tonemap(&truth, tone);
-                fitted
-                    .iter()
-                    .map(|m| sphere_psnr(&metrics::tonemap(&render(m), tone), &truth_picture, &truth.covered))
-                    .collect()
-            })
-            .collect();
-        let by_variant: Vec<Vec<f64>> = (0..VARIANTS.len()).map(|v| per_map.iter().map(|p| p[v]).collect()).collect();
-        let psnr = by_variant[chosen].clone();
-        eprintln!(
-            "{name}: {} {} ({:.1} s)",
-            fit.chosen.name(),
-            psnr.iter().map(|p| format!("{p:.2} dB")).collect::<Vec<_>>().join(", "),
-            start.elapsed().as_secs_f64()
-        );
-        rows.push(Row { name, fit, albedo, psnr, by_variant });
+    let cases: Vec<Case> = MAPS.iter().map(|(name, az, el, _)| Case::new(name, *az, *el)).collect();
+    let rows: Vec<Row> = MATERIALS
+        .into_iter()
+        .filter(|n| only.as_ref().is_none_or(|o| n.contains(o.as_str())))
+        .map(|name| measure(name, &settings, &cases))
+        .collect();
+    let complete = rows.len() == MATERIALS.len();
+    if complete {
+        let png = plot(&rows);
+        std::fs::write(
+            root().join("docs/brdf-fit-psnr.png"),
+            envmap::encode_png_rgb8(png.width, png.height, &png.rgb).expect("encoding the plot"),
+        )
+        .expect("writing docs/brdf-fit-psnr.png");
     }
+    let report = report(&rows, &settings, complete);
+    print!("{report}");
+    std::fs::write(work().join("report.md"), &report).expect("writing the report");
+}
 
-    let mut report = String::new();
-    let mut out = |line: String| {
-        println!("{line}");
-        report.push_str(&line);
-        report.push('\n');
-    };
-    out("# brdf-fit: the glTF material against the measured table".into());
-    out(String::new());
-    out(format!("Measured at {}.", Stamp::now()));
-    out(String::new());
-    out(format!(
-        "Fits at brdf-fit's defaults (objective {}, masking {}, a variant with an extension kept when {}% lower). \
-         PSNR: the fit's MERL table against the measured one, both by the converged estimator ({SAMPLES_PER_STRATEGY} samples \
-         per strategy, one seed), {SIZE} x {SIZE} sphere, the sphere's pixels, 8-bit after the map's tone mapping; cameras on \
-         the brightest light's reflection. Albedo error: the fit's directional albedo (luminance) against the table's at \
-         theta_o 0 / 30 / 60 / 80 degrees.",
-        settings.objective.name(),
-        settings.masking.name(),
-        settings.margin * 100.0
-    ));
-    out(String::new());
-    out("## The kept material".into());
-    out(String::new());
-    let map_names: Vec<&str> = MAPS.iter().map(|m| m.0).collect();
-    out(format!(
-        "| material | variant | baseColor | metallic | roughness | specular | specularColor | clearcoat | clearcoatRoughness | \
-         objective | albedo error % | {} |",
-        map_names.iter().map(|m| format!("{m} dB")).collect::<Vec<_>>().join(" | ")
-    ));
-    out(format!("|---|---|---|---:|---:|---:|---|---:|---:|---:|---|{}", "---:|".repeat(MAPS.len())));
+/// Fits the material `name` and renders the measured table and every variant's under each case.
+fn measure(name: &'static str, settings: &Settings, cases: &[Case]) -> Row {
+    let start = std::time::Instant::now();
+    let bytes = merl::read_bytes(&material_path(name)).expect("the table");
+    let table = MerlTable::parse(&bytes).expect("the table");
+    let fit = gltf_fit::fit(&table, settings);
+    let tables: Vec<MerlTable> = VARIANTS
+        .iter()
+        .map(|&v| gltf_fit::fitted_table(&fit.variant(v).material, settings.masking, table.dims()))
+        .collect();
+    let chosen = VARIANTS.iter().position(|&v| v == fit.chosen).expect("a variant");
+    let albedo = gltf_fit::albedo_rows(&table, &tables[chosen]);
+    let measured = material(table);
+    let fitted: Vec<Material> = tables.into_iter().map(material).collect();
+    // Per case, each variant's PSNR.
+    let per_case: Vec<Vec<f64>> = cases
+        .iter()
+        .map(|case| {
+            let render = |m: &Material| -> Image {
+                render::converged::converged(&case.scene, m, &case.lighting, SAMPLES_PER_STRATEGY, SEED)
+                    .expect("the converged estimate")
+            };
+            let truth = render(&measured);
+            let truth_picture = metrics::tonemap(&truth, &case.tone);
+            fitted
+                .iter()
+                .map(|m| sphere_psnr(&metrics::tonemap(&render(m), &case.tone), &truth_picture, &truth.covered))
+                .collect()
+        })
+        .collect();
+    let by_variant: Vec<Vec<f64>> = (0..VARIANTS.len()).map(|v| per_case.iter().map(|p| p[v]).collect()).collect();
+    let psnr = by_variant[chosen].clone();
+    eprintln!(
+        "{name}: {} {} ({:.1} s)",
+        fit.chosen.name(),
+        psnr.iter().map(|p| format!("{p:.2} dB")).collect::<Vec<_>>().join(", "),
+        start.elapsed().as_secs_f64()
+    );
+    Row { name, fit, albedo, psnr, by_variant }
+}
+
+/// The report (markdown) of `rows`; with every material (`complete`), it shows the plot.
+fn report(rows: &[Row], settings: &Settings, complete: bool) -> String {
+    let mut lines = vec![
+        "# brdf-fit: the glTF material against the measured table".to_string(),
+        String::new(),
+        format!("Measured at {}.", Stamp::now()),
+        String::new(),
+        format!(
+            "Fits at brdf-fit's defaults (objective {}, masking {}, a variant with an extension kept when {}% lower). \
+             PSNR: the fit's MERL table against the measured one, both by the converged estimator ({SAMPLES_PER_STRATEGY} \
+             samples per strategy, one seed), {SIZE} x {SIZE} sphere, the sphere's pixels, 8-bit after the map's tone \
+             mapping; cameras on the brightest light's reflection. Albedo error: the fit's directional albedo (luminance) \
+             against the table's at theta_o 0 / 30 / 60 / 80 degrees.",
+            settings.objective.name(),
+            settings.masking.name(),
+            settings.margin * 100.0
+        ),
+        String::new(),
+    ];
+    lines.extend(kept_table(rows));
+    lines.push(String::new());
+    lines.extend(variant_table(rows));
+    lines.push(String::new());
+    lines.extend(summaries(rows));
+    if complete {
+        lines.push(String::new());
+        lines.push("![The fit's PSNR per material and map, sorted](brdf-fit-psnr.png)".into());
+    }
+    lines.iter().map(|l| format!("{l}\n")).collect()
+}
+
+/// The maps' names, in the order of [`MAPS`] (a row's PSNRs).
+fn map_names() -> Vec<&'static str> {
+    MAPS.iter().map(|m| m.0).collect()
+}
+
+/// The kept material of each row: factors, objective, albedo error, PSNR per map.
+fn kept_table(rows: &[Row]) -> Vec<String> {
+    let mut lines = vec![
+        "## The kept material".to_string(),
+        String::new(),
+        format!(
+            "| material | variant | baseColor | metallic | roughness | specular | specularColor | clearcoat | \
+             clearcoatRoughness | objective | albedo error % | {} |",
+            map_names().iter().map(|m| format!("{m} dB")).collect::<Vec<_>>().join(" | ")
+        ),
+        format!("|---|---|---|---:|---:|---:|---|---:|---:|---:|---|{}", "---:|".repeat(MAPS.len())),
+    ];
     let triple = |v: [f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
-    for r in &rows {
+    for r in rows {
         let chosen = r.fit.chosen();
         let m = &chosen.material;
         let variant = chosen.variant.name();
         let albedo: Vec<String> = r.albedo.iter().map(|a| format!("{:+.1}", 100.0 * a.relative_error())).collect();
-        out(format!(
+        lines.push(format!(
             "| {} | {variant} | {} | {:.3} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.2e} | {} | {} |",
             r.name,
             triple(m.base_color),
@@ -208,19 +250,25 @@ fn main() {
             r.psnr.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join(" | ")
         ));
     }
-    out(String::new());
-    out("## Every variant: objective and PSNR (`*` the kept one)".into());
-    out(String::new());
+    lines
+}
+
+/// Every variant of each row: its objective and its PSNR per map, the kept one marked.
+fn variant_table(rows: &[Row]) -> Vec<String> {
     let header: Vec<String> = VARIANTS
         .iter()
         .flat_map(|v| {
             std::iter::once(format!("{} objective", v.name()))
-                .chain(map_names.iter().map(move |m| format!("{} {m} dB", v.name())))
+                .chain(map_names().into_iter().map(move |m| format!("{} {m} dB", v.name())))
         })
         .collect();
-    out(format!("| material | {} |", header.join(" | ")));
-    out(format!("|---|{}", "---:|".repeat(header.len())));
-    for r in &rows {
+    let mut lines = vec![
+        "## Every variant: objective and PSNR (`*` the kept one)".to_string(),
+        String::new(),
+        format!("| material | {} |", header.join(" | ")),
+        format!("|---|{}", "---:|".repeat(header.len())),
+    ];
+    for r in rows {
         let cells: Vec<String> = VARIANTS
             .iter()
             .zip(&r.by_variant)
@@ -230,10 +278,15 @@ fn main() {
                     .chain(psnr.iter().map(|p| format!("{p:.2}")))
             })
             .collect();
-        out(format!("| {} | {} |", r.name, cells.join(" | ")));
+        lines.push(format!("| {} | {} |", r.name, cells.join(" | ")));
     }
-    out(String::new());
-    for (k, map) in map_names.iter().enumerate() {
+    lines
+}
+
+/// Per map: whether the least objective draws the best picture, and the kept fits' PSNRs.
+fn summaries(rows: &[Row]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for (k, map) in map_names().iter().enumerate() {
         // The variant of least objective against the variant of best picture.
         let objective = |r: &Row, v: usize| r.fit.variant(VARIANTS[v]).objective;
         let least = |r: &Row| (0..VARIANTS.len()).min_by(|&a, &b| objective(r, a).total_cmp(&objective(r, b)));
@@ -242,7 +295,7 @@ fn main() {
         let mut loss: Vec<f64> = rows.iter().filter_map(|r| Some(r.by_variant[best(r)?][k] - r.psnr[k])).collect();
         loss.sort_by(f64::total_cmp);
         if let Some(worst) = loss.last() {
-            out(format!(
+            lines.push(format!(
                 "{map}: the variant of least objective draws the best picture for {agree} of {} materials; the kept \
                  variant's picture is {:.2} dB below the best variant's at the median, {worst:.2} dB at most.",
                 rows.len(),
@@ -250,27 +303,19 @@ fn main() {
             ));
         }
     }
-    out(String::new());
-    for (k, map) in map_names.iter().enumerate() {
+    lines.push(String::new());
+    for (k, map) in map_names().iter().enumerate() {
         let mut v: Vec<f64> = rows.iter().map(|r| r.psnr[k]).collect();
         v.sort_by(f64::total_cmp);
         if let (Some(lo), Some(hi)) = (v.first(), v.last()) {
-            out(format!(
+            lines.push(format!(
                 "{map}: min {lo:.2} dB, median {:.2} dB, max {hi:.2} dB over {} materials.",
                 median(&v),
                 v.len()
             ));
         }
     }
-    if rows.len() == MATERIALS.len() {
-        let png = plot(&rows, &map_names);
-        let path = root().join("docs/brdf-fit-psnr.png");
-        std::fs::write(&path, envmap::encode_png_rgb8(png.width, png.height, &png.rgb).expect("encoding the plot"))
-            .expect("writing docs/brdf-fit-psnr.png");
-        out(String::new());
-        out("![The fit's PSNR per material and map, sorted](brdf-fit-psnr.png)".into());
-    }
-    std::fs::write(work().join("report.md"), &report).expect("writing the report");
+    lines
 }
 
 /// The median of sorted values (of an even count, the mean of the two middle ones).
@@ -281,7 +326,7 @@ fn median(sorted: &[f64]) -> f64 {
 
 /// One row per material, sorted by its lowest PSNR (worst at the top), a dot per map on a PSNR
 /// axis, the material's name as the row's tick label; a legend of the maps below.
-fn plot(rows: &[Row], maps: &[&str]) -> Canvas {
+fn plot(rows: &[Row]) -> Canvas {
     // A row holds a label (14 pixels) and the gap heat_map keeps between labels.
     const ROW: usize = 20;
     const WIDTH: usize = 480;
@@ -321,7 +366,7 @@ fn plot(rows: &[Row], maps: &[&str]) -> Canvas {
     );
     let mut legend = Canvas::new(width, 14 * TEXT_SCALE, BACKGROUND);
     let mut x0 = 10;
-    for (map, (_, _, _, colour)) in maps.iter().zip(MAPS) {
+    for (map, _, _, colour) in MAPS {
         legend.fill_rect(x0, 4, 10, 10, colour);
         legend.text(x0 + 16, 2, map, TEXT_SCALE, INK);
         x0 += 16 + picture::font::text_width(map, TEXT_SCALE) as isize + 24;
