@@ -1,7 +1,7 @@
 //! `view::layer_coordinate`: the blend between the two layers around a view's bandwidth agrees
 //! with the nearest layer and moves continuously with the bandwidth.
 
-use brdf_atlas::view::{layer_coordinate, nearest_layer};
+use brdf_atlas::view::{LAYER_OVER_VIEW_BANDWIDTH, layer_coordinate, nearest_layer, view_coordinates};
 
 /// The default layers' bandwidths at an analysis size of 256 (`bake`'s layer test prints them).
 const LAYERS: [f64; 7] = [0.2909, 0.3176, 0.4484, 0.8741, 1.7171, 3.3612, 6.3283];
@@ -35,6 +35,31 @@ fn flat_broad_and_sharp_views_take_the_end_layers() {
     assert_eq!(layer_coordinate(0.01, &LAYERS), 0.0);
     assert_eq!(layer_coordinate(100.0, &LAYERS), 6.0);
     assert_eq!(layer_coordinate(1.0, &[0.5]), 0.0, "one layer");
+}
+
+/// What the renderers read: the layer of twice a view's bandwidth, continuing one layer past
+/// the sharpest (the map itself) at the last step's ratio, continuously, and no further.
+#[test]
+fn views_sharper_than_the_sharpest_layer_read_one_past_it() {
+    let last = LAYERS[6];
+    let past = last * last / LAYERS[5];
+    let views = [0.0, LAYERS[4] / 2.0, last / 2.0, last, (last * past).sqrt() / 2.0, past / 2.0, 100.0];
+    let x = view_coordinates(&views, &LAYERS);
+    let expected = [0.0, 4.0, 6.0, 7.0, 6.5, 7.0, 7.0];
+    for ((nu, x), want) in views.iter().zip(&x).zip(expected) {
+        // Up to one ulp of f32 away from the layer the doubled bandwidth measures.
+        assert!((f64::from(*x) - want).abs() < 1e-5, "view {nu}: {x}, expected {want}");
+    }
+    assert_eq!(LAYER_OVER_VIEW_BANDWIDTH, 2.0, "the expectations above double the views");
+    let mut previous = 0.0;
+    for i in 0..=30_000 {
+        let nu = 0.1 * (1000.0f64).powf(i as f64 / 30_000.0);
+        let x = view_coordinates(&[nu], &LAYERS)[0];
+        assert!(x >= previous && x - previous < 0.01, "nu {nu}: {previous} then {x}");
+        previous = x;
+    }
+    assert_eq!(previous, 7.0, "at most one past the sharpest");
+    assert_eq!(view_coordinates(&[5.0], &[0.5]), vec![0.0], "one layer: nothing to continue");
 }
 
 #[test]

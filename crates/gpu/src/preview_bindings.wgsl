@@ -39,7 +39,9 @@ const SUBPIXELS: f32 = 256.0;
 // than textures: float32 textures need not be filterable, and doing the bilinear weights by hand
 // makes them the CPU's arithmetic.
 @group(1) @binding(2) var<storage, read> env_texels: array<f32>;
-// `render::Material::view_layers`: each view row's Phong layer coordinate.
+// `render::Material::view_layers`: each view row's Phong layer coordinate (`shade.n_view_rows`
+// of them), then the `shade.n_layers` layers' exponents (`render::Lighting::exponents`) and the
+// exponent of the one past the sharpest (`render::past_exponent`).
 @group(1) @binding(3) var<storage, read> view_layers: array<f32>;
 // The mesh, as `preview_raster.wgsl` reads it: twelve values per vertex, three indices per
 // triangle. Per vertex: the clip-space position with the current camera and the snapped viewport

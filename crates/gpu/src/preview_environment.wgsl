@@ -65,6 +65,9 @@ fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
 // `render::FIS_LOD_BIAS`.
 const FIS_LOD_BIAS: f32 = -1.0;
 
+// `render::PREFILTERED_FOOTPRINT_LAYERS`.
+const PREFILTERED_FOOTPRINT_LAYERS: f32 = 1.0;
+
 // `envmap::MipChain::lod_solid_angle` for one of `filter_samples` samples (the picture's, over
 // its frames) of density `pdf` per unit solid angle, plus `FIS_LOD_BIAS` (`render::shade::shade`):
 // max(log4(width height / (filter_samples pdf 2 pi^2)) + FIS_LOD_BIAS, 0), as a difference of
@@ -110,27 +113,60 @@ fn view_layer_coordinate(frame: ShadingFrame) -> f32 {
     return a;
 }
 
-// The Phong layers the prefiltered estimator blends at this pixel: `shade.layer_shift` layers
-// sharper than the view's coordinate, the sharpest at most; (first layer, its weight's
-// complement t) as `render::shade` blends them: (1 - t) layer k + t layer k + 1.
-struct LayerBlend {
-    k: u32,
-    t: f32,
+// The prefiltered mode's layer coordinate at this pixel in `render::shade::shade`:
+// `shade.layer_shift` layers sharper than the view's, at most the one past the sharpest (the
+// smooth map itself).
+fn pixel_layer(frame: ShadingFrame) -> f32 {
+    return min(view_layer_coordinate(frame) + f32(shade.layer_shift), f32(shade.n_layers));
 }
 
-// The prefiltered mode's layers in `render::shade::shade`.
-fn layer_blend(frame: ShadingFrame) -> LayerBlend {
-    let x = min(view_layer_coordinate(frame) + f32(shade.layer_shift), f32(shade.n_layers - 1u));
+// The exponent of layer `k` (`shade.n_layers` past the sharpest), after the view rows.
+// No Rust twin: the CPU reads `render::Lighting::exponents` and `render::past_exponent`.
+fn layer_exponent_at(k: u32) -> f32 {
+    return view_layers[shade.n_view_rows + k];
+}
+
+// `render::exponent_layer`: the layer coordinate of exponent `n`.
+fn exponent_layer(n: f32) -> f32 {
+    if (!(n > layer_exponent_at(0u))) {
+        return 0.0;
+    }
+    if (n >= layer_exponent_at(shade.n_layers)) {
+        return f32(shade.n_layers);
+    }
+    var k = 0u;
+    while (k + 1u < shade.n_layers && layer_exponent_at(k + 1u) <= n) {
+        k++;
+    }
+    let a = log(layer_exponent_at(k));
+    return f32(k) + (log(n) - a) / (log(layer_exponent_at(k + 1u)) - a);
+}
+
+// `render::shade::footprint_layer`: the layer coordinate of the footprint of one of `n`
+// samples of density `pdf`, PREFILTERED_FOOTPRINT_LAYERS sharper.
+fn footprint_layer(n: u32, pdf: f32) -> f32 {
+    return exponent_layer(2.0 * PI * f32(n) * pdf - 1.0) + PREFILTERED_FOOTPRINT_LAYERS;
+}
+
+// The map of layer `k` in `render::shade::layers_lookup`: the Phong layer, or past the sharpest
+// the smooth part's level 0 (the first map of the chain fis reads).
+fn layer_map(k: u32) -> u32 {
+    if (k < shade.n_layers) {
+        return shade.layers_first + k;
+    }
+    return shade.mips_first;
+}
+
+// `render::shade::layers_lookup`: the layers at coordinate `x` (the view's, or a sample's
+// footprint's where that is broader), blended.
+fn layers_bilinear(x_view: f32, x_sample: f32, uv: vec2<f32>) -> vec3<f32> {
+    let x = clamp(min(x_view, x_sample), 0.0, f32(shade.n_layers));
     let k = u32(floor(x));
-    return LayerBlend(k, x - f32(k));
-}
-
-// The blended layers at `uv`: `render::shade::blend` of two `envmap::EnvMap::lookup_uv`.
-fn layers_bilinear(blend: LayerBlend, uv: vec2<f32>) -> vec3<f32> {
-    let a = env_bilinear(shade.layers_first + blend.k, uv);
-    if (blend.t > 0.0) {
-        let b = env_bilinear(shade.layers_first + min(blend.k + 1u, shade.n_layers - 1u), uv);
-        return a * (1.0 - blend.t) + b * blend.t;
+    let t = x - f32(k);
+    let a = env_bilinear(layer_map(k), uv);
+    if (t > 0.0) {
+        let b = env_bilinear(layer_map(k + 1u), uv);
+        return a * (1.0 - t) + b * t;
     }
     return a;
 }
@@ -145,6 +181,5 @@ fn debug_index(frame: ShadingFrame) -> vec3<f32> {
     if (shade.n_view_rows == 0u) {
         return vec3<f32>(-1.0, 1.0, 0.0);
     }
-    let blend = layer_blend(frame);
-    return vec3<f32>(f32(blend.k) + blend.t, 1.0, 0.0);
+    return vec3<f32>(pixel_layer(frame), 1.0, 0.0);
 }

@@ -13,7 +13,7 @@
 // One frame's estimate at a covered pixel: 1 / spp of `estimate_sum` over its spp terms.
 // One frame of the loop over frames in `render::shade::shade`.
 fn estimate(frame: ShadingFrame, pixel: u32, f: u32, spp: u32) -> vec3<f32> {
-    return estimate_sum(frame, pixel, f, spp, 0u, spp) / f32(spp);
+    return estimate_sum(frame, pixel, f, spp, 0u, spp, shade.filter_samples) / f32(spp);
 }
 
 // The light the two strategies of multiple importance sampling share in this mode
@@ -36,17 +36,19 @@ fn sampled_light() -> SampledLight {
 // The sum of terms `first .. first + count` of the pixel's `spp` in frame `f`
 // (`render::shade::shade`): term `j` is the BRDF's sample at point `base + j` of the pixel's
 // BRDF sequence and, where the mode samples a light, the light's at the same point of its own.
-fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, count: u32) -> vec3<f32> {
+// `n_filter` is the pixel's samples over all its frames, whose footprints the prefiltered mode
+// reads.
+fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, count: u32, n_filter: u32) -> vec3<f32> {
     let k = slice_of(frame);
     let range = sample_range(pixel, f, spp);
     let base = range.x * shade.n_samples + range.y;
     let words = pixel_words(pixel);
     let light = sampled_light();
-    var blend = LayerBlend(0u, 0.0);
+    var x_view = 0.0;
     var diffuse = vec3<f32>(0.0);
     var sum = vec3<f32>(0.0);
     if (shade.mode == MODE_PREFILTERED) {
-        blend = layer_blend(frame);
+        x_view = pixel_layer(frame);
     }
     // The filtered modes' diffuse part and its integral, once per term (the terms' sum is divided
     // by their count); never nonzero without a cosine layer to read.
@@ -66,7 +68,7 @@ fn estimate_sum(frame: ShadingFrame, pixel: u32, f: u32, spp: u32, first: u32, c
                 if (shade.mode == MODE_FIS) {
                     sum += rest * mip_trilinear(uv, mip_lod(s.pdf)) * (s.wi.z / s.pdf);
                 } else if (shade.mode == MODE_PREFILTERED) {
-                    sum += rest * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
+                    sum += rest * layers_bilinear(x_view, footprint_layer(n_filter, s.pdf), uv) * (s.wi.z / s.pdf);
                 }
                 if (light.valid) {
                     let weight = mis_weight(s.pdf, latlong_pdf(light.distribution, uv));
@@ -172,7 +174,7 @@ fn shade_blocks(
         while (j < end) {
             let first = j % per_frame;
             let count = min(end - j, per_frame - first);
-            radiance += estimate_sum(surface.frame, pixel, j / per_frame, per_frame, first, count);
+            radiance += estimate_sum(surface.frame, pixel, j / per_frame, per_frame, first, count, item.y);
             j += count;
         }
         radiance /= f32(item.y);

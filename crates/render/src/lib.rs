@@ -149,12 +149,20 @@
 //!   horizon: the light of the ground wrapped over a Lambertian sphere's lower half (9.5 levels
 //!   of 8-bit bias). The rest, `f - f_d` in the `F` term (the `M` term keeps `f`): `F` the
 //!   smooth part's Phong layers
-//!   ([`Lighting::smooth_layers`]) blended at the pixel's layer coordinate `x` =
+//!   ([`Lighting::smooth_layers`]) blended at the sample's layer coordinate `x`: `(1 - t)` of
+//!   layer `k` and `t` of layer `k + 1`, `k + t = x`, each bilinear, where layer `K` (one past
+//!   the sharpest of `K`) is the smooth part's level 0 itself. `x` is the pixel's
 //!   [`view_layer`]`(cos_o)` (the material's [`Material::view_layers`], one per row of the
-//!   bandwidth atlas, interpolated between the rows' centres) `+ layer_shift`, at most the last
-//!   layer: `(1 - t)` of layer `k` and `t` of layer `k + 1`, `k + t = x`, each bilinear. Blending
-//!   by a coordinate that moves continuously with the view leaves no seam where the chosen layer
-//!   changes. An adaptive frame's shaded blocks read sharper layers
+//!   bandwidth atlas, interpolated between the rows' centres) `+ layer_shift`, at most `K`, and
+//!   at most the sample's footprint's ([`PREFILTERED_FOOTPRINT_LAYERS`]: the lobe of solid
+//!   angle `1 / (N p_b)`, one layer sharper). Blending by a coordinate that moves continuously
+//!   with the view leaves no seam where the chosen layer changes. A mirror-like lobe (chrome,
+//!   whose views measure 18 to 27 cycles per radian, twice that wanted, against the sharpest
+//!   default layer's 13.4 at 512 x 256) reads level 0, which a 1024 x 512 map resolves to
+//!   about 80; its tail's samples, rare and far from the mirror direction, read the broad
+//!   layers of their footprint instead of sharp light, which left sparkles (chrome under
+//!   `studio_small_03`: 7x7 bias max 3.47 levels with every sample at the sharpest layer, 1.47
+//!   with both). An adaptive frame's shaded blocks read sharper layers
 //!   (`adaptive::Settings::layer_shift`, module `adaptive`, "Shading"). `M` and `p_l` as fis.
 //!
 //! Where the environment has no peaks, the filtered modes take no light's directions (`M = 0`).
@@ -309,7 +317,8 @@ pub struct Material {
     /// For [`Mode::Prefiltered`]: where each of `R` view elevations, in equal steps of
     /// `cos theta_o`, falls among the Phong layers of [`Lighting::layers`], as a layer coordinate
     /// (`brdf_atlas::view::view_coordinates`: the layer of twice the view's bandwidth, `k + t`
-    /// blending layer `k` and `k + 1` by `t`). Row
+    /// blending layer `k` and `k + 1` by `t`, up to the number of layers: the smooth map itself
+    /// past the sharpest). Row
     /// `r` is for `1 - cos theta_o = (r + 1/2) / R`; a pixel interpolates the rows around it
     /// ([`view_layer`]).
     pub view_layers: Vec<f32>,
@@ -429,15 +438,57 @@ pub fn view_layer(view_layers: &[f32], cos_o: f64) -> f64 {
     if t > 0.0 { a + (f64::from(view_layers[r + 1]) - a) * t } else { a }
 }
 
-/// The Phong exponent at layer coordinate `x` among layers of `exponents`: geometric between the
-/// two layers it blends (`n_k^(1 - t) n_(k+1)^t`), as the lobes' widths are.
+/// The Phong exponent at layer coordinate `x` among layers of `exponents` (increasing): geometric
+/// between the two layers it blends (`n_k^(1 - t) n_(k+1)^t`), as the lobes' widths are. Index
+/// `exponents.len()` is the layer past the sharpest, the smooth map itself, which the
+/// pre-filtered estimator reads where the sharpest layer is too broad (crate documentation, "The
+/// estimators"); it stands at the exponents' last step continued ([`past_exponent`]). `x` is
+/// clamped to `[0, exponents.len()]`; `exponents` must not be empty.
 pub fn layer_exponent(exponents: &[u32], x: f32) -> f64 {
-    let last = exponents.len() - 1;
-    let x = f64::from(x).clamp(0.0, last as f64);
-    let k = (x.floor() as usize).min(last);
-    let (a, b) = (f64::from(exponents[k]), f64::from(exponents[(k + 1).min(last)]));
-    a.powf(1.0 - (x - k as f64)) * b.powf(x - k as f64)
+    let n = |k: usize| exponents.get(k).map_or_else(|| past_exponent(exponents), |&e| f64::from(e));
+    let x = f64::from(x).clamp(0.0, exponents.len() as f64);
+    let k = x.floor() as usize;
+    let t = x - k as f64;
+    if t > 0.0 { n(k).powf(1.0 - t) * n(k + 1).powf(t) } else { n(k) }
 }
+
+/// The exponent the layer past the sharpest stands at: the last one's times the last step's
+/// ratio (4 between the default layers, as between every two of them), 4 times it where there
+/// is one layer.
+pub fn past_exponent(exponents: &[u32]) -> f64 {
+    let last = f64::from(exponents[exponents.len() - 1]);
+    let step = match exponents {
+        [.., a, b] if *a > 0 => f64::from(*b) / f64::from(*a),
+        _ => 4.0,
+    };
+    last * step
+}
+
+/// The layer coordinate of Phong exponent `n` among layers of `exponents` (increasing), the
+/// inverse of [`layer_exponent`]: linear in `ln n` between the layers around it, 0 at or below
+/// the broadest, `exponents.len()` (the smooth map itself) at or above [`past_exponent`].
+pub fn exponent_layer(exponents: &[u32], n: f64) -> f64 {
+    let past = past_exponent(exponents);
+    // NaN (no footprint) reads the broadest layer.
+    if n.is_nan() || n <= f64::from(exponents[0]) {
+        return 0.0;
+    }
+    if n >= past {
+        return exponents.len() as f64;
+    }
+    let e = |k: usize| exponents.get(k).map_or(past, |&e| f64::from(e));
+    let k = exponents.partition_point(|&e| f64::from(e) <= n) - 1;
+    k as f64 + (n.ln() - e(k).ln()) / (e(k + 1).ln() - e(k).ln())
+}
+
+/// Layers added to the pre-filtered estimator's footprint coordinate (crate documentation, "The
+/// estimators"): a sample of density `p` among `N` reads at most the layer whose lobe is one
+/// layer sharper than its footprint of solid angle `1 / (N p)`, as fis reads one mip level finer
+/// ([`FIS_LOD_BIAS`]). Against Mitsuba 3 (the Mitsuba bench's cases, 128 x 128, brdf-preview's
+/// defaults), chrome under `studio_small_03`, the only cases it moves by more than 0.05 levels:
+/// 7x7 bias p99 / max 1.00 / 1.87 and 1.57 / 2.73 (light before and behind the sphere) without
+/// the cap, 1.57 / 2.37 and 1.53 / 2.06 at 0 layers, 0.94 / 1.47 and 0.96 / 1.51 at 1.
+pub const PREFILTERED_FOOTPRINT_LAYERS: f64 = 1.0;
 
 /// The point sequences of pixel `pixel`: `[brdf, environment]`, Owen-scrambled Sobol' sequences
 /// scrambled by words of [`pcg_hash`] (crate documentation, "Samples"), so both renderers draw

@@ -193,14 +193,16 @@ pub(crate) fn brdf(material: &Material, wi_local: DVec3, wo_local: DVec3) -> [f6
 /// Where a mode reads `L`.
 #[derive(Clone, Copy)]
 enum Source<'a> {
-    /// Bilinear in two Phong layers, blended: `(1 - t)` of the first and `t` of the second.
-    Layers(&'a EnvMap, &'a EnvMap, f64),
+    /// The Phong layers at the view's layer coordinate, or the sample's footprint's where that
+    /// is broader, blended: `(1 - t)` of layer `k` and `t` of layer `k + 1`, `k + t` the
+    /// coordinate; layer `len` is the smooth map itself.
+    Layers(f64),
     /// Trilinear in the mip chain at the sample's level of detail (filtered importance sampling).
     Mips(&'a MipChain),
 }
 
 /// The estimate of one covered pixel, averaged over the frames; the prefiltered estimator reads
-/// the layer `layer_shift` layers sharper than the view's (the sharpest at most: an adaptive
+/// the layer `layer_shift` layers sharper than the view's (the smooth map at most: an adaptive
 /// frame's shaded blocks, `adaptive::Settings::layer_shift`; 0 for [`render`]).
 pub(crate) fn shade(
     frame: &ShadingFrame,
@@ -222,11 +224,8 @@ pub(crate) fn shade(
         Mode::Reference => None,
         Mode::Fis => Some(Source::Mips(lighting.smooth_mips())),
         Mode::Prefiltered => {
-            let layers = lighting.smooth_layers();
-            let last = (layers.len() - 1) as f64;
-            let x = (view_layer(&material.view_layers, frame.cos_o) + f64::from(layer_shift)).min(last);
-            let k = x.floor() as usize;
-            Some(Source::Layers(&layers[k], &layers[(k + 1).min(layers.len() - 1)], x - k as f64))
+            let past = lighting.smooth_layers().len() as f64;
+            Some(Source::Layers((view_layer(&material.view_layers, frame.cos_o) + f64::from(layer_shift)).min(past)))
         }
     };
     let sampled = match (settings.mode, &lighting.peaks) {
@@ -255,13 +254,9 @@ pub(crate) fn shade(
                     let wi = frame.to_world(wi_local);
                     let (u, v) = envmap::uv(wi);
                     match filtered {
-                        Some(Source::Layers(a, b, t)) => {
-                            let radiance = if t > 0.0 {
-                                blend(a.lookup_uv(u, v), b.lookup_uv(u, v), t)
-                            } else {
-                                a.lookup_uv(u, v)
-                            };
-                            add(rest, radiance, wi_local.z / sample.pdf);
+                        Some(Source::Layers(x_view)) => {
+                            let x = x_view.min(footprint_layer(&lighting.exponents, filter_samples, sample.pdf));
+                            add(rest, layers_lookup(lighting, x, u, v), wi_local.z / sample.pdf);
                         }
                         Some(Source::Mips(mips)) => {
                             let lod = mips.lod_solid_angle(filter_samples, sample.pdf) + crate::FIS_LOD_BIAS;
@@ -307,6 +302,27 @@ fn diffuse_term(frame: &ShadingFrame, material: &Material, lighting: &Lighting, 
     let (u, v) = envmap::uv(frame.n);
     let l_1 = lighting.smooth_layers()[0].lookup_uv(u, v);
     (diffuse, std::array::from_fn(|c| std::f64::consts::PI * diffuse[c] * f64::from(l_1[c])))
+}
+
+/// The layer coordinate of the footprint of one of `n` samples of solid-angle density `pdf`:
+/// the Phong lobe of the same solid angle `1 / (n pdf)`, whose exponent is `2 pi n pdf - 1`
+/// (the normalized lobe's peak is `(e + 1) / (2 pi)`), [`crate::PREFILTERED_FOOTPRINT_LAYERS`]
+/// sharper.
+pub(crate) fn footprint_layer(exponents: &[u32], n: usize, pdf: f64) -> f64 {
+    let exponent = 2.0 * std::f64::consts::PI * n as f64 * pdf - 1.0;
+    crate::exponent_layer(exponents, exponent) + crate::PREFILTERED_FOOTPRINT_LAYERS
+}
+
+/// The smooth part's layers at coordinate `x` (clamped to `[0, layers]`) in direction `(u, v)`:
+/// `(1 - t)` of layer `k` and `t` of layer `k + 1`, each bilinear, the smooth part's level 0
+/// past the sharpest.
+fn layers_lookup(lighting: &Lighting, x: f64, u: f64, v: f64) -> [f32; 3] {
+    let layers = lighting.smooth_layers();
+    let x = x.clamp(0.0, layers.len() as f64);
+    let k = x.floor() as usize;
+    let t = x - k as f64;
+    let layer = |k: usize| layers.get(k).unwrap_or_else(|| lighting.smooth_mips().level(0));
+    if t > 0.0 { blend(layer(k).lookup_uv(u, v), layer(k + 1).lookup_uv(u, v), t) } else { layer(k).lookup_uv(u, v) }
 }
 
 /// `(1 - t) a + t b`.
@@ -390,10 +406,9 @@ pub fn check_settings(
         if view_layers.is_empty() {
             return Err(Error::Invalid("prefiltered mode needs at least one view-layer entry".into()));
         }
-        if let Some(&bad) = view_layers.iter().find(|&&l| !(l >= 0.0 && l as f64 <= (n_layers - 1) as f64)) {
+        if let Some(&bad) = view_layers.iter().find(|&&l| !(l >= 0.0 && l as f64 <= n_layers as f64)) {
             return Err(Error::Invalid(format!(
-                "view layer coordinate {bad} is outside 0 to {} (the last of {n_layers} prefiltered layers)",
-                n_layers - 1
+                "view layer coordinate {bad} is outside 0 to {n_layers} (the smooth map past the {n_layers} prefiltered layers)"
             )));
         }
     }

@@ -166,6 +166,57 @@ fn the_prefiltered_mode_leaves_no_seam_where_the_layer_changes() {
     assert!(worst < 0.12, "a step of {:.1}% between neighbouring pixels", 100.0 * worst);
 }
 
+/// Past the sharpest layer the prefiltered mode reads the smooth map itself, and a sample never
+/// reads a layer sharper than its footprint. Constant maps: layers 0 and 1 of `L` and `2 L`
+/// (exponents 1 and 4, so the layer past them stands at 16), level 0 of `3 L`; a Lambertian
+/// (its diffuse part set to 0, so that the whole lobe is read in the layers) at view coordinate 2,
+/// past the sharpest. A Lambertian's samples weigh `f cos / pdf`, its albedo whatever the
+/// direction (to the table's tabulation of the cosine), so the light a picture reads is its mean
+/// over the reference estimator's under the constant map `L` (128 samples per pixel). With 16
+/// samples over 8 frames a sample of density `cos / pi` has a footprint of exponent `256 cos - 1`,
+/// at least 16 for `cos > 1/15`: nearly every sample reads level 0, `3 L` (measured: 3.002).
+/// With one sample the footprint's exponent `2 cos - 1` is at most 1, so the footprint coordinate
+/// is 0 and, one layer sharper, 1: every sample reads layer 1, `2 L` (measured: 2.004).
+/// Tolerance 2%: the table's cosine against the analytic one.
+#[test]
+fn the_prefiltered_mode_reads_the_smooth_map_past_the_sharpest_layer_and_no_sharper_than_a_footprint() {
+    let map = |k: f32| EnvMap::constant(64, 32, support::L.map(|c| c * k)).expect("a 2:1 map");
+    let lighting = Lighting::new(MipChain::new(&map(3.0)), vec![map(1.0), map(2.0)], vec![1, 4]).expect("valid");
+    assert!(lighting.peaks.is_none(), "a constant map has no peaks");
+    let material = Material { view_layers: vec![2.0; 4], diffuse: [0.0; 3], ..support::lambertian(0).clone() };
+    let scene = support::sphere_scene(32, 32);
+    let albedo_light = |settings: &Settings| {
+        let image = render::render(&scene, &material, &lighting, settings).expect("valid inputs");
+        let settings = Settings { mode: Mode::Reference, spp: 16, frames: 8, seed: 1 };
+        let reference = render::render(&scene, &material, &support::constant_lighting(), &settings).expect("valid");
+        metrics::mean_luminance(&image) / metrics::mean_luminance(&reference)
+    };
+    let many = albedo_light(&Settings { mode: Mode::Prefiltered, spp: 16, frames: 8, seed: 1 });
+    let one = albedo_light(&Settings { mode: Mode::Prefiltered, spp: 1, frames: 1, seed: 1 });
+    println!("light read: {many:.3} L with 128 samples per pixel, {one:.3} L with one");
+    assert!((many / 3.0 - 1.0).abs() < 0.02, "128 samples read {many:.3} L, not level 0's 3 L");
+    assert!((one / 2.0 - 1.0).abs() < 0.02, "one sample reads {one:.3} L, not layer 1's 2 L");
+}
+
+/// The layer coordinate of an exponent and the exponent of a coordinate are inverse, geometric
+/// between the layers, and the layer past the sharpest stands at the last step continued.
+#[test]
+fn layer_coordinates_and_exponents_are_inverse() {
+    let exponents = [1, 4, 16, 64, 256, 1024, 4096, 16384];
+    assert_eq!(render::past_exponent(&exponents), 65536.0);
+    assert_eq!(render::past_exponent(&[10, 30]), 90.0);
+    assert_eq!(render::past_exponent(&[7]), 28.0);
+    for x in [0.0f32, 0.25, 1.0, 3.5, 6.9, 7.0, 7.5, 8.0] {
+        let n = render::layer_exponent(&exponents, x);
+        let back = render::exponent_layer(&exponents, n);
+        assert!((back - f64::from(x)).abs() < 1e-9, "{x} -> {n} -> {back}");
+    }
+    assert_eq!(render::layer_exponent(&exponents, 1.5), 8.0);
+    assert_eq!(render::layer_exponent(&exponents, 7.5), 32768.0);
+    assert_eq!(render::exponent_layer(&exponents, 0.5), 0.0);
+    assert_eq!(render::exponent_layer(&exponents, 1e9), 8.0);
+}
+
 /// The diffuse part of the analytic tables: all of a Lambertian's value (albedo / pi), none of a
 /// Phong lobe's (it falls to 0 away from its mirror direction), and a Phong lobe's Lambertian base.
 /// The table holds each value scaled into MERL's integer-free doubles, so the least cell equals

@@ -66,10 +66,13 @@ fn prefiltered_mode_needs_layers() {
     expect_invalid(render::render(&scene, material, &mismatch, &prefiltered), "1 prefiltered layers but 2 exponents");
     let no_rows = Material { view_layers: Vec::new(), ..material.clone() };
     expect_invalid(render::render(&scene, &no_rows, &lighting, &prefiltered), "at least one view-layer entry");
-    let out_of_range = Material { view_layers: vec![0.0, 1.0], ..material.clone() };
+    // Coordinate 1 of one layer is the smooth map past it; 1.5 is nothing.
+    let past = Material { view_layers: vec![0.0, 1.0], ..material.clone() };
+    assert!(render::render(&scene, &past, &lighting, &prefiltered).is_ok());
+    let out_of_range = Material { view_layers: vec![0.0, 1.5], ..material.clone() };
     expect_invalid(
         render::render(&scene, &out_of_range, &lighting, &prefiltered),
-        "view layer coordinate 1 is outside 0 to 0",
+        "view layer coordinate 1.5 is outside 0 to 1",
     );
 }
 

@@ -158,6 +158,8 @@ export class Bake {
             uFirstFrame: { value: firstFrame },
             uFrameCount: { value: frames },
             uDivisor: { value: divisor ?? frames },
+            uFilterSamples: { value: spp * frames },
+            uLayerExponents: { value: layerExponents(f.exponents) },
             ...rayUniforms(),
         };
     }
@@ -282,6 +284,17 @@ function fullScreen(material, rotation) {
 
 /** The full-screen quad's geometry, shared by every background and deferred pass (never disposed). */
 const QUAD = new THREE.PlaneGeometry(2, 2);
+
+// uLayerExponents: the layers' exponents, then render::past_exponent (the last one's times the
+// last step's ratio, 4 times it for a single layer), padded to MAX_LAYERS + 1 (65).
+function layerExponents(exponents) {
+    const n = exponents.length;
+    const step = n >= 2 ? exponents[n - 1] / exponents[n - 2] : 4;
+    const values = new Float32Array(65);
+    values.set(exponents);
+    values[n] = exponents[n - 1] * step;
+    return values;
+}
 
 function rayUniforms() {
     return {

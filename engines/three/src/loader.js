@@ -176,7 +176,7 @@ function roles(f) {
     return {
         'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: f.merl_size, range: [0, Infinity] },
         'engine-brdf-tables': { uniform: 'uBrdfTables', channels: 1, kind: 'array', shape: [Math.max(R, C) + 1, R + 2, f.slices], range: [0, 1] },
-        'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [f.view_rows, 1, 1], range: [0, f.exponents.length - 1] },
+        'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [f.view_rows, 1, 1], range: [0, f.exponents.length] },
         'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [W, H, 2], range: [0, Infinity] },
         'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [Math.max(W, H) + 1, H + 1, 2], range: [0, 1] },
         'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, Infinity] },

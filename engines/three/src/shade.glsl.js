@@ -24,6 +24,10 @@ const float PI = 3.14159265358979;
 const float HALF_PI = 1.5707963267948966;
 // The largest f32 below 1 (sampling::ONE_MINUS_EPSILON in f32).
 const float ONE_BELOW = 0.99999994;
+// The most layers a bake's engine textures may hold (the loader's check on the exponents).
+#define MAX_LAYERS 64
+// render::PREFILTERED_FOOTPRINT_LAYERS.
+const float PREFILTERED_FOOTPRINT_LAYERS = 1.0;
 
 // engine-environment.ktx2: layer 0 the environment's level 0, layer 1 its peaks.
 uniform sampler2DArray uEnvironment;
@@ -236,6 +240,12 @@ uniform sampler2DArray uLightTables;
 uniform sampler2D uViewLayers;
 // engine-layers.ktx2: the smooth part's Phong layers.
 uniform sampler2DArray uLayers;
+// The layers' exponents (the manifest's), then render::past_exponent (the smooth map past the
+// sharpest layer); the rest unused.
+uniform float uLayerExponents[MAX_LAYERS + 1];
+// render::Settings::filter_samples: the samples of the picture (spp times its frames), whose
+// footprints the prefiltered estimator reads.
+uniform uint uFilterSamples;
 
 uniform uint uMode;
 uniform uint uSeed;
@@ -624,26 +634,52 @@ float view_layer_coordinate(ShadingFrame frame) {
     return a;
 }
 
-// layer_blend (layer_shift 0): (1 - t) layer k + t layer k + 1.
-struct LayerBlend {
-    int k;
-    float t;
-};
-
-LayerBlend layer_blend(ShadingFrame frame) {
-    int n_layers = textureSize(uLayers, 0).z;
-    float x = min(view_layer_coordinate(frame), float(n_layers - 1));
-    int k = int(floor(x));
-    return LayerBlend(k, x - float(k));
+// pixel_layer (layer_shift 0): the view's layer coordinate, at most the one past the sharpest.
+float pixel_layer(ShadingFrame frame) {
+    return min(view_layer_coordinate(frame), float(textureSize(uLayers, 0).z));
 }
 
-// layers_bilinear: the blended layers at uv.
-vec3 layers_bilinear(LayerBlend blend, vec2 uv) {
+// render::exponent_layer: the layer coordinate of exponent n.
+float exponent_layer(float n) {
     int n_layers = textureSize(uLayers, 0).z;
-    vec3 a = env_bilinear(uLayers, blend.k, uv);
-    if (blend.t > 0.0) {
-        vec3 b = env_bilinear(uLayers, min(blend.k + 1, n_layers - 1), uv);
-        return a * (1.0 - blend.t) + b * blend.t;
+    if (!(n > uLayerExponents[0])) {
+        return 0.0;
+    }
+    if (n >= uLayerExponents[n_layers]) {
+        return float(n_layers);
+    }
+    int k = 0;
+    while (k + 1 < n_layers && uLayerExponents[k + 1] <= n) {
+        k++;
+    }
+    float a = log(uLayerExponents[k]);
+    return float(k) + (log(n) - a) / (log(uLayerExponents[k + 1]) - a);
+}
+
+// render::shade::footprint_layer: the footprint of one of n samples of density pdf.
+float footprint_layer(uint n, float pdf) {
+    return exponent_layer(2.0 * PI * float(n) * pdf - 1.0) + PREFILTERED_FOOTPRINT_LAYERS;
+}
+
+// layer_map: layer k at uv, or past the sharpest the smooth part's level 0 (level 0 less its
+// peaks, which are 0 where there are none).
+vec3 layer_bilinear(int k, vec2 uv) {
+    if (k < textureSize(uLayers, 0).z) {
+        return env_bilinear(uLayers, k, uv);
+    }
+    return max(env_bilinear(uEnvironment, 0, uv) - env_bilinear(uEnvironment, 1, uv), vec3(0.0));
+}
+
+// render::shade::layers_lookup: the layers at the view's coordinate, or the sample's where that
+// is broader, blended: (1 - t) layer k + t layer k + 1.
+vec3 layers_bilinear(float x_view, float x_sample, vec2 uv) {
+    float x = clamp(min(x_view, x_sample), 0.0, float(textureSize(uLayers, 0).z));
+    int k = int(floor(x));
+    float t = x - float(k);
+    vec3 a = layer_bilinear(k, uv);
+    if (t > 0.0) {
+        vec3 b = layer_bilinear(k + 1, uv);
+        return a * (1.0 - t) + b * t;
     }
     return a;
 }
@@ -659,11 +695,11 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     bool reference = uMode == MODE_REFERENCE;
     bool light_valid = reference || uPeaks;
     int light = reference ? 0 : 1;
-    LayerBlend blend = LayerBlend(0, 0.0);
+    float x_view = 0.0;
     vec3 diffuse = vec3(0.0);
     vec3 sum = vec3(0.0);
     if (uMode == MODE_PREFILTERED) {
-        blend = layer_blend(frame);
+        x_view = pixel_layer(frame);
         // The diffuse part's integral, once per term (the sum is divided by spp).
         diffuse = uDiffuse;
         sum = (PI * diffuse * env_bilinear(uLayers, 0, env_uv(frame.n))) * float(spp);
@@ -677,7 +713,7 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
             if (any(notEqual(brdf, vec3(0.0))) || any(notEqual(rest, vec3(0.0)))) {
                 vec2 uv = env_uv(to_world(frame, s.wi));
                 if (uMode == MODE_PREFILTERED) {
-                    sum += rest * layers_bilinear(blend, uv) * (s.wi.z / s.pdf);
+                    sum += rest * layers_bilinear(x_view, footprint_layer(uFilterSamples, s.pdf), uv) * (s.wi.z / s.pdf);
                 }
                 if (light_valid) {
                     float weight = mis_weight(s.pdf, latlong_pdf(light, uv));

@@ -133,7 +133,7 @@ test('textures of the wrong format or shape, or with values out of range, are re
         [(f, files) => { files['engine-layers'] = ktx2(4, 'array', [4, 2, 2], (i) => (i === 5 ? NaN : 1)); }, 'engine-layers.ktx2: value 5 (texel 1, channel 1) is NaN'],
         [(f, files) => { files['engine-environment'] = ktx2(4, 'array', [4, 2, 2], (i) => (i === 0 ? -1 : 1)); }, 'engine-environment.ktx2: value 0 (texel 0, channel 0) is -1'],
         [(f, files) => { files['engine-light-tables'] = ktx2(1, 'array', [5, 3, 2], (i) => (i === 7 ? 1.5 : 0.5)); }, 'engine-light-tables.ktx2: value 7', 'outside [0, 1]'],
-        [(f, files) => { files['engine-view-layers'] = ktx2(1, '2d', [2, 1, 1], () => 2); }, 'engine-view-layers.ktx2: value 0', 'outside [0, 1]'],
+        [(f, files) => { files['engine-view-layers'] = ktx2(1, '2d', [2, 1, 1], () => 2.5); }, 'engine-view-layers.ktx2: value 0', 'outside [0, 2]'],
         [(f, files) => { files['engine-merl'] = new Uint8Array([1, 2, 3]); }, 'engine-merl.ktx2: not a ktx2 file'],
     ];
     for (const [edit, ...needles] of cases) await refused(load(edit), ...needles);

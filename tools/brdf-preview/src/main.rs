@@ -22,7 +22,9 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///                environment's mip chain at the level of its footprint's solid angle
 ///
 ///   prefiltered  the Phong layers (001 sections 2.5 and 4.3) around the layer the bake's
-///                selection gives the view, blended, read by few samples
+///                selection gives the view, blended, read by few samples; past the sharpest
+///                layer the map itself (a mirror's lobe), and no layer sharper than a
+///                sample's footprint
 ///
 ///   adaptive     bandwidth-driven multi-resolution shading (001 sections 2-3): the bake's
 ///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
@@ -150,8 +152,8 @@ struct Args {
     lobe_weight: bool,
 
     /// adaptive-prefiltered: the shaded blocks read the Phong layer N layers sharper than the one
-    /// the bake picks for the view (each a lobe half as wide; the sharpest at most), N from 0. The bake's
-    /// pick suits 16 samples per pixel; a shaded block takes tens, and sharper layers blur less
+    /// the bake picks for the view (each a lobe half as wide; the map itself past the sharpest
+    /// at most), N from 0. The bake's pick suits 16 samples per pixel; a shaded block takes tens, and sharper layers blur less
     /// (crate render, module adaptive, "Shading": gold-paint under potsdamer 46.2 dB at 0, 50.5
     /// at 1; under quarry's sun sharper layers cost noise).
     #[arg(long, value_name = "N", default_value_t = render::adaptive::LAYER_SHIFT)]

@@ -225,10 +225,18 @@ impl Renderer {
             let samples_buffer = storage("preview samples", bytemuck::cast_slice(&samples.texels));
             let maps_buffer = storage("preview env maps", bytemuck::cast_slice(&env_maps));
             let texels_buffer = storage("preview env texels", bytemuck::cast_slice(&env_texels));
-            // A binding cannot be empty; a table nobody reads (the mode check rejects the
-            // prefiltered mode without one) holds one unused entry.
-            let view_layers = if material.view_layers.is_empty() { &[0.0][..] } else { &material.view_layers[..] };
-            let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(view_layers));
+            // The view rows' layer coordinates, then the layers' exponents and the one past the
+            // sharpest (`render::past_exponent`). A binding cannot be empty; a table nobody reads
+            // (the mode check rejects the prefiltered mode without one) holds one unused entry.
+            let mut view_layers = material.view_layers.clone();
+            if !lighting.exponents.is_empty() {
+                view_layers.extend(lighting.exponents.iter().map(|&n| n as f32));
+                view_layers.push(render::past_exponent(&lighting.exponents) as f32);
+            }
+            if view_layers.is_empty() {
+                view_layers.push(0.0);
+            }
+            let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(&view_layers));
             let tables_buffer = storage("preview sampling tables", bytemuck::cast_slice(&tables));
             let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview bake"),

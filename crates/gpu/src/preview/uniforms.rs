@@ -167,7 +167,14 @@ mod tests {
         let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
         let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
         let lod_bias = format!("const FIS_LOD_BIAS: f32 = {:?};", render::FIS_LOD_BIAS as f32);
-        for (wgsl, decl) in [(&PREVIEW_SAMPLING, salt), (&PREVIEW_BINDINGS, no_map), (&PREVIEW_ENVIRONMENT, lod_bias)] {
+        let footprint =
+            format!("const PREFILTERED_FOOTPRINT_LAYERS: f32 = {:?};", render::PREFILTERED_FOOTPRINT_LAYERS as f32);
+        for (wgsl, decl) in [
+            (&PREVIEW_SAMPLING, salt),
+            (&PREVIEW_BINDINGS, no_map),
+            (&PREVIEW_ENVIRONMENT, lod_bias),
+            (&PREVIEW_ENVIRONMENT, footprint),
+        ] {
             assert!(wgsl.source.contains(&decl), "{} does not declare `{decl}`", wgsl.file);
         }
     }

@@ -156,7 +156,8 @@
 //! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
 //! ... at the level given by the maximum frequency of the BRDF") reads the Phong layers
 //! [`Settings::layer_shift`] layers sharper than the coordinate the bake's selection gives the
-//! view ([`Material::view_layers`], crate docs "The estimators"), the sharpest at most. That
+//! view ([`Material::view_layers`], crate docs "The estimators"), the map itself past the
+//! sharpest at most, and no layer sharper than a sample's footprint among the block's. That
 //! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
 //! `bake`, `stage::layers`), where a sharper layer's noise costs about what its blur saves. A
 //! shaded block takes tens to hundreds of samples, the budget of the pixels it stands for, and
@@ -399,7 +400,7 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
     }
     if settings.lobe_weight
         && (material.view_layers.is_empty()
-            || material.view_layers.iter().any(|&l| !(l >= 0.0 && (l as usize) < lighting.exponents.len())))
+            || material.view_layers.iter().any(|&l| !(l >= 0.0 && f64::from(l) <= lighting.exponents.len() as f64)))
     {
         return Err(Error::Invalid(
             "the lobe weight reads the bake's layer selection, which is missing or out of range".into(),
