@@ -528,3 +528,45 @@ fn a_predictor_replaces_the_prediction_and_is_checked() {
     let missing = with(&mut adaptive::replay_predictor(&none)).unwrap_err().to_string();
     assert!(missing.contains("no prediction to replay"), "{missing}");
 }
+
+/// Grading bounds each shadeable pixel's level by the finest within `GRADE_RADIUS` plus
+/// `GRADE_SLACK`, and leaves the pixels that are not shadeable alone: against a direct minimum
+/// over each pixel's square, on random levels with holes, and on one fine pixel in a coarse field.
+#[test]
+fn grading_bounds_a_level_by_its_neighbourhood() {
+    let (w, h) = (37, 23);
+    let mut rng = StdRng::seed_from_u64(7);
+    let levels: Vec<i32> = (0..w * h).map(|_| if rng.random_bool(0.1) { -1 } else { rng.random_range(0..6) }).collect();
+    let predictions = |levels: &[i32]| -> Vec<Prediction> {
+        levels.iter().map(|&level| Prediction { level, ..Default::default() }).collect()
+    };
+    let mut graded = predictions(&levels);
+    adaptive::grade_levels(&mut graded, w, h);
+    let r = adaptive::GRADE_RADIUS as i64;
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            let own = levels[(y * w as i64 + x) as usize];
+            let least = (-r..=r)
+                .flat_map(|dy| (-r..=r).map(move |dx| (x + dx, y + dy)))
+                .filter(|&(qx, qy)| qx >= 0 && qy >= 0 && qx < w as i64 && qy < h as i64)
+                .map(|(qx, qy)| levels[(qy * w as i64 + qx) as usize])
+                .filter(|&l| l >= 0)
+                .min();
+            let want = match least {
+                _ if own < 0 => -1,
+                Some(least) => own.min(least + adaptive::GRADE_SLACK),
+                None => own,
+            };
+            assert_eq!(graded[(y * w as i64 + x) as usize].level, want, "pixel ({x}, {y})");
+        }
+    }
+    // One fine pixel among coarse ones: its square takes the slack's level, the rest keep theirs.
+    let mut field = vec![5; w * h];
+    field[11 * w + 17] = 0;
+    let mut graded = predictions(&field);
+    adaptive::grade_levels(&mut graded, w, h);
+    let refined = graded.iter().filter(|p| p.level == adaptive::GRADE_SLACK).count();
+    let side = 2 * adaptive::GRADE_RADIUS + 1;
+    assert_eq!(refined, side * side - 1);
+    assert_eq!(graded.iter().filter(|p| p.level == 5).count(), w * h - side * side);
+}

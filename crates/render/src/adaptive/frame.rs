@@ -362,6 +362,7 @@ pub fn render_with(
             }
         }
     }
+    grade_levels(&mut predictions, width, height);
     let predict_ms = lap();
     let levels = pyramid(&predictions, width, height, top);
     let covered_output = geometry.covered.iter().filter(|&&c| c).count() as u64;

@@ -40,6 +40,39 @@ pub(super) fn block_pixel(level: usize, bx: usize, by: usize, width: usize, heig
     ((bx * size + half).min(width - 1), (by * size + half).min(height - 1))
 }
 
+/// The render pixels around a pixel whose levels bound its own ([`grade_levels`]): a square of
+/// `2 GRADE_RADIUS + 1` on a side, a prediction block's width at the default
+/// [`Settings::predict_level`] (module docs, "The pyramid").
+pub const GRADE_RADIUS: usize = 4;
+
+/// How many levels coarser than the finest shadeable pixel within [`GRADE_RADIUS`] a pixel may be.
+pub const GRADE_SLACK: i32 = 1;
+
+/// Grades the predicted levels (module docs, "The pyramid"): each shadeable pixel's level is at
+/// most [`GRADE_SLACK`] more than the least level of the shadeable pixels within
+/// [`GRADE_RADIUS`] (Chebyshev distance, clamped to the image); pixels that are not shadeable
+/// (level -1) stay so and bound nothing. A separable minimum, rows then columns.
+pub fn grade_levels(predictions: &mut [Prediction], width: usize, height: usize) {
+    let level: Vec<i32> = predictions.iter().map(|p| p.level).collect();
+    let least = |values: &mut dyn Iterator<Item = i32>| values.filter(|&l| l >= 0).min().unwrap_or(i32::MAX);
+    let rows: Vec<i32> = (0..height * width)
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            let span = x.saturating_sub(GRADE_RADIUS)..=(x + GRADE_RADIUS).min(width - 1);
+            least(&mut span.map(|q| level[y * width + q]))
+        })
+        .collect();
+    for (i, p) in predictions.iter_mut().enumerate() {
+        if p.level < 0 {
+            continue;
+        }
+        let (x, y) = (i % width, i / width);
+        let span = y.saturating_sub(GRADE_RADIUS)..=(y + GRADE_RADIUS).min(height - 1);
+        let m = span.map(|q| rows[q * width + x]).min().unwrap_or(i32::MAX);
+        p.level = p.level.min(m.saturating_add(GRADE_SLACK));
+    }
+}
+
 /// The min and max pyramids of a bandwidth buffer of `width x height` pixels, levels `0..=top`.
 pub fn pyramid(predictions: &[Prediction], width: usize, height: usize, top: usize) -> Vec<Level> {
     let mut levels = vec![Level {

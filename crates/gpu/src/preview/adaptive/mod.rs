@@ -312,6 +312,8 @@ impl Renderer {
                 };
                 let per_level = &state.candidates_per_level;
                 run(&mut cpass, &pipelines.levels, levels_slot, groups(per_level[0]));
+                run(&mut cpass, &pipelines.grade, levels_slot, groups(per_level[0]));
+                run(&mut cpass, &pipelines.grade_apply, levels_slot, groups(per_level[0]));
                 for (k, &n) in per_level.iter().enumerate().skip(1) {
                     run(&mut cpass, &pipelines.reduce, k as u64, groups(n));
                 }
@@ -525,6 +527,12 @@ mod tests {
         let rate = format!("const SAMPLES_PER_CYCLE: f32 = {:.1};", render::adaptive::SAMPLES_PER_CYCLE);
         assert!(ADAPTIVE_STATE.source.contains(&rate), "the WGSL lacks {rate}");
         assert!(ADAPTIVE_STATE.source.contains("const NONE: u32 = 0xffffffffu;"));
+        for decl in [
+            format!("const GRADE_RADIUS: i32 = {};", render::adaptive::GRADE_RADIUS),
+            format!("const GRADE_SLACK: i32 = {};", render::adaptive::GRADE_SLACK),
+        ] {
+            assert!(crate::wgsl::ADAPTIVE_PLAN.source.contains(&decl), "plan.wgsl lacks {decl}");
+        }
         for (name, value) in [
             ("CONTROL_SHADED", CONTROL_SHADED),
             ("CONTROL_STATUS", CONTROL_STATUS),

@@ -32,6 +32,56 @@ fn adaptive_levels(
     levels[p] = vec4<u32>(bitcast<u32>(level), bitcast<u32>(variance), 0u, 0u);
 }
 
+// `render::adaptive::GRADE_RADIUS` and `GRADE_SLACK`.
+const GRADE_RADIUS: i32 = 4;
+const GRADE_SLACK: i32 = 1;
+
+// Each shadeable render pixel's graded level (`render::adaptive::grade_levels`): at most
+// GRADE_SLACK more than the least level of the shadeable pixels within GRADE_RADIUS, kept in
+// the entry's third word until `adaptive_grade_apply` (the pixels read their neighbours' levels,
+// which this pass must leave as they are). After `adaptive_levels`.
+// `render::adaptive::grade_levels`.
+@compute @workgroup_size(64)
+fn adaptive_grade(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let p = candidate(0u, adaptive_item(group, local, groups));
+    if (p == NONE) {
+        return;
+    }
+    let size = level_info(0u);
+    let x = i32(p % size.x);
+    let y = i32(p / size.x);
+    var least = min_level(p);
+    for (var qy = max(y - GRADE_RADIUS, 0); qy <= min(y + GRADE_RADIUS, i32(size.y) - 1); qy++) {
+        for (var qx = max(x - GRADE_RADIUS, 0); qx <= min(x + GRADE_RADIUS, i32(size.x) - 1); qx++) {
+            let l = min_level(u32(qy) * size.x + u32(qx));
+            if (l >= 0) {
+                least = min(least, l);
+            }
+        }
+    }
+    levels[p].z = bitcast<u32>(min(min_level(p), least + GRADE_SLACK));
+}
+
+// The graded levels into the min pyramid's level 0, the third word cleared for the plan.
+// No Rust twin: `render::adaptive::grade_levels` grades in place from a copy.
+@compute @workgroup_size(64)
+fn adaptive_grade_apply(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let p = candidate(0u, adaptive_item(group, local, groups));
+    if (p == NONE) {
+        return;
+    }
+    levels[p].x = levels[p].z;
+    levels[p].z = 0u;
+}
+
 // Level `adapt.level` of the pyramids from the level below: the least level and the largest
 // variance of each block's children.
 // `render::adaptive::pyramid` above level 0.

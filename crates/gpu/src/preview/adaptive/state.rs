@@ -326,6 +326,8 @@ impl Renderer {
 #[derive(Debug)]
 pub(crate) struct Pipelines {
     pub levels: wgpu::ComputePipeline,
+    pub grade: wgpu::ComputePipeline,
+    pub grade_apply: wgpu::ComputePipeline,
     pub reduce: wgpu::ComputePipeline,
     pub plan: wgpu::ComputePipeline,
     pub scatter: wgpu::ComputePipeline,
@@ -340,6 +342,8 @@ impl Pipelines {
     pub(crate) fn new(make: impl Fn(&'static str) -> wgpu::ComputePipeline) -> Pipelines {
         Pipelines {
             levels: make("adaptive_levels"),
+            grade: make("adaptive_grade"),
+            grade_apply: make("adaptive_grade_apply"),
             reduce: make("adaptive_reduce"),
             plan: make("adaptive_plan"),
             scatter: make("adaptive_scatter"),
