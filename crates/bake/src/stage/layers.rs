@@ -3,11 +3,14 @@
 //! same analysis, as an asset of kind `layer-selection` that the renderers read.
 //!
 //! How often the 20 shared real-derived materials select each layer (views per layer over the 64
-//! rows, default bake): n = 1: 0, n = 4: 2, n = 16: 146, n = 64: 240, n = 256: 118, n = 1024:
-//! 142, n = 4096: 632. Nine of them (chrome, steel, brass, ...) select n = 4096 at every view:
-//! their lobes carry a cusp at the mirror direction (the neural fits' `sqrt(theta_h)` input), whose
-//! fine detail the band quantile counts; the diffuse-looking ones (pink-fabric,
-//! silver-metallic-paint) stay at n = 16 to 64.
+//! rows, default bake, `asset-info --json layer-selection.asset`'s `view_layer`): n = 1: 0,
+//! n = 4: 2, n = 16: 146, n = 64: 236, n = 256: 115, n = 1024: 118, n = 4096: 161, n = 16384:
+//! 502. Six of them (black-obsidian, blue-acrylic, brass, chrome, red-metallic-paint, steel)
+//! select n = 16384 at every view: their lobes carry a cusp at the mirror direction (the neural
+//! fits' `sqrt(theta_h)` input), whose fine detail the band quantile counts, and the renderers
+//! read them sharper still (`brdf_atlas::view::view_coordinates`: past the sharpest layer, the
+//! map itself); the diffuse-looking ones (pink-fabric, silver-metallic-paint) stay at n = 16 to
+//! 256, most rows at 16 and 64.
 
 use brdf_atlas::view::{LayerSelection, ViewReduction, select_layers};
 use brdf_atlas::{AtlasBuild, Config};
