@@ -69,9 +69,10 @@ pub enum ReadingChoice {
     /// that the paper's reading lets a strong edge mask, so the paper's plans hold for it; a
     /// mirror-like lobe shows that detail, and the paper's reading then plans blocks across it.
     /// Measured on chrome under studio_small_03_1k at 512 x 512, brdf-preview's defaults, against
-    /// a converged estimate of 256 samples per strategy: `adaptive` leaves 1734 covered pixels more
-    /// than 20 levels off with the paper's reading (shading 7% of the pixels), 16 with the
-    /// level-normalized one (42%); gold-paint, whose lobes are wider than the sharpest layer's,
+    /// a converged estimate of 256 samples per strategy: `adaptive` leaves 1708 covered pixels more
+    /// than 20 levels off with the paper's reading (shading 8% of the pixels), 14 with the
+    /// level-normalized one (44%) (`brdf-bake --env-reading paper` or `auto`, then `brdf-preview
+    /// --mode adaptive --size 512x512 --json` and a count against `--converged 256`); gold-paint, whose lobes are wider than the sharpest layer's,
     /// keeps the paper's plans (`cargo bench -p brdf-preview --bench adaptive` has both readings
     /// per case).
     #[default]
