@@ -171,7 +171,7 @@ fn errors_leave_stdout_empty_with_json() {
         let r = run(cmd, "").expect_code(2).expect_error(&missing, "no such file");
         assert!(r.stdout.is_empty(), "{r}");
     }
-    // merl-synth refuses to run without --out (it used to write 35 MB into the current folder).
+    // merl-synth refuses to run without --out: a 35 MB table never lands in the current folder unasked.
     let r = tool_run("merl-synth", &["lambertian".as_ref(), "--json".as_ref()]).expect_code(2);
     assert!(r.stdout.is_empty() && r.stderr.contains("--out <FILE>"), "{r}");
     assert!(!out.exists());
