@@ -69,29 +69,7 @@ pub fn debug_views(
         "predicted variance",
     );
     let width = panels.width();
-    let shaded = &frame.shaded_per_level;
-    let per_level: Vec<String> =
-        shaded.iter().enumerate().filter(|(_, n)| **n > 0).map(|(k, n)| format!("{n} at {k}")).collect();
-    let text = format!(
-        "Level k: the pixel's value comes from a block of s x s pixels, s = 2 to the power k, shaded once and \
-         up-sampled (0: shaded on its own). Shaded blocks per level: {}. {} samples of a budget of {}; shaded fraction {}. Samples per \
-         pixel: a shaded block's samples over its pixels. Bandwidth: cycles per pixel from the environment's and \
-         the BRDF's bandwidth through the paper's reflection operators (001 eq. 3-6); the level is \
-         floor(log2(1 / ({} bandwidth))), {} samples per cycle. Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). \
-         A shaded block's samples: {}. Black: background or silhouette.",
-        per_level.join(", "),
-        render::adaptive::SAMPLES_PER_CYCLE,
-        render::adaptive::SAMPLES_PER_CYCLE,
-        frame.samples,
-        frame.budget,
-        format_number((frame.shaded_fraction() * 1e4).round() / 1e4),
-        match allocation {
-            render::adaptive::Allocation::Variance => "in proportion to the variance",
-            render::adaptive::Allocation::StdDev => "in proportion to the square root of its pixels times the variance",
-            render::adaptive::Allocation::Area =>
-                "in proportion to the square root of its pixels (the variance not used)",
-        },
-    );
+    let text = caption_text(frame, allocation);
     panels.footer(stack(&[
         Legend::new(levels, viridis, "shaded at level k (a block of s x s pixels, s = 2 to the power k; linear)")
             .render(width),
@@ -107,4 +85,62 @@ pub fn debug_views(
         caption(&text, width),
     ]));
     panels.render()
+}
+
+/// The caption under the debug views: the shaded blocks per level, the samples against the
+/// budget, and how each view reads.
+fn caption_text(frame: &Adaptive, allocation: render::adaptive::Allocation) -> String {
+    let per_level: Vec<String> = frame
+        .shaded_per_level
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(k, n)| format!("{n} at {k}"))
+        .collect();
+    let per_cycle = render::adaptive::SAMPLES_PER_CYCLE;
+    let fraction = format_number((frame.shaded_fraction() * 1e4).round() / 1e4);
+    let (samples, budget) = (frame.samples, frame.budget);
+    let allocation = match allocation {
+        render::adaptive::Allocation::Variance => "in proportion to the variance",
+        render::adaptive::Allocation::StdDev => "in proportion to the square root of its pixels times the variance",
+        render::adaptive::Allocation::Area => "in proportion to the square root of its pixels (the variance not used)",
+    };
+    format!(
+        "Level k: the pixel's value comes from a block of s x s pixels, s = 2 to the power k, shaded once and \
+         up-sampled (0: shaded on its own). Shaded blocks per level: {per_level}. {samples} samples of a budget of \
+         {budget}; shaded fraction {fraction}. Samples per pixel: a shaded block's samples over its pixels. \
+         Bandwidth: cycles per pixel from the environment's and the BRDF's bandwidth through the paper's reflection \
+         operators (001 eq. 3-6); the level is floor(log2(1 / ({per_cycle} bandwidth))), {per_cycle} samples per \
+         cycle. Variance: the bound of 001 eq. 9 (eq. 10 when prefiltered). A shaded block's samples: \
+         {allocation}. Black: background or silhouette.",
+        per_level = per_level.join(", "),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each figure lands in its own place in the caption (they were once formatted out of
+    /// order, so that the budget read as the samples per cycle).
+    #[test]
+    fn the_caption_puts_each_figure_in_its_place() {
+        let frame = Adaptive {
+            image: render::Image { width: 0, height: 0, rgb: Vec::new(), covered: Vec::new() },
+            width: 0,
+            height: 0,
+            shadeable: 1000,
+            shaded_per_level: vec![7, 0, 3],
+            samples: 123_456,
+            budget: 123_457,
+            timings: render::adaptive::Timings::default(),
+            details: None,
+        };
+        let text = caption_text(&frame, render::adaptive::Allocation::Area);
+        assert!(text.contains("Shaded blocks per level: 7 at 0, 3 at 2."), "{text}");
+        assert!(text.contains("123456 samples of a budget of 123457; shaded fraction 0.01."), "{text}");
+        let per_cycle = render::adaptive::SAMPLES_PER_CYCLE;
+        assert!(text.contains(&format!("floor(log2(1 / ({per_cycle} bandwidth))), {per_cycle} samples per cycle")));
+        assert!(text.contains("A shaded block's samples: in proportion to the square root of its pixels"), "{text}");
+    }
 }
