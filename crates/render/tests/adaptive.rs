@@ -130,6 +130,21 @@ fn check_plan(frame: &adaptive::Adaptive, settings: &adaptive::Settings) {
                         sum += f64::from(w);
                     }
                     assert!((sum - 1.0).abs() <= 1e-6, "level {k} block {b}: weights sum to {sum}");
+                    // No extrapolation: every parent of the bilinear four with a share of the
+                    // block is valid, and counted (the sphere's depth is continuous).
+                    let coarser = &plan.levels[k + 1];
+                    let xs = bilinear_parents(b % level.width, k, coarser.width);
+                    let ys = bilinear_parents(b / level.width, k, coarser.height);
+                    for &py in &ys {
+                        for &px in &xs {
+                            let p = py * coarser.width + px;
+                            assert!(
+                                parents[..count as usize].iter().any(|&(q, _)| q as usize == p),
+                                "level {k} block {b}: up-sampled without its bilinear parent {p} (valid: {})",
+                                coarser.valid(p)
+                            );
+                        }
+                    }
                 }
             }
         }
@@ -150,6 +165,16 @@ fn check_plan(frame: &adaptive::Adaptive, settings: &adaptive::Settings) {
         }
     }
     assert!(plan.samples() <= plan.budget, "{} samples over a budget of {}", plan.samples(), plan.budget);
+}
+
+/// Along one axis, the blocks of level `k + 1` (`n` of them) that bilinear interpolation gives a
+/// share of block `b` of level `k`, from the blocks' centres (`b 2^k + floor(2^k / 2)`, the
+/// module docs' "Coarse to fine"), clamped at the edges.
+fn bilinear_parents(b: usize, k: usize, n: usize) -> Vec<usize> {
+    let centre = |b: usize, level: usize| (b * (1 << level) + (1 << level) / 2) as f64;
+    let t = ((centre(b, k) - centre(0, k + 1)) / f64::from(1u32 << (k + 1))).clamp(0.0, (n - 1) as f64);
+    let (lo, hi) = (t.floor() as usize, t.ceil() as usize);
+    if lo == hi { vec![lo] } else { vec![lo, hi] }
 }
 
 #[test]

@@ -104,7 +104,8 @@ pub fn pyramid(predictions: &[Prediction], width: usize, height: usize, top: usi
 pub enum Action {
     /// Not computed at this level (not valid).
     Skip,
-    /// Shaded with this many samples; `rescued` when its parents' weights all vanished.
+    /// Shaded with this many samples; `rescued` when it could have been up-sampled but its
+    /// parents do not represent it (a bilinear parent not valid, or the weights vanish).
     Shade { samples: u32, rescued: bool },
     /// The weighted mean of `count` blocks of the next coarser level: `(index, weight)`, the
     /// weights summing to 1.
@@ -173,8 +174,9 @@ impl Plan {
 /// parents as this one in `f64`.
 pub const MIN_WEIGHT: f64 = 7.888609052210118e-31;
 
-/// The up-sampling weights of block `(bx, by)` of `child` from the valid blocks of `parent`
-/// (module docs); `None` when they all vanish.
+/// The up-sampling weights of block `(bx, by)` of `child` from its bilinear parents in `parent`
+/// (module docs, "Coarse to fine"); `None` (shade it) when one of them is not valid, or their
+/// weights vanish or sum to at most the rescue threshold.
 pub(super) fn upsample_weights(
     child: &Level,
     parent: &Level,
@@ -209,11 +211,16 @@ pub(super) fn upsample_weights(
         let alpha = (if dx == 0 { 1.0 - fx } else { fx }) * (if dy == 0 { 1.0 - fy } else { fy });
         let (px, py) = ((x0 + dx).min(parent.width - 1), (y0 + dy).min(parent.height - 1));
         let b = py * parent.width + px;
-        if alpha <= 0.0 || !parent.valid(b) || out[..count as usize].iter().any(|(i, _)| *i as usize == b) {
+        if alpha <= 0.0 || out[..count as usize].iter().any(|(i, _)| *i as usize == b) {
             continue;
         }
+        // A parent that is not valid lies where the image needs a finer level (or holds a
+        // silhouette): the others would extrapolate across it.
+        if !parent.valid(b) {
+            return None;
+        }
         let (rx, ry) = parent.pixel(px, py, width, height);
-        let Some(them) = pixels[ry * width + rx].as_ref() else { continue };
+        let them = pixels[ry * width + rx].as_ref()?;
         let dz = (me.depth - them.depth) / (depth_sigma * me.depth);
         let g_z = (-0.5 * dz * dz).exp();
         let v = [

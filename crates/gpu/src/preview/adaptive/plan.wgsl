@@ -143,7 +143,8 @@ fn block_centre(b: u32, k: u32) -> f32 {
 }
 
 // `render::adaptive::upsample_weights` of block (bx, by) of level k from level k + 1: writes the
-// parents and their weights into the block's plan entry and returns how many count (0: rescue).
+// parents and their weights into the block's plan entry and returns how many count (0: rescue:
+// a bilinear parent not valid, the weights vanished or summed to at most the threshold).
 fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
     let parent = level_info(k + 1u);
     let me = record(block_pixel(k, bx, by));
@@ -185,12 +186,15 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
         let py = min(first.y + dy, parent.y - 1u);
         let b = py * parent.x + px;
         let seen = any((chosen == vec4<u32>(b)) & (slots < vec4<u32>(count)));
-        if (alpha <= 0.0 || min_level(parent.z + b) < i32(k + 1u) || seen) {
+        if (alpha <= 0.0 || seen) {
             continue;
+        }
+        if (min_level(parent.z + b) < i32(k + 1u)) {
+            return 0u;
         }
         let them = record(block_pixel(k + 1u, px, py));
         if (them.prediction == NONE) {
-            continue;
+            return 0u;
         }
         let dz = (me.depth - them.depth) / (adapt.depth_sigma * me.depth);
         let g_z = exp(-0.5 * dz * dz);
