@@ -140,8 +140,8 @@ target/merl/%.binary: | setup-python
 bench: setup-gpu setup-mitsuba setup-node setup-chromium test-data
 	python3 scripts/benchmarks.py $(BENCH)
 
-## three-cases: the three.js material in headless Chromium against brdf-preview on the issue's six
-## cases (white-paint, gold-paint, chrome under quarry_01 and potsdamer_platz, 128 x 128, both
+## three-cases: the three.js material in headless Chromium against brdf-preview on six cases
+## (white-paint, gold-paint, chrome under quarry_01 and potsdamer_platz, 128 x 128, both
 ## modes at brdf-preview's default samples) and against the converged estimate; prints the table.
 ## About 10 minutes on 2 cores (most of it SwiftShader's reference renders); pictures in
 ## target/three-cases/.

@@ -220,8 +220,9 @@ fn pca_of_the_shared_materials() {
     for name in MATERIALS {
         let material = nbrdf_table(name);
         let out = tmp.path().join(name);
-        // At 64 x 64 (the issue-3 table's setting) every lobe of these materials reaches the
-        // limit, which the tool reports as a problem (exit 1); the atlas is still written.
+        // The table is made at an analysis size of 64 x 64, where every lobe of these materials
+        // reaches the limit, which the tool reports as a problem (exit 1); the atlas is still
+        // written.
         brdf_bandwidth(&material, &out, &["--analysis-size", "64"]).expect_code(1);
         let r =
             bandwidth_pca(&out.join("bandwidth-atlas.asset"), &out, &["--max-error", "0.02", "--json"]).expect_code(0);

@@ -1,4 +1,4 @@
-//! One dialect for every tool (issue "the first hour", point 3): with `--json`, stdout is exactly
+//! One dialect for every tool: with `--json`, stdout is exactly
 //! one JSON object, which lists the files the tool wrote (and those files exist, with the size
 //! and hash it gives); the human report goes to stderr. With an error, stdout stays empty and
 //! stderr is one `error: ...` line.

@@ -1,4 +1,4 @@
-//! `brdf-preview` on the six cases (white-paint, gold-paint and chrome, rebuilt from the
+//! `brdf-preview` on six cases (white-paint, gold-paint and chrome, rebuilt from the
 //! shared neural fits, under potsdamer_platz and quarry_01; a 128 x 128 sphere), on the GPU the
 //! machine has (lavapipe in CI):
 //!

@@ -56,7 +56,7 @@ fn pattern(axis: [f64; 3], k: f64) -> Image {
 /// by at most `1 / sin(theta) = sqrt 2` (half an octave), and pixels at least one wavelength
 /// `2 pi / k` from the axis and its antipode, where the pattern is a bull's eye rather than a
 /// plane wave. Within one octave on at least 90% of them (one octave: the estimate's own
-/// resolution; 90%: the bound, lower than test 1's for the Jacobian's half octave).
+/// resolution; 90%: lower than test 1's 95%, for the Jacobian's half octave).
 #[test]
 fn sphere_patterns_read_k_over_two_pi_cycles_per_radian() {
     let config = Config::default();

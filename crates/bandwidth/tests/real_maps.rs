@@ -1,5 +1,5 @@
 //! The estimator on the five real 1024 x 512 maps of `../shared/data/env`: a Gaussian blur of
-//! the analysed image never raises the estimate (the bar), and the windowed FFT
+//! the analysed image raises the estimate at no more than 1% of the pixels, and the windowed FFT
 //! comparison, printed as a diagnostic.
 //!
 //! What is blurred: the analysed image, `ln(1 + Y)`, not the linear RGB. The property under test
@@ -26,7 +26,7 @@ const MAPS: [&str; 5] = [
     "KernerEnvLatLong.exr",
 ];
 
-/// The blur widths, in pixels.
+/// The blur widths (sigma), in pixels.
 const SIGMAS: [f64; 3] = [1.0, 2.0, 4.0];
 
 /// `../shared/data/env`, or a panic that says where it was expected.
@@ -51,9 +51,9 @@ fn load(file: &str) -> (Image, Image) {
 }
 
 /// Separable Gaussian blur of a lat-long image, the kernel cut at 4 sigma and normalized: rows
-/// wrap (the map is periodic in `phi`), columns clamp at the top and bottom rows (the issue's
-/// rule; the estimator itself continues across the poles, which a clamped blur only
-/// approximates within 4 sigma of them).
+/// wrap (the map is periodic in `phi`), columns clamp at the top and bottom rows (the estimator
+/// itself continues across the poles, which a clamped blur only approximates within 4 sigma of
+/// them).
 fn blur_latlong(image: &Image, sigma: f64) -> Image {
     let r = (4.0 * sigma).ceil() as i64;
     let kernel: Vec<f64> = (-r..=r).map(|i| (-((i * i) as f64) / (2.0 * sigma * sigma)).exp()).collect();
@@ -98,7 +98,7 @@ fn raised_lowered(before: &AngularBandwidthMap, after: &AngularBandwidthMap) -> 
 /// coefficients over an edge can come within reach of the blurred edge's coefficients at that
 /// level (typically a coarse level, read where only a coarser one reached). Eq. 7 is also
 /// relative to the pixel's largest `lambda_j`, which the blur lowers a little too. Both move a
-/// few pixels near edges by one level; 1% is the bound, and the measured fractions are
+/// few pixels near edges by one level; hence a bound of 1%, and the measured fractions are
 /// printed (they are well below it).
 #[test]
 fn blurring_never_raises_the_estimate() {

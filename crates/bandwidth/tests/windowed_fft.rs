@@ -5,10 +5,9 @@ use bandwidth::{Image, WindowedFftConfig, window_spread, windowed_fft_bandwidth}
 use crate::sinusoid;
 
 /// Every window of a sinusoid of period 3 to 16 pixels (1/3 to 1/16 cycle per pixel, 2 to 10
-/// cycles in a 32-pixel window), at 0, 30 and 45 degrees, reads its frequency within 20% (the
-/// issue's bound). The radii lie on a grid of 1/64 cycle per pixel (2x zero padding), so a
-/// reading can be off by half a step, 1/128, 12.5% of the lowest frequency here; the measured
-/// error is printed.
+/// cycles in a 32-pixel window), at 0, 30 and 45 degrees, reads its frequency within 20%. The
+/// radii lie on a grid of 1/64 cycle per pixel (2x zero padding), so a reading can be off by
+/// half a step, 1/128, 12.5% of the lowest frequency here; the measured error is printed.
 #[test]
 fn sinusoids_read_their_frequency_within_twenty_percent() {
     let config = WindowedFftConfig::default();

@@ -457,7 +457,8 @@ fn build_slice(table: &MerlTable, config: &Config, rows: &HalfVectorRows, theta_
 }
 
 /// How well a slice samples its material, by deterministic quadrature (no sampling noise): the
-/// numbers `merl-importance` reports and the tests hold to the bars.
+/// numbers `merl-importance` reports and the tests bound (relative variance, albedo error, the
+/// mass above the horizon: `tests/importance.rs`).
 pub mod quality {
     use merl::albedo::{Quadrature, hemisphere_integral};
     use merl::{Interp, MerlTable, luminance};

@@ -118,7 +118,7 @@ fn density_integrates_to_one() {
             }
             assert!((total - 1.0).abs() < 1e-9, "{name} slice {k}: density over h integrates to {total}");
             // Over the upper hemisphere of wi, by the independent half-vector quadrature of the
-            // merl crate: what falls below the horizon is lost, at most 0.5% by the bar.
+            // merl crate: what falls below the horizon is lost, and may be at most 0.5%.
             // The quadrature's own error on a density that does not vanish at the horizon is
             // under 1e-4 here (cosine-like densities do vanish there).
             let [upper] = hemisphere_integral(|wi| [slice.pdf(wi)], slice.wo(), Quadrature::default());
@@ -160,7 +160,7 @@ fn samples_pass_a_chi_square_test_against_the_density() {
 #[test]
 fn the_chi_square_test_rejects_a_density_off_by_the_jacobian() {
     // The same samples judged against a density that forgets dwi = 4 (wo . h) dwh: the test
-    // must see it (the calibration caught exactly this mistake).
+    // must see it (the mistake the chi-square test is calibrated to catch).
     let (_, _, tables) = &materials()[1];
     let slice = &tables.slices()[6];
     let wrong = |wi: DVec3| {

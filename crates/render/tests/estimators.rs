@@ -35,7 +35,7 @@ fn luminance(image: &Image) -> Vec<f64> {
 
 /// Each pixel draws its own directions, so the reference mode's error at one pixel says nothing
 /// of its neighbour's: the correlation of neighbouring pixels' residuals against the converged
-/// estimate stays below 0.2 (the bar), in linear luminance and in the tone-mapped picture,
+/// estimate stays below 0.2 in magnitude, in linear luminance and in the tone-mapped picture,
 /// under the sky's sun, with the frames that use every point of a pixel's slice once. A small
 /// bake (2 vectors of 64 samples) at 128 x 128, where a slice (1 degree of `theta_o`) spans
 /// several neighbouring pixels: pixels that shared their slice's directions, as the papers'

@@ -1,4 +1,4 @@
-//! The previewer's benchmark (a benchmark, not a test): over the six cases (white-paint,
+//! The previewer's benchmark (a benchmark, not a test): over six cases (white-paint,
 //! gold-paint and chrome under potsdamer_platz and quarry_01, a 128 x 128 sphere),
 //!
 //! 1. the layer selection's calibration: the prefiltered mode's PSNR against the converged
