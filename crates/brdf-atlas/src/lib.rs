@@ -39,14 +39,14 @@
 //!   an isotropic atlas ([`Atlas::is_isotropic`]) is stored as its rows ([`Atlas::rows`], one
 //!   tile per row, 1/64 of the texels) and expanded on reading ([`Atlas::expand_rows`]), and its
 //!   PCA is fitted on the rows: `lobes_x` copies of each tile have the same mean and components
-//!   as the tiles alone, so the model loses nothing. Drawing the lobes in the tangent
-//!   frame instead (the first version of this crate, with a concentric-disk grid of `wi`) makes
-//!   the tiles of a ring rotated copies of each other, which PCA cannot compress: on the 20
-//!   shared materials 2% relative RMSE then needed 186 to 212 of 256 components (a model of 77
-//!   to 88% of the atlas's size); in the frame of the plane of incidence it needs 28 to 52 (4.6
-//!   to 8.6 times smaller than the full grid with one set of coefficients per lobe; fitted on the
-//!   64 rows, such a model is 0.56 to 1.03 times the size of the rows themselves: at 2%, PCA
-//!   saves little over storing each distinct tile once, and for pink-fabric, K = 52, nothing).
+//!   as the tiles alone, so the model loses nothing. Drawing the lobes in the tangent frame
+//!   instead (with a concentric-disk grid of `wi`) makes the tiles of a ring rotated copies of
+//!   each other, which PCA cannot compress: on the 20 shared materials 2% relative RMSE then
+//!   needed 186 to 212 of 256 components (a model of 77 to 88% of the atlas's size); in the
+//!   frame of the plane of incidence it needs 28 to 52 (4.6 to 8.6 times smaller than the full
+//!   grid with one set of coefficients per lobe; fitted on the 64 rows, such a model is 0.56 to
+//!   1.03 times the size of the rows themselves: at 2%, PCA saves little over storing each
+//!   distinct tile once, and for pink-fabric, K = 52, nothing).
 //!
 //! # Lobe images
 //!
@@ -79,26 +79,26 @@
 //! where the lobe is steep at the horizon (at 64 x 64, broad Phong lobes (n = 2) read the
 //! grid's limit on the rim), the odd reflection alone a jump in curvature, which reads the
 //! limit where a narrow lobe straddles the horizon (Phong n = 1000 at 512 x 512: 320 of 4096
-//! lobes, the last five rows; now none).
+//! lobes, the last five rows; with the three-point rule, none).
 //!
 //! Pixels with no table data around them (all eight trilinear corners in columns of the table
 //! that hold no data at all, which a damaged or hand-made table may have) are filled with the
 //! mean of their neighbours ([`lobe_image`]); on the 20 shared materials none is.
 //!
-//! What remained at the horizon was the table's own: MERL tables hold no data for
+//! The table has an edge of its own at the horizon: MERL tables hold no data for
 //! configurations below it, and `merl`'s trilinear lookup leaves those corners out and
 //! renormalizes, which holds the lobe flat across the last cell before the horizon. Where a
 //! narrow lobe meets the horizon nearly opposite `wi` (grazing incidence, where the half vector
-//! swings fast with `wo` and a cell is small in `wo`) that read the limit on the horizon's last
-//! pixel at any analysis size (`merl-synth phong -n 1000`: rows at theta_i 86.9 and 89.6
-//! degrees at 512, 86.9 at 1024), while the same lobe analytically, or tabulated with values
-//! beyond the horizon, read it in none (test
+//! swings fast with `wo` and a cell is small in `wo`), the lobe read that way reaches the
+//! limit on the horizon's last pixel at any analysis size (`merl-synth phong -n 1000`: rows at
+//! theta_i 86.9 and 89.6 degrees at 512, 86.9 at 1024), while the same lobe analytically, or
+//! tabulated with values beyond the horizon, reads it in none (test
 //! `phong_1000_across_the_horizon_is_resolved_at_the_default_size`). The analysis therefore
 //! reads the table with its cells below the horizon continued linearly along `theta_d`
 //! ([`LuminanceTable`]); a table of Phong n = 1000 then reads the limit nowhere at the default
-//! size. (The table's other edge, its cells linear in `sqrt(theta_h)`, a cusp at the mirror
-//! direction, was suspected too; reading the first cells linearly in `theta_h` instead changed
-//! no count at 512 or 1024, and is not done.)
+//! size. The table's other edge, its cells linear in `sqrt(theta_h)`, a cusp at the mirror
+//! direction, is read as it is: reading the first cells linearly in `theta_h` instead changes no
+//! count at 512 or 1024.
 //!
 //! # Boundaries
 //!
@@ -199,11 +199,13 @@
 //! lookups, with their reads of the table's cells as gathers, the transform's rows, eq. 7, the
 //! band energies' sums) are compiled for the best instruction set the processor has, AVX-512 or
 //! AVX2 where present, chosen at run time (`pulp`); the compiler never fuses a multiply and an
-//! add unasked, so every processor computes the same bits. At the default size, of about 2.3 s
-//! of CPU time on gold-paint, the lookups take two fifths, the two D4 transforms per row (the
+//! add unasked, so every processor computes the same bits. Of the build's CPU time at the
+//! default size, the lookups take about two fifths, the two D4 transforms per row (the
 //! continuation's and the band energies' mirror tiling, with their rows made on demand) a
 //! little less, eq. 7 with its per-level maxima about a tenth (`perf record
-//! target/release/brdf-bandwidth target/merl/gold-paint.binary --out-dir DIR`).
+//! target/release/brdf-bandwidth target/merl/gold-paint.binary --out-dir DIR`). `cargo bench -p
+//! brdf-atlas --bench atlas` times the build (`make bench BENCH=atlas` writes its report into
+//! `docs/benchmarks.md`).
 //!
 //! # Angles
 //!
@@ -213,8 +215,8 @@
 //! components times `rho |s|` (no normalization, no rotation), each by a branch-free `atan2` of
 //! this crate's own (a polynomial after reducing the octant and `pi / 4`, within 2 ulp of the
 //! system's libm; its tests hold it there on 3 million arguments), so that a block of pairs is
-//! one loop the compiler vectorizes, where libm's `atan2` was a call per angle, three per
-//! lookup, half of the build's time.
+//! one loop the compiler vectorizes (measured with libm's `atan2`, a call per angle and three
+//! per lookup: half of the build's time).
 //!
 //! That moves the last bits of the lobe images. The reference is [`LuminanceTable::lookup_libm`]
 //! (libm's `atan2` of the normalized half vector and of `wi` rotated into its frame, as
@@ -224,7 +226,7 @@
 //! of the eight corners (test `fast_angles_equal_libms_to_rounding`, a million random pairs).
 //! The band energies ([`view::band_energy`]) are summed as the transform makes each row of
 //! coefficients ([`dwt::Workspace2::detail_energy`]: eight partial sums per row and orientation,
-//! which vectorize, the rows in order), where the stored details were added one after another,
+//! which vectorize, the rows in order), rather than stored and added one after another, which is
 //! bound by the addition's latency: the two orders are each within `m u` of the exact sum of
 //! their `m` terms (`u = 2^-53`).
 //!
@@ -234,8 +236,8 @@
 //! 5e-14 of the lobe's peak, every band energy within 2e-13 and every view bandwidth within
 //! 5e-14 (relative); **no texel of any atlas differs** (a pixel's level moves only where a
 //! coefficient sits within such a difference of an eq. 7 threshold: none does) and **no row's
-//! layer**. `brdf-bandwidth` writes the same files, byte for byte, as before either change on all
-//! 20.
+//! layer**: `brdf-bandwidth` writes the same files, byte for byte, as it would with libm's lookups
+//! and one sum after another, on all 20.
 
 mod analysis;
 mod atan;

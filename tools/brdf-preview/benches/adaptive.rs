@@ -35,9 +35,9 @@
 //! doubling of its samples around an adaptive frame's PSNR, or it never reaches it but by less
 //! than [`PLATEAU_DB`]), an equal-quality speed-up is the luck of the samples, and the report
 //! marks the row `~` and summarizes the rows off the plateau apart. A brute force that finds a
-//! small bright source only by chance flattens so: the reference mode before it sampled the
-//! environment did under quarry's sun; with multiple importance sampling of the environment it
-//! converges there like anywhere.
+//! small bright source only by chance flattens so (one that sampled the material alone would,
+//! under quarry's sun); the reference mode samples the environment too (multiple importance
+//! sampling) and converges there like anywhere.
 //!
 //! # On the GPU
 //!
@@ -76,9 +76,9 @@ const BAKE_CHOICE: &str = "the bake's (auto)";
 /// The default render size (`--size N`): the paper's (`001` Fig. 11). The speed-ups depend on it:
 /// a frame's fixed costs (prediction, plan, up-sampling) grow with the pixels as the brute
 /// force's do, but the shaded pixels do not, as an image's bandwidth in cycles per pixel halves
-/// when its width doubles. On lavapipe (`--gpu`), paper reading, the `adaptive` median was 3.45x
-/// and 3.9x (two runs) at 256 x 256; at 512 x 512 see the module docs (adaptive frames 90 to
-/// 420 ms there, the brute force's 5 to 9 s at 256 spp).
+/// when its width doubles, so the speed-ups grow with the size. `make bench` writes the report
+/// at this size (`cargo bench -p brdf-preview --bench adaptive -- --gpu`) into
+/// `docs/benchmarks.md`; `-- --size 256` measures a smaller one.
 const SIZE: usize = 512;
 const BRUTE_SPP: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
 

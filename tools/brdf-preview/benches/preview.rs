@@ -10,7 +10,7 @@
 //!    once) against the converged estimate: the image's mean luminance ratio, with the 128
 //!    importance vectors the end-to-end tests bake. The tests check the estimator under the map
 //!    without a sun at 64 x 64 (0.5%); what the bake's finite sample set leaves under quarry's
-//!    sun is measured here (it was a 2% test bar, 7 minutes of `make test` on 2 cores).
+//!    sun is measured here, not tested (as a test, about 7 minutes of `make test` on 2 cores).
 //!
 //! `cargo bench -p brdf-preview --bench preview [-- --quick] [-- --no-calibration]`. Needs
 //! `../shared` (the maps, and nbrdf2merl.py with numpy for the materials, made once under

@@ -220,8 +220,9 @@ fn describe(
 
 /// The values of rank `round((n - 1) q)` in `values` (`n` of them, ordered by `total_cmp`) for
 /// each of the ascending quantiles `qs`: what indexing the sorted values gives, by selection
-/// (each selection leaves the values above its rank to the next; a sort of the million texels
-/// took about 20 ms, after the atlas and before the files are written).
+/// (each selection leaves the values above its rank to the next) rather than a sort of the
+/// million texels: the quantiles are taken after the atlas and before the files are written,
+/// so their time adds to the stage's (`cargo bench -p bake --bench stages` times it).
 fn quantiles<const Q: usize>(values: &[f32], qs: [f64; Q]) -> [f64; Q] {
     let mut values = values.to_vec();
     let mut start = 0;
