@@ -250,9 +250,9 @@ fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
 /// `switch-blocked`: a non-empty folder where a rebake with `--cube` writes `layers-cube.ktx2`; and
 /// the same with `--engine-textures` and a non-empty `engine-merl.ktx2/`. Each rebake exits 2 with
 /// one line naming the folder in the way and changes nothing: the previous manifest and every file
-/// it lists, with its checksum, the folder in the way with its note, no temporary file (before this,
-/// the switch renamed new files over the old ones, met the folder, and its undo deleted the new
-/// files, leaving 3 of 21 files and no manifest).
+/// it lists, with its checksum, the folder in the way with its note, no temporary file (a switch
+/// that renamed new files over the old ones until it met the folder, then undid by deleting the
+/// new files, would leave 3 of 21 files and no manifest).
 #[test]
 fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
     let tmp = temp_dir();
@@ -293,7 +293,7 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
 /// `make-cases.sh`'s `duplicate-1000` (the manifest lists `importance.png` 1000 more times) and a
 /// 100 000-entry one made here (compact JSON, under the 16 MiB limit): every reader (a preview,
 /// `--sheet`, `brdf-wavelet` adding its stage) refuses the manifest at once with one line naming
-/// it and the path listed twice, instead of hashing or drawing every copy (before this, 29 s for
+/// it and the path listed twice, instead of hashing or drawing every copy (measured: 29 s for
 /// 3 000 copies, an allocation failure for 100 000); `brdf-bake` counts it as no manifest and
 /// bakes again, hashing nothing it lists.
 #[test]
@@ -397,8 +397,9 @@ fn names_from_a_file_cannot_forge_messages() {
 /// Tools that write one file (`merl-info --asset`, `brdf-preview --out`) into a bake folder: a
 /// name the manifest lists (or the manifest) is refused with one line, the bake left as it was;
 /// while a bake holds the folder's lock (taken here by `flock(1)`, as a bake takes it) any name is
-/// refused at once; an unlisted name is written when no bake runs (before this, both wrote into a
-/// folder during a bake, and `merl-info --asset BAKE/importance.asset` overwrote a listed file).
+/// refused at once; an unlisted name is written when no bake runs (so neither tool writes into a
+/// folder during a bake, and `merl-info --asset BAKE/importance.asset` cannot overwrite a listed
+/// file).
 #[test]
 fn tools_that_write_one_file_leave_a_bake_alone() {
     let tmp = temp_dir();
@@ -447,8 +448,8 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
 
 /// A bake whose manifest is just under the readers' 16 MiB limit (a stage's figures padded):
 /// `brdf-wavelet` adding its stage would write a manifest over it, which every reader refuses; it
-/// exits 2 with one line instead and leaves the bake as it was (before this, it exited 0 with a
-/// 24 MB manifest).
+/// exits 2 with one line instead and leaves the bake as it was, rather than exit 0 with a 24 MB
+/// manifest that no reader would read.
 #[test]
 fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
     let tmp = temp_dir();
@@ -480,9 +481,9 @@ fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
 /// A folder moved while a bake runs (`mv D D.old; mkdir D`), and a second bake into the new `D`
 /// at once, at seeded random offsets into the first: each folder ends one complete bake (its
 /// manifest lists exactly the files there, each with its size and hash); where both ran, the first
-/// landed in `D.old` and the second in `D` (before this, the staging, the manifest's removal and the
-/// renames went by path, so `D` ended with the first bake's files, or one manifest and 14 unlisted
-/// files, and the moved folder's manifest named files the bake had deleted).
+/// landed in `D.old` and the second in `D` (were the staging, the manifest's removal and the
+/// renames done by path, `D` could end with the first bake's files, or one manifest and 14
+/// unlisted files, and the moved folder's manifest name files the bake had deleted).
 #[test]
 fn a_folder_moved_during_a_bake_keeps_both_bakes_whole() {
     let tmp = temp_dir();

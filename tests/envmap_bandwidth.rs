@@ -160,7 +160,8 @@ fn bad_arguments() {
         (&["--out-dir", "x", "--eps", "2"], "2 is not in (0, 1]"),
         (&["--out-dir", "x", "--levels", "0"], "expected a whole number from 1 up"),
         (&["--out-dir", "x", "--eps", "NaN"], "NaN is not in (0, 1]"),
-        // The options that no longer exist are refused, not ignored.
+        // `--png` is not an option (the picture is one of the files of `--out-dir`): refused, not
+        // ignored.
         (&["--out-dir", "x", "--png", "x.png"], "--png"),
     ];
     for (args, needle) in usage {

@@ -223,11 +223,11 @@ fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
     assert!(!r.stderr.contains("error:"), "a successful run printed an error line\n{r}");
 }
 
-/// Values behind valid checksums: a bake whose importance samples, bandwidth
-/// rows or layer selection hold a value no bake writes, with the manifest's size and hash made to
-/// match, is refused by the previewer with one line naming the asset, the field and the value, and
-/// `asset-info` says the same of the asset (it used to report NaN samples as valid). A pdf within
-/// its range but not the density the tables give its direction is refused as well: decoding
+/// Values behind valid checksums: a bake whose importance samples, bandwidth rows or layer
+/// selection hold a value no bake writes, with the manifest's size and hash made to match, is
+/// refused by the previewer with one line naming the asset, the field and the value, and
+/// `asset-info` says the same of the asset. A pdf within its range but not the density the tables
+/// give its direction is refused as well: decoding
 /// accepts it (a payload check across fields, `ImportanceSamples::check_densities`), the previewer
 /// refuses it and `asset-info` reports it as a problem (exit 1).
 #[test]
@@ -298,8 +298,8 @@ fn values_behind_valid_checksums_are_refused_by_every_reader() {
 }
 
 /// A map of finite radiance whose layers overflow (every texel RGBE exponent 255, about 1e38): the
-/// error names the map (before this, `error: prefilter: layer of the phong n 4096: non-finite
-/// radiance inf` named no file).
+/// error names the map (`analysing MAP: prefilter: ...`), not only the layer (`prefilter: layer of
+/// the phong n 4096: non-finite radiance inf` alone names no file).
 #[test]
 fn a_map_whose_layers_overflow_is_named() {
     let tmp = temp_dir();

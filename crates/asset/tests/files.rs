@@ -159,8 +159,9 @@ fn old_set() -> Vec<(String, String)> {
 }
 
 /// A name the set writes that holds a folder (or a FIFO) fails the commit before anything is
-/// touched: the old set, its index included, is as it was (before this, a rebake's switch renamed
-/// files over the old ones, met the folder, and its undo deleted the new files, leaving 3 of 21).
+/// touched: the old set, its index included, is as it was (a switch that renamed files over the
+/// old ones until it met the folder, then undid by deleting the new files, would leave a rebake 3
+/// of its 21 files).
 #[test]
 fn a_commit_blocked_by_a_folder_changes_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -225,8 +226,8 @@ fn a_commit_that_fails_midway_restores_the_old_set() {
 }
 
 /// A set goes through its folder's descriptor: a folder moved (and another made at its path)
-/// between staging and commit gets the whole set, the new folder nothing (before this, a bake's
-/// renames went by path and landed in the new folder).
+/// between staging and commit gets the whole set, the new folder nothing (renames by path would
+/// land in the new folder).
 #[test]
 fn a_set_lands_in_its_folder_wherever_the_folder_moved() {
     let tmp = tempfile::tempdir().unwrap();
@@ -242,8 +243,8 @@ fn a_set_lands_in_its_folder_wherever_the_folder_moved() {
 }
 
 /// Beside a bake, `write_atomic` writes no name the bake's manifest lists, nor the manifest, and
-/// nothing while a bake holds the folder's lock (before this, `merl-info --asset BAKE/importance.asset`
-/// overwrote a listed file, and wrote into a folder a bake was writing).
+/// nothing while a bake holds the folder's lock (so `merl-info --asset BAKE/importance.asset`
+/// cannot overwrite a listed file, nor write into a folder a bake is writing).
 #[test]
 fn write_atomic_leaves_a_bakes_files_and_a_locked_folder_alone() {
     let dir = tempfile::tempdir().unwrap();

@@ -342,7 +342,7 @@ fn an_unknown_manifest_version_is_named() {
 }
 
 /// A path listed twice, in one stage or in two, of either version, is refused naming the path
-/// (before this, a manifest listing one file 1000 times had readers hash and draw every copy).
+/// (were it accepted, readers would hash and draw every copy of a file listed 1000 times).
 #[test]
 fn a_path_listed_twice_is_refused() {
     let mut in_one_stage = example();
@@ -364,8 +364,8 @@ fn a_path_listed_twice_is_refused() {
     assert!(BakeManifest::from_json(&example().to_string()).is_ok());
 }
 
-/// A key given twice is named, whichever comes first (before this, a second `manifest_version` of 1
-/// after a 2 was reported as "unknown field `parameters`").
+/// A key given twice is named, whichever comes first (were the last one read, a second
+/// `manifest_version` of 1 after a 2 would be reported as "unknown field `parameters`").
 #[test]
 fn a_key_given_twice_is_named() {
     let text = example().to_string();

@@ -158,8 +158,9 @@ mod tests {
     }
 
     /// A manifest listing many pictures of one role (distinct files, each as described) gets the
-    /// first of them drawn: a sheet has at most one picture per role (before this, a manifest
-    /// listing one picture 100 000 times made `--sheet` abort on allocation).
+    /// first of them drawn: a sheet has at most one picture per role, so its size does not grow
+    /// with the manifest (drawing every entry, a manifest listing one picture 100 000 times would
+    /// make `--sheet` abort on allocation).
     #[test]
     fn one_picture_per_role() {
         let dir = tempfile::tempdir().unwrap();
