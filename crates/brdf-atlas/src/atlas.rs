@@ -9,8 +9,9 @@ use crate::lobe::LuminanceTable;
 use crate::param::{IncidentGrid, LobeMap, to_incidence_frame};
 use glam::DVec3;
 
-/// How the atlas is made. [`Config::default`] is the papers' setting: 64 x 64 incident
-/// directions, each lobe analysed at 64 x 64 and reduced to 16 x 16, a 1024 x 1024 atlas.
+/// How the atlas is made. [`Config::default`] is the papers' layout, 64 x 64 incident
+/// directions, each lobe reduced to 16 x 16, a 1024 x 1024 atlas, with each lobe analysed at
+/// 1024 x 1024 ([`Config::analysis_size`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
     /// Lobes per side of the incident grid ([`IncidentGrid`]).
