@@ -80,12 +80,14 @@
 //! shadeable pixel's level is at most [`GRADE_SLACK`] (1) more than the finest level among the
 //! shadeable pixels within [`GRADE_RADIUS`] (4 render pixels, a prediction block at the default
 //! level). Against Mitsuba 3 (`cargo bench -p brdf-preview --bench mitsuba`, 7x7 bias max in
-//! levels, ungraded and graded): chrome under `studio_small_03`, `adaptive` 4.20 and 3.82 (light
-//! before and behind the sphere) against 3.22 and 2.18, `adaptive-prefiltered` 4.24 and 3.61
-//! against 3.10 and 2.63; a Lambertian under quarry's sun 1.90 against 1.48. PSNR moves by
-//! -0.3 to +1.0 dB: the few pixels grading refines take little of the budget. Taking the finest
-//! level within the radius instead (a slack of 0) cleared chrome's blocks as well (max 2.06 and
-//! 2.10) but refined so much that every case lost 1 to 4 dB to noise.
+//! levels; ungraded, graded, and graded with the blocks beside a finer region shaded rather than
+//! extrapolated, "Coarse to fine"): chrome under `studio_small_03`, `adaptive` 4.20, 3.22 and
+//! 2.61 with the light before the sphere, 3.82, 2.18 and 2.18 behind it; `adaptive-prefiltered`
+//! 4.24, 3.10 and 3.14, and 3.61, 2.63 and 2.63; a Lambertian under quarry's sun 1.90, 1.48 and
+//! 1.14. Grading moved PSNR by -0.3 to +1.0 dB: the few pixels it refines take little of the
+//! budget. Taking the finest level within the radius instead (a slack of 0) cleared chrome's
+//! blocks as well (max 2.06 and 2.10) but refined so much that every case lost 1 to 4 dB to
+//! noise.
 //!
 //! # The pyramid (`001` section 3.1)
 //!
