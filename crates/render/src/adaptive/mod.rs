@@ -142,7 +142,13 @@
 //! white-paint under quarry_01 (default camera) `adaptive` 54.29 dB (14) and 55.55 (1),
 //! `adaptive-prefiltered` 54.34 (13) and 55.62 (0); gold-paint 55.26 (0) and 56.42 (0); under
 //! quarry's sun (camera -144, 10) 50.98 (0) and 51.01 (0); chrome under studio_small_03
-//! 47.49 (14) and 47.73 (1), `adaptive-prefiltered` 46.77 (16) and 46.74 (1).
+//! 47.49 (14) and 47.73 (1), `adaptive-prefiltered` 46.77 (16) and 46.74 (1). In the adaptive
+//! benchmark (`cargo bench -p brdf-preview --bench adaptive -- --gpu`, paper reading) the plans'
+//! ceilings rose by 1 to 5 dB (gold-paint under quarry_01 55.28 to 57.10 dB on the sphere, 55.68
+//! to 59.90 on the torus), and the frames gained up to 2.6 dB at 8 and 16 spp but lost 0.5 to 1.5
+//! dB at 2 and 4, where the same budget spread over more blocks is noisier: the median speed-up
+//! at equal PSNR fell from 6.2x to 5.1x (`adaptive`) and from 8.6x to 6.8x
+//! (`adaptive-prefiltered`).
 //!
 //! # Samples
 //!
