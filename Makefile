@@ -16,13 +16,14 @@ export XDG_RUNTIME_DIR ?= $(shell d=/tmp/xdg-runtime-$$(id -u); mkdir -p $$d && 
 setup: setup-gpu setup-python setup-node setup-chromium setup-ktx
 
 ## setup-gpu: the software Vulkan driver (lavapipe), for brdf-preview and the GPU tests on machines
-## without a GPU driver. Installed only when missing; quiet.
+## without a GPU driver, and Mesa's GL through EGL (llvmpipe), the adapter the portability test runs
+## the previewer on. Installed only when missing; quiet.
 setup-gpu:
-	@if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then \
-	  echo "installing mesa-vulkan-drivers and libvulkan1 (a software Vulkan driver for the previewer and the GPU tests)"; \
+	@if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1 || ! ls /usr/lib/*/libEGL_mesa.so.0 >/dev/null 2>&1; then \
+	  echo "installing mesa-vulkan-drivers, libvulkan1 and Mesa's EGL (software Vulkan and GL drivers for the previewer and the GPU tests)"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq >/dev/null && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null; \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri >/dev/null; \
 	fi
 
 ## setup-python: numpy, for ../shared/tools/nbrdf2merl.py (the real-derived test materials).

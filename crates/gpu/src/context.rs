@@ -20,7 +20,7 @@ impl Gpu {
     /// Opens the preferred adapter: Vulkan first (the backend CI runs on, through lavapipe), then
     /// a real GPU before a software one. `WGPU_BACKEND` and the other wgpu variables are honoured.
     ///
-    /// The device gets the adapter's own limits rather than the WebGPU defaults, and fails with
+    /// The device asks for what the tools' passes need ([`required_limits`]), and fails with
     /// [`GpuError::AdapterLimit`] if the adapter cannot bind a whole MERL table of the largest
     /// size (360 cells in `phi_d`, 35 MB as f32).
     pub fn new() -> Result<Gpu, GpuError> {
@@ -29,7 +29,19 @@ impl Gpu {
 
     async fn new_async() -> Result<Gpu, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Gpu::open(&instance, None).await
+        Gpu::open(&instance, None, &|limits| limits).await
+    }
+
+    /// Opens the preferred adapter among `backends` as [`Gpu::new`] does (`WGPU_BACKEND` aside),
+    /// with the limits it would ask for passed through `cap`: the GPU tests run the previewer on
+    /// Mesa's GL (`wgpu::Backends::GL`) and stand in for a smaller adapter by lowering a limit.
+    pub fn with_backends(
+        backends: wgpu::Backends,
+        cap: &dyn Fn(wgpu::Limits) -> wgpu::Limits,
+    ) -> Result<Gpu, GpuError> {
+        let descriptor =
+            wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle_from_env() };
+        pollster::block_on(Gpu::open(&wgpu::Instance::new(descriptor), None, cap))
     }
 
     /// Opens the preferred adapter of `instance` among those that can present to `surface` (a
@@ -37,10 +49,14 @@ impl Gpu {
     /// must be the one the surface was created with. Fails with [`GpuError::NoPresentAdapter`]
     /// where adapters exist but none can present to the surface.
     pub fn for_surface(instance: &wgpu::Instance, surface: &wgpu::Surface<'_>) -> Result<Gpu, GpuError> {
-        pollster::block_on(Gpu::open(instance, Some(surface)))
+        pollster::block_on(Gpu::open(instance, Some(surface), &|limits| limits))
     }
 
-    async fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Gpu, GpuError> {
+    async fn open(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+        cap: &dyn Fn(wgpu::Limits) -> wgpu::Limits,
+    ) -> Result<Gpu, GpuError> {
         let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
         let found: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
         let need = table_bytes(merl::Dims::MERL_FULL_PHI);
@@ -56,9 +72,7 @@ impl Gpu {
                 _ => GpuError::NoAdapter,
             })?;
         let info = adapter.get_info();
-        // Asking for everything the adapter has costs nothing here and lets batch sizes follow
-        // the hardware; the WebGPU defaults are a floor for portability we do not need.
-        let limits = adapter.limits();
+        let limits = cap(required_limits(&adapter.limits()));
         check_buffer_fits(&limits, &info, need, "a MERL table of 90 x 90 x 360 cells")?;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
@@ -121,7 +135,7 @@ impl Gpu {
     }
 }
 
-fn describe(info: &wgpu::AdapterInfo) -> String {
+pub(crate) fn describe(info: &wgpu::AdapterInfo) -> String {
     let driver = [info.driver.as_str(), info.driver_info.as_str()]
         .into_iter()
         .filter(|s| !s.is_empty())
@@ -146,6 +160,24 @@ fn preference(info: &wgpu::AdapterInfo) -> (bool, u8) {
         wgpu::DeviceType::Other => 0,
     };
     (info.backend == wgpu::Backend::Vulkan, kind)
+}
+
+/// The limits a device asks of `adapter`: wgpu's downlevel defaults (what Mesa's GL and WebGPU's
+/// compute-capable adapters offer), raised to what the passes need where it is more, and to the
+/// adapter's own for the sizes that follow the work (buffers, the image's side, dispatches): the
+/// most storage buffers a previewer pass binds per shader stage
+/// ([`crate::preview::most_storage_buffers`]), fewer where the adapter has fewer (the modes that
+/// need more then fail with the limit, and the others run).
+pub(crate) fn required_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
+    wgpu::Limits {
+        max_storage_buffers_per_shader_stage: crate::preview::most_storage_buffers(),
+        max_storage_buffer_binding_size: adapter.max_storage_buffer_binding_size,
+        max_buffer_size: adapter.max_buffer_size,
+        max_texture_dimension_2d: adapter.max_texture_dimension_2d,
+        max_compute_workgroups_per_dimension: adapter.max_compute_workgroups_per_dimension,
+        ..wgpu::Limits::downlevel_defaults()
+    }
+    .or_worse_values_from(adapter)
 }
 
 /// Whether one buffer of `bytes` can be created and bound whole as a storage buffer.

@@ -11,15 +11,15 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use envmap::{EnvMap, MipChain, ToneMapping};
-use gpu::GpuError;
 use gpu::preview::Renderer;
+use gpu::{Gpu, GpuError};
 use merl::Dims;
 use merl::analytic::Analytic;
 use render::metrics::{psnr_db, relative_error, tonemap};
 use render::{Camera, Image, Lighting, Material, Mesh, Mode, SampleSet, Scene, Settings};
 
 use crate::fixtures::bandwidths;
-use crate::support::{gpu, log};
+use crate::support::{gl_gpu, gpu, log};
 
 /// PSNR of the tone-mapped GPU image against the CPU's, in dB, must reach this. The two differ by
 /// f32 against f64 arithmetic (1e-6 relative, far below one 8-bit step) plus the rare sample that
@@ -118,7 +118,11 @@ fn settings(mode: Mode) -> Settings {
 }
 
 fn renderer(scene: &Scene, material: &Material, lighting: &Lighting) -> Renderer {
-    Renderer::new(gpu(), scene, material, lighting).unwrap_or_else(|e| panic!("setting up the renderer: {e}"))
+    renderer_on(gpu(), scene, material, lighting)
+}
+
+fn renderer_on(gpu: &Gpu, scene: &Scene, material: &Material, lighting: &Lighting) -> Renderer {
+    Renderer::new(gpu, scene, material, lighting).unwrap_or_else(|e| panic!("setting up the renderer: {e}"))
 }
 
 fn render_gpu(renderer: &mut Renderer, settings: &Settings) -> Image {
@@ -162,10 +166,15 @@ fn coverage_mismatches(a: &[bool], b: &[bool], width: usize) -> Vec<(usize, usiz
 
 /// One GPU render against the CPU's with the same inputs.
 fn check_against_cpu(name: &str, material: &Material, mode: Mode) {
+    check_against_cpu_on(gpu(), name, material, mode);
+}
+
+/// [`check_against_cpu`] on the device `on`.
+fn check_against_cpu_on(on: &Gpu, name: &str, material: &Material, mode: Mode) {
     let scene = sphere_scene(SIZE);
     let lighting = sky_lighting();
     let settings = settings(mode);
-    let gpu = render_gpu(&mut renderer(&scene, material, lighting), &settings);
+    let gpu = render_gpu(&mut renderer_on(on, &scene, material, lighting), &settings);
     let cpu = render_cpu(&scene, material, lighting, &settings);
     let mismatches = coverage_mismatches(&gpu.covered, &cpu.covered, SIZE);
     let (psnr, relative) = compare(&gpu, &cpu);
@@ -628,6 +637,11 @@ impl AdaptiveCase {
 /// each other: the same plan (weights to f32 rounding), samples and image, stages within the wall
 /// time (see [`adaptive_reference_frame_equals_the_cpu`] for what the cases cover).
 fn check_adaptive_frame(case: AdaptiveCase) {
+    check_adaptive_frame_on(gpu(), case);
+}
+
+/// [`check_adaptive_frame`] on the device `on`.
+fn check_adaptive_frame_on(on: &Gpu, case: AdaptiveCase) {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let whole = sphere_scene(SIZE);
     // From 1.5 radii away the sphere subtends 84 degrees; a 30 degree view sees only the sphere.
@@ -645,7 +659,7 @@ fn check_adaptive_frame(case: AdaptiveCase) {
     let (w, h) = (render_scene.width, render_scene.height);
     // An oracle that asks for every level somewhere: a ramp over the image.
     let ramp: Vec<f64> = (0..w * h).map(|i| 0.6 * ((i % w) as f64 / w as f64).powi(3)).collect();
-    let mut renderer = renderer(&render_scene, material, lighting);
+    let mut renderer = renderer_on(on, &render_scene, material, lighting);
     renderer.set_bandwidths(&bandwidths).unwrap();
     let options = gpu::preview::FrameOptions { oracle: oracle.then_some(&ramp[..]), details: true };
     let gpu_frame = renderer
@@ -810,4 +824,50 @@ fn an_adaptive_frame_without_bandwidths_is_an_error() {
 /// Frame options that keep the frame's buffers.
 fn details() -> gpu::preview::FrameOptions<'static> {
     gpu::preview::FrameOptions { details: true, ..Default::default() }
+}
+
+/// Mesa's GL (llvmpipe through EGL) binds 16 storage buffers per shader stage where lavapipe binds
+/// more: every mode runs there, each pass's layout naming only the groups it reads, and equals the
+/// CPU as it does on lavapipe.
+#[test]
+fn every_mode_on_mesa_gl_equals_the_cpu() {
+    let gl = gl_gpu(&|limits| limits);
+    for mode in [Mode::Reference, Mode::Fis, Mode::Prefiltered] {
+        check_against_cpu_on(&gl, "ggx on gl", ggx(), mode);
+    }
+    check_adaptive_frame_on(&gl, AdaptiveCase::new(Mode::Reference, 8));
+    check_adaptive_frame_on(&gl, AdaptiveCase::new(Mode::Prefiltered, 4));
+}
+
+/// An adapter short of storage buffers per shader stage fails with one line that names the limit,
+/// what the adapter has and what the work needs: the shading passes bind 12 (groups 0 to 2), so
+/// WebGPU's default of 8 runs no mode; at 12 the shading modes run and an adaptive frame, whose
+/// prediction binds 13, names the modes that do.
+#[test]
+fn an_adapter_short_of_storage_buffers_names_the_limit_and_the_modes_it_runs() {
+    let capped =
+        |n: u32| move |limits: wgpu::Limits| wgpu::Limits { max_storage_buffers_per_shader_stage: n, ..limits };
+    let (scene, material, lighting) = (sphere_scene(SIZE), ggx(), sky_lighting());
+    let webgpu_default = Gpu::with_backends(wgpu::Backends::all(), &capped(8)).unwrap();
+    let error = Renderer::new(&webgpu_default, &scene, material, lighting).expect_err("8 storage buffers");
+    let message = error.to_string();
+    assert!(
+        message.contains("max_storage_buffers_per_shader_stage is 8, shading (every mode) needs 12")
+            && !message.contains('\n'),
+        "{message}"
+    );
+
+    let twelve = Gpu::with_backends(wgpu::Backends::all(), &capped(12)).unwrap();
+    let mut renderer = renderer_on(&twelve, &scene, material, lighting);
+    let image = render_gpu(&mut renderer, &settings(Mode::Prefiltered));
+    assert!(image.covered.iter().any(|&c| c), "the shading modes run with 12");
+    let error = renderer.set_bandwidths(&bandwidths()).expect_err("an adaptive frame needs 13");
+    let message = error.to_string();
+    assert!(
+        message.contains(
+            "max_storage_buffers_per_shader_stage is 12, an adaptive frame (reference, fis and prefiltered run on \
+             this adapter) needs 13"
+        ) && !message.contains('\n'),
+        "{message}"
+    );
 }

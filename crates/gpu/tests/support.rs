@@ -27,3 +27,17 @@ pub fn gpu() -> &'static Gpu {
 pub fn log(line: &str) {
     let _ = writeln!(std::io::stderr(), "{line}");
 }
+
+/// A device on Mesa's GL alone (llvmpipe through EGL), with `cap` applied to the limits it asks
+/// for. Panics with the packages to install where the machine has no GL adapter: the portability
+/// tests fail, never skip.
+pub fn gl_gpu(cap: &dyn Fn(wgpu::Limits) -> wgpu::Limits) -> Gpu {
+    let gpu = Gpu::with_backends(wgpu::Backends::GL, cap).unwrap_or_else(|e| {
+        panic!(
+            "no GL adapter ({e}): on Debian/Ubuntu install Mesa's EGL and GL drivers with \
+             'apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri'"
+        )
+    });
+    log(&format!("gl tests run on {}", gpu.adapter_summary()));
+    gpu
+}

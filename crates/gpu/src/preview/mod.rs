@@ -30,7 +30,7 @@
 //! prefiltered layers as f32 RGB, the view-layer table) rather than textures: float32 textures
 //! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
 
-use std::cell::{Cell, RefCell};
+use std::cell::{Cell, OnceCell, RefCell};
 use std::sync::Arc;
 
 use bytemuck::Pod;
@@ -51,6 +51,7 @@ pub(crate) mod uniforms;
 pub use adaptive::FrameOptions;
 pub use present::Presenter;
 
+pub(crate) use setup::most_storage_buffers;
 use setup::{storage_entry, uniform_entry};
 use tables::*;
 use uniforms::*;
@@ -173,16 +174,11 @@ pub struct Renderer {
     shade_pipeline: wgpu::ComputePipeline,
     /// `shade_backdrop`: the environment behind the mesh, drawn with the G-buffer.
     backdrop_pipeline: wgpu::ComputePipeline,
-    /// `shade_blocks`: the shaded blocks of an adaptive frame.
-    blocks_pipeline: wgpu::ComputePipeline,
-    /// `predict_blocks`: the bandwidth buffer of an adaptive frame, with group 3 from
-    /// `predict_layout`, made by [`Renderer::set_bandwidths`].
-    predict_pipeline: wgpu::ComputePipeline,
-    predict_layout: wgpu::BindGroupLayout,
+    /// The prediction's inputs, made by [`Renderer::set_bandwidths`].
     prediction: Option<Prediction>,
-    /// The passes of an adaptive frame after its prediction, group 3 from `adaptive_layout`.
-    adaptive_pipelines: adaptive::Pipelines,
-    adaptive_layout: wgpu::BindGroupLayout,
+    /// The adaptive frames' pipelines and group-3 layouts, made at the first that needs them
+    /// ([`Renderer::adaptive_pipelines`]).
+    adaptive_pipelines: OnceCell<adaptive::Pipelines>,
     /// The adaptive frames' state on the GPU, for the last geometry and settings.
     adaptive: RefCell<Option<adaptive::State>>,
     /// For the limit errors of later uploads.
@@ -190,6 +186,8 @@ pub struct Renderer {
     table_group: wgpu::BindGroup,
     bake_group: wgpu::BindGroup,
     render_group: wgpu::BindGroup,
+    /// The shading module and its layouts, for the pipelines made later.
+    shading: setup::Shading,
     shade_uniform: wgpu::Buffer,
     frame_uniform: wgpu::Buffer,
     /// Bytes between the frame slots of `frame_uniform` (the dynamic-offset alignment).
@@ -401,6 +399,7 @@ impl Renderer {
         atlas.check().map_err(|e| render::Error::Invalid(format!("the BRDF atlas: {e}")))?;
         let texels: Vec<f32> = environment.values().iter().chain(&atlas.data).copied().collect();
         check_buffer_fits(&self.device.limits(), &self.adapter_info, 4 * texels.len() as u64, "the bandwidths")?;
+        let predict_layout = &self.adaptive_pipelines()?.predict_layout;
         let prediction = capture_errors(&self.device, || {
             let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("preview predict"),
@@ -415,7 +414,7 @@ impl Renderer {
             });
             let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview predict"),
-                layout: &self.predict_layout,
+                layout: predict_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: texels.as_entire_binding() },
@@ -478,7 +477,8 @@ impl Renderer {
         let geometry = self.adaptive_geometry(1)?;
         capture_errors(&self.device, || self.write_predict_uniform(prediction, settings))?;
         let items = prediction_items(pixels, geometry.pixels());
-        let values = self.run_items(&self.predict_pipeline, &prediction.group, settings.mode, settings.seed, &items)?;
+        let pipeline = &self.adaptive_pipelines()?.predict;
+        let values = self.run_items(pipeline, &prediction.group, settings.mode, settings.seed, &items)?;
         Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
 
@@ -598,10 +598,15 @@ impl Renderer {
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
     ) -> wgpu::ComputePass<'e> {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes });
+        self.bind_estimator_groups(&mut pass);
+        pass
+    }
+
+    /// Binds groups 0 to 2 for an estimator's pass (frame 0's slot of `Frame`).
+    fn bind_estimator_groups(&self, pass: &mut wgpu::ComputePass) {
         pass.set_bind_group(0, &self.table_group, &[]);
         pass.set_bind_group(1, &self.bake_group, &[]);
         pass.set_bind_group(2, &self.render_group, &[0]);
-        pass
     }
 
     /// Draws the G-buffer with the current camera, and the environment behind the mesh.

@@ -4,6 +4,8 @@
 use render::{Lighting, Material, Scene};
 use wgpu::util::DeviceExt;
 
+use std::cell::OnceCell;
+
 use crate::context::{Gpu, check_buffer_fits};
 use crate::error::GpuError;
 use crate::merl_lookup::{MerlDimsUniform, capture_errors, gpu_table_values, table_bytes};
@@ -45,10 +47,11 @@ impl Renderer {
         let pixels = u64::from(width) * u64::from(height);
         check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
         // Clip-space positions, positions and normals interleaved: one storage buffer for all
-        // three, so that the shading pass stays within the 8 storage buffers every adapter offers.
+        // three, one binding of the shading passes' 12 (`Shading::storage_buffers`).
         let n_vertices = scene.mesh.positions.len() as u64;
         check_buffer_fits(&limits, info, 4 * VERTEX_FLOATS * n_vertices, "the mesh's vertices")?;
         check_buffer_fits(&limits, info, 4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
+        check_storage_buffers(&limits, info, Shading::storage_buffers(), "shading (every mode)")?;
 
         let device = gpu.device().clone();
         let queue = gpu.queue().clone();
@@ -117,80 +120,30 @@ impl Renderer {
             let depth_target = target("preview depth", DEPTH_FORMAT, T::RENDER_ATTACHMENT);
 
             // The shading pass.
-            let compute = wgpu::ShaderStages::COMPUTE;
-            let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("merl table"),
-                entries: &[
-                    uniform_entry(0, compute, false),
-                    storage_entry(1, compute, true),
-                    uniform_entry(2, compute, false),
-                    storage_entry(3, compute, true),
-                    storage_entry(4, compute, true),
-                ],
-            });
-            let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview bake"),
-                entries: &(0..7).map(|binding| storage_entry(binding, compute, true)).collect::<Vec<_>>(),
-            });
-            let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview render"),
-                entries: &[
-                    uniform_entry(0, compute, false),
-                    uniform_entry(1, compute, true),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 2,
-                        visibility: compute,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Uint,
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
-                    storage_entry(3, compute, false),
-                    storage_entry(4, compute, false),
-                ],
-            });
-            let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("preview_shade.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(
-                    crate::wgsl::module(&[
-                        &crate::wgsl::PREVIEW_SHADE,
-                        &crate::wgsl::ADAPTIVE_PREDICT,
-                        &crate::wgsl::ADAPTIVE_PLAN,
-                        &crate::wgsl::ADAPTIVE_SAMPLES,
-                        &crate::wgsl::ADAPTIVE_FRAME,
-                    ])
-                    .into(),
-                ),
-            });
-            // A pipeline of the shading module: groups 0 to 2, and `group3` where the entry has one.
-            let compute_pipeline = |group3: Option<&wgpu::BindGroupLayout>, entry: &'static str| {
-                let layouts = [Some(&table_layout), Some(&bake_layout), Some(&render_layout), group3];
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(entry),
-                    bind_group_layouts: &layouts[..3 + usize::from(group3.is_some())],
-                    immediate_size: 0,
-                });
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&layout),
-                    module: &shade_module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
+            let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
             };
-            let shade_pipeline = compute_pipeline(None, "shade_frame");
-            let backdrop_pipeline = compute_pipeline(None, "shade_backdrop");
-            let blocks_pipeline = compute_pipeline(None, "shade_blocks");
-            let predict_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview predict"),
-                entries: &[uniform_entry(0, compute, false), storage_entry(1, compute, true)],
-            });
-            let predict_pipeline = compute_pipeline(Some(&predict_layout), "predict_blocks");
-            let adaptive_layout = adaptive::layout(&device);
-            let adaptive_pipelines = adaptive::Pipelines::new(|entry| compute_pipeline(Some(&adaptive_layout), entry));
+            let shading = Shading {
+                module: device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("preview_shade.wgsl"),
+                    source: wgpu::ShaderSource::Wgsl(
+                        crate::wgsl::module(&[
+                            &crate::wgsl::PREVIEW_SHADE,
+                            &crate::wgsl::ADAPTIVE_PREDICT,
+                            &crate::wgsl::ADAPTIVE_PLAN,
+                            &crate::wgsl::ADAPTIVE_SAMPLES,
+                            &crate::wgsl::ADAPTIVE_FRAME,
+                        ])
+                        .into(),
+                    ),
+                }),
+                table: layout("merl table", &table_entries()),
+                bake: layout("preview bake", &bake_entries()),
+                render: layout("preview render", &render_entries()),
+            };
+            let shade_pipeline = shading.pipeline(&device, true, None, "shade_frame");
+            let backdrop_pipeline = shading.pipeline(&device, true, None, "shade_backdrop");
+            let (table_layout, bake_layout, render_layout) = (&shading.table, &shading.bake, &shading.render);
 
             let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("merl dims"),
@@ -213,7 +166,7 @@ impl Renderer {
             let wavelet_slices_buffer = storage("wavelet slices", bytemuck::cast_slice(slices));
             let table_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("merl table"),
-                layout: &table_layout,
+                layout: table_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: dims_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: table_buffer.as_entire_binding() },
@@ -240,7 +193,7 @@ impl Renderer {
             let tables_buffer = storage("preview sampling tables", bytemuck::cast_slice(&tables));
             let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview bake"),
-                layout: &bake_layout,
+                layout: bake_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: samples_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: maps_buffer.as_entire_binding() },
@@ -269,7 +222,7 @@ impl Renderer {
             let view = |texture: &wgpu::Texture| texture.create_view(&Default::default());
             let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview render"),
-                layout: &render_layout,
+                layout: render_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: shade_uniform.as_entire_binding() },
                     wgpu::BindGroupEntry {
@@ -304,17 +257,14 @@ impl Renderer {
                 depth_target,
                 shade_pipeline,
                 backdrop_pipeline,
-                blocks_pipeline,
-                predict_pipeline,
-                predict_layout,
                 prediction: None,
-                adaptive_pipelines,
-                adaptive_layout,
+                adaptive_pipelines: OnceCell::new(),
                 adaptive: RefCell::new(None),
                 adapter_info: info.clone(),
                 table_group,
                 bake_group,
                 render_group,
+                shading,
                 shade_uniform,
                 frame_uniform,
                 frame_stride,
@@ -342,6 +292,128 @@ pub(super) fn check_scene(scene: &Scene, material: &Material, lighting: &Lightin
     scene.mesh.validate()?;
     render::raster::check_size(scene.width, scene.height)?;
     Ok(render::check_inputs(material, lighting)?)
+}
+
+/// What every compute pipeline of the shading module is made from: the module and the layouts of
+/// its groups 0 to 2. The shading passes are made with the renderer, the adaptive frames' at the
+/// first adaptive frame ([`Renderer::adaptive_pipelines`]).
+#[derive(Debug)]
+pub(super) struct Shading {
+    module: wgpu::ShaderModule,
+    table: wgpu::BindGroupLayout,
+    bake: wgpu::BindGroupLayout,
+    render: wgpu::BindGroupLayout,
+}
+
+impl Shading {
+    /// The pipeline of `entry`: groups 0 to 2 where `estimator` (a pass that reads the BRDF, the
+    /// samples or the maps), group 2 alone otherwise, and `group3` where the entry has one. A
+    /// layout names only the groups its pass reads, so that only their storage buffers count
+    /// against the adapter's limit per shader stage ([`Shading::storage_buffers`]).
+    pub(super) fn pipeline(
+        &self,
+        device: &wgpu::Device,
+        estimator: bool,
+        group3: Option<&wgpu::BindGroupLayout>,
+        entry: &'static str,
+    ) -> wgpu::ComputePipeline {
+        let (table, bake) = if estimator { (Some(&self.table), Some(&self.bake)) } else { (None, None) };
+        let layouts = [table, bake, Some(&self.render), group3];
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(entry),
+            bind_group_layouts: &layouts[..3 + usize::from(group3.is_some())],
+            immediate_size: 0,
+        });
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&layout),
+            module: &self.module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    }
+
+    /// The storage buffers a shading pass binds in its stage: groups 0 to 2.
+    pub(super) fn storage_buffers() -> u32 {
+        storage_buffers(&[&table_entries(), &bake_entries(), &render_entries()])
+    }
+}
+
+/// The most storage buffers one of the previewer's passes binds in a shader stage: the device asks
+/// for that many (`Gpu::new`), or the adapter's most where it has fewer, and the modes that need
+/// more fail with the limit ([`check_storage_buffers`]).
+pub(crate) fn most_storage_buffers() -> u32 {
+    Shading::storage_buffers().max(adaptive::storage_buffers())
+}
+
+/// The storage buffers among `groups`' entries.
+pub(super) fn storage_buffers(groups: &[&[wgpu::BindGroupLayoutEntry]]) -> u32 {
+    let storage = |e: &&wgpu::BindGroupLayoutEntry| {
+        matches!(e.ty, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { .. }, .. })
+    };
+    groups.iter().map(|g| g.iter().filter(storage).count() as u32).sum()
+}
+
+/// Fails with [`GpuError::AdapterLimit`] where the adapter binds fewer than `need` storage buffers
+/// per shader stage; `what` names the work and, where some modes still run, which.
+pub(super) fn check_storage_buffers(
+    limits: &wgpu::Limits,
+    info: &wgpu::AdapterInfo,
+    need: u32,
+    what: &'static str,
+) -> Result<(), GpuError> {
+    let have = limits.max_storage_buffers_per_shader_stage;
+    if have < need {
+        return Err(GpuError::AdapterLimit {
+            adapter: crate::context::describe(info),
+            limit: "max_storage_buffers_per_shader_stage",
+            have: have.into(),
+            need: need.into(),
+            what,
+        });
+    }
+    Ok(())
+}
+
+/// Group 0: the MERL table's dimensions and values, the wavelet BRDF's parameters, map and slices
+/// (`merl_lookup.wgsl`, `wavelet_brdf.wgsl`).
+fn table_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    [
+        uniform_entry(0, compute, false),
+        storage_entry(1, compute, true),
+        uniform_entry(2, compute, false),
+        storage_entry(3, compute, true),
+        storage_entry(4, compute, true),
+    ]
+}
+
+/// Group 1: what the scene, material and lighting upload once (`preview_bindings.wgsl`).
+fn bake_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
+    std::array::from_fn(|binding| storage_entry(binding as u32, wgpu::ShaderStages::COMPUTE, true))
+}
+
+/// Group 2: the render (`preview_bindings.wgsl`): `Shade`, `Frame` at a dynamic offset, the
+/// G-buffer, the accumulation and the backdrop.
+pub(super) fn render_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    [
+        uniform_entry(0, compute, false),
+        uniform_entry(1, compute, true),
+        wgpu::BindGroupLayoutEntry {
+            binding: 2,
+            visibility: compute,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        },
+        storage_entry(3, compute, false),
+        storage_entry(4, compute, false),
+    ]
 }
 
 pub(super) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {

@@ -40,7 +40,7 @@ mod state;
 use crate::error::GpuError;
 use crate::merl_lookup::capture_errors;
 use state::*;
-pub(super) use state::{Pipelines, State, layout};
+pub(super) use state::{Pipelines, State, storage_buffers};
 
 /// `AdaptivePass` of `state.wgsl`.
 #[repr(C)]
@@ -133,15 +133,20 @@ fn parts(
 }
 
 /// Dispatches one of the adaptive passes in `(x, y)` workgroups, with the pass uniform's slot at
-/// byte `offset`.
+/// byte `offset`. Groups 2 and 3 are bound again after the pipeline: the adaptive passes' layouts
+/// leave groups 0 and 1 out where the estimators' name them, and Vulkan disturbs a set bound under
+/// a layout whose lower sets differ, which wgpu does not bind again (on lavapipe a second frame
+/// then read stale bindings and differed from the first); `shade_blocks` binds 0 to 2 likewise.
 fn dispatch(
     cpass: &mut wgpu::ComputePass,
+    render: &wgpu::BindGroup,
     pipeline: &wgpu::ComputePipeline,
     state: &State,
     offset: u64,
     (x, y): (u32, u32),
 ) {
     cpass.set_pipeline(pipeline);
+    cpass.set_bind_group(2, render, &[0]);
     cpass.set_bind_group(3, &state.group, &[offset as u32]);
     cpass.dispatch_workgroups(x, y, 1);
 }
@@ -215,7 +220,7 @@ impl Renderer {
         let candidates: u32 = state.candidates_per_level.iter().sum();
         let chunks = candidates.div_ceil(CHUNK).max(1);
         let out_pixels = (out_width * out_height) as u64;
-        let pipelines = &self.adaptive_pipelines;
+        let pipelines = self.adaptive_pipelines()?;
         // The shading uniform of the frame's passes with `items` items (the prediction's, then
         // `shade_blocks`' parts): the estimator, the seed, the pre-convolved estimator's layers.
         let shade_uniform = |items: u32| super::ShadeUniform {
@@ -230,7 +235,8 @@ impl Renderer {
         // and the output: `Some(count)` dispatches a known count, `None` the counts
         // `adaptive_allocate` left in the indirect buffer.
         let shading = |cpass: &mut wgpu::ComputePass, parts: Option<u32>, shaded: Option<u32>| {
-            cpass.set_pipeline(&self.blocks_pipeline);
+            cpass.set_pipeline(&pipelines.blocks);
+            self.bind_estimator_groups(cpass);
             match parts {
                 Some(0) => {}
                 Some(n) => {
@@ -240,18 +246,35 @@ impl Renderer {
                 None => cpass.dispatch_workgroups_indirect(&state.indirect, 0),
             }
             match shaded {
-                Some(n) => dispatch(cpass, &pipelines.scatter, state, scatter_slot * stride, groups(n)),
+                Some(n) => {
+                    dispatch(cpass, &self.render_group, &pipelines.scatter, state, scatter_slot * stride, groups(n))
+                }
                 None => {
                     cpass.set_pipeline(&pipelines.scatter);
+                    cpass.set_bind_group(2, &self.render_group, &[0]);
                     cpass.set_bind_group(3, &state.group, &[(scatter_slot * stride) as u32]);
                     cpass.dispatch_workgroups_indirect(&state.indirect, 12);
                 }
             }
             for k in (0..top).rev() {
                 let slot = scatter_slot + 1 + k as u64;
-                dispatch(cpass, &pipelines.upsample, state, slot * stride, groups(state.candidates_per_level[k]));
+                dispatch(
+                    cpass,
+                    &self.render_group,
+                    &pipelines.upsample,
+                    state,
+                    slot * stride,
+                    groups(state.candidates_per_level[k]),
+                );
             }
-            dispatch(cpass, &pipelines.output, state, output_slot * stride, groups(out_pixels as u32));
+            dispatch(
+                cpass,
+                &self.render_group,
+                &pipelines.output,
+                state,
+                output_slot * stride,
+                groups(out_pixels as u32),
+            );
         };
 
         // Submission 1: prediction, levels, pyramids, plan, the list of shaded blocks in the
@@ -298,7 +321,7 @@ impl Renderer {
             {
                 let mut cpass = self.begin_timed_pass(&mut encoder, stamp(0, None));
                 if state.n_items > 0 {
-                    cpass.set_pipeline(&self.predict_pipeline);
+                    cpass.set_pipeline(&pipelines.predict);
                     cpass.set_bind_group(3, &prediction.group, &[]);
                     let (x, y) = super::item_groups(state.n_items);
                     cpass.dispatch_workgroups(x, y, 1);
@@ -308,7 +331,7 @@ impl Renderer {
                     cpass = self.begin_timed_pass(&mut encoder, stamp(1, None));
                 }
                 let run = |cpass: &mut wgpu::ComputePass, pipeline, slot: u64, groups| {
-                    dispatch(cpass, pipeline, state, slot * stride, groups)
+                    dispatch(cpass, &self.render_group, pipeline, state, slot * stride, groups)
                 };
                 let per_level = &state.candidates_per_level;
                 run(&mut cpass, &pipelines.levels, levels_slot, groups(per_level[0]));

@@ -13,6 +13,9 @@ use crate::context::check_buffer_fits;
 use crate::error::GpuError;
 use crate::merl_lookup::capture_errors;
 use crate::preview::Renderer;
+use crate::preview::setup::{
+    Shading, render_entries, storage_buffers as storage_buffers_of, storage_entry, uniform_entry,
+};
 
 /// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
 /// and pyramid top: `state.wgsl`'s state.
@@ -99,6 +102,23 @@ pub(super) fn slots(top: usize) -> u64 {
 }
 
 impl Renderer {
+    /// The adaptive frames' pipelines, made at the first call: a renderer of the other modes
+    /// never makes them. Fails with [`GpuError::AdapterLimit`] where the adapter binds fewer
+    /// storage buffers per shader stage than their passes need ([`storage_buffers`]).
+    pub(in crate::preview) fn adaptive_pipelines(&self) -> Result<&Pipelines, GpuError> {
+        if let Some(pipelines) = self.adaptive_pipelines.get() {
+            return Ok(pipelines);
+        }
+        crate::preview::setup::check_storage_buffers(
+            &self.device.limits(),
+            &self.adapter_info,
+            storage_buffers(),
+            "an adaptive frame (reference, fis and prefiltered run on this adapter)",
+        )?;
+        let pipelines = capture_errors(&self.device, || Pipelines::new(&self.device, &self.shading))?;
+        Ok(self.adaptive_pipelines.get_or_init(|| pipelines))
+    }
+
     /// The state for `geometry` and `settings`, made and uploaded when the geometry, the
     /// prediction level or the top changed since the last frame.
     pub(super) fn adaptive_state(
@@ -108,6 +128,7 @@ impl Renderer {
         material: &Material,
         lighting: &Lighting,
     ) -> Result<(), GpuError> {
+        let state_layout = &self.adaptive_pipelines()?.layout;
         let (width, height) = geometry.render_size();
         let top = render::adaptive::top_level(width, height, settings.max_level);
         let l = settings.prediction_level(top);
@@ -271,7 +292,7 @@ impl Renderer {
             }
             let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("adaptive"),
-                layout: &self.adaptive_layout,
+                layout: state_layout,
                 entries: &entries,
             });
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
@@ -321,10 +342,17 @@ impl Renderer {
     }
 }
 
-/// The adaptive frame's pipelines (`plan.wgsl`, `samples.wgsl`, `frame.wgsl`), group 3 from
-/// [`Renderer`]'s `adaptive_layout`.
+/// The adaptive frames' pipelines: `predict_blocks` and `shade_blocks` (the estimators' passes,
+/// groups 0 to 2) and the passes after the prediction (group 2 and the state), with the layouts of
+/// their groups 3. Made at the first adaptive frame ([`Renderer::adaptive_pipelines`]).
 #[derive(Debug)]
 pub(crate) struct Pipelines {
+    /// Group 3 of `predict_blocks`: the prediction's uniform and bandwidths.
+    pub predict_layout: wgpu::BindGroupLayout,
+    /// Group 3 of the passes after the prediction: the pass uniform and the state's buffers.
+    pub layout: wgpu::BindGroupLayout,
+    pub predict: wgpu::ComputePipeline,
+    pub blocks: wgpu::ComputePipeline,
     pub levels: wgpu::ComputePipeline,
     pub grade: wgpu::ComputePipeline,
     pub grade_apply: wgpu::ComputePipeline,
@@ -339,29 +367,52 @@ pub(crate) struct Pipelines {
 }
 
 impl Pipelines {
-    pub(crate) fn new(make: impl Fn(&'static str) -> wgpu::ComputePipeline) -> Pipelines {
+    pub(crate) fn new(device: &wgpu::Device, shading: &Shading) -> Pipelines {
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+        };
+        let predict_layout = layout("preview predict", &predict_entries());
+        let state = layout("adaptive", &state_entries());
+        let pass = |entry| shading.pipeline(device, false, Some(&state), entry);
         Pipelines {
-            levels: make("adaptive_levels"),
-            grade: make("adaptive_grade"),
-            grade_apply: make("adaptive_grade_apply"),
-            reduce: make("adaptive_reduce"),
-            plan: make("adaptive_plan"),
-            scatter: make("adaptive_scatter"),
-            upsample: make("adaptive_upsample"),
-            output: make("adaptive_output"),
-            allocate: make("adaptive_allocate"),
-            offsets: make("adaptive_offsets"),
-            list: make("adaptive_list"),
+            predict: shading.pipeline(device, true, Some(&predict_layout), "predict_blocks"),
+            blocks: shading.pipeline(device, true, None, "shade_blocks"),
+            levels: pass("adaptive_levels"),
+            grade: pass("adaptive_grade"),
+            grade_apply: pass("adaptive_grade_apply"),
+            reduce: pass("adaptive_reduce"),
+            plan: pass("adaptive_plan"),
+            scatter: pass("adaptive_scatter"),
+            upsample: pass("adaptive_upsample"),
+            output: pass("adaptive_output"),
+            allocate: pass("adaptive_allocate"),
+            offsets: pass("adaptive_offsets"),
+            list: pass("adaptive_list"),
+            predict_layout,
+            layout: state,
         }
     }
 }
 
-/// The layout of group 3 of the adaptive passes: binding 2 the pass uniform (one slot per pass),
-/// 3 to 12 the state's buffers ([`Buffers`]; the records and the tables read-only).
-pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+/// The most storage buffers an adaptive frame's pass binds in its stage: `predict_blocks` binds
+/// groups 0 to 2 and its own, the passes after it group 2 and the state.
+pub(crate) fn storage_buffers() -> u32 {
+    let predict = Shading::storage_buffers() + storage_buffers_of(&[&predict_entries()]);
+    predict.max(storage_buffers_of(&[&render_entries(), &state_entries()]))
+}
+
+/// Group 3 of `predict_blocks` (`predict.wgsl`): its uniform and the bandwidths.
+fn predict_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
     let compute = wgpu::ShaderStages::COMPUTE;
-    let mut entries = vec![crate::preview::uniform_entry(2, compute, true)];
+    [uniform_entry(0, compute, false), storage_entry(1, compute, true)]
+}
+
+/// Group 3 of the passes after the prediction (`state.wgsl`): binding 2 the pass uniform (one
+/// slot per pass), 3 to 12 the state's buffers ([`Buffers`]; the records and the tables
+/// read-only).
+fn state_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let mut entries = vec![uniform_entry(2, compute, true)];
+    entries.extend((3..=12).map(|binding| storage_entry(binding, compute, matches!(binding, 3 | 4 | 11))));
     entries
-        .extend((3..=12).map(|binding| crate::preview::storage_entry(binding, compute, matches!(binding, 3 | 4 | 11))));
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("adaptive"), entries: &entries })
 }
