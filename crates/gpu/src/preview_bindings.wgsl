@@ -103,8 +103,8 @@ struct Shade {
     // The length of the list a pass over items reads (`predict_blocks`, `shade_blocks`): their
     // items arrive in `accumulation`.
     items: u32,
-    // The samples the fis estimator's footprints are sized for: `spp` times the frames the
-    // picture averages.
+    // The samples the filtered estimators' footprints are sized for: `spp` times the frames the
+    // picture averages; in `shade_blocks` the frames alone, times each block's samples.
     filter_samples: u32,
     _pad1: u32,
     _pad2: u32,

@@ -152,7 +152,8 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
 // a block of more reads `samples / n_samples` frames of `n_samples` (term `j` is term
 // `j % n_samples` of frame `j / n_samples`), a part that spans frames taking each frame's terms
 // in turn. A block's samples in several parts run side by side rather than one after another in
-// one invocation. Each invocation reads and writes its own item only.
+// one invocation. Each invocation reads and writes its own item only. The footprints are sized for
+// the block's samples times the frames the picture averages (`shade.filter_samples` here).
 @compute @workgroup_size(64)
 fn shade_blocks(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -174,7 +175,7 @@ fn shade_blocks(
         while (j < end) {
             let first = j % per_frame;
             let count = min(end - j, per_frame - first);
-            radiance += estimate_sum(surface.frame, pixel, j / per_frame, per_frame, first, count, item.y);
+            radiance += estimate_sum(surface.frame, pixel, j / per_frame, per_frame, first, count, item.y * shade.filter_samples);
             j += count;
         }
         radiance /= f32(item.y);

@@ -613,6 +613,8 @@ struct AdaptiveCase {
     oracle: bool,
     allocation: render::adaptive::Allocation,
     max_spp: u32,
+    /// The frames the picture averages (the pre-convolved blocks' footprints).
+    frames: u32,
 }
 
 /// A block cap of one vector's samples (the test material's 64).
@@ -629,6 +631,7 @@ impl AdaptiveCase {
             oracle: false,
             allocation: render::adaptive::Allocation::Area,
             max_spp: ONE_VECTOR,
+            frames: 1,
         }
     }
 }
@@ -647,12 +650,13 @@ fn check_adaptive_frame_on(on: &Gpu, case: AdaptiveCase) {
     // From 1.5 radii away the sphere subtends 84 degrees; a 30 degree view sees only the sphere.
     let filled_camera = Camera::orbit(glam::Vec3::ZERO, 1.5, 0.3, 0.2, 30f32.to_radians()).unwrap();
     let scene = if case.filled { Scene { camera: filled_camera, ..whole.clone() } } else { whole };
-    let AdaptiveCase { mode, supersample, spp, lobe_weight, oracle, allocation, max_spp, .. } = case;
+    let AdaptiveCase { mode, supersample, spp, lobe_weight, oracle, allocation, max_spp, frames, .. } = case;
     let settings = render::adaptive::Settings {
         supersample,
         max_spp,
         lobe_weight,
         allocation,
+        frames,
         ..render::adaptive::Settings::new(mode, spp)
     };
     let render_scene = Scene { width: SIZE * supersample, height: SIZE * supersample, ..scene.clone() };
@@ -726,6 +730,19 @@ fn check_adaptive_frame_on(on: &Gpu, case: AdaptiveCase) {
         t.gpu_clock,
     ));
     assert!(psnr >= MIN_PSNR_DB && relative <= MAX_ADAPTIVE_RELATIVE_ERROR, "{psnr} dB, {relative}");
+    if frames > 1 {
+        // The frames reach the GPU's footprints: the same plan on the CPU sized for one frame is
+        // far further from the GPU's than the CPU's own frame.
+        let mut replay = render::adaptive::replay_predictor(&gpu_frame.details().predictions);
+        let hooks = render::adaptive::Hooks { predictor: Some(&mut replay), ..Default::default() };
+        let one = render::adaptive::Settings { frames: 1, ..settings };
+        let one = render::adaptive::render_with(&geometry, material, lighting, &bandwidths, &one, hooks).unwrap();
+        let apart = render::metrics::relative_error(&one.image.rgb, &cpu_frame.image.rgb);
+        assert!(
+            relative * 10.0 < apart,
+            "GPU against CPU {relative:.2e}, one frame's footprints against {frames}: {apart:.2e}"
+        );
+    }
 }
 
 /// The cases below cover the reference and the pre-convolved estimators, 2 x 2 anti-aliasing, the
@@ -741,7 +758,8 @@ fn adaptive_reference_frame_equals_the_cpu() {
 
 #[test]
 fn adaptive_prefiltered_frame_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase::new(Mode::Prefiltered, 4));
+    // One frame of 8 averaged: the blocks' footprints are sized for 8 times their samples.
+    check_adaptive_frame(AdaptiveCase { frames: 8, ..AdaptiveCase::new(Mode::Prefiltered, 4) });
 }
 
 #[test]

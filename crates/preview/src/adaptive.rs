@@ -36,9 +36,10 @@ pub(crate) fn render(
         lobe_weight: request.lobe_weight,
         layer_shift: request.layer_shift,
         seed: request.seed,
+        frames: request.frames.unwrap_or(render::adaptive::FRAMES),
         ..render::adaptive::Settings::new(mode, request.spp.unwrap_or(render::adaptive::SPP))
     };
-    let frames = request.frames.unwrap_or(render::adaptive::FRAMES);
+    let frames = settings.frames;
     let scene = scene(request)?;
     let ss = settings.supersample;
     let pixels = (scene.width * ss * scene.height * ss) as u128;

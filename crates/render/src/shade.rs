@@ -45,7 +45,7 @@ pub fn render_with_progress(
     let gbuffer = visibility(scene)?;
     let width = scene.width;
     Ok(shade_rows(scene, &gbuffer, lighting.mips.level(0), progress, |frame, x, y| {
-        shade(frame, (y * width + x) as u32, material, lighting, settings, 0)
+        shade(frame, (y * width + x) as u32, material, lighting, settings, BlockFilter::NONE)
     }))
 }
 
@@ -201,22 +201,34 @@ enum Source<'a> {
     Mips(&'a MipChain),
 }
 
-/// The estimate of one covered pixel, averaged over the frames; the prefiltered estimator reads
-/// the layer `layer_shift` layers sharper than the view's (the smooth map at most: an adaptive
-/// frame's shaded blocks, `adaptive::Settings::layer_shift`; 0 for [`render`]).
+/// How an adaptive frame's shaded block filters (`adaptive::Settings::layer_shift` and
+/// `frames`): the prefiltered estimator reads the layer `layer_shift` layers sharper than the
+/// view's (the smooth map at most) and sizes its footprints for the block's samples times
+/// `frames`, the frames the picture averages. [`BlockFilter::NONE`] for [`render`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockFilter {
+    pub layer_shift: u32,
+    pub frames: u32,
+}
+
+impl BlockFilter {
+    pub const NONE: BlockFilter = BlockFilter { layer_shift: 0, frames: 1 };
+}
+
+/// The estimate of one covered pixel, averaged over the frames, filtered as `block` says.
 pub(crate) fn shade(
     frame: &ShadingFrame,
     pixel: u32,
     material: &Material,
     lighting: &Lighting,
     settings: &Settings,
-    layer_shift: u32,
+    block: BlockFilter,
 ) -> [f64; 3] {
     let s: &SampleSet = &material.samples;
     let (n_vectors, n_samples, spp) = (s.n_vectors as u32, s.n_samples as u32, settings.spp);
     let table = &s.tables[slice_of(frame.theta_o(), s.n_slices)];
     let [brdf_points, env_points] = pixel_sequences(pixel, settings.seed);
-    let filter_samples = settings.filter_samples() as usize;
+    let filter_samples = settings.filter_samples() as usize * block.frames as usize;
     // The light a filtered estimator reads (`Some` in fis and prefiltered) and the light that
     // multiple importance sampling of the BRDF's and a light's strategy takes: level 0 whole in
     // the reference mode, the peaks in the filtered modes (crate documentation).
@@ -225,7 +237,9 @@ pub(crate) fn shade(
         Mode::Fis => Some(Source::Mips(lighting.smooth_mips())),
         Mode::Prefiltered => {
             let past = lighting.smooth_layers().len() as f64;
-            Some(Source::Layers((view_layer(&material.view_layers, frame.cos_o) + f64::from(layer_shift)).min(past)))
+            Some(Source::Layers(
+                (view_layer(&material.view_layers, frame.cos_o) + f64::from(block.layer_shift)).min(past),
+            ))
         }
     };
     let sampled = match (settings.mode, &lighting.peaks) {

@@ -34,8 +34,9 @@ fn frames_average_the_noise_of_the_shaded_blocks() {
     let (scene, material, lighting, bandwidths) = (sphere_scene(48, 48), phong(0), sky_lighting(), bandwidths());
     let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Mode::Reference, 4) };
     let one = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap().image;
-    assert_eq!(adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings, 1).unwrap(), one);
-    let eight = adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings, 8).unwrap();
+    assert_eq!(adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings).unwrap(), one);
+    let settings = adaptive::Settings { frames: 8, ..settings };
+    let eight = adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings).unwrap();
     assert_eq!(eight.covered, one.covered);
     let truth = render::converged::converged(&scene, material, &lighting, 256, 1).unwrap();
     let error = |image: &render::Image| render::metrics::relative_error(&image.rgb, &truth.rgb);

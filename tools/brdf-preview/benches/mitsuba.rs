@@ -224,10 +224,11 @@ fn ours(
         let settings = adaptive::Settings {
             predict_level: 2,
             allocation: adaptive::Allocation::Area,
+            frames: adaptive::FRAMES,
             ..adaptive::Settings::new(mode, adaptive::SPP)
         };
         let start = Instant::now();
-        let image = adaptive::render_frames(scene, material, lighting, bandwidths, &settings, adaptive::FRAMES)
+        let image = adaptive::render_frames(scene, material, lighting, bandwidths, &settings)
             .unwrap_or_else(|e| panic!("rendering {name}: {e}"));
         images.push((name, image, start.elapsed().as_secs_f64()));
     }

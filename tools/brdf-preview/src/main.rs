@@ -117,10 +117,10 @@ struct Args {
     /// Frames averaged, from 1; each pixel's frames walk through its own sequence of points (render
     /// crate docs, "Samples"). Default: for reference, as many as the bake's vectors hold samples
     /// at this spp (32 at 64 spp with the default bake: 2048 directions of each strategy); 8 for
-    /// fis (whose filter is sized for spp x frames samples: more frames, less blur) and
-    /// prefiltered (more frames average its noise away, not its bias); 8 for the
-    /// adaptive modes, each frame planned from its own predictions with its own seed (crate
-    /// render, module adaptive, "Frames"). Within --max-samples.
+    /// fis and prefiltered (whose footprints are sized for spp x frames samples: more frames,
+    /// less blur); 8 for the adaptive modes, each frame planned from its own predictions with its
+    /// own seed (crate render, module adaptive, "Frames"), adaptive-prefiltered's blocks sized
+    /// for their samples x frames. Within --max-samples.
     #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     frames: Option<u32>,
 

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use crate::error::Error;
 use crate::raster::GBuffer;
-use crate::shade::{background, shade};
+use crate::shade::{BlockFilter, background, shade};
 use crate::{Image, Lighting, Material, Scene};
 
 use super::*;
@@ -152,20 +152,19 @@ pub fn frame_seed(seed: u32, frame: u32) -> u32 {
     if frame == 0 { seed } else { crate::pcg_hash(seed ^ crate::pcg_hash(frame)) }
 }
 
-/// The mean of `frames` adaptive frames of `scene` (module docs, "Frames"): frame `f` rendered
-/// with [`frame_seed`]`(settings.seed, f)`, the [`Geometry`] made once. `frames` from 1.
+/// The mean of [`Settings::frames`] adaptive frames of `scene` (module docs, "Frames"): frame `f`
+/// rendered with [`frame_seed`]`(settings.seed, f)`, the [`Geometry`] made once.
 pub fn render_frames(
     scene: &Scene,
     material: &Material,
     lighting: &Lighting,
     bandwidths: &Bandwidths,
     settings: &Settings,
-    frames: u32,
 ) -> Result<Image, Error> {
     check_settings(settings, material, lighting)?;
     let geometry = Geometry::of_scene(scene, settings.supersample)?;
     let mut mean = FrameMean::default();
-    for f in 0..frames {
+    for f in 0..settings.frames {
         let settings = Settings { seed: frame_seed(settings.seed, f), ..*settings };
         mean.add(&render_with(&geometry, material, lighting, bandwidths, &settings, Hooks::default())?.image);
     }
@@ -408,7 +407,8 @@ pub fn render_with(
                 let local = shading_frame(gbuffer, frame.eye, pixel as usize);
                 let spp = samples.min(n_samples);
                 let shading = crate::Settings { mode: settings.mode, spp, frames: samples / spp, seed: settings.seed };
-                shade(&local, pixel, material, lighting, &shading, settings.layer_shift).map(|v| v as f32)
+                let block = BlockFilter { layer_shift: settings.layer_shift, frames: settings.frames };
+                shade(&local, pixel, material, lighting, &shading, block).map(|v| v as f32)
             })
             .collect(),
     };

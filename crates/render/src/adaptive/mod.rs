@@ -189,6 +189,12 @@
 //! points); a block of more samples (a power of two, so a multiple of `N`) with `spp = N` and
 //! `count / N` frames, the first `count / N` vectors' worth of its pixel's walk through its
 //! `V N` points (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
+//! The pre-convolved estimator sizes the block's footprints for `count` times
+//! [`Settings::frames`], the frames the picture averages, as the full-resolution mode sizes
+//! them for `spp` times its frames: each frame's block draws other points. Measured against the
+//! converged estimate (chrome under studio_small_03, the Mitsuba benchmark's camera 82.8, 43.1,
+//! 128 x 128, 8 frames), footprints for `count` alone left the picture 0.21 levels too bright on
+//! average (7x7 bias p99 1.88) where those for `8 count` leave it 0.05 (p99 0.88).
 //!
 //! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
 //! ... at the level given by the maximum frequency of the BRDF") reads the Phong layers
@@ -340,6 +346,12 @@ pub struct Settings {
     /// wide), the map itself past the sharpest layer at most (module docs, "Shading"). Default
     /// [`LAYER_SHIFT`].
     pub layer_shift: u32,
+    /// The frames the picture averages, each planned and shaded with its own seed
+    /// ([`render_frames`] renders and averages them; a previewer may loop over [`render`]):
+    /// the pre-convolved estimator sizes a shaded block's footprints for its samples times
+    /// these, as [`crate::Settings::filter_samples`] counts `spp` times the frames (module docs,
+    /// "Shading"). From 1; default 1.
+    pub frames: u32,
 }
 
 /// [`Settings::layer_shift`]'s default (module docs, "Shading").
@@ -409,6 +421,7 @@ impl Settings {
             lobe_weight: false,
             rescue_below: 0.0,
             layer_shift: LAYER_SHIFT,
+            frames: 1,
         }
     }
 }
@@ -431,10 +444,10 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
     let per_frame = settings.max_spp.min(u32::try_from(n_samples).unwrap_or(u32::MAX));
     let base = crate::Settings { mode: settings.mode, spp: per_frame, frames: 1, seed: settings.seed };
     crate::check_settings(&base, n_samples, lighting.layers.len(), &material.view_layers)?;
-    if settings.spp == 0 || settings.n_b == 0 || !matches!(settings.supersample, 1 | 2 | 4) {
+    if settings.spp == 0 || settings.n_b == 0 || settings.frames == 0 || !matches!(settings.supersample, 1 | 2 | 4) {
         return Err(Error::Invalid(format!(
-            "spp {} and n_b {} must be at least 1 and supersample ({}) 1, 2 or 4",
-            settings.spp, settings.n_b, settings.supersample
+            "spp {}, n_b {} and frames {} must be at least 1 and supersample ({}) 1, 2 or 4",
+            settings.spp, settings.n_b, settings.frames, settings.supersample
         )));
     }
     if settings.lobe_weight

@@ -226,6 +226,7 @@ impl Renderer {
         let shade_uniform = |items: u32| super::ShadeUniform {
             layer_shift: settings.layer_shift,
             items,
+            filter_samples: settings.frames,
             ..self.shade_uniform(
                 super::mode_index(settings.mode),
                 &render::Settings { mode: settings.mode, spp: 1, frames: 1, seed: settings.seed },
