@@ -8,9 +8,9 @@
 use std::mem::{offset_of, size_of};
 
 use crate::merl_lookup::{DirPair, GpuSample, MerlDimsUniform};
-use crate::preview::adaptive::AdaptivePass;
+use crate::preview::adaptive::{AdaptivePass, RecordLobe, RecordSurface};
 use crate::preview::present::PresentUniform;
-use crate::preview::uniforms::{PredictUniform, ShadeUniform, WaveletUniform};
+use crate::preview::uniforms::{FrameUniform, PredictUniform, ShadeUniform, WaveletUniform};
 use crate::wgsl::{
     ADAPTIVE_PREDICT, ADAPTIVE_STATE, MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_BINDINGS, PREVIEW_PRESENT, WAVELET_BRDF,
 };
@@ -88,6 +88,11 @@ fn shared_structs() -> Vec<Shared> {
             "peak_marginal" => tables.peak_marginal, "peak_conditional" => tables.peak_conditional,
             "items" => items, "filter_samples" => filter_samples, "_pad1" => _pad1, "_pad2" => _pad2, "diffuse" => diffuse,
         }),
+        shared!(PREVIEW_BINDINGS.source, "Frame", FrameUniform { "index" => index }),
+        shared!(ADAPTIVE_STATE.source, "RecordSurface", RecordSurface {
+            "depth" => depth, "cos_o" => cos_o, "screen_normal" => screen_normal,
+        }),
+        shared!(ADAPTIVE_STATE.source, "RecordLobe", RecordLobe { "mirror" => mirror, "prediction" => prediction }),
         shared!(ADAPTIVE_PREDICT.source, "Predict", PredictUniform {
             "n_b" => n_b, "env_width" => env_width, "env_height" => env_height, "lobes_x" => lobes_x,
             "lobes_y" => lobes_y, "tile" => tile, "radians_per_pixel" => radians_per_pixel, "_pad" => _pad,

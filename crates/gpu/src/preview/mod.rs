@@ -361,7 +361,8 @@ impl Renderer {
                 let count = FRAMES_PER_SUBMIT.min(end - first);
                 let mut slots = vec![0u8; (self.frame_stride * u64::from(count)) as usize];
                 for (i, slot) in slots.chunks_exact_mut(self.frame_stride as usize).enumerate() {
-                    slot[..4].copy_from_slice(&(first + i as u32).to_le_bytes());
+                    let frame = FrameUniform { index: first + i as u32 };
+                    slot[..size_of::<FrameUniform>()].copy_from_slice(bytemuck::bytes_of(&frame));
                 }
                 // Takes effect before the submission below and after the ones before it.
                 self.queue.write_buffer(&self.frame_uniform, 0, &slots);
@@ -517,7 +518,7 @@ impl Renderer {
         let (x, y) = item_groups(count);
         let encoder = capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
-            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
+            self.queue.write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&FrameUniform::default()));
             self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(items));
             let mut encoder = self.device.create_command_encoder(&Default::default());
             {

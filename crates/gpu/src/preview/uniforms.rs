@@ -35,6 +35,14 @@ impl WaveletUniform {
     }
 }
 
+/// `Frame` of the WGSL: the index of the frame a dispatch shades, one slot per frame of a
+/// submission at the dynamic-offset alignment.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct FrameUniform {
+    pub(crate) index: u32,
+}
+
 /// Must equal `SHADE_WORKGROUP` in the WGSL (checked by a test below).
 pub(crate) const SHADE_WORKGROUP: u32 = 8;
 
@@ -145,7 +153,7 @@ pub(crate) const MODE_DEBUG_SLICE: u32 = 7;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::{PREVIEW_BINDINGS, PREVIEW_ENVIRONMENT, PREVIEW_SAMPLING};
+    use crate::wgsl::{ADAPTIVE_PREDICT, PREVIEW_BINDINGS, PREVIEW_ENVIRONMENT, PREVIEW_SAMPLING};
 
     #[test]
     fn workgroup_size_matches_the_shader() {
@@ -165,12 +173,14 @@ mod tests {
     #[test]
     fn sampling_constants_match_the_cpu() {
         let salt = format!("const SEQUENCE_SALT: u32 = {:#010x}u;", render::SEQUENCE_SALT);
+        let prediction_salt = format!("const PREDICTION_SALT: u32 = {:#010x}u;", render::adaptive::PREDICTION_SALT);
         let no_map = format!("const NO_MAP: u32 = {NO_MAP:#010x}u;");
         let lod_bias = format!("const FIS_LOD_BIAS: f32 = {:?};", render::FIS_LOD_BIAS as f32);
         let footprint =
             format!("const PREFILTERED_FOOTPRINT_LAYERS: f32 = {:?};", render::PREFILTERED_FOOTPRINT_LAYERS as f32);
         for (wgsl, decl) in [
             (&PREVIEW_SAMPLING, salt),
+            (&ADAPTIVE_PREDICT, prediction_salt),
             (&PREVIEW_BINDINGS, no_map),
             (&PREVIEW_ENVIRONMENT, lod_bias),
             (&PREVIEW_ENVIRONMENT, footprint),

@@ -29,7 +29,7 @@
 //! at or beside a silhouette split into its quarters ([`prediction_pixels`]): the prediction
 //! costs as much as shading `n_b` samples, and a block's pixels are alike), `n_b` incident
 //! directions (default 16): the first `n_b` samples of one baked vector of the pixel's slice
-//! (the vector `pcg_hash(pixel ^ pcg_hash(seed ^ 0x9e37_79b9)) % V`; the prefix of an
+//! (the vector `pcg_hash(pixel ^ pcg_hash(seed ^ PREDICTION_SALT)) % V`; the prefix of an
 //! Owen-scrambled Sobol' vector is stratified), each with its pdf. For each `wi`:
 //!
 //! - the light's bandwidth `nu_l = [0, nu_env(wi)]`, `nu_env` the bake's environment bandwidth

@@ -166,7 +166,7 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
     let s = &material.samples;
     let level0 = lighting.mips.level(0);
     let n_b = settings.n_b.min(s.n_samples);
-    let hashed_seed = pcg_hash(settings.seed ^ 0x9e37_79b9);
+    let hashed_seed = pcg_hash(settings.seed ^ PREDICTION_SALT);
     let k = slice_of(shading.theta_o(), s.n_slices);
     let vector = pcg_hash(i as u32 ^ hashed_seed) as usize % s.n_vectors;
     let start = (k * s.n_vectors + vector) * s.n_samples;
@@ -220,6 +220,10 @@ pub fn bandwidth_at_eye(nu_env: f64, rho: f64, curvature: f64, depth: f64, cos_x
 /// Samples per cycle of the predicted bandwidth that a pixel's level gives it (module docs, "The
 /// bandwidth buffer"): twice the Nyquist rate, a power of two.
 pub const SAMPLES_PER_CYCLE: f64 = 4.0;
+
+/// Mixed into the seed of the prediction's choice of a vector per pixel (module docs, "The
+/// bandwidth buffer"), so that it is not the shading's.
+pub const PREDICTION_SALT: u32 = 0x9e37_79b9;
 
 /// Eq. 11 at [`SAMPLES_PER_CYCLE`]: `floor(log2(1 / (4 bandwidth)))` clamped to `[0, top]`.
 pub fn level_of(bandwidth: f64, top: usize) -> i32 {

@@ -74,7 +74,7 @@ fn adaptive_output(
         let y = oy * adapt.ss + j / adapt.ss;
         let p = y * adapt.width + x;
         // The depth alone tells the three apart: the rest of the record is not read.
-        let depth = records_surface[p].x;
+        let depth = records_surface[p].depth;
         if (depth < 0.0) {
             sum += backdrop[p].xyz;
         } else {

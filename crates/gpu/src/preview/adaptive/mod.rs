@@ -41,6 +41,8 @@ use crate::error::GpuError;
 use crate::merl_lookup::capture_errors;
 use state::*;
 pub(super) use state::{Pipelines, State, storage_buffers};
+#[cfg(test)]
+pub(crate) use state::{RecordLobe, RecordSurface};
 
 /// `AdaptivePass` of `state.wgsl`.
 #[repr(C)]
@@ -285,7 +287,7 @@ impl Renderer {
             self.progress.set(None);
             self.write_predict_uniform(prediction, settings);
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade_uniform(state.n_items)));
-            self.queue.write_buffer(&self.frame_uniform, 0, &[0u8; 16]);
+            self.queue.write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&super::FrameUniform::default()));
             if let Some(oracle) = options.oracle {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
                 self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));

@@ -21,6 +21,9 @@ struct Predict {
 }
 
 @group(3) @binding(0) var<uniform> predict: Predict;
+
+// `render::adaptive::PREDICTION_SALT`: mixed into the seed of the vector each prediction reads.
+const PREDICTION_SALT: u32 = 0x9e3779b9u;
 // The environment bandwidth (cycles per radian), then the atlas: one buffer, so that the pass
 // stays within the storage buffers an adapter offers per stage.
 @group(3) @binding(1) var<storage, read> bandwidth_texels: array<f32>;
@@ -95,7 +98,7 @@ fn predict_pixel(x: u32, y: u32, curvature: f32) -> vec2<f32> {
     let pixel = y * shade.width + x;
     let n_b = min(predict.n_b, shade.n_samples);
     let k = slice_of(frame);
-    let vector = pcg_hash(pixel ^ pcg_hash(shade.seed ^ 0x9e3779b9u)) % shade.n_vectors;
+    let vector = pcg_hash(pixel ^ pcg_hash(shade.seed ^ PREDICTION_SALT)) % shade.n_vectors;
     let start = (k * shade.n_vectors + vector) * shade.n_samples;
     var weight = 0.0;
     var weighted = 0.0;

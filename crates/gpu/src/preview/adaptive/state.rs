@@ -101,6 +101,25 @@ pub(super) fn slots(top: usize) -> u64 {
     2 * top as u64 + 4
 }
 
+/// `RecordSurface` of `state.wgsl`: a render pixel's depth, `cos theta_o` and screen-projected
+/// normal (`render::adaptive::Pixel`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct RecordSurface {
+    pub(crate) depth: f32,
+    pub(crate) cos_o: f32,
+    pub(crate) screen_normal: [f32; 2],
+}
+
+/// `RecordLobe` of `state.wgsl`: a render pixel's mirror direction and the index of its
+/// prediction.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct RecordLobe {
+    pub(crate) mirror: [f32; 3],
+    pub(crate) prediction: u32,
+}
+
 impl Renderer {
     /// The adaptive frames' pipelines, made at the first call: a renderer of the other modes
     /// never makes them. Fails with [`GpuError::AdapterLimit`] where the adapter binds fewer
@@ -209,20 +228,23 @@ impl Renderer {
             capacity: p,
             ..Default::default()
         };
-        let (mut surface, mut lobe) = (vec![[0f32; 4]; p as usize], vec![[0u32; 4]; p as usize]);
+        let (mut surface, mut lobe) =
+            (vec![RecordSurface::default(); p as usize], vec![RecordLobe::default(); p as usize]);
         for (i, (s, l)) in surface.iter_mut().zip(&mut lobe).enumerate() {
-            let f = |v: f64| (v as f32).to_bits();
             match &pixels[i] {
                 Some(px) => {
-                    let [nx, ny] = px.screen_normal;
-                    *s = [px.depth, px.cos_o, nx, ny].map(|v| v as f32);
-                    *l = [f(px.mirror.x), f(px.mirror.y), f(px.mirror.z), of_pixel[i]];
+                    *s = RecordSurface {
+                        depth: px.depth as f32,
+                        cos_o: px.cos_o as f32,
+                        screen_normal: px.screen_normal.map(|v| v as f32),
+                    };
+                    *l = RecordLobe { mirror: px.mirror.as_vec3().to_array(), prediction: of_pixel[i] };
                 }
                 None => {
                     // The WGSL's output tells covered pixels without a shading frame by a depth
                     // of 0: a shaded pixel's is positive.
-                    s[0] = if geometry.covers(i) { 0.0 } else { -1.0 };
-                    l[3] = NONE;
+                    s.depth = if geometry.covers(i) { 0.0 } else { -1.0 };
+                    l.prediction = NONE;
                 }
             }
         }

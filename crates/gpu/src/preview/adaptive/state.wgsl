@@ -43,11 +43,26 @@ struct AdaptivePass {
     _pad: u32,
 }
 
+// A render pixel's `render::adaptive::Pixel` as `preview/adaptive/state.rs` writes it, in two
+// records: what the levels and the output read, and the lobe the up-sampling weights read.
+struct RecordSurface {
+    // -1 where no triangle covers the pixel, 0 where one covers it but it is not shadeable.
+    depth: f32,
+    cos_o: f32,
+    // The screen-projected normal.
+    screen_normal: vec2<f32>,
+}
+
+struct RecordLobe {
+    // The mirror direction.
+    mirror: vec3<f32>,
+    // The index of its prediction; `NONE` where the pixel is not shadeable.
+    prediction: u32,
+}
+
 // The state, per render pixel or per block of every level (blocks of level k start at the level
 // table's offset for k):
-// - records, per render pixel: its depth (-1 where no triangle covers it, 0 where one covers it
-//   but it is not shadeable), cos theta_o and the screen-projected normal (x, y); and its mirror
-//   direction (x, y, z) with the index of its prediction (`NONE` where it is not shadeable);
+// - records, per render pixel (`RecordSurface`, `RecordLobe`);
 // - bandwidths, per render pixel: its image bandwidth (cycles per pixel);
 // - levels, per block: the min pyramid (i32), the max pyramid of the variance, the action
 //   (`ACTION_*`, with the parents' count in bits 8 and up), unused;
@@ -63,8 +78,8 @@ struct AdaptivePass {
 //   valid: the host writes their min level (-1) and action (skipped) once per geometry, and the
 //   passes run over the candidates only); `n_rows` lobe sharpnesses per view row.
 @group(3) @binding(2) var<uniform> adapt: AdaptivePass;
-@group(3) @binding(3) var<storage, read> records_surface: array<vec4<f32>>;
-@group(3) @binding(4) var<storage, read> records_lobe: array<vec4<u32>>;
+@group(3) @binding(3) var<storage, read> records_surface: array<RecordSurface>;
+@group(3) @binding(4) var<storage, read> records_lobe: array<RecordLobe>;
 @group(3) @binding(5) var<storage, read_write> bandwidths: array<f32>;
 @group(3) @binding(6) var<storage, read_write> levels: array<vec4<u32>>;
 @group(3) @binding(7) var<storage, read_write> parents: array<vec4<u32>>;
@@ -132,13 +147,7 @@ struct Record {
 fn record(pixel: u32) -> Record {
     let a = records_surface[pixel];
     let b = records_lobe[pixel];
-    var r: Record;
-    r.depth = a.x;
-    r.cos_o = a.y;
-    r.screen_normal = a.zw;
-    r.mirror = bitcast<vec3<f32>>(b.xyz);
-    r.prediction = b.w;
-    return r;
+    return Record(a.depth, a.cos_o, a.screen_normal, b.mirror, b.prediction);
 }
 
 // Level k's width, height and first block.
