@@ -330,7 +330,6 @@ pub fn render_with(
             settings.supersample, geometry.supersample
         )));
     }
-    let (ss, (output_width, output_height)) = (geometry.supersample, geometry.size);
     let (width, height) = geometry.render_size();
     let (gbuffer, pixels) = (&geometry.gbuffer, &geometry.pixels);
     let clock = std::time::Instant::now();
@@ -349,17 +348,7 @@ pub fn render_with(
     };
     let mut predictions = predict(pixels, (width, height), &frame, predictor)?;
     if let Some(oracle) = oracle {
-        if oracle.len() != predictions.len() {
-            return Err(Error::Invalid(format!(
-                "an oracle of {} values for {width} x {height} render pixels",
-                oracle.len()
-            )));
-        }
-        for (p, &bandwidth) in predictions.iter_mut().zip(oracle) {
-            if p.level >= 0 {
-                *p = Prediction { bandwidth, level: level_of(bandwidth, top), ..*p };
-            }
-        }
+        apply_oracle(&mut predictions, oracle, top, (width, height))?;
     }
     grade_levels(&mut predictions, width, height);
     let predict_ms = lap();
@@ -378,79 +367,9 @@ pub fn render_with(
         sharpness.as_deref(),
     )?;
     let plan_ms = lap();
-
-    // Shading does not depend on up-sampling: every shaded block at once, then coarse to fine.
-    // A block's samples come a vector's worth at most per frame (module docs, "Shading").
-    let n_samples = material.samples.n_samples as u32;
-    let mut shaded: Vec<(u32, u32)> = Vec::new();
-    let mut slot: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
-    for (k, actions) in plan.actions.iter().enumerate() {
-        let level = &plan.levels[k];
-        slot[k] = actions
-            .iter()
-            .enumerate()
-            .map(|(b, action)| match *action {
-                Action::Shade { samples, .. } => {
-                    let (x, y) = level.pixel(b % level.width, b / level.width, width, height);
-                    shaded.push(((y * width + x) as u32, samples));
-                    (shaded.len() - 1) as u32
-                }
-                _ => u32::MAX,
-            })
-            .collect();
-    }
-    let estimates = match shader {
-        Some(shader) => shader(&shaded)?,
-        None => shaded
-            .par_iter()
-            .map(|&(pixel, samples)| {
-                let local = shading_frame(gbuffer, frame.eye, pixel as usize);
-                let spp = samples.min(n_samples);
-                let shading = crate::Settings { mode: settings.mode, spp, frames: samples / spp, seed: settings.seed };
-                let block = BlockFilter { layer_shift: settings.layer_shift, frames: settings.frames };
-                shade(&local, pixel, material, lighting, &shading, block).map(|v| v as f32)
-            })
-            .collect(),
-    };
-    if estimates.len() != shaded.len() {
-        return Err(Error::Invalid(format!(
-            "the shader returned {} estimates for {} blocks",
-            estimates.len(),
-            shaded.len()
-        )));
-    }
-    let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
-    for k in (0..=top).rev() {
-        let coarser = if k < top { &values[k + 1] } else { &Vec::new() };
-        values[k] = plan.actions[k]
-            .par_iter()
-            .enumerate()
-            .map(|(b, action)| match *action {
-                Action::Skip => [0.0; 3],
-                Action::Shade { .. } => estimates[slot[k][b] as usize],
-                Action::Upsample { parents, count } => {
-                    let mut value = [0.0f32; 3];
-                    for &(i, w) in &parents[..count as usize] {
-                        for c in 0..3 {
-                            value[c] += w * coarser[i as usize][c];
-                        }
-                    }
-                    value
-                }
-            })
-            .collect();
-    }
-
-    let (level0, rays) = (lighting.mips.level(0), geometry.camera.rays(width, height));
-    let render_rgb: Vec<[f32; 3]> = (0..width * height)
-        .into_par_iter()
-        .map(|i| match (&gbuffer.hits[i], &pixels[i]) {
-            (None, _) => background(&rays, level0, i % width, i / width).map(|v| v as f32),
-            (Some(_), None) => [0.0; 3],
-            (Some(_), Some(_)) => values[0][i],
-        })
-        .collect();
-    let image = downsample(&render_rgb, geometry.covered.clone(), output_width, output_height, ss);
+    let (estimates, slots) = shade_blocks(&plan, &frame, shader)?;
+    let values = upsample(&plan, &estimates, &slots);
+    let image = compose(geometry, lighting, &values);
     let shade_ms = lap();
     let timings = Timings {
         gbuffer_ms: geometry.millis,
@@ -473,6 +392,125 @@ pub fn render_with(
         budget: plan.budget,
         details: Some(Details { predictions, plan, shaded_level, samples_per_pixel }),
     })
+}
+
+/// Replaces the predicted bandwidths of the shadeable pixels by `oracle`'s (one per render pixel
+/// of `width x height`), and their levels by eq. 11's for them.
+fn apply_oracle(
+    predictions: &mut [Prediction],
+    oracle: &[f64],
+    top: usize,
+    (width, height): (usize, usize),
+) -> Result<(), Error> {
+    if oracle.len() != predictions.len() {
+        return Err(Error::Invalid(format!(
+            "an oracle of {} values for {width} x {height} render pixels",
+            oracle.len()
+        )));
+    }
+    for (p, &bandwidth) in predictions.iter_mut().zip(oracle) {
+        if p.level >= 0 {
+            *p = Prediction { bandwidth, level: level_of(bandwidth, top), ..*p };
+        }
+    }
+    Ok(())
+}
+
+/// The estimates of the plan's shaded blocks, by `shader` or here (module docs, "Shading"), and
+/// per level and block the index of its estimate (`u32::MAX` where the block is not shaded).
+/// Shading does not depend on up-sampling: every shaded block at once.
+fn shade_blocks(plan: &Plan, frame: &Frame, shader: Option<Shader>) -> Result<(Vec<[f32; 3]>, Vec<Vec<u32>>), Error> {
+    let Frame { gbuffer, material, lighting, settings, .. } = *frame;
+    let (width, height) = (gbuffer.width, gbuffer.height);
+    let mut shaded: Vec<(u32, u32)> = Vec::new();
+    let slots = plan
+        .actions
+        .iter()
+        .zip(&plan.levels)
+        .map(|(actions, level)| {
+            actions
+                .iter()
+                .enumerate()
+                .map(|(b, action)| match *action {
+                    Action::Shade { samples, .. } => {
+                        let (x, y) = level.pixel(b % level.width, b / level.width, width, height);
+                        shaded.push(((y * width + x) as u32, samples));
+                        (shaded.len() - 1) as u32
+                    }
+                    _ => u32::MAX,
+                })
+                .collect()
+        })
+        .collect();
+    // A block's samples come a vector's worth at most per frame.
+    let n_samples = material.samples.n_samples as u32;
+    let estimates = match shader {
+        Some(shader) => shader(&shaded)?,
+        None => shaded
+            .par_iter()
+            .map(|&(pixel, samples)| {
+                let local = shading_frame(gbuffer, frame.eye, pixel as usize);
+                let spp = samples.min(n_samples);
+                let shading = crate::Settings { mode: settings.mode, spp, frames: samples / spp, seed: settings.seed };
+                let block = BlockFilter { layer_shift: settings.layer_shift, frames: settings.frames };
+                shade(&local, pixel, material, lighting, &shading, block).map(|v| v as f32)
+            })
+            .collect(),
+    };
+    if estimates.len() != shaded.len() {
+        return Err(Error::Invalid(format!(
+            "the shader returned {} estimates for {} blocks",
+            estimates.len(),
+            shaded.len()
+        )));
+    }
+    Ok((estimates, slots))
+}
+
+/// Every level's block values, coarse to fine: a shaded block's estimate, an up-sampled block's
+/// weighted parents (module docs, "Coarse to fine").
+fn upsample(plan: &Plan, estimates: &[[f32; 3]], slots: &[Vec<u32>]) -> Vec<Vec<[f32; 3]>> {
+    let top = plan.levels.len() - 1;
+    let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
+    for k in (0..=top).rev() {
+        let coarser = if k < top { &values[k + 1] } else { &Vec::new() };
+        values[k] = plan.actions[k]
+            .par_iter()
+            .enumerate()
+            .map(|(b, action)| match *action {
+                Action::Skip => [0.0; 3],
+                Action::Shade { .. } => estimates[slots[k][b] as usize],
+                Action::Upsample { parents, count } => {
+                    let mut value = [0.0f32; 3];
+                    for &(i, w) in &parents[..count as usize] {
+                        for c in 0..3 {
+                            value[c] += w * coarser[i as usize][c];
+                        }
+                    }
+                    value
+                }
+            })
+            .collect();
+    }
+    values
+}
+
+/// The output image: level 0's values where a pixel is shadeable, black where a triangle covers
+/// it without a shading frame, the environment behind the mesh elsewhere, averaged over each
+/// output pixel's `supersample x supersample` render pixels.
+fn compose(geometry: &Geometry, lighting: &Lighting, values: &[Vec<[f32; 3]>]) -> Image {
+    let (width, height) = geometry.render_size();
+    let (level0, rays) = (lighting.mips.level(0), geometry.camera.rays(width, height));
+    let render_rgb: Vec<[f32; 3]> = (0..width * height)
+        .into_par_iter()
+        .map(|i| match (&geometry.gbuffer.hits[i], &geometry.pixels[i]) {
+            (None, _) => background(&rays, level0, i % width, i / width).map(|v| v as f32),
+            (Some(_), None) => [0.0; 3],
+            (Some(_), Some(_)) => values[0][i],
+        })
+        .collect();
+    let (output_width, output_height) = geometry.size;
+    downsample(&render_rgb, geometry.covered.clone(), output_width, output_height, geometry.supersample)
 }
 
 /// Per output pixel: whether a triangle covers any of its `ss x ss` render pixels.

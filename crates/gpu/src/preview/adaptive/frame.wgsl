@@ -5,7 +5,7 @@
 // The shaded blocks' estimates in place: the sum of each one's parts (`accumulation`, as
 // `shade_blocks` leaves them; the list's entry `i` holds the block, its first part and their count).
 // Dispatched for the list (`CONTROL_ARGS` + 3 where the GPU allocates).
-// The shaded blocks' values in `render::adaptive::render_with` (the `Action::Shade` arm).
+// The shaded blocks' values in `render::adaptive::frame::upsample` (the `Action::Shade` arm).
 @compute @workgroup_size(64)
 fn adaptive_scatter(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -25,7 +25,7 @@ fn adaptive_scatter(
 }
 
 // Level `adapt.level`'s up-sampled blocks: the weighted means of their parents' values.
-// The `Action::Upsample` arm of `render::adaptive::render_with`.
+// The `Action::Upsample` arm of `render::adaptive::frame::upsample`.
 @compute @workgroup_size(64)
 fn adaptive_upsample(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -54,7 +54,7 @@ fn adaptive_upsample(
 // The output image into `accumulation`: each output pixel the mean of its ss x ss render
 // pixels (level 0's values, the environment (`backdrop`) where no triangle covers the pixel, black
 // where one covers it without a shading frame), w = 1 where a triangle covers any of them.
-// `render::adaptive::render_with`'s render pixels then `render::adaptive::frame::downsample`.
+// `render::adaptive::frame::compose`: its render pixels, then `render::adaptive::frame::downsample`.
 @compute @workgroup_size(64)
 fn adaptive_output(
     @builtin(workgroup_id) group: vec3<u32>,

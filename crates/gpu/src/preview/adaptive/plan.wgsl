@@ -6,7 +6,7 @@
 // (in `accumulation`, as `predict_blocks` leaves it), or the oracle's bandwidth. A
 // prediction whose pixel the GPU's raster does not find shadeable (-1) stands for the pixel
 // grid's Nyquist limit, 1/2 cycle per pixel, as `Renderer::predict_blocks` reads it. Level 0
-// of `render::adaptive::pyramid`, with the oracle as `render::adaptive::render_with` reads it.
+// of `render::adaptive::pyramid`, with the oracle as `render::adaptive::frame::apply_oracle` reads it.
 @compute @workgroup_size(64)
 fn adaptive_levels(
     @builtin(workgroup_id) group: vec3<u32>,

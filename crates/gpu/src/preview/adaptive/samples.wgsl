@@ -209,7 +209,7 @@ var<workgroup> chunk_empty: u32;
 // The inclusive prefix sum of `value` over a workgroup of `size` (at most 256) invocations
 // (Hillis and Steele).
 // No Rust twin: GPU plumbing (the CPU builds the list in one loop,
-// `render::adaptive::render_with`).
+// `render::adaptive::frame::shade_blocks`).
 fn workgroup_scan(local: u32, value: u32, size: u32) -> u32 {
     scan_words[local] = value;
     workgroupBarrier();
@@ -226,8 +226,8 @@ fn workgroup_scan(local: u32, value: u32, size: u32) -> u32 {
 }
 
 // Whether candidate `c` (in the plan's order: level by level, by block) is shaded.
-// The blocks whose `render::adaptive::Action` is `Shade`: those `render::adaptive::render_with`
-// lists.
+// The blocks whose `render::adaptive::Action` is `Shade`: those
+// `render::adaptive::frame::shade_blocks` lists.
 fn shaded_candidate(c: u32) -> bool {
     let action = levels[tables[adapt.candidates + c]].z & 0xffu;
     return action == ACTION_SHADE || action == ACTION_RESCUED;
@@ -278,7 +278,7 @@ fn adaptive_offsets(@builtin(local_invocation_index) local: u32) {
 // candidate's entry at its rank. Where the GPU allocates, also its samples (the first of its
 // level that `adaptive_allocate` doubled get twice its level's) and its parts in
 // `shade_blocks`' items, as `gpu::preview::adaptive::parts` lays them out. The CPU's list: the
-// shaded blocks of `render::adaptive::render_with`, in the same order.
+// shaded blocks of `render::adaptive::frame::shade_blocks`, in the same order.
 @compute @workgroup_size(64)
 fn adaptive_list(
     @builtin(workgroup_id) group: vec3<u32>,
