@@ -367,8 +367,8 @@ pub fn render_with(
         sharpness.as_deref(),
     )?;
     let plan_ms = lap();
-    let (estimates, slots) = shade_blocks(&plan, &frame, shader)?;
-    let values = upsample(&plan, &estimates, &slots);
+    let shaded = shade_blocks(&plan, &frame, shader)?;
+    let values = upsample(&plan, &shaded);
     let image = compose(geometry, lighting, &values);
     let shade_ms = lap();
     let timings = Timings {
@@ -416,10 +416,17 @@ fn apply_oracle(
     Ok(())
 }
 
-/// The estimates of the plan's shaded blocks, by `shader` or here (module docs, "Shading"), and
-/// per level and block the index of its estimate (`u32::MAX` where the block is not shaded).
+/// The estimates of a plan's shaded blocks.
+struct Shaded {
+    /// One per shaded block, in the plan's order.
+    estimates: Vec<[f32; 3]>,
+    /// Per level and block, the index of its estimate (`u32::MAX` where it is not shaded).
+    slots: Vec<Vec<u32>>,
+}
+
+/// The estimates of the plan's shaded blocks, by `shader` or here (module docs, "Shading").
 /// Shading does not depend on up-sampling: every shaded block at once.
-fn shade_blocks(plan: &Plan, frame: &Frame, shader: Option<Shader>) -> Result<(Vec<[f32; 3]>, Vec<Vec<u32>>), Error> {
+fn shade_blocks(plan: &Plan, frame: &Frame, shader: Option<Shader>) -> Result<Shaded, Error> {
     let Frame { gbuffer, material, lighting, settings, .. } = *frame;
     let (width, height) = (gbuffer.width, gbuffer.height);
     let mut shaded: Vec<(u32, u32)> = Vec::new();
@@ -464,12 +471,13 @@ fn shade_blocks(plan: &Plan, frame: &Frame, shader: Option<Shader>) -> Result<(V
             shaded.len()
         )));
     }
-    Ok((estimates, slots))
+    Ok(Shaded { estimates, slots })
 }
 
 /// Every level's block values, coarse to fine: a shaded block's estimate, an up-sampled block's
 /// weighted parents (module docs, "Coarse to fine").
-fn upsample(plan: &Plan, estimates: &[[f32; 3]], slots: &[Vec<u32>]) -> Vec<Vec<[f32; 3]>> {
+fn upsample(plan: &Plan, shaded: &Shaded) -> Vec<Vec<[f32; 3]>> {
+    let Shaded { estimates, slots } = shaded;
     let top = plan.levels.len() - 1;
     let mut values: Vec<Vec<[f32; 3]>> = vec![Vec::new(); top + 1];
     for k in (0..=top).rev() {
