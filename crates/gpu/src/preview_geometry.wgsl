@@ -34,7 +34,7 @@ fn mesh_normal(v: u32) -> vec3<f32> {
 }
 
 // Whether a clip-space vertex lies in the volume `render::raster` clips to
-// (`plane_distances` all >= 0): 0 <= z <= w, |x|, |y| <= G w.
+// (`render::raster::plane_distances` all >= 0): 0 <= z <= w, |x|, |y| <= G w.
 fn inside_clip_volume(c: vec4<f32>) -> bool {
     let g = GUARD_BAND * c.w;
     return c.z >= 0.0 && c.w - c.z >= 0.0 && c.x + g >= 0.0 && g - c.x >= 0.0 && c.y + g >= 0.0 && g - c.y >= 0.0;
@@ -99,7 +99,8 @@ fn edge(a: vec2<i32>, b: vec2<i32>) -> Wide {
     return wide_add(wide_product(a.x, b.y), wide_negate(wide_product(a.y, b.x)));
 }
 
-// Steps 5 and 6 of `render::raster` at pixel (x, y) for a triangle drawn whole (no vertex outside
+// Steps 5 and 6 of `render::raster` (`render::raster::for_each_covered`,
+// `render::raster::SubTriangle::hit`) at pixel (x, y) for a triangle drawn whole (no vertex outside
 // the clip volume): screen-space barycentrics from the snapped vertices' edge functions at the
 // pixel centre, exact as on the CPU and divided in f32, then perspective-correct weights
 // (b_i / w_i) / sum_j (b_j / w_j).
@@ -134,7 +135,7 @@ fn ray_weights(p: array<vec3<f32>, 3>, x: u32, y: u32) -> vec3<f32> {
     ) / area;
 }
 
-// `render::raster`'s hit at pixel (x, y) on triangle `t`: position and normal interpolated with
+// `render::raster::SubTriangle::hit` at pixel (x, y) on triangle `t`: position and normal interpolated with
 // the weights above, the normal normalized unless it is zero (glam's normalize_or_zero).
 fn interpolate_hit(t: u32, x: u32, y: u32) -> Hit {
     var p: array<vec3<f32>, 3>;

@@ -147,7 +147,7 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
 // The shaded blocks of an adaptive frame (`render::adaptive`), in parts: item `i` of `shade.items`
 // items arrives in `accumulation[i]` as the bits of (pixel, samples, first, count) and leaves as
 // terms `first .. first + count` of the pixel's estimate with that many samples
-// (`render::adaptive`'s shading, the same estimator as `shade_frame`) over `samples`, w = 1: the
+// (`render::adaptive::frame::shade_blocks`, the same estimator as `shade_frame`) over `samples`, w = 1: the
 // parts of a block sum to its estimate. Up to a vector's `n_samples` the samples are frame 0's;
 // a block of more reads `samples / n_samples` frames of `n_samples` (term `j` is term
 // `j % n_samples` of frame `j / n_samples`), a part that spans frames taking each frame's terms

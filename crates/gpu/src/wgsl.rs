@@ -281,89 +281,224 @@ mod tests {
             .collect()
     }
 
-    /// The workspace's crates (`crates/<dir>`, named with `_` for `-`) with the names declared
-    /// under their `src/`: items (`fn`, `struct`, `enum`, `const`, `static`, `type`, `trait`,
-    /// `mod`), public fields (`pub name:`) and the modules that files and folders make.
-    fn workspace_declarations() -> BTreeMap<String, BTreeSet<String>> {
-        fn walk(dir: &std::path::Path, names: &mut BTreeSet<String>) {
-            for entry in std::fs::read_dir(dir).unwrap().map(Result::unwrap) {
-                let path = entry.path();
-                let stem = path.file_stem().unwrap().to_string_lossy().to_string();
-                if path.is_dir() {
-                    names.insert(stem);
-                    walk(&path, names);
-                } else if path.extension().is_some_and(|e| e == "rs") {
-                    names.insert(stem);
-                    let code = code(&std::fs::read_to_string(&path).unwrap());
-                    for line in code.lines() {
-                        let words: Vec<String> = tokens(line).into_iter().map(|(_, w)| w).collect();
-                        for pair in words.windows(2) {
-                            let item = ["fn", "struct", "enum", "const", "static", "type", "trait", "mod"];
-                            if item.contains(&pair[0].as_str()) {
-                                names.insert(pair[1].clone());
-                            }
-                        }
-                        let field = line.trim_start().strip_prefix("pub").map(|rest| {
-                            let rest = rest.trim_start();
-                            rest.strip_prefix('(').and_then(|r| r.split_once(')')).map_or(rest, |(_, r)| r.trim_start())
-                        });
-                        if let Some((name, _)) = field.and_then(|f| f.split_once(':'))
-                            && !name.is_empty()
-                            && name.chars().all(|c| c.is_alphanumeric() || c == '_')
-                        {
-                            names.insert(name.to_string());
-                        }
-                    }
-                }
-            }
-        }
-        let crates = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
-        let mut out = BTreeMap::new();
-        for entry in std::fs::read_dir(crates).unwrap().map(Result::unwrap) {
-            let src = entry.path().join("src");
-            if src.is_dir() {
-                let mut names = BTreeSet::new();
-                walk(&src, &mut names);
-                out.insert(entry.file_name().to_string_lossy().replace('-', "_"), names);
-            }
-        }
-        out
+    /// A module of a workspace crate: the file that holds it and the folder of its child modules.
+    struct Module {
+        file: std::path::PathBuf,
+        dir: std::path::PathBuf,
     }
 
-    /// Every WGSL function names its CPU twin (a backticked path into a workspace crate, e.g.
-    /// `` `render::pcg_hash` ``) in the comment block right above it, or says `No Rust twin:` and
-    /// why; and every workspace path such a block names is declared in that crate, each segment
-    /// after the crate's name (a path that starts with no crate's name, such as
-    /// `Renderer::run_items`, is prose and not checked).
+    impl Module {
+        /// The root module of workspace crate `name` (`_` for `-`), if there is one.
+        fn root(name: &str) -> Option<Module> {
+            let crates = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+            let src = crates.join(name.replace('_', "-")).join("src");
+            src.join("lib.rs").is_file().then(|| Module { file: src.join("lib.rs"), dir: src })
+        }
+
+        /// Child module `name`: `name.rs` or `name/mod.rs` in the folder of child modules.
+        fn child(&self, name: &str) -> Option<Module> {
+            let file = self.dir.join(format!("{name}.rs"));
+            let folder = self.dir.join(name);
+            if file.is_file() {
+                Some(Module { file, dir: folder })
+            } else {
+                let file = folder.join("mod.rs");
+                file.is_file().then_some(Module { file, dir: folder })
+            }
+        }
+
+        fn code(&self) -> String {
+            code(&std::fs::read_to_string(&self.file).unwrap())
+        }
+
+        /// The file that declares item `name` in this module (a public one where `public`): here,
+        /// or a public one in a child module it re-exports (`pub use child::*`,
+        /// `pub(crate) use child::{..., name, ...}`).
+        fn item(&self, name: &str, public: bool) -> Option<std::path::PathBuf> {
+            let code = self.code();
+            let item = ["fn", "struct", "enum", "const", "static", "type", "trait", "mod"];
+            for line in code.lines() {
+                let words: Vec<String> = tokens(line).into_iter().map(|(_, w)| w).collect();
+                let declared = words.windows(2).any(|p| item.contains(&p[0].as_str()) && p[1] == name);
+                if declared && (!public || line.trim_start().starts_with("pub")) {
+                    return Some(self.file.clone());
+                }
+            }
+            for statement in code.split(';') {
+                let statement = statement.trim();
+                let Some(used) = ["pub use ", "pub(crate) use ", "pub(super) use "]
+                    .iter()
+                    .find_map(|prefix| statement.strip_prefix(prefix))
+                else {
+                    continue;
+                };
+                let (path, names) = used.split_once("::{").map_or_else(
+                    || used.rsplit_once("::").unwrap_or(("", used)),
+                    |(path, list)| (path, list.trim_end_matches('}')),
+                );
+                let listed = names.split(',').map(|n| n.split(" as ").next().unwrap().trim());
+                if !listed.clone().any(|n| n == "*" || n == name) {
+                    continue;
+                }
+                let mut module = Some(Module { file: self.file.clone(), dir: self.dir.clone() });
+                for segment in path.split("::").filter(|s| *s != "self") {
+                    module = module.and_then(|m| m.child(segment));
+                }
+                if let Some(found) = module.and_then(|m| m.item(name, true)) {
+                    return Some(found);
+                }
+            }
+            None
+        }
+    }
+
+    /// Whether `code` declares a member `name` of a type it declares: a method or associated
+    /// constant (`fn name`, `const name`), a field (`name:`) or a variant (`name,`, `name {`,
+    /// `name(`).
+    fn declares_member(code: &str, name: &str) -> bool {
+        code.lines().any(|line| {
+            let words: Vec<String> = tokens(line).into_iter().map(|(_, w)| w).collect();
+            let line = line.trim_start();
+            let line = line.strip_prefix("pub").map_or(line, |rest| {
+                let rest = rest.trim_start();
+                rest.strip_prefix('(').and_then(|r| r.split_once(')')).map_or(rest, |(_, r)| r.trim_start())
+            });
+            words.windows(2).any(|p| matches!(p[0].as_str(), "fn" | "const" | "type") && p[1] == name)
+                || line.strip_prefix(name).is_some_and(|rest| rest.starts_with([':', ',', '{', '(', ' ']))
+        })
+    }
+
+    /// What a resolved path names.
+    #[derive(Debug, PartialEq)]
+    enum Resolved {
+        Module,
+        Item,
+    }
+
+    /// Resolves a path into a workspace crate (`crate::module::...::item`, then members of a
+    /// type): each module a file of the crate, the item declared in the last one (or in a child
+    /// module it re-exports), a member declared in the file that declares its type. `None` when
+    /// the path starts with no workspace crate's name (prose, such as `Renderer::run_items`).
+    fn resolve(path: &[String]) -> Option<Result<Resolved, String>> {
+        let mut module = Module::root(&path[0])?;
+        for (i, segment) in path.iter().enumerate().skip(1) {
+            if let Some(child) = module.child(segment) {
+                module = child;
+                continue;
+            }
+            let Some(file) = module.item(segment, false) else {
+                return Some(Err(format!("{} declares no {segment}", module.file.display())));
+            };
+            let code = code(&std::fs::read_to_string(&file).unwrap());
+            return Some(match path[i + 1..].iter().find(|member| !declares_member(&code, member)) {
+                Some(member) => Err(format!("{} declares no member {member} of {segment}", file.display())),
+                None => Ok(Resolved::Item),
+            });
+        }
+        Some(Ok(Resolved::Module))
+    }
+
+    /// Every WGSL function names its CPU twin (a backticked path to an item of a workspace
+    /// crate, e.g. `` `render::pcg_hash` ``, not only a module) in the comment block right above
+    /// it, or says `No Rust twin:` and why; and every workspace path such a block names resolves
+    /// ([`resolve`]: its modules, the item, the members of a type).
     #[test]
     fn every_wgsl_function_names_its_rust_twin_or_says_why_not() {
-        let crates = workspace_declarations();
-        assert!(crates.contains_key("render") && crates.contains_key("wavelet_brdf"), "crates: {:?}", crates.keys());
         let mut wrong = Vec::new();
         let mut functions = 0;
         for w in ALL {
             for (name, comment) in function_comments(w.source) {
                 functions += 1;
-                let paths = backticked_paths(&comment);
-                let twins: Vec<&Vec<String>> = paths.iter().filter(|p| crates.contains_key(&p[0])).collect();
-                if twins.is_empty() && !comment.contains("No Rust twin:") {
-                    wrong.push(format!("{}: fn {name} names no Rust twin and does not say `No Rust twin:`", w.file));
+                let resolved: Vec<(Vec<String>, Result<Resolved, String>)> = backticked_paths(&comment)
+                    .into_iter()
+                    .filter_map(|path| resolve(&path).map(|r| (path, r)))
+                    .collect();
+                let twin = resolved.iter().any(|(_, r)| *r == Ok(Resolved::Item));
+                if !twin && !comment.contains("No Rust twin:") {
+                    wrong.push(format!(
+                        "{}: fn {name} names no Rust function or item as its twin and does not say `No Rust twin:`",
+                        w.file
+                    ));
                 }
-                for path in twins {
-                    let declared = &crates[&path[0]];
-                    if let Some(missing) = path[1..].iter().find(|s| !declared.contains(*s)) {
-                        wrong.push(format!(
-                            "{}: fn {name} names `{}`, but crates/{}/src declares no {missing}",
-                            w.file,
-                            path.join("::"),
-                            path[0].replace('_', "-")
-                        ));
+                for (path, result) in resolved {
+                    if let Err(e) = result {
+                        wrong.push(format!("{}: fn {name} names `{}`, but {e}", w.file, path.join("::")));
                     }
                 }
             }
         }
         assert!(functions > 100, "{functions} functions found");
         assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    }
+
+    /// The three.js port's GLSL (`engines/three/src/shade.glsl.js`), function for function: each
+    /// GLSL function is a WGSL function of the same name, or the comment block right above it
+    /// names a twin (a Rust path to an item, or a WGSL function) or says `No twin:` and why; and
+    /// every Rust path a comment block names resolves ([`resolve`]; the port names them without
+    /// backticks, `envmap::geometry::uv`).
+    #[test]
+    fn every_glsl_function_of_the_three_js_port_names_its_twin() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../engines/three/src/shade.glsl.js");
+        let glsl = std::fs::read_to_string(&path).unwrap();
+        let wgsl: BTreeSet<String> =
+            ALL.iter().flat_map(|w| function_comments(w.source)).map(|(name, _)| name).collect();
+        let types = ["float", "vec2", "vec3", "vec4", "int", "uint", "bool", "void", "mat3", "uvec2", "ivec2"];
+        let lines: Vec<&str> = glsl.lines().collect();
+        let (mut wrong, mut functions) = (Vec::new(), 0);
+        for (i, line) in lines.iter().enumerate() {
+            let Some((ty, rest)) = line.split_once(' ') else { continue };
+            let Some((name, _)) = rest.split_once('(') else { continue };
+            if !types.contains(&ty) || !line.ends_with('{') || name == "main" {
+                continue;
+            }
+            functions += 1;
+            let above = lines[..i].iter().rev().take_while(|l| l.starts_with("//"));
+            let mut block: Vec<&str> = above.map(|l| l.trim_start_matches('/').trim()).collect();
+            block.reverse();
+            let comment = block.join(" ");
+            let paths: Vec<Vec<String>> = comment
+                .split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+                .map(|word| word.trim_matches(':'))
+                .filter(|word| word.contains("::"))
+                .map(|word| word.split("::").map(str::to_string).collect())
+                .collect();
+            let mut twin = wgsl.contains(name) || comment.contains("No twin:");
+            twin |= tokens(&comment).iter().any(|(_, word)| wgsl.contains(word));
+            for path in paths {
+                match resolve(&path) {
+                    Some(Ok(resolved)) => twin |= resolved == Resolved::Item,
+                    Some(Err(e)) => wrong.push(format!("{name} names `{}`, but {e}", path.join("::"))),
+                    None => {}
+                }
+            }
+            if !twin {
+                wrong.push(format!("{name} is no WGSL function's name and names no twin (nor `No twin:`)"));
+            }
+        }
+        assert!(functions > 40, "{functions} GLSL functions found in {}", path.display());
+        assert!(wrong.is_empty(), "{}:\n{}", path.display(), wrong.join("\n"));
+    }
+
+    /// The resolver itself, on paths whose answers are known: a re-exported function, a private
+    /// function by its module path, a type's method and field, a module, and three that do not
+    /// resolve (a private function through a re-export among them).
+    #[test]
+    fn twin_paths_resolve_through_modules_and_re_exports() {
+        let path = |p: &str| p.split("::").map(str::to_string).collect::<Vec<_>>();
+        for good in [
+            "render::adaptive::render_with",
+            "render::adaptive::frame::upsample",
+            "render::adaptive::Plan::compare",
+            "render::Lighting::exponents",
+        ] {
+            assert_eq!(resolve(&path(good)), Some(Ok(Resolved::Item)), "{good}");
+        }
+        assert_eq!(resolve(&path("render::raster")), Some(Ok(Resolved::Module)));
+        for bad in ["render::adaptive::upsample", "render::adaptive::Plan::no_such_method", "render::nowhere::pcg_hash"]
+        {
+            assert!(matches!(resolve(&path(bad)), Some(Err(_))), "{bad} resolved");
+        }
+        assert_eq!(resolve(&path("Renderer::run_items")), None);
     }
 
     /// A module holds each file once, after the files it needs.

@@ -100,7 +100,8 @@ vec3 tonemap(vec3 radiance) {
 
 // What a pixel writes to gl_FragColor: brdf-preview's exposure, Reinhard and sRGB
 // (PREVIEW_OUTPUT), or the linear radiance times uExposure, which three's tone mapping and output
-// colour space take next (OUTPUT below, after the write).
+// colour space take next (OUTPUT below, after the write). No twin: the previewer presents with
+// tonemap alone.
 vec4 present(vec3 value) {
 #ifdef PREVIEW_OUTPUT
     return vec4(tonemap(value), 1.0);
@@ -346,7 +347,7 @@ uvec2 sample_range(uint pixel, uint f, uint spp) {
 // render::SEQUENCE_SALT.
 const uint SEQUENCE_SALT = 0x6a09e667u;
 
-// WGSL's reverseBits (GLSL ES 3.0 has no bitfieldReverse).
+// No twin: WGSL's builtin reverseBits (GLSL ES 3.0 has no bitfieldReverse).
 uint reverse_bits(uint value) {
     uint v = value;
     v = ((v >> 1u) & 0x55555555u) | ((v & 0x55555555u) << 1u);
@@ -397,7 +398,8 @@ vec2 sequence_point(uvec2 words, uint index) {
     return vec2(float(x >> 8u), float(y >> 8u)) / 16777216.0;
 }
 
-// A CDF table is a row of one layer of a table texture.
+// A CDF table is a row of one layer of a table texture. No twin: the WGSL indexes its storage
+// buffer (sampling_tables) where this fetches a texel.
 float table_value(sampler2DArray tables, int layer, int row, uint i) {
     return texelFetch(tables, ivec3(int(i), row, layer), 0).r;
 }
@@ -440,6 +442,8 @@ vec3 slice_wo(uint k) {
     return vec3(sin(theta_o), 0.0, cos(theta_o));
 }
 
+// Row edge i (t = 1 - cos theta_h) of slice k's table, render::SampleSet::tables' t_edges. No
+// twin: the WGSL reads it from sampling_tables inline.
 float t_edge(uint k, uint i) {
     return table_value(uBrdfTables, int(k), 0, i);
 }
@@ -737,8 +741,8 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     return sum;
 }
 
-// The radiance at pixel p (rows from the bottom), or where the G-buffer has no triangle the
-// environment behind.
+// shade_frame at pixel p (render::shade::shade_rows): the radiance (rows from the bottom), or
+// where the G-buffer has no triangle the environment behind.
 vec3 shade_pixel(uvec2 p) {
     // Row 0 at the top, as render's pixel index counts.
     uint pixel = (uResolution.y - 1u - p.y) * uResolution.x + p.x;

@@ -224,7 +224,7 @@ fn upsample_weights(k: u32, bx: u32, by: u32, block: u32) -> u32 {
     return count;
 }
 
-// The plan (`render::adaptive`, "Coarse to fine") of every candidate block of every level: skipped,
+// The plan (`render::adaptive::plan::plan`, "Coarse to fine") of every candidate block of every level: skipped,
 // shaded (appended to the list), rescued (shaded, appended) or up-sampled with its weights.
 @compute @workgroup_size(64)
 fn adaptive_plan(

@@ -83,7 +83,7 @@ fn bandwidth_at_eye(nu_env: f32, rho: f32, c: f32, depth: f32, cos_x: f32) -> f3
     return abs(nu.y);
 }
 
-// `render::adaptive::predict_pixel` at the shadeable pixel (x, y) of G-buffer curvature
+// `render::adaptive::predict::predict_pixel` at the shadeable pixel (x, y) of G-buffer curvature
 // `curvature` (the CPU's, a camera's: `render::adaptive::Geometry`): the image bandwidth (cycles
 // per pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the pre-convolved estimator) from
 // the first `n_b` samples of the pixel's vector; (-1, -1) where the pixel is not shadeable.
