@@ -20,255 +20,47 @@ impl Renderer {
     /// a buffer or the image exceeds what the adapter can hold.
     pub fn new(gpu: &Gpu, scene: &Scene, material: &Material, lighting: &Lighting) -> Result<Renderer, GpuError> {
         check_scene(scene, material, lighting)?;
+        let uploads = Uploads::new(material, lighting);
+        uploads.check_fits(gpu, scene, material)?;
         let (width, height) = (scene.width as u32, scene.height as u32);
-        let limits = gpu.limits();
-        let info = gpu.adapter_info();
-        if width.max(height) > limits.max_texture_dimension_2d {
-            return Err(GpuError::AdapterLimit {
-                adapter: gpu.adapter_summary(),
-                limit: "max_texture_dimension_2d",
-                have: limits.max_texture_dimension_2d.into(),
-                need: width.max(height).into(),
-                what: "the image",
-            });
-        }
-
-        let table = &material.table;
-        check_buffer_fits(&limits, info, table_bytes(table.dims()), "the MERL table")?;
-        if let Some(w) = &material.wavelet_brdf {
-            check_buffer_fits(&limits, info, 4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
-        }
-        let samples = &material.samples;
-        check_buffer_fits(&limits, info, 16 * samples.texels.len() as u64, "the importance samples")?;
-        let (env_maps, env_texels, maps) = env_buffers(lighting);
-        check_buffer_fits(&limits, info, 4 * env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
-        let (tables, sampling_layout) = sampling_tables(material, lighting);
-        check_buffer_fits(&limits, info, 4 * tables.len() as u64, "the sampling tables")?;
-        let pixels = u64::from(width) * u64::from(height);
-        check_buffer_fits(&limits, info, 16 * pixels, "the accumulation buffer")?;
-        // Clip-space positions, positions and normals interleaved: one storage buffer for all
-        // three, one binding of the shading passes' 12 (`Shading::storage_buffers`).
-        let n_vertices = scene.mesh.positions.len() as u64;
-        check_buffer_fits(&limits, info, 4 * VERTEX_FLOATS * n_vertices, "the mesh's vertices")?;
-        check_buffer_fits(&limits, info, 4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
-        check_storage_buffers(&limits, info, Shading::storage_buffers(), "shading (every mode)")?;
-
         let device = gpu.device().clone();
-        let queue = gpu.queue().clone();
-        let frame_stride = u64::from(limits.min_uniform_buffer_offset_alignment).max(16);
+        let frame_stride = u64::from(gpu.limits().min_uniform_buffer_offset_alignment).max(16);
         let renderer = capture_errors(&device, || {
-            let storage = |label: &str, contents: &[u8]| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-            };
-            let uniform = |label: &str, size: u64| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-
-            // The mesh, read by both passes.
-            // Written by `rasterize`, with the camera's projection.
-            let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview mesh vertices"),
-                size: 4 * VERTEX_FLOATS * n_vertices,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let index_buffer = storage("preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
-
-            // The raster pass.
-            let vertex = wgpu::ShaderStages::VERTEX;
-            let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("preview raster"),
-                entries: &[storage_entry(0, vertex, true), storage_entry(1, vertex, true)],
-            });
-            let raster_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("preview_raster.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(crate::wgsl::PREVIEW_RASTER.source.into()),
-            });
-            let raster_pipeline = raster_pipeline(&device, &raster_layout, &raster_module);
-            let raster_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview raster"),
-                layout: &raster_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: vertex_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: index_buffer.as_entire_binding() },
-                ],
-            });
-            let target = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
-            use wgpu::TextureUsages as T;
-            let triangle_target =
-                target("preview gbuffer triangle", TRIANGLE_FORMAT, T::RENDER_ATTACHMENT | T::TEXTURE_BINDING);
-            let depth_target = target("preview depth", DEPTH_FORMAT, T::RENDER_ATTACHMENT);
-
-            // The shading pass.
-            let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
-            };
-            let shading = Shading {
-                module: device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("preview_shade.wgsl"),
-                    source: wgpu::ShaderSource::Wgsl(
-                        crate::wgsl::module(&[
-                            &crate::wgsl::PREVIEW_SHADE,
-                            &crate::wgsl::ADAPTIVE_PREDICT,
-                            &crate::wgsl::ADAPTIVE_PLAN,
-                            &crate::wgsl::ADAPTIVE_SAMPLES,
-                            &crate::wgsl::ADAPTIVE_FRAME,
-                        ])
-                        .into(),
-                    ),
-                }),
-                table: layout("merl table", &table_entries()),
-                bake: layout("preview bake", &bake_entries()),
-                render: layout("preview render", &render_entries()),
-            };
-            let shade_pipeline = shading.pipeline(&device, true, None, "shade_frame");
-            let backdrop_pipeline = shading.pipeline(&device, true, None, "shade_backdrop");
-            let (table_layout, bake_layout, render_layout) = (&shading.table, &shading.bake, &shading.render);
-
-            let dims_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("merl dims"),
-                contents: bytemuck::bytes_of(&MerlDimsUniform::new(table.dims())),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let table_buffer = storage("merl table", bytemuck::cast_slice(&gpu_table_values(table)));
-            let wavelet = WaveletUniform::new(material.wavelet_brdf.as_ref());
-            let wavelet_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("wavelet params"),
-                contents: bytemuck::bytes_of(&wavelet),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            // Without a wavelet the shader never reads these; a binding cannot be empty.
-            let (map, slices) = match &material.wavelet_brdf {
-                Some(w) => (w.brdf.map(), w.brdf.slices()),
-                None => (&[0u32][..], &[0f32][..]),
-            };
-            let wavelet_map_buffer = storage("wavelet map", bytemuck::cast_slice(map));
-            let wavelet_slices_buffer = storage("wavelet slices", bytemuck::cast_slice(slices));
-            let table_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("merl table"),
-                layout: table_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: dims_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: table_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: wavelet_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: wavelet_map_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: wavelet_slices_buffer.as_entire_binding() },
-                ],
-            });
-            let samples_buffer = storage("preview samples", bytemuck::cast_slice(&samples.texels));
-            let maps_buffer = storage("preview env maps", bytemuck::cast_slice(&env_maps));
-            let texels_buffer = storage("preview env texels", bytemuck::cast_slice(&env_texels));
-            // The view rows' layer coordinates, then the layers' exponents and the one past the
-            // sharpest (`render::past_exponent`). A binding cannot be empty; a table nobody reads
-            // (the mode check rejects the prefiltered mode without one) holds one unused entry.
-            let mut view_layers = material.view_layers.clone();
-            if !lighting.exponents.is_empty() {
-                view_layers.extend(lighting.exponents.iter().map(|&n| n as f32));
-                view_layers.push(render::past_exponent(&lighting.exponents) as f32);
-            }
-            if view_layers.is_empty() {
-                view_layers.push(0.0);
-            }
-            let view_layers_buffer = storage("preview view layers", bytemuck::cast_slice(&view_layers));
-            let tables_buffer = storage("preview sampling tables", bytemuck::cast_slice(&tables));
-            let bake_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview bake"),
-                layout: bake_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: samples_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: maps_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: texels_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: view_layers_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: vertex_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: index_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 6, resource: tables_buffer.as_entire_binding() },
-                ],
-            });
-
-            let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
-            let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
-            let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview accumulation"),
-                size: 16 * pixels,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let backdrop = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview backdrop"),
-                size: 16 * pixels,
-                usage: wgpu::BufferUsages::STORAGE,
-                mapped_at_creation: false,
-            });
-            let view = |texture: &wgpu::Texture| texture.create_view(&Default::default());
-            let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview render"),
-                layout: render_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: shade_uniform.as_entire_binding() },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &frame_uniform,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(16),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&view(&triangle_target)),
-                    },
-                    wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: backdrop.as_entire_binding() },
-                ],
-            });
+            let raster = Raster::new(&device, scene);
+            let shading = Shading::new(&device);
+            let table_group = table_group(&device, &shading.table, material);
+            let bake_group = uploads.bake_group(&device, &shading.bake, material, &raster);
+            let render =
+                RenderGroup::new(&device, &shading.render, &raster.triangle_target, frame_stride, (width, height));
+            let samples = &material.samples;
             Renderer {
                 device: device.clone(),
-                queue: queue.clone(),
+                queue: gpu.queue().clone(),
                 width,
                 height,
                 camera: scene.camera,
                 n_indices: scene.mesh.indices.len() as u32,
-                raster_pipeline,
-                vertex_buffer,
+                raster_pipeline: raster.pipeline,
+                vertex_buffer: raster.vertex_buffer,
                 mesh: scene.mesh.clone(),
                 geometry: RefCell::new(None),
-                raster_group,
-                triangle_target,
-                depth_target,
-                shade_pipeline,
-                backdrop_pipeline,
+                raster_group: raster.group,
+                triangle_target: raster.triangle_target,
+                depth_target: raster.depth_target,
+                shade_pipeline: shading.pipeline(&device, true, None, "shade_frame"),
+                backdrop_pipeline: shading.pipeline(&device, true, None, "shade_backdrop"),
                 prediction: None,
                 adaptive_pipelines: OnceCell::new(),
                 adaptive: RefCell::new(None),
-                adapter_info: info.clone(),
+                adapter_info: gpu.adapter_info().clone(),
                 table_group,
                 bake_group,
-                render_group,
+                render_group: render.group,
                 shading,
-                shade_uniform,
-                frame_uniform,
+                shade_uniform: render.shade_uniform,
+                frame_uniform: render.frame_uniform,
                 frame_stride,
-                accumulation,
+                accumulation: render.accumulation,
                 progress: Cell::new(None),
                 n_slices: samples.n_slices as u32,
                 n_vectors: samples.n_vectors as u32,
@@ -277,12 +69,259 @@ impl Renderer {
                 n_layers: lighting.layers.len(),
                 view_layers: material.view_layers.clone(),
                 diffuse: render::diffuse_split(material, lighting),
-                maps,
-                tables: sampling_layout,
+                maps: uploads.maps,
+                tables: uploads.sampling_layout,
             }
         })?;
         renderer.rasterize()?;
         Ok(renderer)
+    }
+}
+
+/// What group 1 uploads from the material and the lighting, laid out for the WGSL.
+struct Uploads {
+    env_maps: Vec<[u32; 4]>,
+    env_texels: Vec<f32>,
+    maps: MapLayout,
+    tables: Vec<f32>,
+    sampling_layout: TableLayout,
+    /// The view rows' layer coordinates, then the layers' exponents and the one past the
+    /// sharpest (`render::past_exponent`). A binding cannot be empty; a table nobody reads (the
+    /// mode check rejects the prefiltered mode without one) holds one unused entry.
+    view_layers: Vec<f32>,
+}
+
+impl Uploads {
+    fn new(material: &Material, lighting: &Lighting) -> Uploads {
+        let (env_maps, env_texels, maps) = env_buffers(lighting);
+        let (tables, sampling_layout) = sampling_tables(material, lighting);
+        let mut view_layers = material.view_layers.clone();
+        if !lighting.exponents.is_empty() {
+            view_layers.extend(lighting.exponents.iter().map(|&n| n as f32));
+            view_layers.push(render::past_exponent(&lighting.exponents) as f32);
+        }
+        if view_layers.is_empty() {
+            view_layers.push(0.0);
+        }
+        Uploads { env_maps, env_texels, maps, tables, sampling_layout, view_layers }
+    }
+
+    /// Fails with [`GpuError::AdapterLimit`] where the image, a buffer or the shading passes'
+    /// bindings exceed what the adapter holds.
+    fn check_fits(&self, gpu: &Gpu, scene: &Scene, material: &Material) -> Result<(), GpuError> {
+        let (limits, info) = (gpu.limits(), gpu.adapter_info());
+        let side = scene.width.max(scene.height) as u32;
+        if side > limits.max_texture_dimension_2d {
+            return Err(GpuError::AdapterLimit {
+                adapter: gpu.adapter_summary(),
+                limit: "max_texture_dimension_2d",
+                have: limits.max_texture_dimension_2d.into(),
+                need: side.into(),
+                what: "the image",
+            });
+        }
+        let fits = |bytes: u64, what| check_buffer_fits(&limits, info, bytes, what);
+        fits(table_bytes(material.table.dims()), "the MERL table")?;
+        if let Some(w) = &material.wavelet_brdf {
+            fits(4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
+        }
+        fits(16 * material.samples.texels.len() as u64, "the importance samples")?;
+        fits(4 * self.env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
+        fits(4 * self.tables.len() as u64, "the sampling tables")?;
+        fits(16 * (scene.width * scene.height) as u64, "the accumulation buffer")?;
+        // Clip-space positions, positions and normals interleaved: one storage buffer for all
+        // three, one binding of the shading passes' 12 (`Shading::storage_buffers`).
+        fits(4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64, "the mesh's vertices")?;
+        fits(4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
+        check_storage_buffers(&limits, info, Shading::storage_buffers(), "shading (every mode)")
+    }
+
+    /// Group 1: the samples, every map, the view-layer table, the mesh and the sampling tables.
+    fn bake_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        material: &Material,
+        raster: &Raster,
+    ) -> wgpu::BindGroup {
+        let buffers = [
+            storage(device, "preview samples", bytemuck::cast_slice(&material.samples.texels)),
+            storage(device, "preview env maps", bytemuck::cast_slice(&self.env_maps)),
+            storage(device, "preview env texels", bytemuck::cast_slice(&self.env_texels)),
+            storage(device, "preview view layers", bytemuck::cast_slice(&self.view_layers)),
+        ];
+        let tables = storage(device, "preview sampling tables", bytemuck::cast_slice(&self.tables));
+        let resources =
+            [&buffers[0], &buffers[1], &buffers[2], &buffers[3], &raster.vertex_buffer, &raster.index_buffer, &tables];
+        let entries: Vec<wgpu::BindGroupEntry> = (0..)
+            .zip(resources)
+            .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("preview bake"), layout, entries: &entries })
+    }
+}
+
+/// A read-only storage buffer holding `contents`.
+fn storage(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
+/// The raster pass: the mesh's buffers (read by the shading passes too), its pipeline and group,
+/// and its targets.
+struct Raster {
+    /// Written by `rasterize`, with the camera's projection.
+    vertex_buffer: wgpu::Buffer,
+    index_buffer: wgpu::Buffer,
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    triangle_target: wgpu::Texture,
+    depth_target: wgpu::Texture,
+}
+
+impl Raster {
+    fn new(device: &wgpu::Device, scene: &Scene) -> Raster {
+        let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview mesh vertices"),
+            size: 4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let index_buffer = storage(device, "preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("preview raster"),
+            entries: &[storage_entry(0, vertex, true), storage_entry(1, vertex, true)],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("preview_raster.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(crate::wgsl::PREVIEW_RASTER.source.into()),
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("preview raster"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: vertex_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: index_buffer.as_entire_binding() },
+            ],
+        });
+        let target = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: scene.width as u32,
+                    height: scene.height as u32,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        use wgpu::TextureUsages as T;
+        Raster {
+            pipeline: raster_pipeline(device, &layout, &module),
+            group,
+            triangle_target: target(
+                "preview gbuffer triangle",
+                TRIANGLE_FORMAT,
+                T::RENDER_ATTACHMENT | T::TEXTURE_BINDING,
+            ),
+            depth_target: target("preview depth", DEPTH_FORMAT, T::RENDER_ATTACHMENT),
+            vertex_buffer,
+            index_buffer,
+        }
+    }
+}
+
+/// Group 0: the MERL table and the wavelet BRDF. Without a wavelet the shader never reads its
+/// map and slices; a binding cannot be empty.
+fn table_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, material: &Material) -> wgpu::BindGroup {
+    let table = &material.table;
+    let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("merl dims"),
+        contents: bytemuck::bytes_of(&MerlDimsUniform::new(table.dims())),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let values = storage(device, "merl table", bytemuck::cast_slice(&gpu_table_values(table)));
+    let wavelet = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("wavelet params"),
+        contents: bytemuck::bytes_of(&WaveletUniform::new(material.wavelet_brdf.as_ref())),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let (map, slices) = match &material.wavelet_brdf {
+        Some(w) => (w.brdf.map(), w.brdf.slices()),
+        None => (&[0u32][..], &[0f32][..]),
+    };
+    let map = storage(device, "wavelet map", bytemuck::cast_slice(map));
+    let slices = storage(device, "wavelet slices", bytemuck::cast_slice(slices));
+    let entries: Vec<wgpu::BindGroupEntry> = (0..)
+        .zip([&dims, &values, &wavelet, &map, &slices])
+        .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("merl table"), layout, entries: &entries })
+}
+
+/// Group 2: the render's uniforms (`Shade`, and `Frame` one slot per frame of a submission), the
+/// G-buffer, the accumulation and the backdrop.
+struct RenderGroup {
+    group: wgpu::BindGroup,
+    shade_uniform: wgpu::Buffer,
+    frame_uniform: wgpu::Buffer,
+    accumulation: wgpu::Buffer,
+}
+
+impl RenderGroup {
+    fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        triangle_target: &wgpu::Texture,
+        frame_stride: u64,
+        (width, height): (u32, u32),
+    ) -> RenderGroup {
+        let uniform = |label: &str, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let pixels = u64::from(width) * u64::from(height);
+        let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
+        let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
+        let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview accumulation"),
+            size: 16 * pixels,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let backdrop = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview backdrop"),
+            size: 16 * pixels,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let frame = wgpu::BufferBinding { buffer: &frame_uniform, offset: 0, size: wgpu::BufferSize::new(16) };
+        let triangles = triangle_target.create_view(&Default::default());
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("preview render"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: shade_uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Buffer(frame) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&triangles) },
+                wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: backdrop.as_entire_binding() },
+            ],
+        });
+        RenderGroup { group, shade_uniform, frame_uniform, accumulation }
     }
 }
 
@@ -306,6 +345,30 @@ pub(super) struct Shading {
 }
 
 impl Shading {
+    /// The shading module (`preview_shade.wgsl` and the adaptive files, `crate::wgsl::module`)
+    /// and the layouts of groups 0 to 2.
+    fn new(device: &wgpu::Device) -> Shading {
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+        };
+        let files = [
+            &crate::wgsl::PREVIEW_SHADE,
+            &crate::wgsl::ADAPTIVE_PREDICT,
+            &crate::wgsl::ADAPTIVE_PLAN,
+            &crate::wgsl::ADAPTIVE_SAMPLES,
+            &crate::wgsl::ADAPTIVE_FRAME,
+        ];
+        Shading {
+            module: device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("preview_shade.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(crate::wgsl::module(&files).into()),
+            }),
+            table: layout("merl table", &table_entries()),
+            bake: layout("preview bake", &bake_entries()),
+            render: layout("preview render", &render_entries()),
+        }
+    }
+
     /// The pipeline of `entry`: groups 0 to 2 where `estimator` (a pass that reads the BRDF, the
     /// samples or the maps), group 2 alone otherwise, and `group3` where the entry has one. A
     /// layout names only the groups its pass reads, so that only their storage buffers count
