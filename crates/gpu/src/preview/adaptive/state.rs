@@ -5,6 +5,8 @@
 
 use std::sync::Arc;
 
+use wgpu::util::DeviceExt;
+
 use render::adaptive::Geometry;
 use render::{Lighting, Material};
 
@@ -162,20 +164,8 @@ impl Renderer {
         let pixels = geometry.pixels();
         let shadeable: Vec<bool> = pixels.iter().map(Option::is_some).collect();
         let (at, of_pixel) = render::adaptive::prediction_pixels(&shadeable, (width, height), l);
-        let mut levels = Vec::with_capacity(top + 1);
-        let (mut w, mut h, mut blocks) = (width as u32, height as u32, 0u32);
-        for _ in 0..=top {
-            levels.push((w, h, blocks));
-            blocks += w * h;
-            (w, h) = (w.div_ceil(2), h.div_ceil(2));
-        }
-        if levels.len() > MAX_LEVELS {
-            return Err(render::Error::Invalid(format!(
-                "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
-                levels.len()
-            ))
-            .into());
-        }
+        let levels = level_sizes((width, height), top)?;
+        let blocks = levels.last().map_or(0, |&(w, h, first)| first + w * h);
         // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
         // (`check_settings` holds the rows in range where the lobe weight is on).
         let sharpness: Vec<f32> = match lighting.exponents.is_empty() {
@@ -185,30 +175,9 @@ impl Renderer {
             }
         };
         let p = (width * height) as u32;
-        // The candidates: blocks that hold a shadeable pixel, level by level.
-        let mut any_shadeable: Vec<bool> = shadeable.clone();
-        let mut candidates: Vec<u32> = (0..p).filter(|&i| shadeable[i as usize]).collect();
-        let mut candidates_per_level = vec![candidates.len() as u32];
-        for k in 1..levels.len() {
-            let ((w, h, first), (cw, ch, _)) = (levels[k], levels[k - 1]);
-            let child = &any_shadeable;
-            let mine: Vec<bool> = (0..w * h)
-                .map(|b| {
-                    let (bx, by) = (b % w, b / w);
-                    (0..4).any(|j| {
-                        let (cx, cy) = (2 * bx + j % 2, 2 * by + j / 2);
-                        cx < cw && cy < ch && child[(cy * cw + cx) as usize]
-                    })
-                })
-                .collect();
-            let before = candidates.len();
-            candidates.extend((0..w * h).filter(|&b| mine[b as usize]).map(|b| first + b));
-            candidates_per_level.push((candidates.len() - before) as u32);
-            any_shadeable = mine;
-        }
+        let (candidates, candidates_per_level) = candidates(&shadeable, &levels);
         let n_candidates = candidates.len() as u32;
         let candidates_at = 4 * (levels.len() as u32 + 1);
-        let sharpness_at = candidates_at + n_candidates;
         let limits = self.device.limits();
         // The largest of the buffers: a vec4 per block.
         let fits = |bytes: u64| check_buffer_fits(&limits, &self.adapter_info, bytes, "an adaptive frame's buffers");
@@ -222,74 +191,17 @@ impl Renderer {
             out_height: geometry.size().1 as u32,
             ss: settings.supersample as u32,
             level_table: 0,
-            sharpness: sharpness_at,
+            sharpness: candidates_at + n_candidates,
             n_rows: sharpness.len() as u32,
             candidates: candidates_at,
             capacity: p,
             ..Default::default()
         };
-        let (mut surface, mut lobe) =
-            (vec![RecordSurface::default(); p as usize], vec![RecordLobe::default(); p as usize]);
-        for (i, (s, l)) in surface.iter_mut().zip(&mut lobe).enumerate() {
-            match &pixels[i] {
-                Some(px) => {
-                    *s = RecordSurface {
-                        depth: px.depth as f32,
-                        cos_o: px.cos_o as f32,
-                        screen_normal: px.screen_normal.map(|v| v as f32),
-                    };
-                    *l = RecordLobe { mirror: px.mirror.as_vec3().to_array(), prediction: of_pixel[i] };
-                }
-                None => {
-                    // The WGSL's output tells covered pixels without a shading frame by a depth
-                    // of 0: a shaded pixel's is positive.
-                    s.depth = if geometry.covers(i) { 0.0 } else { -1.0 };
-                    l.prediction = NONE;
-                }
-            }
-        }
-        let mut first_candidate = 0;
-        let mut table: Vec<u32> = Vec::with_capacity(4 * (levels.len() + 1));
-        for (&(w, h, first), &n) in levels.iter().zip(&candidates_per_level) {
-            table.extend([w, h, first, first_candidate]);
-            first_candidate += n;
-        }
-        table.extend([0, 0, blocks, first_candidate]);
-        table.extend(&candidates);
-        table.extend(sharpness.iter().map(|v| v.to_bits()));
-        // Every block not a candidate: min level -1, skipped, for every frame of the geometry.
-        let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
+        let (surface, lobe) = records(geometry, &of_pixel);
+        let table = tables(&levels, &candidates_per_level, blocks, &candidates, &sharpness);
         let items = crate::preview::prediction_items(&at, pixels);
         let state = capture_errors(&self.device, || {
-            use wgpu::BufferUsages as U;
-            use wgpu::util::DeviceExt;
-            let init = |label: &str, contents: &[u8]| {
-                self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
-                })
-            };
-            let empty = |label: &str, bytes: u64| {
-                self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: bytes.max(16),
-                    usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-            let buffers = Buffers {
-                records_surface: init("adaptive records", bytemuck::cast_slice(&surface)),
-                records_lobe: init("adaptive records", bytemuck::cast_slice(&lobe)),
-                bandwidths: empty("adaptive bandwidths", 4 * u64::from(p)),
-                levels: init("adaptive levels", bytemuck::cast_slice(&idle)),
-                parents: empty("adaptive parents", 16 * u64::from(blocks)),
-                weights: empty("adaptive weights", 16 * u64::from(blocks)),
-                values: empty("adaptive values", 16 * u64::from(blocks)),
-                list: empty("adaptive list", 16 * u64::from(blocks)),
-                tables: init("adaptive tables", bytemuck::cast_slice(&table)),
-                control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(CHUNK))),
-            };
+            let buffers = Buffers::new(&self.device, (&surface, &lobe), &table, p, blocks, n_candidates);
             let items_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("adaptive prediction pixels"),
                 contents: bytemuck::cast_slice(if items.is_empty() { &[[0u32; 4]][..] } else { &items }),
@@ -301,43 +213,17 @@ impl Renderer {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniform,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
-                }),
-            }];
-            for (binding, buffer) in (3..).zip(buffers.in_binding_order()) {
-                entries.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
-            }
-            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("adaptive"),
-                layout: state_layout,
-                entries: &entries,
-            });
+            let group = buffers.group(&self.device, state_layout, &uniform);
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
             let readback = self.readback_buffer(
                 (16 * u64::from(blocks)).max(16 * out_pixels + 4 * u64::from(CONTROL_CHUNKS) + CLOCK_BYTES),
             );
-            let clock = self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Clock {
-                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("adaptive stages"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 4,
-                }),
-                resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("adaptive stages"),
-                    size: CLOCK_BYTES,
-                    usage: U::QUERY_RESOLVE | U::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
-            });
+            let clock =
+                self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Clock::new(&self.device));
             let indirect = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("adaptive indirect dispatches"),
                 size: 24,
-                usage: U::INDIRECT | U::COPY_DST,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
             State {
@@ -361,6 +247,176 @@ impl Renderer {
         })?;
         *self.adaptive.borrow_mut() = Some(state);
         Ok(())
+    }
+}
+
+/// Per level of a render of `width x height` pixels up to `top`: its width and height in blocks
+/// and the index of its first block among every level's.
+fn level_sizes((width, height): (usize, usize), top: usize) -> Result<Vec<(u32, u32, u32)>, GpuError> {
+    let mut levels = Vec::with_capacity(top + 1);
+    let (mut w, mut h, mut blocks) = (width as u32, height as u32, 0u32);
+    for _ in 0..=top {
+        levels.push((w, h, blocks));
+        blocks += w * h;
+        (w, h) = (w.div_ceil(2), h.div_ceil(2));
+    }
+    if levels.len() > MAX_LEVELS {
+        return Err(render::Error::Invalid(format!(
+            "an adaptive frame of {width} x {height} render pixels has {} levels: at most {MAX_LEVELS}",
+            levels.len()
+        ))
+        .into());
+    }
+    Ok(levels)
+}
+
+/// The candidates (`state.wgsl`): the blocks that hold a shadeable pixel, level by level, as
+/// indices among every level's blocks; and their count per level.
+fn candidates(shadeable: &[bool], levels: &[(u32, u32, u32)]) -> (Vec<u32>, Vec<u32>) {
+    let mut any_shadeable: Vec<bool> = shadeable.to_vec();
+    let mut candidates: Vec<u32> = (0..shadeable.len() as u32).filter(|&i| shadeable[i as usize]).collect();
+    let mut per_level = vec![candidates.len() as u32];
+    for k in 1..levels.len() {
+        let ((w, h, first), (cw, ch, _)) = (levels[k], levels[k - 1]);
+        let child = &any_shadeable;
+        let mine: Vec<bool> = (0..w * h)
+            .map(|b| {
+                let (bx, by) = (b % w, b / w);
+                (0..4).any(|j| {
+                    let (cx, cy) = (2 * bx + j % 2, 2 * by + j / 2);
+                    cx < cw && cy < ch && child[(cy * cw + cx) as usize]
+                })
+            })
+            .collect();
+        let before = candidates.len();
+        candidates.extend((0..w * h).filter(|&b| mine[b as usize]).map(|b| first + b));
+        per_level.push((candidates.len() - before) as u32);
+        any_shadeable = mine;
+    }
+    (candidates, per_level)
+}
+
+/// The records of the geometry's render pixels, `of_pixel` the index of each one's prediction.
+fn records(geometry: &Geometry, of_pixel: &[u32]) -> (Vec<RecordSurface>, Vec<RecordLobe>) {
+    geometry
+        .pixels()
+        .iter()
+        .enumerate()
+        .map(|(i, pixel)| match pixel {
+            Some(px) => (
+                RecordSurface {
+                    depth: px.depth as f32,
+                    cos_o: px.cos_o as f32,
+                    screen_normal: px.screen_normal.map(|v| v as f32),
+                },
+                RecordLobe { mirror: px.mirror.as_vec3().to_array(), prediction: of_pixel[i] },
+            ),
+            // The WGSL's output tells covered pixels without a shading frame by a depth of 0: a
+            // shaded pixel's is positive.
+            None => (
+                RecordSurface { depth: if geometry.covers(i) { 0.0 } else { -1.0 }, ..Default::default() },
+                RecordLobe { prediction: NONE, ..Default::default() },
+            ),
+        })
+        .unzip()
+}
+
+/// The tables buffer (`state.wgsl`): the level table, the candidates, the lobe sharpness per view
+/// row.
+fn tables(
+    levels: &[(u32, u32, u32)],
+    candidates_per_level: &[u32],
+    blocks: u32,
+    candidates: &[u32],
+    sharpness: &[f32],
+) -> Vec<u32> {
+    let mut first_candidate = 0;
+    let mut table: Vec<u32> = Vec::with_capacity(4 * (levels.len() + 1) + candidates.len() + sharpness.len());
+    for (&(w, h, first), &n) in levels.iter().zip(candidates_per_level) {
+        table.extend([w, h, first, first_candidate]);
+        first_candidate += n;
+    }
+    table.extend([0, 0, blocks, first_candidate]);
+    table.extend(candidates);
+    table.extend(sharpness.iter().map(|v| v.to_bits()));
+    table
+}
+
+impl Buffers {
+    /// The state's buffers for `p` render pixels and `blocks` blocks of every level: the records
+    /// and the tables uploaded, every block not a candidate's level entry at min level -1 and
+    /// skipped (for every frame of the geometry), the rest written by the passes.
+    fn new(
+        device: &wgpu::Device,
+        (surface, lobe): (&[RecordSurface], &[RecordLobe]),
+        table: &[u32],
+        p: u32,
+        blocks: u32,
+        n_candidates: u32,
+    ) -> Buffers {
+        use wgpu::BufferUsages as U;
+        let init = |label: &str, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+            })
+        };
+        let empty = |label: &str, bytes: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
+        Buffers {
+            records_surface: init("adaptive records", bytemuck::cast_slice(surface)),
+            records_lobe: init("adaptive records", bytemuck::cast_slice(lobe)),
+            bandwidths: empty("adaptive bandwidths", 4 * u64::from(p)),
+            levels: init("adaptive levels", bytemuck::cast_slice(&idle)),
+            parents: empty("adaptive parents", 16 * u64::from(blocks)),
+            weights: empty("adaptive weights", 16 * u64::from(blocks)),
+            values: empty("adaptive values", 16 * u64::from(blocks)),
+            list: empty("adaptive list", 16 * u64::from(blocks)),
+            tables: init("adaptive tables", bytemuck::cast_slice(table)),
+            control: empty("adaptive control", 4 * u64::from(CONTROL_CHUNKS + n_candidates.div_ceil(CHUNK))),
+        }
+    }
+
+    /// Group 3 of the passes after the prediction: the pass uniform's slot (binding 2, at a
+    /// dynamic offset) and the buffers.
+    fn group(&self, device: &wgpu::Device, layout: &wgpu::BindGroupLayout, uniform: &wgpu::Buffer) -> wgpu::BindGroup {
+        let slot = wgpu::BufferBinding {
+            buffer: uniform,
+            offset: 0,
+            size: wgpu::BufferSize::new(size_of::<AdaptivePass>() as u64),
+        };
+        let mut entries = vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Buffer(slot) }];
+        for (binding, buffer) in (3..).zip(self.in_binding_order()) {
+            entries.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("adaptive"), layout, entries: &entries })
+    }
+}
+
+impl Clock {
+    /// Four timestamps and the buffer they are resolved into.
+    fn new(device: &wgpu::Device) -> Clock {
+        Clock {
+            set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("adaptive stages"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 4,
+            }),
+            resolved: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("adaptive stages"),
+                size: CLOCK_BYTES,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+        }
     }
 }
 
