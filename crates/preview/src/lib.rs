@@ -15,10 +15,11 @@ pub mod window;
 
 pub use checks::mesh;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use render::{Mode as Estimator, Settings, metrics};
+use envmap::ToneMapping;
+use render::{Image, Lighting, Mode as Estimator, Scene, Settings, metrics};
 use serde_json::json;
 
 use crate::checks::{
@@ -186,199 +187,284 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
         checks::check_output_folder(path)?;
     }
     let mut loaded = bake::load(&request.bake, request.material.as_deref())?;
-    if request.brdf == Brdf::WaveletBrdf {
-        let (path, brdf) = match &request.wavelet_brdf {
-            Some(path) => (path.clone(), bake::load_wavelet_brdf(path, &loaded)?),
-            None => bake::bake_wavelet_brdf(&loaded)?,
-        };
-        let levels = brdf.grid().levels() as f64;
-        if !(0.0..=levels).contains(&request.wavelet_brdf_lod) {
-            bail!(
-                "--wavelet-brdf-lod {} is outside 0 to {levels} (the levels of {})",
-                request.wavelet_brdf_lod,
-                path.display()
-            );
-        }
-        loaded.material.wavelet_brdf = Some(render::WaveletBrdf { brdf, lod: request.wavelet_brdf_lod });
-    } else if request.wavelet_brdf.is_some() {
-        bail!("--wavelet-brdf names the asset for --brdf wavelet-brdf; add --brdf wavelet-brdf to render with it");
-    }
+    set_wavelet_brdf(request, &mut loaded)?;
     // Every output is encoded before any is written.
-    let mut files: Vec<Output> = Vec::new();
-    let mut report = Vec::new();
-    let mut value = json!({});
+    let mut rendered = Rendered { files: Vec::new(), report: Vec::new(), problems: Vec::new(), json: json!({}) };
     if let Some(path) = &request.sheet {
         let sheet = contact_sheet(&loaded)?;
-        files.push(Output {
-            path: path.clone(),
-            role: "contact-sheet",
-            bytes: png(&sheet.rgb, sheet.width, sheet.height)?,
-        });
+        let bytes = png(&sheet.rgb, sheet.width, sheet.height)?;
+        rendered.files.push(Output { path: path.clone(), role: "contact-sheet", bytes });
     }
-    let mut problems = Vec::new();
-    if request.out.is_some() || request.window {
-        let Some(lighting) = &loaded.lighting else {
-            bail!(
-                "{}: the bake has no environment, nothing to light the material with: bake it with brdf-bake --env",
-                request.bake.display()
-            );
-        };
-        if request.mode.is_adaptive() {
-            if request.window {
-                bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
-            }
-            let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
-            let step = adaptive::render(request, &loaded, lighting, out, host)?;
-            files.extend(step.files);
-            report.extend(step.report);
-            problems.extend(step.problems);
-            value = step.json;
-        } else {
-            let mode = request.mode.estimator();
-            let settings =
-                Settings::previewer(mode, &loaded.material.samples, request.spp, request.frames, request.seed);
-            let scene = scene(request)?;
-            let pixels = (scene.width * scene.height) as u128;
-            let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
-            let renders = if loaded.material.wavelet_brdf.is_some() { 2 } else { 1 };
-            check_work(
-                request,
-                &[
-                    ("on the GPU", renders * gpu_samples),
-                    ("for --validate on the CPU", if request.validate { gpu_samples } else { 0 }),
-                    ("for --converged on the CPU", pixels * 3 * u128::from(request.converged.unwrap_or(0))),
-                ],
-            )?;
-            let tone_mapping = tone_mapping(request, lighting);
-            if request.window {
-                let screenshot = request.window_screenshot.as_deref();
-                let shown = window::run(&loaded.material, lighting, &scene, &settings, &tone_mapping, screenshot)?;
-                return Ok(Outcome::Window(shown));
-            }
-            let gpu = host.open_gpu()?;
-            let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
-            let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
-            host.step(format!("{} on the GPU", mode.name()));
-            let start = Instant::now();
-            let image = renderer.render_frames(&settings)?;
-            check_finite(request, &image.rgb, "the GPU render")?;
-            let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
-            let picture = metrics::tonemap(&image, &tone_mapping);
-            let names = names(&loaded.manifest);
-            let brdf = match &loaded.material.wavelet_brdf {
-                Some(w) => format!("wavelet-brdf {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
-                None => "table".to_string(),
-            };
-            let caption = format!(
-                "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
-                names,
-                mode.name(),
-                settings.spp,
-                settings.frames,
-                scene.width,
-                scene.height,
-                tone_mapping.exposure_ev
-            );
-            let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-            files.push(Output {
-                path: out.clone(),
-                role: "preview",
-                bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
-            });
-            report.push(format!(
-                "{}: {} on {} ({}), {:.1} ms per frame",
-                out.display(),
-                mode.name(),
-                gpu.adapter_summary(),
-                request.mesh,
-                ms_per_frame
-            ));
-            value = json!({
-                "bake": request.bake.display().to_string(),
-                "mode": mode.name(),
-                "brdf": match request.brdf { Brdf::Table => "table", Brdf::WaveletBrdf => "wavelet-brdf" },
-                "spp": settings.spp,
-                "frames": settings.frames,
-                "width": scene.width,
-                "height": scene.height,
-                "exposure_ev": tone_mapping.exposure_ev,
-                "adapter": gpu.adapter_summary(),
-                "ms_per_frame": ms_per_frame,
-                "mean_luminance": metrics::mean_luminance(&image),
-            });
-
-            if loaded.material.wavelet_brdf.is_some() {
-                // What the compression costs: the same render from the table itself.
-                let table_material = render::Material { wavelet_brdf: None, ..loaded.material.clone() };
-                host.step(format!("{} from the table on the GPU", mode.name()));
-                let table =
-                    gpu::preview::Renderer::new(&gpu, &scene, &table_material, lighting)?.render_frames(&settings)?;
-                check_finite(request, &table.rgb, "the GPU render from the table")?;
-                let table_picture = metrics::tonemap(&table, &tone_mapping);
-                let psnr = metrics::psnr_db(&picture, &table_picture);
-                let relative = metrics::relative_error(&image.rgb, &table.rgb);
-                files.push(Output {
-                    path: sibling(out, "table"),
-                    role: "table",
-                    bytes: png(&table_picture, scene.width, scene.height)?,
-                });
-                report.push(format!(
-                "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB,                  relative error {relative:.3}",
-                db(psnr)
-            ));
-                value["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
-            }
-            if request.validate {
-                host.step(format!("{} on the CPU (--validate)", mode.name()));
-                let cpu = render::render_with_progress(&scene, &loaded.material, lighting, &settings, &|done, all| {
-                    host.work(done, all)
-                })?;
-                check_finite(request, &cpu.rgb, "the CPU render")?;
-                let cpu_picture = metrics::tonemap(&cpu, &tone_mapping);
-                let psnr = metrics::psnr_db(&picture, &cpu_picture);
-                let relative = metrics::relative_error(&image.rgb, &cpu.rgb);
-                let coverage = image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
-                let difference =
-                    picture::layout::difference(&picture, &cpu_picture, scene.width, scene.height, "GPU - CPU");
-                files.push(Output {
-                    path: sibling(out, "difference"),
-                    role: "difference",
-                    bytes: png(&difference.rgb, difference.width, difference.height)?,
-                });
-                report.push(format!(
-                "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
-                 pixels covered by one renderer only",
-                db(psnr)
-            ));
-                value["psnr_db"] = json_db(psnr);
-                value["relative_error"] = json!(relative);
-                value["coverage_mismatches"] = json!(coverage);
-                check_psnr(request, "against the CPU", psnr, &mut problems);
-            }
-            if let Some(n) = request.converged {
-                let Converged { image: converged, picture: converged_picture, psnr, relative } =
-                    converged(request, &scene, &loaded.material, lighting, n, (&image, &picture), &tone_mapping, host)?;
-                let luminance_ratio = metrics::mean_luminance(&image) / metrics::mean_luminance(&converged);
-                files.push(Output {
-                    path: sibling(out, "converged"),
-                    role: "converged",
-                    bytes: png(&converged_picture, scene.width, scene.height)?,
-                });
-                report.push(format!(
-                "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
-                 mean luminance ratio {luminance_ratio:.4}",
-                db(psnr)
-            ));
-                value["converged"] = json!({
-                    "samples_per_strategy": n,
-                    "psnr_db": json_db(psnr),
-                    "relative_error": relative,
-                    "mean_luminance_ratio": luminance_ratio,
-                });
-                check_psnr(request, "against the converged estimate", psnr, &mut problems);
-            }
+    if request.out.is_none() && !request.window {
+        return Ok(Outcome::Rendered(rendered));
+    }
+    let Some(lighting) = &loaded.lighting else {
+        bail!(
+            "{}: the bake has no environment, nothing to light the material with: bake it with brdf-bake --env",
+            request.bake.display()
+        );
+    };
+    let step = if request.mode.is_adaptive() {
+        if request.window {
+            bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
         }
+        let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
+        adaptive::render(request, &loaded, lighting, out, host)?
+    } else {
+        match estimator(request, &loaded, lighting, host)? {
+            Outcome::Rendered(step) => step,
+            window => return Ok(window),
+        }
+    };
+    rendered.files.extend(step.files);
+    rendered.report.extend(step.report);
+    rendered.problems.extend(step.problems);
+    rendered.json = step.json;
+    Ok(Outcome::Rendered(rendered))
+}
+
+/// With `--brdf wavelet-brdf`, the material's wavelet encoding: the one `--wavelet-brdf` names
+/// or one baked now, at `--wavelet-brdf-lod`.
+fn set_wavelet_brdf(request: &Request, loaded: &mut bake::Loaded) -> Result<(), Error> {
+    if request.brdf != Brdf::WaveletBrdf {
+        if request.wavelet_brdf.is_some() {
+            bail!("--wavelet-brdf names the asset for --brdf wavelet-brdf; add --brdf wavelet-brdf to render with it");
+        }
+        return Ok(());
+    }
+    let (path, brdf) = match &request.wavelet_brdf {
+        Some(path) => (path.clone(), bake::load_wavelet_brdf(path, loaded)?),
+        None => bake::bake_wavelet_brdf(loaded)?,
+    };
+    let levels = brdf.grid().levels() as f64;
+    if !(0.0..=levels).contains(&request.wavelet_brdf_lod) {
+        bail!(
+            "--wavelet-brdf-lod {} is outside 0 to {levels} (the levels of {})",
+            request.wavelet_brdf_lod,
+            path.display()
+        );
+    }
+    loaded.material.wavelet_brdf = Some(render::WaveletBrdf { brdf, lod: request.wavelet_brdf_lod });
+    Ok(())
+}
+
+/// One of the estimators (`reference`, `fis`, `prefiltered`) on the GPU, written to `out` or shown
+/// in the window, with the checks `request` asks for: the table's render where the material is
+/// a wavelet encoding, the CPU's (`--validate`), the converged estimate (`--converged`).
+fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host: &dyn Host) -> Result<Outcome, Error> {
+    let mode = request.mode.estimator();
+    let settings = Settings::previewer(mode, &loaded.material.samples, request.spp, request.frames, request.seed);
+    let scene = scene(request)?;
+    let pixels = (scene.width * scene.height) as u128;
+    let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
+    let renders = if loaded.material.wavelet_brdf.is_some() { 2 } else { 1 };
+    check_work(
+        request,
+        &[
+            ("on the GPU", renders * gpu_samples),
+            ("for --validate on the CPU", if request.validate { gpu_samples } else { 0 }),
+            ("for --converged on the CPU", pixels * 3 * u128::from(request.converged.unwrap_or(0))),
+        ],
+    )?;
+    let tone_mapping = tone_mapping(request, lighting);
+    if request.window {
+        let screenshot = request.window_screenshot.as_deref();
+        let shown = window::run(&loaded.material, lighting, &scene, &settings, &tone_mapping, screenshot)?;
+        return Ok(Outcome::Window(shown));
+    }
+    let gpu = host.open_gpu()?;
+    let out = request.out.as_ref().expect("a request renders to `out` unless it opens the window");
+    let mut renderer = gpu::preview::Renderer::new(&gpu, &scene, &loaded.material, lighting)?;
+    host.step(format!("{} on the GPU", mode.name()));
+    let start = Instant::now();
+    let image = renderer.render_frames(&settings)?;
+    check_finite(request, &image.rgb, "the GPU render")?;
+    let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
+    let picture = metrics::tonemap(&image, &tone_mapping);
+    let brdf = match &loaded.material.wavelet_brdf {
+        Some(w) => format!("wavelet-brdf {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
+        None => "table".to_string(),
+    };
+    let caption = format!(
+        "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+        names(&loaded.manifest),
+        mode.name(),
+        settings.spp,
+        settings.frames,
+        scene.width,
+        scene.height,
+        tone_mapping.exposure_ev
+    );
+    let captioned = with_caption(&picture, scene.width, scene.height, &caption);
+    let mut step = Rendered {
+        files: vec![Output {
+            path: out.clone(),
+            role: "preview",
+            bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
+        }],
+        report: vec![format!(
+            "{}: {} on {} ({}), {:.1} ms per frame",
+            out.display(),
+            mode.name(),
+            gpu.adapter_summary(),
+            request.mesh,
+            ms_per_frame
+        )],
+        problems: Vec::new(),
+        json: json!({
+            "bake": request.bake.display().to_string(),
+            "mode": mode.name(),
+            "brdf": match request.brdf { Brdf::Table => "table", Brdf::WaveletBrdf => "wavelet-brdf" },
+            "spp": settings.spp,
+            "frames": settings.frames,
+            "width": scene.width,
+            "height": scene.height,
+            "exposure_ev": tone_mapping.exposure_ev,
+            "adapter": gpu.adapter_summary(),
+            "ms_per_frame": ms_per_frame,
+            "mean_luminance": metrics::mean_luminance(&image),
+        }),
+    };
+    let render = EstimatorRender {
+        scene: &scene,
+        settings: &settings,
+        tone_mapping: &tone_mapping,
+        out,
+        image: &image,
+        picture: &picture,
+    };
+    if loaded.material.wavelet_brdf.is_some() {
+        render.against_table(request, &gpu, loaded, lighting, host, &mut step)?;
+    }
+    if request.validate {
+        render.against_cpu(request, loaded, lighting, host, &mut step)?;
+    }
+    if let Some(n) = request.converged {
+        render.against_converged(request, loaded, lighting, n, host, &mut step)?;
+    }
+    Ok(Outcome::Rendered(step))
+}
+
+/// An estimator's render on the GPU, for the checks that compare it.
+struct EstimatorRender<'a> {
+    scene: &'a Scene,
+    settings: &'a Settings,
+    tone_mapping: &'a ToneMapping,
+    out: &'a Path,
+    image: &'a Image,
+    picture: &'a [u8],
+}
+
+impl EstimatorRender<'_> {
+    /// What the wavelet compression costs: the same render from the table itself.
+    fn against_table(
+        &self,
+        request: &Request,
+        gpu: &gpu::Gpu,
+        loaded: &bake::Loaded,
+        lighting: &Lighting,
+        host: &dyn Host,
+        step: &mut Rendered,
+    ) -> Result<(), Error> {
+        let (scene, settings) = (self.scene, self.settings);
+        let table_material = render::Material { wavelet_brdf: None, ..loaded.material.clone() };
+        host.step(format!("{} from the table on the GPU", settings.mode.name()));
+        let table = gpu::preview::Renderer::new(gpu, scene, &table_material, lighting)?.render_frames(settings)?;
+        check_finite(request, &table.rgb, "the GPU render from the table")?;
+        let table_picture = metrics::tonemap(&table, self.tone_mapping);
+        let psnr = metrics::psnr_db(self.picture, &table_picture);
+        let relative = metrics::relative_error(&self.image.rgb, &table.rgb);
+        step.files.push(Output {
+            path: sibling(self.out, "table"),
+            role: "table",
+            bytes: png(&table_picture, scene.width, scene.height)?,
+        });
+        step.report.push(format!(
+            "against the table (same estimator, same samples, the MERL table's nearest lookup): PSNR {} dB, \
+             relative error {relative:.3}",
+            db(psnr)
+        ));
+        step.json["against_table"] = json!({ "psnr_db": json_db(psnr), "relative_error": relative });
+        Ok(())
     }
 
-    Ok(Outcome::Rendered(Rendered { files, report, problems, json: value }))
+    /// `--validate`: the same render on the CPU, and the difference picture.
+    fn against_cpu(
+        &self,
+        request: &Request,
+        loaded: &bake::Loaded,
+        lighting: &Lighting,
+        host: &dyn Host,
+        step: &mut Rendered,
+    ) -> Result<(), Error> {
+        let scene = self.scene;
+        host.step(format!("{} on the CPU (--validate)", self.settings.mode.name()));
+        let cpu = render::render_with_progress(scene, &loaded.material, lighting, self.settings, &|done, all| {
+            host.work(done, all)
+        })?;
+        check_finite(request, &cpu.rgb, "the CPU render")?;
+        let cpu_picture = metrics::tonemap(&cpu, self.tone_mapping);
+        let psnr = metrics::psnr_db(self.picture, &cpu_picture);
+        let relative = metrics::relative_error(&self.image.rgb, &cpu.rgb);
+        let coverage = self.image.covered.iter().zip(&cpu.covered).filter(|(a, b)| a != b).count();
+        let difference =
+            picture::layout::difference(self.picture, &cpu_picture, scene.width, scene.height, "GPU - CPU");
+        step.files.push(Output {
+            path: sibling(self.out, "difference"),
+            role: "difference",
+            bytes: png(&difference.rgb, difference.width, difference.height)?,
+        });
+        step.report.push(format!(
+            "against the CPU (same estimator, same samples): PSNR {} dB, relative error {relative:.2e}, {coverage} \
+             pixels covered by one renderer only",
+            db(psnr)
+        ));
+        step.json["psnr_db"] = json_db(psnr);
+        step.json["relative_error"] = json!(relative);
+        step.json["coverage_mismatches"] = json!(coverage);
+        check_psnr(request, "against the CPU", psnr, &mut step.problems);
+        Ok(())
+    }
+
+    /// `--converged N`: the converged estimate of `n` samples per strategy on the CPU.
+    fn against_converged(
+        &self,
+        request: &Request,
+        loaded: &bake::Loaded,
+        lighting: &Lighting,
+        n: u32,
+        host: &dyn Host,
+        step: &mut Rendered,
+    ) -> Result<(), Error> {
+        let scene = self.scene;
+        let Converged { image: converged, picture: converged_picture, psnr, relative } = converged(
+            request,
+            scene,
+            &loaded.material,
+            lighting,
+            n,
+            (self.image, self.picture),
+            self.tone_mapping,
+            host,
+        )?;
+        let luminance_ratio = metrics::mean_luminance(self.image) / metrics::mean_luminance(&converged);
+        step.files.push(Output {
+            path: sibling(self.out, "converged"),
+            role: "converged",
+            bytes: png(&converged_picture, scene.width, scene.height)?,
+        });
+        step.report.push(format!(
+            "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
+             mean luminance ratio {luminance_ratio:.4}",
+            db(psnr)
+        ));
+        step.json["converged"] = json!({
+            "samples_per_strategy": n,
+            "psnr_db": json_db(psnr),
+            "relative_error": relative,
+            "mean_luminance_ratio": luminance_ratio,
+        });
+        check_psnr(request, "against the converged estimate", psnr, &mut step.problems);
+        Ok(())
+    }
 }
