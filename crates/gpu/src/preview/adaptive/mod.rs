@@ -158,6 +158,249 @@ fn slot_stride(alignment: u64) -> u64 {
     (size_of::<AdaptivePass>() as u64).div_ceil(alignment) * alignment
 }
 
+/// The passes of one adaptive frame after its prediction, and their slots of the pass uniform:
+/// the levels' (0), one per coarser level's reduction (1 to `top`), the plan's, the scatter's,
+/// one per level's up-sampling and the output's.
+struct Passes<'a> {
+    renderer: &'a Renderer,
+    state: &'a State,
+    pipelines: &'a Pipelines,
+    /// Bytes between the slots.
+    stride: u64,
+    top: usize,
+    out_pixels: u64,
+}
+
+impl Passes<'_> {
+    const LEVELS_SLOT: u64 = 0;
+
+    fn plan_slot(&self) -> u64 {
+        1 + self.top as u64
+    }
+
+    fn scatter_slot(&self) -> u64 {
+        2 + self.top as u64
+    }
+
+    fn output_slot(&self) -> u64 {
+        self.scatter_slot() + 1 + self.top as u64
+    }
+
+    fn run(&self, cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64, groups: (u32, u32)) {
+        dispatch(cpass, &self.renderer.render_group, pipeline, self.state, slot * self.stride, groups);
+    }
+
+    /// The pass uniform's slots, written at once: `base` with each pass's level or count.
+    fn uniform(&self, base: AdaptivePass, candidates: u32) -> Vec<u8> {
+        let mut uniform = vec![0u8; (self.stride * slots(self.top)) as usize];
+        let mut pass = |slot: u64, fields: AdaptivePass| {
+            uniform[(slot * self.stride) as usize..][..size_of::<AdaptivePass>()]
+                .copy_from_slice(bytemuck::bytes_of(&fields));
+        };
+        pass(Self::LEVELS_SLOT, base);
+        for k in 1..=self.top {
+            pass(k as u64, AdaptivePass { level: k as u32, ..base });
+        }
+        pass(self.plan_slot(), AdaptivePass { count: candidates, ..base });
+        for slot in self.scatter_slot()..=self.output_slot() {
+            let level = (slot - self.scatter_slot()).saturating_sub(1) as u32;
+            pass(slot, AdaptivePass { level, ..base });
+        }
+        uniform
+    }
+
+    /// The levels, their grading, the pyramids, the plan of every candidate, where the GPU
+    /// allocates its samples, and the list of shaded blocks (`chunks` chunks of candidates).
+    fn plan(&self, cpass: &mut wgpu::ComputePass, candidates: u32, chunks: u32, on_gpu: bool) {
+        let (pipelines, per_level) = (self.pipelines, &self.state.candidates_per_level);
+        self.run(cpass, &pipelines.levels, Self::LEVELS_SLOT, groups(per_level[0]));
+        self.run(cpass, &pipelines.grade, Self::LEVELS_SLOT, groups(per_level[0]));
+        self.run(cpass, &pipelines.grade_apply, Self::LEVELS_SLOT, groups(per_level[0]));
+        for (k, &n) in per_level.iter().enumerate().skip(1) {
+            self.run(cpass, &pipelines.reduce, k as u64, groups(n));
+        }
+        self.run(cpass, &pipelines.plan, self.plan_slot(), groups(candidates));
+        if on_gpu {
+            self.run(cpass, &pipelines.allocate, self.plan_slot(), (1, 1));
+        }
+        self.run(cpass, &pipelines.offsets, self.plan_slot(), (1, 1));
+        self.run(cpass, &pipelines.list, self.plan_slot(), super::workgroups(chunks));
+    }
+
+    /// Submission 1: the prediction, the levels, pyramids and plan, the list of shaded blocks in
+    /// the plan's order; where the GPU allocates (`on_gpu`) also the samples and all of
+    /// submission 2, the passes after the prediction's timestamped where the adapter can.
+    fn encode(
+        &self,
+        prediction: &super::Prediction,
+        candidates: u32,
+        chunks: u32,
+        on_gpu: bool,
+    ) -> wgpu::CommandEncoder {
+        let (renderer, state) = (self.renderer, self.state);
+        let mut encoder = renderer.device.create_command_encoder(&Default::default());
+        // Every word, the chunks' too: the plan adds to them.
+        encoder.clear_buffer(&state.buffers.control, 0, None);
+        encoder.copy_buffer_to_buffer(&state.items, 0, &renderer.accumulation, 0, 16 * u64::from(state.n_items));
+        // The one-submission frame's passes start with timestamps where the adapter has them.
+        let stamp = |start: u32, end: Option<u32>| {
+            let clock = state.clock.as_ref().filter(|_| on_gpu)?;
+            Some(wgpu::ComputePassTimestampWrites {
+                query_set: &clock.set,
+                beginning_of_pass_write_index: Some(start),
+                end_of_pass_write_index: end,
+            })
+        };
+        {
+            let mut cpass = renderer.begin_timed_pass(&mut encoder, stamp(0, None));
+            if state.n_items > 0 {
+                cpass.set_pipeline(&self.pipelines.predict);
+                cpass.set_bind_group(3, &prediction.group, &[]);
+                let (x, y) = super::item_groups(state.n_items);
+                cpass.dispatch_workgroups(x, y, 1);
+            }
+            if on_gpu {
+                drop(cpass);
+                cpass = renderer.begin_timed_pass(&mut encoder, stamp(1, None));
+            }
+            self.plan(&mut cpass, candidates, chunks, on_gpu);
+        }
+        if on_gpu {
+            let items_at = std::mem::offset_of!(super::ShadeUniform, items) as u64;
+            let control = &state.buffers.control;
+            encoder.copy_buffer_to_buffer(control, 4 * u64::from(CONTROL_PARTS), &renderer.shade_uniform, items_at, 4);
+            encoder.copy_buffer_to_buffer(control, 4 * u64::from(CONTROL_ARGS), &state.indirect, 0, 24);
+            self.shade(&mut renderer.begin_timed_pass(&mut encoder, stamp(2, Some(3))), None, None);
+            if let Some(clock) = state.clock.as_ref() {
+                encoder.resolve_query_set(&clock.set, 0..4, &clock.resolved, 0);
+            }
+        }
+        encoder
+    }
+
+    /// The samples of the `n_shaded` blocks of the list, allocated on the host
+    /// (`render::adaptive::allocation`) from their variances.
+    fn allocate_on_host(
+        &self,
+        n_shaded: u32,
+        budget: u64,
+        settings: &render::adaptive::Settings,
+        (width, height): (usize, usize),
+    ) -> Result<HostSamples, GpuError> {
+        let (renderer, state) = (self.renderer, self.state);
+        let encoder = renderer.device.create_command_encoder(&Default::default());
+        let shaded: Vec<u32> =
+            renderer.submit_and_read(encoder, &[(&state.buffers.list, 16 * u64::from(n_shaded))], &state.readback)?;
+        let list: Vec<[u32; 4]> = shaded.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let blocks_in: Vec<(usize, f64)> =
+            list.iter().map(|e| (e[0] as usize, f64::from(f32::from_bits(e[2])))).collect();
+        let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
+        let (items, targets) = parts(&list, &samples, &state.levels, width * height);
+        Ok(HostSamples { total: samples.iter().map(|&n| u64::from(n)).sum(), items, targets })
+    }
+
+    /// Submission 2 of a frame whose samples the host allocated: the parts, their estimates in
+    /// place, the up-sampling and the output, read back as RGB.
+    fn shade_on_host(
+        &self,
+        samples: &HostSamples,
+        n_shaded: u32,
+        shade_uniform: &dyn Fn(u32) -> super::ShadeUniform,
+    ) -> Result<Vec<f32>, GpuError> {
+        let (renderer, state) = (self.renderer, self.state);
+        let HostSamples { items, targets, .. } = samples;
+        capture_errors(&renderer.device, || {
+            let shade = shade_uniform(items.len() as u32);
+            renderer.queue.write_buffer(&renderer.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            if !items.is_empty() {
+                renderer.queue.write_buffer(&renderer.accumulation, 0, bytemuck::cast_slice(items));
+                renderer.queue.write_buffer(&state.buffers.list, 0, bytemuck::cast_slice(targets));
+            }
+            let mut encoder = renderer.device.create_command_encoder(&Default::default());
+            self.shade(&mut renderer.begin_pass(&mut encoder), Some(items.len() as u32), Some(n_shaded));
+            encoder
+        })
+        .and_then(|encoder| {
+            let sources = [(&renderer.accumulation, 16 * self.out_pixels)];
+            renderer.submit_and_map(encoder, &sources, &state.readback, |rgba| super::rgb_of(rgba, 1.0))
+        })
+    }
+
+    /// The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling and
+    /// the output: `Some(count)` dispatches a known count, `None` the counts `adaptive_allocate`
+    /// left in the indirect buffer.
+    fn shade(&self, cpass: &mut wgpu::ComputePass, parts: Option<u32>, shaded: Option<u32>) {
+        let (pipelines, state) = (self.pipelines, self.state);
+        cpass.set_pipeline(&pipelines.blocks);
+        self.renderer.bind_estimator_groups(cpass);
+        match parts {
+            Some(0) => {}
+            Some(n) => {
+                let (x, y) = super::item_groups(n);
+                cpass.dispatch_workgroups(x, y, 1);
+            }
+            None => cpass.dispatch_workgroups_indirect(&state.indirect, 0),
+        }
+        match shaded {
+            Some(n) => self.run(cpass, &pipelines.scatter, self.scatter_slot(), groups(n)),
+            None => {
+                cpass.set_pipeline(&pipelines.scatter);
+                cpass.set_bind_group(2, &self.renderer.render_group, &[0]);
+                cpass.set_bind_group(3, &state.group, &[(self.scatter_slot() * self.stride) as u32]);
+                cpass.dispatch_workgroups_indirect(&state.indirect, 12);
+            }
+        }
+        for k in (0..self.top).rev() {
+            let slot = self.scatter_slot() + 1 + k as u64;
+            self.run(cpass, &pipelines.upsample, slot, groups(state.candidates_per_level[k]));
+        }
+        self.run(cpass, &pipelines.output, self.output_slot(), groups(self.out_pixels as u32));
+    }
+}
+
+/// The samples the host allocated for a frame: their total, `shade_blocks`' items and the list's
+/// targets ([`parts`]).
+struct HostSamples {
+    total: u64,
+    items: Vec<[u32; 4]>,
+    targets: Vec<[u32; 4]>,
+}
+
+/// A frame's timings: in one submission (`gpu`: its timestamps and their period) the stages on
+/// the GPU's clock where it has one, all of it the shading's otherwise; in two, the wall clock's
+/// laps at the prediction's end, the host's allocation's and the frame's (ms).
+fn frame_timings(
+    gpu: Option<(&[u32], f32)>,
+    gbuffer_ms: f64,
+    (predict_ms, plan_ms, shade_ms): (f64, f64, f64),
+) -> Timings {
+    let Some((stamps, period)) = gpu else {
+        return Timings {
+            gbuffer_ms,
+            predict_ms,
+            plan_ms: plan_ms - predict_ms,
+            shade_ms: shade_ms - plan_ms,
+            total_ms: shade_ms,
+            submissions: 2,
+            gpu_clock: false,
+        };
+    };
+    let ticks: Vec<u64> = stamps.chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
+    let period_ms = f64::from(period) * 1e-6;
+    let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period_ms;
+    let (predict_ms, plan_ms, stages_ms) =
+        if ticks.len() == 4 { (ms(0, 1), ms(1, 2), ms(2, 3)) } else { (0.0, 0.0, shade_ms) };
+    Timings {
+        gbuffer_ms,
+        predict_ms,
+        plan_ms,
+        shade_ms: stages_ms,
+        total_ms: shade_ms,
+        submissions: 1,
+        gpu_clock: ticks.len() == 4,
+    }
+}
+
 /// Workgroups of 64 for `count` items, as `(x, y)` within the dispatch limits.
 fn groups(count: u32) -> (u32, u32) {
     super::workgroups(count.div_ceil(64).max(1))
@@ -217,8 +460,6 @@ impl Renderer {
             allocate: u32::from(on_gpu),
             ..state.base
         };
-        let (levels_slot, plan_slot, scatter_slot) = (0, 1 + top as u64, 2 + top as u64);
-        let output_slot = scatter_slot + 1 + top as u64;
         let candidates: u32 = state.candidates_per_level.iter().sum();
         let chunks = candidates.div_ceil(CHUNK).max(1);
         let out_pixels = (out_width * out_height) as u64;
@@ -234,51 +475,7 @@ impl Renderer {
                 &render::Settings { mode: settings.mode, spp: 1, frames: 1, seed: settings.seed },
             )
         };
-        // The shaded blocks' parts (`shade_blocks`), their estimates in place, the up-sampling
-        // and the output: `Some(count)` dispatches a known count, `None` the counts
-        // `adaptive_allocate` left in the indirect buffer.
-        let shading = |cpass: &mut wgpu::ComputePass, parts: Option<u32>, shaded: Option<u32>| {
-            cpass.set_pipeline(&pipelines.blocks);
-            self.bind_estimator_groups(cpass);
-            match parts {
-                Some(0) => {}
-                Some(n) => {
-                    let (x, y) = super::item_groups(n);
-                    cpass.dispatch_workgroups(x, y, 1);
-                }
-                None => cpass.dispatch_workgroups_indirect(&state.indirect, 0),
-            }
-            match shaded {
-                Some(n) => {
-                    dispatch(cpass, &self.render_group, &pipelines.scatter, state, scatter_slot * stride, groups(n))
-                }
-                None => {
-                    cpass.set_pipeline(&pipelines.scatter);
-                    cpass.set_bind_group(2, &self.render_group, &[0]);
-                    cpass.set_bind_group(3, &state.group, &[(scatter_slot * stride) as u32]);
-                    cpass.dispatch_workgroups_indirect(&state.indirect, 12);
-                }
-            }
-            for k in (0..top).rev() {
-                let slot = scatter_slot + 1 + k as u64;
-                dispatch(
-                    cpass,
-                    &self.render_group,
-                    &pipelines.upsample,
-                    state,
-                    slot * stride,
-                    groups(state.candidates_per_level[k]),
-                );
-            }
-            dispatch(
-                cpass,
-                &self.render_group,
-                &pipelines.output,
-                state,
-                output_slot * stride,
-                groups(out_pixels as u32),
-            );
-        };
+        let passes = Passes { renderer: self, state, pipelines, stride, top, out_pixels };
 
         // Submission 1: prediction, levels, pyramids, plan, the list of shaded blocks in the
         // plan's order; on the GPU also the samples and all of submission 2.
@@ -292,86 +489,9 @@ impl Renderer {
                 let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
                 self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
             }
-            // The pass uniform's slots, written at once.
-            let mut uniform = vec![0u8; (stride * slots(top)) as usize];
-            let mut pass = |slot: u64, fields: AdaptivePass| {
-                uniform[(slot * stride) as usize..][..size_of::<AdaptivePass>()]
-                    .copy_from_slice(bytemuck::bytes_of(&fields));
-            };
-            pass(levels_slot, base);
-            for k in 1..=top {
-                pass(k as u64, AdaptivePass { level: k as u32, ..base });
-            }
-            pass(plan_slot, AdaptivePass { count: candidates, ..base });
-            for slot in scatter_slot..=output_slot {
-                let level = (slot - scatter_slot).saturating_sub(1) as u32;
-                pass(slot, AdaptivePass { level, ..base });
-            }
+            let uniform = passes.uniform(base, candidates);
             self.queue.write_buffer(&state.uniform, 0, &uniform);
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            // Every word, the chunks' too: the plan adds to them.
-            encoder.clear_buffer(&state.buffers.control, 0, None);
-            encoder.copy_buffer_to_buffer(&state.items, 0, &self.accumulation, 0, 16 * u64::from(state.n_items));
-            // The one-submission frame's passes start with timestamps where the adapter has them.
-            let stamp = |start: u32, end: Option<u32>| {
-                let clock = state.clock.as_ref().filter(|_| on_gpu)?;
-                Some(wgpu::ComputePassTimestampWrites {
-                    query_set: &clock.set,
-                    beginning_of_pass_write_index: Some(start),
-                    end_of_pass_write_index: end,
-                })
-            };
-            {
-                let mut cpass = self.begin_timed_pass(&mut encoder, stamp(0, None));
-                if state.n_items > 0 {
-                    cpass.set_pipeline(&pipelines.predict);
-                    cpass.set_bind_group(3, &prediction.group, &[]);
-                    let (x, y) = super::item_groups(state.n_items);
-                    cpass.dispatch_workgroups(x, y, 1);
-                }
-                if on_gpu {
-                    drop(cpass);
-                    cpass = self.begin_timed_pass(&mut encoder, stamp(1, None));
-                }
-                let run = |cpass: &mut wgpu::ComputePass, pipeline, slot: u64, groups| {
-                    dispatch(cpass, &self.render_group, pipeline, state, slot * stride, groups)
-                };
-                let per_level = &state.candidates_per_level;
-                run(&mut cpass, &pipelines.levels, levels_slot, groups(per_level[0]));
-                run(&mut cpass, &pipelines.grade, levels_slot, groups(per_level[0]));
-                run(&mut cpass, &pipelines.grade_apply, levels_slot, groups(per_level[0]));
-                for (k, &n) in per_level.iter().enumerate().skip(1) {
-                    run(&mut cpass, &pipelines.reduce, k as u64, groups(n));
-                }
-                run(&mut cpass, &pipelines.plan, plan_slot, groups(candidates));
-                if on_gpu {
-                    run(&mut cpass, &pipelines.allocate, plan_slot, (1, 1));
-                }
-                run(&mut cpass, &pipelines.offsets, plan_slot, (1, 1));
-                run(&mut cpass, &pipelines.list, plan_slot, super::workgroups(chunks));
-            }
-            if on_gpu {
-                let items_at = std::mem::offset_of!(super::ShadeUniform, items) as u64;
-                encoder.copy_buffer_to_buffer(
-                    &state.buffers.control,
-                    4 * u64::from(CONTROL_PARTS),
-                    &self.shade_uniform,
-                    items_at,
-                    4,
-                );
-                encoder.copy_buffer_to_buffer(
-                    &state.buffers.control,
-                    4 * u64::from(CONTROL_ARGS),
-                    &state.indirect,
-                    0,
-                    24,
-                );
-                shading(&mut self.begin_timed_pass(&mut encoder, stamp(2, Some(3))), None, None);
-                if let Some(clock) = state.clock.as_ref() {
-                    encoder.resolve_query_set(&clock.set, 0..4, &clock.resolved, 0);
-                }
-            }
-            encoder
+            passes.encode(prediction, candidates, chunks, on_gpu)
         })
         .and_then(|encoder| {
             let image = if on_gpu { 16 * out_pixels } else { 0 };
@@ -402,31 +522,10 @@ impl Renderer {
         } else {
             // The host: the samples, then submission 2: shading, estimates in place,
             // up-sampling, output.
-            let encoder = self.device.create_command_encoder(&Default::default());
-            let shaded: Vec<u32> =
-                self.submit_and_read(encoder, &[(&state.buffers.list, 16 * u64::from(n_shaded))], &state.readback)?;
-            let list: Vec<[u32; 4]> = shaded.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-            let blocks_in: Vec<(usize, f64)> =
-                list.iter().map(|e| (e[0] as usize, f64::from(f32::from_bits(e[2])))).collect();
-            let samples = render::adaptive::allocation(&blocks_in, budget, settings)?;
-            let (items, targets) = parts(&list, &samples, &state.levels, width * height);
+            let samples = passes.allocate_on_host(n_shaded, budget, settings, (width, height))?;
             let plan_ms = lap();
-            let rgb = capture_errors(&self.device, || {
-                let shade = shade_uniform(items.len() as u32);
-                self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
-                if !items.is_empty() {
-                    self.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&items));
-                    self.queue.write_buffer(&state.buffers.list, 0, bytemuck::cast_slice(&targets));
-                }
-                let mut encoder = self.device.create_command_encoder(&Default::default());
-                shading(&mut self.begin_pass(&mut encoder), Some(items.len() as u32), Some(n_shaded));
-                encoder
-            })
-            .and_then(|encoder| {
-                let sources = [(&self.accumulation, 16 * out_pixels)];
-                self.submit_and_map(encoder, &sources, &state.readback, |rgba| super::rgb_of(rgba, 1.0))
-            })?;
-            (rgb, samples.iter().map(|&n| u64::from(n)).sum(), plan_ms)
+            let rgb = passes.shade_on_host(&samples, n_shaded, &shade_uniform)?;
+            (rgb, samples.total, plan_ms)
         };
         let shade_ms = lap();
         let image = Image { width: out_width, height: out_height, rgb, covered: geometry.output_coverage().to_vec() };
@@ -439,33 +538,11 @@ impl Renderer {
             shaded_per_level,
             samples,
             budget,
-            timings: if on_gpu {
-                // The stages on the GPU's clock; without one, all of it is the shading's.
-                let ticks: Vec<u64> = stamps.chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
-                let period_ms = f64::from(self.queue.get_timestamp_period()) * 1e-6;
-                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period_ms;
-                let (predict_ms, plan_ms, stages_ms) =
-                    if ticks.len() == 4 { (ms(0, 1), ms(1, 2), ms(2, 3)) } else { (0.0, 0.0, shade_ms) };
-                Timings {
-                    gbuffer_ms: geometry.millis(),
-                    predict_ms,
-                    plan_ms,
-                    shade_ms: stages_ms,
-                    total_ms: shade_ms,
-                    submissions: 1,
-                    gpu_clock: ticks.len() == 4,
-                }
-            } else {
-                Timings {
-                    gbuffer_ms: geometry.millis(),
-                    predict_ms,
-                    plan_ms: plan_ms - predict_ms,
-                    shade_ms: shade_ms - plan_ms,
-                    total_ms: shade_ms,
-                    submissions: 2,
-                    gpu_clock: false,
-                }
-            },
+            timings: frame_timings(
+                on_gpu.then_some((&stamps[..], self.queue.get_timestamp_period())),
+                geometry.millis(),
+                (predict_ms, plan_ms, shade_ms),
+            ),
             details,
         })
     }
