@@ -20,7 +20,8 @@ impl Gpu {
     /// Opens the preferred adapter: Vulkan first (the backend CI runs on, through lavapipe), then
     /// a real GPU before a software one. `WGPU_BACKEND` and the other wgpu variables are honoured.
     ///
-    /// The device asks for what the tools' passes need ([`required_limits`]), and fails with
+    /// The device asks for what the tools' passes need (wgpu's downlevel defaults, raised to the
+    /// most storage buffers a previewer pass binds and to the adapter's sizes), and fails with
     /// [`GpuError::AdapterLimit`] if the adapter cannot bind a whole MERL table of the largest
     /// size (360 cells in `phi_d`, 35 MB as f32).
     pub fn new() -> Result<Gpu, GpuError> {
