@@ -14,7 +14,7 @@ use rand::{Rng, SeedableRng};
 
 use crate::brdf_bake::{MANIFEST, check_complete, contents, sha256_hex};
 use crate::support::{
-    bake_command, copy_dir, ggx_copper, reference_bake, root, run, run_within, shared, temp_dir, tool,
+    BAKE_ENV, bake_command, copy_dir, ggx_copper, reference_bake, root, run, run_within, shared_or_skip, temp_dir, tool,
 };
 
 /// Longer than any of these runs takes on a loaded machine, far shorter than forever: a run that
@@ -73,10 +73,11 @@ fn mkfifo(path: &Path) {
 /// rebakes each folder (`--force`) and lists no file outside it.
 #[test]
 fn hostile_bake_folders_touch_nothing_outside_and_never_block() {
+    let Some(shared) = shared_or_skip(&["data/hostile", BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let good = copy_of_reference(tmp.path(), "good");
     let dir = tmp.path().join("hostile");
-    let script = shared().join("data/hostile/bake/make-hostile-bakes.sh");
+    let script = shared.join("data/hostile/bake/make-hostile-bakes.sh");
     let mut cmd = Command::new("bash");
     cmd.arg(&script).arg(&good).arg(&dir);
     run(cmd, "").expect_code(0);
@@ -221,6 +222,7 @@ fn concurrent_bakes_into_one_folder_leave_a_manifest_that_tells_the_truth() {
 /// previews, and `asset-info` passes every asset.
 #[test]
 fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = copy_of_reference(tmp.path(), "bake");
     let before = contents(&dir);
@@ -255,11 +257,12 @@ fn a_rebake_that_fails_keeps_the_previous_bake_listed() {
 /// new files, would leave 3 of 21 files and no manifest).
 #[test]
 fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
+    let Some(shared) = shared_or_skip(&["data/hostile", BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let good = copy_of_reference(tmp.path(), "good");
     let cases = tmp.path().join("cases");
     let mut cmd = Command::new("bash");
-    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    cmd.arg(shared.join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
     run(cmd, "").expect_code(0);
     let engine = copy_of_reference(tmp.path(), "engine-blocked");
     std::fs::create_dir(engine.join("engine-merl.ktx2")).unwrap();
@@ -298,11 +301,12 @@ fn a_rebake_blocked_by_a_folder_at_a_name_it_writes_keeps_the_previous_bake() {
 /// bakes again, hashing nothing it lists.
 #[test]
 fn a_manifest_listing_a_path_twice_is_refused_by_every_reader() {
+    let Some(shared) = shared_or_skip(&["data/hostile", BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let good = copy_of_reference(tmp.path(), "good");
     let cases = tmp.path().join("cases");
     let mut cmd = Command::new("bash");
-    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    cmd.arg(shared.join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
     run(cmd, "").expect_code(0);
     let large = copy_of_reference(tmp.path(), "duplicate-100000");
     let text = std::fs::read_to_string(large.join(MANIFEST)).unwrap();
@@ -344,11 +348,12 @@ fn a_manifest_listing_a_path_twice_is_refused_by_every_reader() {
 /// control characters escaped, and no raw control character reaches the terminal.
 #[test]
 fn names_from_a_file_cannot_forge_messages() {
+    let Some(shared) = shared_or_skip(&["data/hostile", BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let good = copy_of_reference(tmp.path(), "good");
     let cases = tmp.path().join("cases");
     let mut cmd = Command::new("bash");
-    cmd.arg(shared().join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
+    cmd.arg(shared.join("data/hostile/bake2/make-cases.sh")).arg(&good).arg(&cases);
     run(cmd, "").expect_code(0);
     let dir = cases.join("control-chars");
     let forged = "\n\u{1b}[32merror: none, the bake is fine\u{1b}[0m";
@@ -402,6 +407,7 @@ fn names_from_a_file_cannot_forge_messages() {
 /// file).
 #[test]
 fn tools_that_write_one_file_leave_a_bake_alone() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = copy_of_reference(tmp.path(), "bake");
     let before = contents(&dir);
@@ -452,6 +458,7 @@ fn tools_that_write_one_file_leave_a_bake_alone() {
 /// manifest that no reader would read.
 #[test]
 fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = copy_of_reference(tmp.path(), "bake");
     let text = std::fs::read_to_string(dir.join(MANIFEST)).unwrap();
@@ -486,6 +493,7 @@ fn a_writer_refuses_a_manifest_its_readers_would_refuse() {
 /// unlisted files, and the moved folder's manifest name files the bake had deleted).
 #[test]
 fn a_folder_moved_during_a_bake_keeps_both_bakes_whole() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     // The first bake changes a setting (so that it rebakes); the second bakes the reference's.
     let first_bake = |dir: &Path| bake_command(dir, &["--vectors", "1", "--quiet"]);
@@ -534,6 +542,7 @@ fn a_folder_moved_during_a_bake_keeps_both_bakes_whole() {
 /// Another material is refused; so is a single-stage tool that cannot update a manifest.
 #[test]
 fn brdf_wavelet_adds_its_stage_to_a_bake_and_other_tools_refuse_one() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = copy_of_reference(tmp.path(), "bake");
     let mut cmd = tool("brdf-wavelet");
@@ -572,6 +581,7 @@ fn brdf_wavelet_adds_its_stage_to_a_bake_and_other_tools_refuse_one() {
 /// FIFO are not replaced either.
 #[test]
 fn path_options_refuse_fifos_and_devices_without_blocking() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let bake = copy_of_reference(tmp.path(), "bake");
     let fifo = tmp.path().join("fifo");

@@ -17,7 +17,8 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 
 use crate::support::{
-    ReferenceBake, bake_command, bake_env, copy_dir, ggx_copper, png_decode, reference_bake, root, run, temp_dir, tool,
+    BAKE_ENV, ReferenceBake, bake_command, bake_env, copy_dir, ggx_copper, png_decode, reference_bake, root, run,
+    shared_or_skip, temp_dir, tool,
 };
 
 pub(crate) const MANIFEST: &str = "manifest.json";
@@ -145,6 +146,7 @@ fn copy_of_reference(tmp: &tempfile::TempDir) -> (&'static ReferenceBake, std::p
 
 #[test]
 fn a_bake_lists_every_file_with_its_hash_in_a_valid_manifest() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let reference = reference_bake();
     let dir = &reference.dir;
     let manifest = check_complete(dir);
@@ -183,6 +185,7 @@ fn a_bake_lists_every_file_with_its_hash_in_a_valid_manifest() {
 
 #[test]
 fn a_rerun_is_up_to_date_and_writes_nothing() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let (_, dir) = copy_of_reference(&tmp);
     let before = snapshot(&dir);
@@ -202,6 +205,7 @@ fn a_rerun_is_up_to_date_and_writes_nothing() {
 /// data-schema "Bake folders", step 5); a file of the user's stays.
 #[test]
 fn files_no_stage_writes_make_a_manifest_another_bakes() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     for extra in ["notes.bin", "layer-n016.exr"] {
         let tmp = temp_dir();
         let (_, dir) = copy_of_reference(&tmp);
@@ -226,6 +230,7 @@ fn files_no_stage_writes_make_a_manifest_another_bakes() {
 
 #[test]
 fn force_on_one_thread_gives_the_same_bytes() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let (reference, dir) = copy_of_reference(&tmp);
     let mut cmd = bake_command(&dir, &["--force"]);
@@ -241,6 +246,7 @@ fn force_on_one_thread_gives_the_same_bytes() {
 
 #[test]
 fn a_changed_parameter_rebakes_and_removes_the_files_it_no_longer_writes() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let (reference, dir) = copy_of_reference(&tmp);
     // What an interrupted write leaves: the next bake removes it.
@@ -282,6 +288,7 @@ fn a_changed_parameter_rebakes_and_removes_the_files_it_no_longer_writes() {
 /// cleans them and finishes.
 #[test]
 fn killed_bakes_leave_no_stale_manifest_and_no_truncated_file() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let (reference, dir) = copy_of_reference(&tmp);
     let expected = contents(&reference.dir);
@@ -350,6 +357,7 @@ fn killed_bakes_leave_no_stale_manifest_and_no_truncated_file() {
 /// and no manifest.
 #[test]
 fn bad_inputs_and_settings_exit_2_with_one_line() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let out = tmp.path().join("bake");
     let missing = tmp.path().join("missing.binary");
@@ -382,6 +390,7 @@ fn bad_inputs_and_settings_exit_2_with_one_line() {
 /// way.
 #[test]
 fn validation_problems_survive_an_up_to_date_rerun() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = tmp.path().join("bake");
     let command = || {
@@ -453,6 +462,7 @@ fn an_unphysical_table_is_refused_before_anything_is_baked() {
 /// --reading` of that reading writes for the map.
 #[test]
 fn the_environment_bandwidth_reading_follows_the_material() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let reference = reference_bake();
     let stage = |manifest: &Value, name: &str| -> Value {
         manifest["stages"].as_array().unwrap().iter().find(|s| s["name"] == name).cloned().expect(name)

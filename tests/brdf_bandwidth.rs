@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use merl::Dims;
 use merl::analytic::Analytic;
 
-use crate::support::{MATERIALS, Run, exr_header, nbrdf_table, png_decode, root, run, temp_dir, tool};
+use crate::support::{
+    MATERIALS, NBRDF, Run, exr_header, nbrdf_table, png_decode, root, run, shared_or_skip, temp_dir, tool,
+};
 
 /// Writes a MERL table of `brdf` into `dir`.
 fn write_table(dir: &Path, name: &str, brdf: Analytic) -> PathBuf {
@@ -208,6 +210,7 @@ fn bad_inputs_exit_2_naming_the_file() {
 
 #[test]
 fn pca_of_the_shared_materials() {
+    let Some(_) = shared_or_skip(&[NBRDF]) else { return };
     // For each material, the atlas (64 x 64 lobes of 16 x 16, analysed at 64 x 64; stored as its
     // 64 row tiles) and the fewest PCA components whose relative RMSE is at most 2%. Asserted:
     // such a K exists and its measured error is within 2%. The table is printed: the model's size

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::support::{reference_bake, reported_psnr, run, temp_dir, tool};
+use crate::support::{BAKE_ENV, reference_bake, reported_psnr, run, shared_or_skip, temp_dir, tool};
 
 /// `merl-synth phong -n 10 --ks 0.2 --kd 0.8` (Claustres et al. 2007, Table 1's Lewis row).
 fn lewis(dir: &Path) -> std::path::PathBuf {
@@ -89,6 +89,7 @@ fn bad_settings_and_damaged_assets_are_refused() {
 
 #[test]
 fn the_previewer_renders_from_the_wavelet_and_measures_it_against_the_table() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let material = crate::support::ggx_copper();
     // brdf-wavelet into a copy of the bake: the previewer finds the asset there by default.

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use bandwidth::{Config, latlong_bandwidth, local_bandwidth, local_bandwidth_zero_padded, log1p_luminance};
 
-use crate::support::{Run, exr_header, png_decode, run, shared, temp_dir, tool};
+use crate::support::{Run, exr_header, png_decode, run, shared_or_skip, temp_dir, tool};
 
 /// Runs envmap-bandwidth on `input` into `out_dir` with `args`.
 fn envmap_bandwidth(input: &Path, out_dir: &Path, args: &[&str]) -> Run {
@@ -32,9 +32,10 @@ fn figures(r: &Run, out_dir: &Path) -> serde_json::Value {
 
 #[test]
 fn quarry_end_to_end() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
     let dir = temp_dir();
     let out = dir.path().join("quarry");
-    let input = shared().join("data/env/quarry_01_1k.hdr");
+    let input = shared.join("data/env/quarry_01_1k.hdr");
     let r =
         envmap_bandwidth(&input, &out, &[]).expect_code(0).expect_stdout("cycles per radian").expect_stdout("median");
     assert!(r.stdout.contains(&input.display().to_string()), "the report names its input\n{r}");
@@ -69,9 +70,10 @@ fn quarry_end_to_end() {
 
 #[test]
 fn fft_diagnostic() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
     let dir = temp_dir();
     let out = dir.path().join("potsdamer");
-    let input = shared().join("data/env/potsdamer_platz_1k.hdr");
+    let input = shared.join("data/env/potsdamer_platz_1k.hdr");
     let r =
         envmap_bandwidth(&input, &out, &["--fft-diagnostic", "--json"]).expect_code(0).expect_stdout("fft_diagnostic");
     assert!(r.stderr.contains("log2(wavelet / fft)") && r.stderr.contains("spearman"), "{r}");
@@ -91,8 +93,9 @@ fn fft_diagnostic() {
 /// spatial modes take it.
 #[test]
 fn not_two_to_one() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
     let dir = temp_dir();
-    let input = shared().join("data/env/decoder/memorial.exr");
+    let input = shared.join("data/env/decoder/memorial.exr");
     let out = dir.path().join("m");
     envmap_bandwidth(&input, &out, &[]).expect_code(2).expect_error(&input, "not a lat-long map: 512 x 768");
     assert!(!out.exists());
@@ -118,9 +121,10 @@ fn not_two_to_one() {
 /// A tiny texture (4 x 4) is enlarged in the picture so that it stays visible.
 #[test]
 fn tiny_texture() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
     let dir = temp_dir();
     let out = dir.path().join("t");
-    envmap_bandwidth(&shared().join("data/env/decoder/imagers_rgbr4x4.hdr"), &out, &["--spatial", "--pad"])
+    envmap_bandwidth(&shared.join("data/env/decoder/imagers_rgbr4x4.hdr"), &out, &["--spatial", "--pad"])
         .expect_code(0);
     assert_eq!(exr_header(&out.join("env-bandwidth.exr")).0, (4, 4));
     // Enlarged: at 4 x 4 picture pixels the map would be invisible; 64 is a generous floor
@@ -149,7 +153,8 @@ fn input_errors_name_the_file() {
 /// with one line.
 #[test]
 fn bad_arguments() {
-    let input = shared().join("data/env/quarry_01_1k.hdr");
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
+    let input = shared.join("data/env/quarry_01_1k.hdr");
     let dir = temp_dir();
     let out = dir.path().join("bw");
     let usage: [(&[&str], &str); 8] = [
@@ -205,7 +210,8 @@ fn assert_equal(image: &envmap::HdrImage, width: usize, height: usize, expected:
 
 #[test]
 fn angular_map_equals_the_library_estimate() {
-    let path = shared().join("data/env/quarry_01_1k.hdr");
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
+    let path = shared.join("data/env/quarry_01_1k.hdr");
     let map = envmap::load(&path).unwrap();
     let image = log1p_luminance(map.width(), map.height(), map.texels()).unwrap();
     let expected = latlong_bandwidth(&image, &Config::default()).unwrap();
@@ -216,7 +222,8 @@ fn angular_map_equals_the_library_estimate() {
 /// A 512 x 768 file (not 2:1) in both spatial modes, and the options reach the library.
 #[test]
 fn spatial_maps_equal_the_library_estimate() {
-    let path = shared().join("data/env/decoder/memorial.exr");
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
+    let path = shared.join("data/env/decoder/memorial.exr");
     let file = envmap::read_image(&path, &envmap::Limits::default()).unwrap();
     let image = log1p_luminance(file.width, file.height, file.rgb.as_chunks::<3>().0).unwrap();
     let padded = local_bandwidth_zero_padded(&image, &Config::default()).unwrap();
@@ -236,8 +243,9 @@ fn spatial_maps_equal_the_library_estimate() {
 /// paper's; on quarry it reads the fine texture the paper's reading masks (its median is higher).
 #[test]
 fn the_level_normalized_reading_reads_finer() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
     let dir = temp_dir();
-    let input = shared().join("data/env/quarry_01_1k.hdr");
+    let input = shared.join("data/env/quarry_01_1k.hdr");
     let (paper_dir, normalized_dir) = (dir.path().join("paper"), dir.path().join("normalized"));
     let paper = envmap_bandwidth(&input, &paper_dir, &["--json"]).expect_code(0);
     let normalized =

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use asset::Payload;
 
-use crate::support::{png_decode, run, shared, temp_dir, tool};
+use crate::support::{png_decode, run, shared, shared_or_skip, temp_dir, tool};
 
 fn env_dir() -> PathBuf {
     shared().join("data").join("env")
@@ -31,6 +31,7 @@ fn ktx2_header(path: &Path) -> (u32, u32, u32, u32, u32) {
 
 #[test]
 fn writes_every_output_for_the_real_maps_and_they_verify() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     for name in ["quarry_01_1k.hdr", "potsdamer_platz_1k.hdr"] {
         let tmp = temp_dir();
         let out = tmp.path().join("prefiltered");
@@ -120,6 +121,7 @@ fn writes_every_output_for_the_real_maps_and_they_verify() {
 /// Options: other exponents and sizes, and the method forced.
 #[test]
 fn exponents_size_and_method_are_honoured() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let tmp = temp_dir();
     let out = tmp.path().join("small");
     let mut cmd = tool("envmap-prefilter");
@@ -148,6 +150,7 @@ fn exponents_size_and_method_are_honoured() {
 
 #[test]
 fn bad_arguments_are_refused() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let cases: [(&[&str], &str); 3] = [
         (&["--exponents", "16,4"], "error: invalid arguments: exponents must increase strictly, found 16 then 4\n"),
         (&["--exponents", "0"], "error: invalid arguments: exponent 0 outside 1 ..= 16777216\n"),
@@ -185,6 +188,7 @@ fn check_refused(path: &Path, problem: &str) {
 /// 2:1 lat-long map: each is refused with the reason. The list must name every file there.
 #[test]
 fn awkward_decoder_files_are_refused_with_the_reason() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let cases = [
         ("imagers_old-rle.hdr", "not a lat-long map: 551 x 276, expected width = 2 x height"),
         ("imagers_rgbr4x4.hdr", "not a lat-long map: 4 x 4, expected width = 2 x height"),
@@ -204,6 +208,7 @@ fn awkward_decoder_files_are_refused_with_the_reason() {
 /// Damaged copies of real maps and files that are no map at all.
 #[test]
 fn damaged_inputs_are_refused_with_the_reason() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let tmp = temp_dir();
     let truncate = |name: &str, len: usize| {
         let bytes = std::fs::read(env_dir().join(name)).unwrap();
@@ -225,6 +230,7 @@ fn damaged_inputs_are_refused_with_the_reason() {
 /// no longer matches, which `asset-info` must say).
 #[test]
 fn asset_info_names_a_stale_or_missing_linked_file() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let tmp = temp_dir();
     let out = tmp.path().join("out");
     let mut cmd = tool("envmap-prefilter");
@@ -353,6 +359,7 @@ fn killed_while_writing_the_folder_stays_consistent() {
 /// `ktx2check` passes every file with warnings as errors. `make setup` installs both.
 #[test]
 fn ktx_parse_reads_the_lat_long_and_cube_files() {
+    let Some(_) = shared_or_skip(&["data/env"]) else { return };
     let script = crate::support::root().join("tests").join("ktx-parse").join("check.mjs");
     let modules = crate::support::root().join("tests").join("ktx-parse").join("node_modules").join("ktx-parse");
     assert!(

@@ -6,7 +6,7 @@ use importance::quality::{albedo_estimate, chi2_against_density, slice_quality};
 use importance::{Config, build};
 use merl::albedo::Quadrature;
 
-use crate::support::{MATERIALS, nbrdf_table, png_decode, run, temp_dir, tool};
+use crate::support::{MATERIALS, NBRDF, nbrdf_table, png_decode, run, shared_or_skip, temp_dir, tool};
 
 /// Nine slices, 10 degrees apart: 0, 30, 60 and 80 degrees are slices 0, 3, 6 and 8.
 const SLICES: [usize; 4] = [0, 3, 6, 8];
@@ -30,6 +30,7 @@ fn worst_albedo_error(
 
 #[test]
 fn relative_variance_and_albedo_on_all_shared_materials() {
+    let Some(_) = shared_or_skip(&[NBRDF]) else { return };
     let mut report =
         String::from("material                 theta_o      rv   rv_cos   albedo err 8x256   8x64   (8x4096)\n");
     let mut failures = Vec::new();
@@ -78,6 +79,7 @@ fn relative_variance_and_albedo_on_all_shared_materials() {
 
 #[test]
 fn samples_pass_a_chi_square_test_on_real_derived_materials() {
+    let Some(_) = shared_or_skip(&[NBRDF]) else { return };
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(12);
     for name in ["chrome", "gold-paint", "white-paint", "pink-fabric"] {

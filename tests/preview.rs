@@ -11,7 +11,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
-use crate::support::{nbrdf_table, png_decode, reported_psnr, root, run, shared, temp_dir, tool};
+use crate::support::{
+    NBRDF, nbrdf_table, png_decode, reported_psnr, root, run, shared, shared_or_skip, temp_dir, tool,
+};
 
 const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
@@ -71,6 +73,7 @@ fn cases() -> impl Iterator<Item = (&'static str, &'static str)> {
 /// f64 arithmetic and the rare sample whose MERL cell flips at a cell edge (measured 76 to 81 dB).
 #[test]
 fn reference_mode_on_the_gpu_equals_the_cpu_on_six_cases() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let mut failures = Vec::new();
     println!("case                              PSNR (dB)   relative error   coverage mismatches");
@@ -101,6 +104,7 @@ fn reference_mode_on_the_gpu_equals_the_cpu_on_six_cases() {
 /// sun too: the benchmarks (`cargo bench -p brdf-preview --bench mitsuba`) measure those cases.
 #[test]
 fn reference_mode_agrees_with_the_converged_estimate_on_three_cases() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let mut failures = Vec::new();
     println!("case                              frames   mean luminance ratio   PSNR against it (dB)");
@@ -131,6 +135,7 @@ fn reference_mode_agrees_with_the_converged_estimate_on_three_cases() {
 /// converged estimate is the benchmark's, not a test's).
 #[test]
 fn fis_and_prefiltered_modes_equal_the_cpu() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let dir = bake("gold-paint", "quarry_01_1k");
     for mode in ["fis", "prefiltered"] {
@@ -145,6 +150,7 @@ fn fis_and_prefiltered_modes_equal_the_cpu() {
 /// `--sheet` lays out every picture of the bake; the preview carries its caption below the render.
 #[test]
 fn the_sheet_and_the_preview_are_pictures() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let dir = bake("chrome", "potsdamer_platz_1k");
     let sheet = tmp.path().join("sheet.png");
@@ -166,6 +172,7 @@ fn the_sheet_and_the_preview_are_pictures() {
 /// 2 with one line saying how to get one.
 #[test]
 fn without_an_adapter_the_previewer_says_how_to_get_one() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let dir = bake("chrome", "potsdamer_platz_1k");
     let mut cmd = tool("brdf-preview");
@@ -186,6 +193,7 @@ fn without_an_adapter_the_previewer_says_how_to_get_one() {
 /// nothing, falls far below).
 #[test]
 fn the_adaptive_modes_report_their_work_and_their_quality() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let tmp = temp_dir();
     let dir = bake("gold-paint", "quarry_01_1k");
     for mode in ["adaptive", "adaptive-prefiltered"] {

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
-use crate::support::{ggx_copper, reference_bake, run, run_within, temp_dir, tool};
+use crate::support::{BAKE_ENV, ggx_copper, reference_bake, run, run_within, shared_or_skip, temp_dir, tool};
 
 /// Any of these runs ends in well under this; a refusal that computes first would not.
 const QUICK: Duration = Duration::from_secs(30);
@@ -27,6 +27,7 @@ fn preview(args: &[&str]) -> Command {
 /// says what it accepts; the work options name the ceiling and how to lift it.
 #[test]
 fn numeric_options_are_refused_outside_their_range() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let png = tmp.path().join("p.png");
     let png = png.to_str().unwrap();
@@ -115,6 +116,7 @@ fn numeric_options_are_refused_outside_their_range() {
 /// which is an error naming the asset, never exit 0 with "relative error inf".
 #[test]
 fn absurd_wavelet_assets_are_refused_and_a_render_that_overflows_is_an_error() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let dir = tmp.path().join("w");
     let mut cmd = tool("brdf-wavelet");
@@ -185,6 +187,7 @@ fn absurd_wavelet_assets_are_refused_and_a_render_that_overflows_is_an_error() {
 /// line starting with `error:`, even where no Wayland session is set up (XDG_RUNTIME_DIR unset).
 #[test]
 fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     let png = reference_bake().dir.join("importance.png");
     let mut cmd = tool("merl-info");
@@ -232,6 +235,7 @@ fn messages_say_what_the_file_or_folder_is_and_what_to_do() {
 /// refuses it and `asset-info` reports it as a problem (exit 1).
 #[test]
 fn values_behind_valid_checksums_are_refused_by_every_reader() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
     let tmp = temp_dir();
     /// The asset, what the message says, whether decoding refuses it (else only the densities'
     /// check does), the edit.

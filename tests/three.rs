@@ -23,7 +23,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::support::{nbrdf_table, root, run, shared, tool};
+use crate::support::{NBRDF, nbrdf_table, root, run, shared, shared_or_skip, tool};
 
 /// The PSNR both modes must reach against brdf-preview drawn exactly: 60 dB, above the 40 dB the
 /// GPU renderer is held to against the CPU's (`tests/preview.rs`), because the same estimator
@@ -90,6 +90,7 @@ fn read_data(path: &Path) -> prefilter::ktx::DecodedData {
 /// among the layers.
 #[test]
 fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
+    let Some(shared) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let dir = bake("white-paint", "potsdamer_platz_1k");
     // A valid manifest (data-schema's JSON schema) listing every file of the folder.
     crate::brdf_bake::check_complete(&dir);
@@ -110,7 +111,7 @@ fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
     let mut cmd = tool("brdf-bake");
     cmd.arg(nbrdf_table("white-paint"))
         .arg("--env")
-        .arg(shared().join("data/env/potsdamer_platz_1k.hdr"))
+        .arg(shared.join("data/env/potsdamer_platz_1k.hdr"))
         .arg("--out-dir")
         .arg(tmp.path().join("bake"))
         .args(["--engine-textures", "--analysis-size", "64", "--quiet"])
@@ -264,6 +265,7 @@ fn engine_textures_need_an_environment() {
 ///   back as floats, within one 8-bit level (measured: 1 and 0).
 #[test]
 fn the_material_is_at_home_in_a_y_up_three_js_scene() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let dir = bake("chrome", "quarry_01_1k");
     let out = root().join("target/test-tmp/three-scene");
     assert!(
@@ -473,6 +475,7 @@ fn problem(case: &Case, coverage: &str) -> Option<String> {
 /// drawn forward, as a scene draws the material.
 #[test]
 fn three_js_renders_a_bake_as_brdf_preview_does() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let dir = bake("gold-paint", "quarry_01_1k");
     let out = root().join("target/test-tmp/three");
     for (mode, coverage, frames) in
@@ -499,6 +502,7 @@ fn three_js_renders_a_bake_as_brdf_preview_does() {
 #[test]
 #[ignore = "about 10 minutes on 2 cores: make three-cases"]
 fn three_js_equals_brdf_preview_on_the_six_cases() {
+    let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
     let out = root().join("target/three-cases");
     let mut rows = Vec::new();
     let mut failures = Vec::new();

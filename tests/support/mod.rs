@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::{Mutex, OnceLock};
 
+mod shared_data;
+pub use shared_data::{shared, shared_or_skip};
+
 /// The workspace root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -196,18 +199,6 @@ pub fn run_within(mut cmd: Command, limit: std::time::Duration) -> (Run, std::ti
     (r, elapsed)
 }
 
-/// `../shared` beside the checkout, which holds the real test data; fails with a clear message
-/// if it is missing (CI always has it).
-pub fn shared() -> PathBuf {
-    let dir = root().join("..").join("shared");
-    assert!(
-        dir.join("data").is_dir(),
-        "the shared test data is missing: expected it at {} (a checkout of the project's shared/ folder beside this repository)",
-        dir.display()
-    );
-    dir
-}
-
 /// The 20 materials of `../shared/data/nbrdf/merl-dev.json`.
 pub const MATERIALS: [&str; 20] = [
     "color-changing-paint3",
@@ -231,6 +222,9 @@ pub const MATERIALS: [&str; 20] = [
     "teflon",
     "silver-metallic-paint",
 ];
+
+/// What [`nbrdf_table`] reads in `../shared` (with `tools/nbrdf2merl.py`), for [`shared_or_skip`].
+pub const NBRDF: &str = "data/nbrdf";
 
 /// A MERL table rebuilt from the shared neural fits, made once under target/merl/ with
 /// `nbrdf2merl.py` (needs python3 with numpy).
@@ -345,10 +339,14 @@ pub fn ggx_copper() -> &'static Path {
     })
 }
 
-/// The smallest shared environment map that works (1024 x 512, a smooth overcast street): the
-/// environment of the bake tests.
+/// The environment of the bake tests, in `../shared`: the smallest shared map that works
+/// (1024 x 512, a smooth overcast street). The tests that use [`bake_env`], [`reference_bake`] or
+/// [`bake_command`] name it to [`shared_or_skip`].
+pub const BAKE_ENV: &str = "data/env/potsdamer_platz_1k.hdr";
+
+/// [`BAKE_ENV`] in `../shared`.
 pub fn bake_env() -> PathBuf {
-    shared().join("data").join("env").join("potsdamer_platz_1k.hdr")
+    shared().join(BAKE_ENV)
 }
 
 /// A finished bake of [`ggx_copper`] in [`bake_env`], made once per test run (with `--force`,

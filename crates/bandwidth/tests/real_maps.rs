@@ -9,8 +9,6 @@
 //! away, so dark pixels beside bright ones gain new structure in `ln(1 + Y)` and some rightly
 //! read higher. That variant is measured and printed too, not gated.
 
-use std::path::{Path, PathBuf};
-
 use bandwidth::{
     AngularBandwidthMap, Config, Image, WindowedFftConfig, compare_maps, latlong_bandwidth, log1p_luminance,
     wavelet_at_windows, windowed_fft_bandwidth,
@@ -29,25 +27,14 @@ const MAPS: [&str; 5] = [
 /// The blur widths (sigma), in pixels.
 const SIGMAS: [f64; 3] = [1.0, 2.0, 4.0];
 
-/// `../shared/data/env`, or a panic that says where it was expected.
-fn shared_env() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/env");
-    assert!(
-        dir.join("README.md").is_file(),
-        "the shared test data is missing: expected the real maps in {} (a checkout of the project's shared/ folder \
-         beside this repository)",
-        dir.display()
-    );
-    dir
-}
-
-/// A real map: its linear luminance and the analysed image `ln(1 + Y)`.
-fn load(file: &str) -> (Image, Image) {
-    let path = shared_env().join(file);
+/// A real map of `../shared/data/env`: its linear luminance and the analysed image `ln(1 + Y)`.
+/// `None` when the calling test is to skip without them ([`crate::shared_data::shared_or_skip`]).
+fn load(file: &str) -> Option<(Image, Image)> {
+    let path = crate::shared_data::shared_or_skip(&["data/env"])?.join("data/env").join(file);
     let map = envmap::load(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let (w, h) = (map.width(), map.height());
     let y = map.texels().iter().map(|p| bandwidth::luminance(p.map(f64::from)).max(0.0)).collect();
-    (Image::new(w, h, y).unwrap(), log1p_luminance(w, h, map.texels()).unwrap())
+    Some((Image::new(w, h, y).unwrap(), log1p_luminance(w, h, map.texels()).unwrap()))
 }
 
 /// Separable Gaussian blur of a lat-long image, the kernel cut at 4 sigma and normalized: rows
@@ -107,7 +94,7 @@ fn blurring_never_raises_the_estimate() {
         String::from("map                       sigma   raised   lowered   (linear-RGB blur: raised  lowered)\n");
     let mut failures = Vec::new();
     for file in MAPS {
-        let (linear, analysed) = load(file);
+        let Some((linear, analysed)) = load(file) else { return };
         assert_eq!((analysed.width(), analysed.height()), (1024, 512), "{file}");
         let before = latlong_bandwidth(&analysed, &config).unwrap();
         let mut previous_lowered = 0.0;
@@ -154,7 +141,7 @@ fn windowed_fft_diagnostic() {
         "map                       windows  one zero   log2(wavelet / fft) p5    p25    p50    p75    p95   spearman\n",
     );
     for file in MAPS {
-        let (_, analysed) = load(file);
+        let Some((_, analysed)) = load(file) else { return };
         let wavelet = latlong_bandwidth(&analysed, &config).unwrap();
         let fft = windowed_fft_bandwidth(&analysed, &fft_config).unwrap();
         let c = compare_maps(&wavelet_at_windows(wavelet.pixels(), &fft), fft.frequency()).unwrap();

@@ -14,6 +14,10 @@ mod split;
 mod windowed_fft;
 mod zero_padding;
 
+/// Finds `../shared`, or skips a test without it where the run allows.
+#[path = "../../../tests/support/shared_data.rs"]
+mod shared_data;
+
 use std::f64::consts::TAU;
 
 use bandwidth::Image;

@@ -82,13 +82,14 @@ fn a_missing_file_is_an_io_error() {
 /// small limit, and the same file loads under the default one.
 #[test]
 fn limits_come_from_the_header() {
-    let path = crate::shared_env().join("potsdamer_platz_1k.hdr");
+    let Some(env) = crate::shared_env() else { return };
+    let path = env.join("potsdamer_platz_1k.hdr");
     let small = envmap::Limits { max_width: 1023, max_height: 8192, ..Default::default() };
     let error = envmap::load_with_limits(&path, &small).expect_err("over the limit");
     assert_eq!(error.to_string(), "limit exceeded: 1024 x 512 is larger than the limit of 1023 x 8192");
     let exact = envmap::Limits { max_width: 1024, max_height: 512, ..Default::default() };
     assert!(envmap::load_with_limits(&path, &exact).is_ok());
-    let exr = crate::shared_env().join("KernerEnvLatLong.exr");
+    let exr = env.join("KernerEnvLatLong.exr");
     let error =
         envmap::load_with_limits(&exr, &envmap::Limits { max_width: 1024, max_height: 511, ..Default::default() })
             .expect_err("exr");
@@ -100,7 +101,8 @@ fn limits_come_from_the_header() {
 /// abort on a 1.4 GB allocation under a 4 GB address-space limit.
 #[test]
 fn the_memory_budget_comes_from_the_header() {
-    let path = crate::shared_env().join("potsdamer_platz_1k.hdr");
+    let Some(shared) = crate::shared_data::shared_or_skip(&["data/env", "data/hostile"]) else { return };
+    let path = shared.join("data/env/potsdamer_platz_1k.hdr");
     let error = envmap::load_with_limits(&path, &envmap::Limits::for_job(64, 1 << 20)).expect_err("over budget");
     assert_eq!(
         error.to_string(),
@@ -109,7 +111,7 @@ fn the_memory_budget_comes_from_the_header() {
     );
     assert!(envmap::load_with_limits(&path, &envmap::Limits::for_job(64, 32 << 20)).is_ok());
 
-    let hostile = crate::shared_env().join("../hostile/repro-oldrle-16384x8192-abort.hdr");
+    let hostile = shared.join("data/hostile/repro-oldrle-16384x8192-abort.hdr");
     let job = envmap::Limits::for_job(48, envmap::DEFAULT_MAX_MEMORY);
     let error = envmap::load_with_limits(&hostile, &job).expect_err("over budget");
     assert_eq!(crate::kind(&error), Kind::Limit, "{error}");
@@ -154,7 +156,8 @@ fn an_exr_header_at_the_size_limit_is_truncated_before_allocating() {
 /// damaged (a release build reports the crate's own error).
 #[test]
 fn damaged_b44_files_are_errors_in_a_debug_build() {
-    let hostile = crate::shared_env().join("../hostile");
+    let Some(shared) = crate::shared_data::shared_or_skip(&["data/hostile"]) else { return };
+    let hostile = shared.join("data/hostile");
     let mut files: Vec<_> = std::fs::read_dir(&hostile)
         .expect("the shared hostile inputs")
         .map(|e| e.expect("entry").path())
@@ -181,9 +184,11 @@ fn random_damage_never_panics() {
         ("f32 exr".to_string(), envmap::encode_exr(32, 16, &channels, envmap::SampleType::F32).expect("exr")),
         ("f16 exr".to_string(), envmap::encode_exr(32, 16, &channels, envmap::SampleType::F16).expect("exr")),
     ];
-    for name in ["imagers_rgbr4x4.hdr", "imagers_old-rle.hdr"] {
-        let path = crate::shared_env().join("decoder").join(name);
-        sources.push((name.to_string(), std::fs::read(&path).expect(name)));
+    if let Some(env) = crate::shared_env() {
+        for name in ["imagers_rgbr4x4.hdr", "imagers_old-rle.hdr"] {
+            let path = env.join("decoder").join(name);
+            sources.push((name.to_string(), std::fs::read(&path).expect(name)));
+        }
     }
     let limits = envmap::Limits::default();
     let mut rng = rand::rngs::StdRng::seed_from_u64(17);

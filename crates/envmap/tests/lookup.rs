@@ -46,7 +46,8 @@ fn new_rejects_what_is_not_a_map() {
 /// centre coordinates are exact).
 #[test]
 fn bilinear_is_exact_at_texel_centres() {
-    let map = envmap::load(&shared_env().join("quarry_01_1k.hdr")).expect("quarry");
+    let Some(env) = shared_env() else { return };
+    let map = envmap::load(&env.join("quarry_01_1k.hdr")).expect("quarry");
     for y in 0..map.height() {
         for x in 0..map.width() {
             let (u, v) = envmap::geometry::texel_center_uv(x, y, map.width(), map.height());

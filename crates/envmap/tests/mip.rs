@@ -24,8 +24,9 @@ fn level_sizes() {
 /// more on these maps, which is why the filter is weighted.
 #[test]
 fn every_level_keeps_the_weighted_mean() {
+    let Some(env) = shared_env() else { return };
     for file in ["quarry_01_1k.hdr", "studio_small_03_1k.hdr", "KernerEnvLatLong.exr"] {
-        let map = envmap::load(&shared_env().join(file)).expect(file);
+        let map = envmap::load(&env.join(file)).expect(file);
         let chain = MipChain::new(&map);
         let want = map.mean_radiance();
         for (l, level) in chain.levels().iter().enumerate() {

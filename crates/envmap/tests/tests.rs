@@ -8,19 +8,16 @@ mod mip;
 mod real_maps;
 mod write;
 
+/// Finds `../shared`, or skips a test without it where the run allows.
+#[path = "../../../tests/support/shared_data.rs"]
+mod shared_data;
+
 use std::path::{Path, PathBuf};
 
-/// `../shared/data/env` next to the workspace: real maps that are never committed. Absent data is
-/// a failure, not a skip: CI always has it.
-pub fn shared_env() -> PathBuf {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/env"));
-    assert!(
-        dir.join("README.md").is_file(),
-        "the shared data is missing: expected the real environment maps in {} (../shared/data/env next to \
-         the workspace root); CI always has it",
-        dir.display()
-    );
-    dir.to_path_buf()
+/// `../shared/data/env` next to the workspace: real maps that are never committed. `None` when the
+/// calling test is to skip without them ([`shared_data::shared_or_skip`]).
+pub fn shared_env() -> Option<PathBuf> {
+    shared_data::shared_or_skip(&["data/env"]).map(|shared| shared.join("data/env"))
 }
 
 /// The damaged files committed with the crate.

@@ -29,7 +29,8 @@ fn exr_round_trip_f32_is_exact() {
     assert_only(dir.path(), &["map.exr"]);
     assert_eq!(envmap::load(&path).expect("load"), map);
     // A real map too.
-    let quarry = envmap::load(&shared_env().join("quarry_01_1k.hdr")).expect("quarry");
+    let Some(env) = shared_env() else { return };
+    let quarry = envmap::load(&env.join("quarry_01_1k.hdr")).expect("quarry");
     quarry.write_exr(&path, SampleType::F32).expect("write quarry");
     assert_eq!(envmap::load(&path).expect("load quarry"), quarry);
 }
@@ -101,8 +102,9 @@ fn exr_writer_rejects_bad_input() {
 #[test]
 fn png_preview_reads_back() {
     let dir = tempfile::tempdir().expect("temporary folder");
+    let Some(env) = shared_env() else { return };
     let path = dir.path().join("preview.png");
-    let map = envmap::load(&shared_env().join("studio_small_03_1k.hdr")).expect("studio");
+    let map = envmap::load(&env.join("studio_small_03_1k.hdr")).expect("studio");
     map.write_preview_png(&path, &ToneMapping::default()).expect("write");
     assert_only(dir.path(), &["preview.png"]);
     let image = image::open(&path).expect("png");

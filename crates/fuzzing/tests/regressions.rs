@@ -4,13 +4,18 @@
 //! replayed through each harness on stable Rust, under the counting allocator: no input may panic
 //! or allocate beyond `fuzzing::check_memory`'s bound. Then the
 //! same bound on the largest legitimate inputs: the real maps in `../shared/data/env` and a MERL
-//! table of full size.
+//! table of full size. A run without `../shared` that allows it replays the rest
+//! ([`shared_data::shared_or_skip`]).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, Once};
 
 use fuzzing::CountingAllocator;
+
+/// Finds `../shared`, or skips a test's use of it where the run allows.
+#[path = "../../../tests/support/shared_data.rs"]
+mod shared_data;
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator;
@@ -54,14 +59,17 @@ fn inputs(dir: &Path, what: &str) -> Vec<PathBuf> {
     files
 }
 
-/// The folders every target reads besides its own, as seeds in `make fuzz` (`FUZZ_SHARED_SEEDS`)
+/// The inputs every target reads besides its own, as seeds in `make fuzz` (`FUZZ_SHARED_SEEDS`)
 /// and here: the committed fixtures (valid and damaged files of every format) and the shared
-/// hostile files (reproducers found before fuzzing was in the repository). A harness skips or
-/// refuses another format's bytes.
-const SHARED_INPUTS: [(&str, &str); 2] = [
-    ("fixtures", "the committed fixtures"),
-    ("../shared/data/hostile", "the shared hostile inputs (the project's shared/ folder beside the workspace)"),
-];
+/// hostile files in `../shared/data/hostile` (reproducers found before fuzzing was in the
+/// repository). A harness skips or refuses another format's bytes.
+fn shared_inputs() -> Vec<PathBuf> {
+    let mut files = inputs(&root().join("fixtures"), "the committed fixtures");
+    if let Some(shared) = shared_data::shared_or_skip(&["data/hostile"]) {
+        files.extend(inputs(&shared.join("data/hostile"), "the shared hostile inputs"));
+    }
+    files
+}
 
 /// Runs `harness` on `bytes` under the allocator: `Err` when it panics or holds more than the
 /// bound allows, with the peak either way.
@@ -98,9 +106,7 @@ fn replay(target: &str) {
             files.extend(inputs(&own, "the inputs of this target"));
         }
     }
-    for (folder, what) in SHARED_INPUTS {
-        files.extend(inputs(&root().join(folder), what));
-    }
+    files.extend(shared_inputs());
     let mut failures = Vec::new();
     let mut largest = (0, String::new());
     for file in &files {
@@ -158,20 +164,7 @@ fn obj() {
 #[test]
 fn legitimate_inputs_keep_the_bound() {
     let alone = alone();
-    let env = root().join("../shared/data/env");
-    assert!(
-        env.join("README.md").is_file(),
-        "the shared data is missing: expected the real environment maps in {} (../shared/data/env next to \
-         the workspace root)",
-        env.display()
-    );
-    let mut maps: Vec<PathBuf> = [env.clone(), env.join("decoder")]
-        .iter()
-        .flat_map(|dir| std::fs::read_dir(dir).expect("listing the shared maps"))
-        .map(|entry| entry.expect("listing the shared maps").path())
-        .filter(|path| path.extension().is_some_and(|e| e == "exr" || e == "hdr"))
-        .collect();
-    maps.sort();
+    let maps = shared_data::shared_or_skip(&["data/env"]).map_or_else(Vec::new, |shared| real_maps(&shared));
     let mut failures = Vec::new();
     for path in &maps {
         let bytes = std::fs::read(path).expect("reading a shared map");
@@ -207,6 +200,19 @@ fn legitimate_inputs_keep_the_bound() {
         }
     }
     assert!(failures.is_empty(), "legitimate inputs above the bound:\n{}", failures.join("\n"));
+}
+
+/// The real maps of `../shared/data/env` and its `decoder/` folder, sorted.
+fn real_maps(shared: &Path) -> Vec<PathBuf> {
+    let env = shared.join("data/env");
+    let mut maps: Vec<PathBuf> = [env.clone(), env.join("decoder")]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(dir).expect("listing the shared maps"))
+        .map(|entry| entry.expect("listing the shared maps").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "exr" || e == "hdr"))
+        .collect();
+    maps.sort();
+    maps
 }
 
 /// A bandwidth atlas of the size `brdf-bandwidth` writes (64 x 64 lobes of 16 x 16 texels) as

@@ -10,27 +10,17 @@ mod ktx;
 mod lobe;
 mod sheet;
 
-use std::path::{Path, PathBuf};
+/// Finds `../shared`, or skips a test without it where the run allows.
+#[path = "../../../tests/support/shared_data.rs"]
+mod shared_data;
 
 use envmap::EnvMap;
 
-/// `../shared/data/env` next to the workspace: real maps that are never committed. Absent data is
-/// a failure, not a skip: CI always has it.
-pub fn shared_env() -> PathBuf {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/env"));
-    assert!(
-        dir.join("README.md").is_file(),
-        "the shared data is missing: expected the real environment maps in {} (../shared/data/env next to \
-         the workspace root); CI always has it",
-        dir.display()
-    );
-    dir.to_path_buf()
-}
-
-/// One of the real maps in `../shared/data/env`.
-pub fn real_map(name: &str) -> EnvMap {
-    let path = shared_env().join(name);
-    envmap::load(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+/// One of the real maps in `../shared/data/env` next to the workspace (never committed). `None`
+/// when the calling test is to skip without them ([`shared_data::shared_or_skip`]).
+pub fn real_map(name: &str) -> Option<EnvMap> {
+    let path = shared_data::shared_or_skip(&["data/env"])?.join("data/env").join(name);
+    Some(envmap::load(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display())))
 }
 
 /// A black map with one texel of radiance `rgb`: a point source of power `rgb * omega` at the
