@@ -26,19 +26,19 @@ pub static MERL_LOOKUP_BATCH: Wgsl = wgsl!("merl_lookup_batch.wgsl", [MERL_LOOKU
 /// The wavelet BRDF decoder and `material_brdf`, the BRDF the estimators read.
 pub static WAVELET_BRDF: Wgsl = wgsl!("wavelet_brdf.wgsl", [MERL_LOOKUP]);
 /// The raster pass, a module of its own.
-pub static PREVIEW_RASTER: Wgsl = wgsl!("preview_raster.wgsl", []);
+pub static PREVIEW_RASTER: Wgsl = wgsl!("preview/preview_raster.wgsl", []);
 /// The shading module's constants, groups 1 and 2 and its dispatch order.
-pub static PREVIEW_BINDINGS: Wgsl = wgsl!("preview_bindings.wgsl", []);
+pub static PREVIEW_BINDINGS: Wgsl = wgsl!("preview/preview_bindings.wgsl", []);
 /// The estimators' sampling.
-pub static PREVIEW_SAMPLING: Wgsl = wgsl!("preview_sampling.wgsl", [MERL_LOOKUP, PREVIEW_BINDINGS]);
+pub static PREVIEW_SAMPLING: Wgsl = wgsl!("preview/preview_sampling.wgsl", [MERL_LOOKUP, PREVIEW_BINDINGS]);
 /// What covers a pixel, its shading frame and its camera ray.
-pub static PREVIEW_GEOMETRY: Wgsl = wgsl!("preview_geometry.wgsl", [PREVIEW_BINDINGS]);
+pub static PREVIEW_GEOMETRY: Wgsl = wgsl!("preview/preview_geometry.wgsl", [PREVIEW_BINDINGS]);
 /// The environment's lookups.
 pub static PREVIEW_ENVIRONMENT: Wgsl =
-    wgsl!("preview_environment.wgsl", [MERL_LOOKUP, PREVIEW_BINDINGS, PREVIEW_GEOMETRY]);
+    wgsl!("preview/preview_environment.wgsl", [MERL_LOOKUP, PREVIEW_BINDINGS, PREVIEW_GEOMETRY]);
 /// The shading pass's entry points.
 pub static PREVIEW_SHADE: Wgsl = wgsl!(
-    "preview_shade.wgsl",
+    "preview/preview_shade.wgsl",
     [MERL_LOOKUP, WAVELET_BRDF, PREVIEW_BINDINGS, PREVIEW_SAMPLING, PREVIEW_GEOMETRY, PREVIEW_ENVIRONMENT]
 );
 /// An adaptive frame, a file per stage of `render::adaptive` named as its Rust twin there
@@ -57,7 +57,7 @@ pub static ADAPTIVE_SAMPLES: Wgsl =
 /// The shaded blocks in place, the up-sampling and the output.
 pub static ADAPTIVE_FRAME: Wgsl = wgsl!("preview/adaptive/frame.wgsl", [PREVIEW_BINDINGS, ADAPTIVE_STATE]);
 /// The present pass, a module of its own.
-pub static PREVIEW_PRESENT: Wgsl = wgsl!("preview_present.wgsl", []);
+pub static PREVIEW_PRESENT: Wgsl = wgsl!("preview/preview_present.wgsl", []);
 
 /// The files that are modules of their own (they bind their own resources under names the shading
 /// module uses too).

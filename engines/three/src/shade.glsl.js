@@ -1,5 +1,5 @@
 // The estimators of the `render` crate (its crate documentation is the specification) in GLSL ES
-// 3.0, for WebGL 2: a port of the shading module of `crates/gpu/src` (`preview_shade.wgsl` and the WGSL files
+// 3.0, for WebGL 2: a port of the shading module of `crates/gpu/src/preview` (`preview_shade.wgsl` and the WGSL files
 // `gpu::wgsl` lists for it, `merl_lookup.wgsl` among them), function
 // for function, each named after its WGSL and Rust twin, in the same order and with the same
 // branches, so that a pixel differs from `brdf-preview`'s by f32 rounding only. The inputs are
