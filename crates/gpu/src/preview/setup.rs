@@ -348,9 +348,7 @@ impl Shading {
     /// The shading module (`preview_shade.wgsl` and the adaptive files, `crate::wgsl::module`)
     /// and the layouts of groups 0 to 2.
     fn new(device: &wgpu::Device) -> Shading {
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
-        };
+        let layout = |label, entries: &[_]| bind_group_layout(device, label, entries);
         let files = [
             &crate::wgsl::PREVIEW_SHADE,
             &crate::wgsl::ADAPTIVE_PREDICT,
@@ -399,7 +397,7 @@ impl Shading {
 
     /// The storage buffers a shading pass binds in its stage: groups 0 to 2.
     pub(super) fn storage_buffers() -> u32 {
-        storage_buffers(&[&table_entries(), &bake_entries(), &render_entries()])
+        count_storage_buffers(&[&table_entries(), &bake_entries(), &render_entries()])
     }
 }
 
@@ -410,8 +408,17 @@ pub(crate) fn most_storage_buffers() -> u32 {
     Shading::storage_buffers().max(adaptive::storage_buffers())
 }
 
+/// A bind group layout of `entries`.
+pub(super) fn bind_group_layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+}
+
 /// The storage buffers among `groups`' entries.
-pub(super) fn storage_buffers(groups: &[&[wgpu::BindGroupLayoutEntry]]) -> u32 {
+pub(super) fn count_storage_buffers(groups: &[&[wgpu::BindGroupLayoutEntry]]) -> u32 {
     let storage = |e: &&wgpu::BindGroupLayoutEntry| {
         matches!(e.ty, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { .. }, .. })
     };

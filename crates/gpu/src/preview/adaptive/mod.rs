@@ -134,25 +134,6 @@ fn parts(
     (items, targets)
 }
 
-/// Dispatches one of the adaptive passes in `(x, y)` workgroups, with the pass uniform's slot at
-/// byte `offset`. Groups 2 and 3 are bound again after the pipeline: the adaptive passes' layouts
-/// leave groups 0 and 1 out where the estimators' name them, and Vulkan disturbs a set bound under
-/// a layout whose lower sets differ, which wgpu does not bind again (on lavapipe a second frame
-/// then read stale bindings and differed from the first); `shade_blocks` binds 0 to 2 likewise.
-fn dispatch(
-    cpass: &mut wgpu::ComputePass,
-    render: &wgpu::BindGroup,
-    pipeline: &wgpu::ComputePipeline,
-    state: &State,
-    offset: u64,
-    (x, y): (u32, u32),
-) {
-    cpass.set_pipeline(pipeline);
-    cpass.set_bind_group(2, render, &[0]);
-    cpass.set_bind_group(3, &state.group, &[offset as u32]);
-    cpass.dispatch_workgroups(x, y, 1);
-}
-
 /// Bytes between the pass uniform's slots: its size rounded up to the dynamic-offset alignment.
 fn slot_stride(alignment: u64) -> u64 {
     (size_of::<AdaptivePass>() as u64).div_ceil(alignment) * alignment
@@ -186,8 +167,21 @@ impl Passes<'_> {
         self.scatter_slot() + 1 + self.top as u64
     }
 
-    fn run(&self, cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64, groups: (u32, u32)) {
-        dispatch(cpass, &self.renderer.render_group, pipeline, self.state, slot * self.stride, groups);
+    /// Sets one of the adaptive passes, with the pass uniform's slot `slot`. Groups 2 and 3 are
+    /// bound again after the pipeline: the adaptive passes' layouts leave groups 0 and 1 out where
+    /// the estimators' name them, and Vulkan disturbs a set bound under a layout whose lower sets
+    /// differ, which wgpu does not bind again (on lavapipe a second frame then read stale bindings
+    /// and differed from the first); `shade_blocks` binds 0 to 2 likewise.
+    fn bind(&self, cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64) {
+        cpass.set_pipeline(pipeline);
+        cpass.set_bind_group(2, &self.renderer.render_group, &[0]);
+        cpass.set_bind_group(3, &self.state.group, &[(slot * self.stride) as u32]);
+    }
+
+    /// Dispatches one of the adaptive passes in `(x, y)` workgroups ([`Passes::bind`]).
+    fn run(&self, cpass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64, (x, y): (u32, u32)) {
+        self.bind(cpass, pipeline, slot);
+        cpass.dispatch_workgroups(x, y, 1);
     }
 
     /// The pass uniform's slots, written at once: `base` with each pass's level or count.
@@ -344,9 +338,7 @@ impl Passes<'_> {
         match shaded {
             Some(n) => self.run(cpass, &pipelines.scatter, self.scatter_slot(), groups(n)),
             None => {
-                cpass.set_pipeline(&pipelines.scatter);
-                cpass.set_bind_group(2, &self.renderer.render_group, &[0]);
-                cpass.set_bind_group(3, &state.group, &[(self.scatter_slot() * self.stride) as u32]);
+                self.bind(cpass, &pipelines.scatter, self.scatter_slot());
                 cpass.dispatch_workgroups_indirect(&state.indirect, 12);
             }
         }

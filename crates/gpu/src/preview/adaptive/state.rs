@@ -16,7 +16,7 @@ use crate::error::GpuError;
 use crate::merl_lookup::capture_errors;
 use crate::preview::Renderer;
 use crate::preview::setup::{
-    Shading, render_entries, storage_buffers as storage_buffers_of, storage_entry, uniform_entry,
+    Shading, bind_group_layout, count_storage_buffers, render_entries, storage_entry, uniform_entry,
 };
 
 /// The frame's state on the GPU for one geometry (camera and supersampling), prediction level
@@ -446,11 +446,8 @@ pub(crate) struct Pipelines {
 
 impl Pipelines {
     pub(crate) fn new(device: &wgpu::Device, shading: &Shading) -> Pipelines {
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
-        };
-        let predict_layout = layout("preview predict", &predict_entries());
-        let state = layout("adaptive", &state_entries());
+        let predict_layout = bind_group_layout(device, "preview predict", &predict_entries());
+        let state = bind_group_layout(device, "adaptive", &state_entries());
         let pass = |entry| shading.pipeline(device, false, Some(&state), entry);
         Pipelines {
             predict: shading.pipeline(device, true, Some(&predict_layout), "predict_blocks"),
@@ -475,8 +472,8 @@ impl Pipelines {
 /// The most storage buffers an adaptive frame's pass binds in its stage: `predict_blocks` binds
 /// groups 0 to 2 and its own, the passes after it group 2 and the state.
 pub(crate) fn storage_buffers() -> u32 {
-    let predict = Shading::storage_buffers() + storage_buffers_of(&[&predict_entries()]);
-    predict.max(storage_buffers_of(&[&render_entries(), &state_entries()]))
+    let predict = Shading::storage_buffers() + count_storage_buffers(&[&predict_entries()]);
+    predict.max(count_storage_buffers(&[&render_entries(), &state_entries()]))
 }
 
 /// Group 3 of `predict_blocks` (`predict.wgsl`): its uniform and the bandwidths.
