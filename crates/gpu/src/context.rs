@@ -3,8 +3,9 @@
 //! picks an adapter that can also present to a window the caller made (the crate knows no
 //! windowing library).
 
+use crate::device::capture_errors;
 use crate::error::GpuError;
-use crate::merl_lookup::{capture_errors, table_bytes};
+use crate::merl_lookup::table_bytes;
 
 /// An adapter, its device and its queue. Created once per process (a device on lavapipe takes
 /// tens of milliseconds, a MERL table upload more); share it by reference.

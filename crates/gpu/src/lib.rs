@@ -7,11 +7,13 @@
 //! shader to the CPU reference in the `merl` crate, cell for cell; the renderer is held the same
 //! way to the CPU renderer of the `render` crate, and the present pass to `envmap::tonemap_rgb8`.
 //!
-//! Architecture Invariant: the WGSL is the only copy of the lookup on the GPU. The previewer
+//! Architecture Invariant: the WGSL file is the only WGSL copy of the lookup. The previewer
 //! includes [`wgsl::MERL_LOOKUP`] rather than a rewrite, so the agreement the tests establish is
-//! the agreement of what is drawn.
+//! the agreement of what is drawn. (The three.js port holds a GLSL port of it, held to the
+//! previewer by the browser tests.)
 
 mod context;
+mod device;
 mod error;
 #[cfg(test)]
 mod layout;

@@ -2,12 +2,11 @@
 //! direction pairs and read back, for each, the value and the cell the shader chose. This is how
 //! the shader is tested against `merl::MerlTable::lookup`; it is not a fast path for baking.
 
-use std::sync::mpsc;
-
 use bytemuck::{Pod, Zeroable};
 use merl::{Dims, MerlTable};
 
 use crate::context::{Gpu, check_buffer_fits};
+use crate::device::{capture_errors, read_back};
 use crate::error::GpuError;
 
 /// Must equal `MERL_WORKGROUP_SIZE` in the WGSL (checked by a test below).
@@ -176,14 +175,7 @@ impl MerlLookup {
             return Ok(samples);
         }
         let capacity = pairs.len().min(self.max_pairs_per_dispatch as usize) as u64;
-        let buffer = |label, bytes, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
+        let buffer = |label, bytes, usage| crate::device::buffer(&self.device, label, bytes, usage);
         use wgpu::BufferUsages as U;
         let (pair_buffer, sample_buffer, readback) = capture_errors(&self.device, || {
             (
@@ -231,54 +223,6 @@ impl MerlLookup {
 
 fn binding(buffer: &wgpu::Buffer, bytes: u64) -> wgpu::BindingResource<'_> {
     wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset: 0, size: wgpu::BufferSize::new(bytes) })
-}
-
-/// Maps the first `bytes` of `buffer`, waits for the GPU, and copies them out.
-pub(crate) fn read_back<T: Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<T>, GpuError> {
-    // Copies through an aligned vector: the mapped bytes carry no alignment promise.
-    read_back_with(device, buffer, bytes, bytemuck::pod_collect_to_vec)
-}
-
-/// `f` of the first `bytes` of `buffer` (`MAP_READ`), mapped once the device is done with it:
-/// a reader that converts as it copies reads the bytes once.
-pub(crate) fn read_back_with<R>(
-    device: &wgpu::Device,
-    buffer: &wgpu::Buffer,
-    bytes: u64,
-    f: impl FnOnce(&[u8]) -> R,
-) -> Result<R, GpuError> {
-    let slice = buffer.slice(..bytes);
-    let (sender, receiver) = mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |result| {
-        // The receiver outlives the poll below; a send can only fail if it has panicked.
-        let _ = sender.send(result);
-    });
-    device.poll(wgpu::PollType::wait_indefinitely())?;
-    receiver
-        .recv()
-        .map_err(|_| GpuError::Readback("the map callback did not run".into()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let values = {
-        let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-        f(&view)
-    };
-    buffer.unmap();
-    Ok(values)
-}
-
-/// Runs `f` with wgpu's errors captured, so that a validation or out-of-memory error becomes a
-/// [`GpuError`] instead of wgpu's default of panicking.
-pub(crate) fn capture_errors<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, GpuError> {
-    let scopes = [wgpu::ErrorFilter::Validation, wgpu::ErrorFilter::OutOfMemory, wgpu::ErrorFilter::Internal]
-        .map(|filter| device.push_error_scope(filter));
-    let value = f();
-    // Scopes pop innermost first.
-    let errors: Vec<Option<wgpu::Error>> =
-        scopes.into_iter().rev().map(|scope| pollster::block_on(scope.pop())).collect();
-    match errors.into_iter().flatten().next() {
-        Some(error) => Err(GpuError::Wgpu(error)),
-        None => Ok(value),
-    }
 }
 
 #[cfg(test)]

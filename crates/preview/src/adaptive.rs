@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use render::{Mode as Estimator, Scene, metrics};
-use serde_json::json;
+use serde_json::{Value, json};
 
 use crate::checks::{
     Converged, check_finite, check_psnr, check_work, converged, db, json_db, names, png, scene, sibling, tone_mapping,
@@ -104,6 +104,23 @@ struct Frames {
     geometry: std::sync::Arc<render::adaptive::Geometry>,
 }
 
+/// Where an adaptive frame's time goes, in words, from its timings (ms).
+fn steps(t: &render::adaptive::Timings) -> String {
+    match (t.submissions, t.gpu_clock) {
+        (1, true) => format!(
+            "one submission; on the GPU's clock prediction {:.1}, pyramids, plan and samples {:.1}, shading, \
+             up-sampling and output {:.1}",
+            t.predict_ms, t.plan_ms, t.shade_ms
+        ),
+        (1, false) => "one submission".to_string(),
+        _ => format!(
+            "prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on the CPU, shading, up-sampling and \
+             output {:.1} on the GPU",
+            t.predict_ms, t.plan_ms, t.shade_ms
+        ),
+    }
+}
+
 impl Inputs<'_> {
     /// The frames on the GPU, each validated on the CPU as it comes where asked.
     fn frames(&self, renderer: &gpu::preview::Renderer) -> Result<Frames, Error> {
@@ -161,28 +178,11 @@ impl Inputs<'_> {
         gpu: &gpu::Gpu,
     ) -> Result<Rendered, Error> {
         let Inputs { request, loaded, settings, .. } = *self;
-        let Frames { sum, first: frame, image, .. } = frames;
+        let Frames { sum, first: frame, .. } = frames;
         let n = settings.frames;
         let t = sum.timings(n);
-        let ms_per_frame = t.total_ms;
-        let aa = settings.supersample * settings.supersample;
-        // The pre-convolved estimator's layers, where they are not the bake's.
-        let layers = match (settings.mode, settings.layer_shift) {
-            (Estimator::Prefiltered, k) if k > 0 => format!(" ({k} layer{} sharper)", if k == 1 { "" } else { "s" }),
-            _ => String::new(),
-        };
-        let shaded_fraction = sum.shaded_fraction / f64::from(n);
-        let caption = format!(
-            "{} | {}{layers} | {} spp budget x {n} frames, {} samples | shaded fraction {shaded_fraction:.3} | AA \
-             {aa}x | {}x{} | exposure {:+.2} EV",
-            names(&loaded.manifest),
-            request.mode.name(),
-            settings.spp,
-            sum.samples,
-            scene.width,
-            scene.height,
-            tone_mapping.exposure_ev
-        );
+        let shaded_fraction = sum.mean_shaded_fraction(n);
+        let caption = self.caption(frames, scene, tone_mapping);
         let captioned = with_caption(picture, scene.width, scene.height, &caption);
         let mut files = vec![Output {
             path: out.to_path_buf(),
@@ -204,31 +204,58 @@ impl Inputs<'_> {
                 bytes: png(&sheet.rgb, sheet.width, sheet.height)?,
             });
         }
-        let steps = match (t.submissions, t.gpu_clock) {
-            (1, true) => format!(
-                "one submission; on the GPU's clock prediction {:.1}, pyramids, plan and samples {:.1}, shading, \
-                 up-sampling and output {:.1}",
-                t.predict_ms, t.plan_ms, t.shade_ms
-            ),
-            (1, false) => "one submission".to_string(),
-            _ => format!(
-                "prediction, pyramids and plan {:.1} on the GPU, samples {:.1} on the CPU, shading, up-sampling and \
-                 output {:.1} on the GPU",
-                t.predict_ms, t.plan_ms, t.shade_ms
-            ),
-        };
         let report = vec![format!(
-            "{}: {} on {} ({}), {n} frames of {ms_per_frame:.1} ms ({steps}; the camera's G-buffer on the CPU \
+            "{}: {} on {} ({}), {n} frames of {:.1} ms ({}; the camera's G-buffer on the CPU \
              before, once: {:.1}); shaded fraction {shaded_fraction:.4}, {} samples of a budget of {}",
             out.display(),
             request.mode.name(),
             gpu.adapter_summary(),
             request.mesh,
+            t.total_ms,
+            steps(&t),
             t.gbuffer_ms,
             sum.samples,
             sum.budget
         )];
-        let json = json!({
+        let json = self.json(frames, scene, tone_mapping, gpu);
+        Ok(Rendered { files, report, problems: Vec::new(), json })
+    }
+
+    /// The picture's caption: the bake, the estimator, the budget and samples, the shaded
+    /// fraction, the anti-aliasing, the size and the exposure.
+    fn caption(&self, frames: &Frames, scene: &Scene, tone_mapping: &envmap::ToneMapping) -> String {
+        let Inputs { request, loaded, settings, .. } = *self;
+        let (sum, n) = (&frames.sum, settings.frames);
+        let aa = settings.supersample * settings.supersample;
+        // The pre-convolved estimator's layers, where they are not the bake's.
+        let layers = match (settings.mode, settings.layer_shift) {
+            (Estimator::Prefiltered, k) if k > 0 => format!(" ({k} layer{} sharper)", if k == 1 { "" } else { "s" }),
+            _ => String::new(),
+        };
+        let shaded_fraction = sum.mean_shaded_fraction(n);
+        format!(
+            "{} | {}{layers} | {} spp budget x {n} frames, {} samples | shaded fraction {shaded_fraction:.3} | AA \
+             {aa}x | {}x{} | exposure {:+.2} EV",
+            names(&loaded.manifest),
+            request.mode.name(),
+            settings.spp,
+            sum.samples,
+            scene.width,
+            scene.height,
+            tone_mapping.exposure_ev
+        )
+    }
+
+    /// The JSON of the frames: their settings, timings, shaded fraction and samples.
+    fn json(&self, frames: &Frames, scene: &Scene, tone_mapping: &envmap::ToneMapping, gpu: &gpu::Gpu) -> Value {
+        let Inputs { request, settings, .. } = *self;
+        let Frames { sum, first: frame, image, .. } = frames;
+        let n = settings.frames;
+        let t = sum.timings(n);
+        let ms_per_frame = t.total_ms;
+        let aa = settings.supersample * settings.supersample;
+        let shaded_fraction = sum.mean_shaded_fraction(n);
+        json!({
             "bake": request.bake.display().to_string(),
             "mode": request.mode.name(),
             "adapter": gpu.adapter_summary(),
@@ -256,8 +283,7 @@ impl Inputs<'_> {
             "samples": sum.samples,
             "budget": sum.budget,
             "mean_luminance": metrics::mean_luminance(image),
-        });
-        Ok(Rendered { files, report, problems: Vec::new(), json })
+        })
     }
 
     /// Against the converged estimate, and without anti-aliasing the plans' ceiling: the same
@@ -387,6 +413,11 @@ impl Sums {
         self.shaded_fraction += frame.shaded_fraction();
         self.samples += frame.samples;
         self.budget += frame.budget;
+    }
+
+    /// The shaded fraction of a mean frame of `frames`.
+    fn mean_shaded_fraction(&self, frames: u32) -> f64 {
+        self.shaded_fraction / f64::from(frames)
     }
 
     /// The timings of a mean frame of `frames`.

@@ -39,8 +39,8 @@ use render::{Camera, Image, Mode, Settings};
 use wgpu::util::DeviceExt;
 
 use crate::context::check_buffer_fits;
+use crate::device::{capture_errors, read_back_with};
 use crate::error::GpuError;
-use crate::merl_lookup::{capture_errors, read_back_with};
 
 pub(crate) mod adaptive;
 pub(crate) mod present;
@@ -402,12 +402,8 @@ impl Renderer {
         check_buffer_fits(&self.device.limits(), &self.adapter_info, 4 * texels.len() as u64, "the bandwidths")?;
         let predict_layout = &self.adaptive_pipelines()?.predict_layout;
         let prediction = capture_errors(&self.device, || {
-            let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview predict"),
-                size: size_of::<PredictUniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let uniform =
+                crate::device::uniform_buffer(&self.device, "preview predict", size_of::<PredictUniform>() as u64);
             let texels = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("preview bandwidths"),
                 contents: bytemuck::cast_slice(&texels),
@@ -579,12 +575,12 @@ impl Renderer {
 
     /// A buffer to map for reading, of `bytes`.
     fn readback_buffer(&self, bytes: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview readback"),
-            size: bytes.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
+        crate::device::buffer(
+            &self.device,
+            "preview readback",
+            bytes.max(4),
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        )
     }
 
     /// A compute pass with the shading pass's groups 0 to 2 set.

@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 
 use super::{Renderer, View, storage_entry, uniform_entry};
 use crate::context::Gpu;
+use crate::device::{capture_errors, read_back};
 use crate::error::GpuError;
-use crate::merl_lookup::{capture_errors, read_back};
 
 /// Entries of the palette (`palette` in the WGSL).
 const PALETTE_SIZE: usize = 256;
@@ -111,12 +111,7 @@ impl Presenter {
                 multiview_mask: None,
                 cache: None,
             });
-            let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview present"),
-                size: size_of::<PresentUniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let uniform = crate::device::uniform_buffer(&device, "preview present", size_of::<PresentUniform>() as u64);
             let colours: Vec<[f32; 4]> = (0..PALETTE_SIZE)
                 .map(|i| {
                     let [r, g, b] = picture::colormap::viridis(i as f64 / (PALETTE_SIZE - 1) as f64);
@@ -243,12 +238,12 @@ impl Presenter {
         let row_bytes = (4 * width).next_multiple_of(ROW_ALIGNMENT);
         let bytes = u64::from(row_bytes) * u64::from(height);
         let readback = capture_errors(&self.device, || {
-            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("preview present readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let buffer = crate::device::buffer(
+                &self.device,
+                "preview present readback",
+                bytes,
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            );
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_texture_to_buffer(
                 texture.as_image_copy(),

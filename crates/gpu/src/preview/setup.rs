@@ -7,8 +7,9 @@ use wgpu::util::DeviceExt;
 use std::cell::OnceCell;
 
 use crate::context::{Gpu, check_buffer_fits};
+use crate::device::capture_errors;
 use crate::error::GpuError;
-use crate::merl_lookup::{MerlDimsUniform, capture_errors, gpu_table_values, table_bytes};
+use crate::merl_lookup::{MerlDimsUniform, gpu_table_values, table_bytes};
 
 use super::*;
 
@@ -184,12 +185,12 @@ struct Raster {
 
 impl Raster {
     fn new(device: &wgpu::Device, scene: &Scene) -> Raster {
-        let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview mesh vertices"),
-            size: 4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let vertex_buffer = crate::device::buffer(
+            device,
+            "preview mesh vertices",
+            4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         let index_buffer = storage(device, "preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
         let vertex = wgpu::ShaderStages::VERTEX;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -285,29 +286,17 @@ impl RenderGroup {
         frame_stride: u64,
         (width, height): (u32, u32),
     ) -> RenderGroup {
-        let uniform = |label: &str, size: u64| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let uniform = |label: &str, size: u64| crate::device::uniform_buffer(device, label, size);
         let pixels = u64::from(width) * u64::from(height);
         let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
         let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
-        let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview accumulation"),
-            size: 16 * pixels,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let backdrop = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview backdrop"),
-            size: 16 * pixels,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
+        let accumulation = crate::device::buffer(
+            device,
+            "preview accumulation",
+            16 * pixels,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
+        let backdrop = crate::device::buffer(device, "preview backdrop", 16 * pixels, wgpu::BufferUsages::STORAGE);
         let frame = wgpu::BufferBinding { buffer: &frame_uniform, offset: 0, size: wgpu::BufferSize::new(16) };
         let triangles = triangle_target.create_view(&Default::default());
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {

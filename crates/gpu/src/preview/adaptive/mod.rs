@@ -37,8 +37,8 @@ use super::{Renderer, no_bandwidths};
 
 mod state;
 
+use crate::device::capture_errors;
 use crate::error::GpuError;
-use crate::merl_lookup::capture_errors;
 use state::*;
 pub(super) use state::{Pipelines, State, storage_buffers};
 #[cfg(test)]
@@ -272,6 +272,62 @@ impl Passes<'_> {
         encoder
     }
 
+    /// Submission 1 written, encoded ([`Passes::encode`]), submitted and read back: the frame's
+    /// uniforms (the prediction's, the shading's `shade`, the passes' from `budget`), the oracle's
+    /// bandwidths where it has one; then the image (where the GPU allocates), the control words and
+    /// the timestamps.
+    fn submit_first(
+        &self,
+        prediction: &super::Prediction,
+        settings: &render::adaptive::Settings,
+        oracle: Option<&[f64]>,
+        budget: Budget,
+        shade: super::ShadeUniform,
+    ) -> Result<FirstRead, GpuError> {
+        let (renderer, state) = (self.renderer, self.state);
+        let base = AdaptivePass {
+            depth_sigma: settings.depth_sigma as f32,
+            rescue_below: settings.rescue_below as f32,
+            n_rows: if settings.lobe_weight { state.base.n_rows } else { 0 },
+            oracle: u32::from(oracle.is_some()),
+            budget: budget.total.min(u64::from(u32::MAX)) as u32,
+            max_spp: settings.max_spp,
+            allocate: u32::from(budget.on_gpu),
+            ..state.base
+        };
+        let candidates: u32 = state.candidates_per_level.iter().sum();
+        let chunks = candidates.div_ceil(CHUNK).max(1);
+        let encoder = capture_errors(&renderer.device, || {
+            renderer.progress.set(None);
+            renderer.write_predict_uniform(prediction, settings);
+            renderer.queue.write_buffer(&renderer.shade_uniform, 0, bytemuck::bytes_of(&shade));
+            renderer.queue.write_buffer(
+                &renderer.frame_uniform,
+                0,
+                bytemuck::bytes_of(&super::FrameUniform::default()),
+            );
+            if let Some(oracle) = oracle {
+                let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
+                renderer.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
+            }
+            renderer.queue.write_buffer(&state.uniform, 0, &self.uniform(base, candidates));
+            self.encode(prediction, candidates, chunks, budget.on_gpu)
+        })?;
+        let image = if budget.on_gpu { 16 * self.out_pixels } else { 0 };
+        let stamps = match &state.clock {
+            Some(clock) if budget.on_gpu => (&clock.resolved, CLOCK_BYTES),
+            _ => (&state.buffers.control, 0),
+        };
+        let control_bytes = 4 * u64::from(CONTROL_CHUNKS);
+        let sources = [(&renderer.accumulation, image), (&state.buffers.control, control_bytes), stamps];
+        renderer.submit_and_map(encoder, &sources, &state.readback, |bytes| {
+            let (image, rest) = bytes.split_at(image as usize);
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(rest);
+            let (control, stamps) = words.split_at(CONTROL_CHUNKS as usize);
+            FirstRead { image_rgb: super::rgb_of(image, 1.0), control: control.to_vec(), stamps: stamps.to_vec() }
+        })
+    }
+
     /// The samples of the `n_shaded` blocks of the list, allocated on the host
     /// (`render::adaptive::allocation`) from their variances.
     fn allocate_on_host(
@@ -350,6 +406,44 @@ impl Passes<'_> {
     }
 }
 
+/// A frame's budget of samples and where they are allocated: on the GPU under the area
+/// allocation, where 32-bit words hold the budget and 64-bit sums of shifts its products (module
+/// docs); otherwise on the host.
+#[derive(Clone, Copy)]
+struct Budget {
+    total: u64,
+    on_gpu: bool,
+}
+
+impl Budget {
+    fn new(settings: &render::adaptive::Settings, covered_output: u64) -> Self {
+        let total = u64::from(settings.spp) * covered_output;
+        let on_gpu =
+            settings.allocation == Allocation::Area && total <= u64::from(u32::MAX) && settings.max_spp <= 1 << 16;
+        Self { total, on_gpu }
+    }
+}
+
+/// What submission 1 reads back: the image's RGB (empty unless the GPU allocated the samples,
+/// where the frame is done), the control words and the timestamps.
+struct FirstRead {
+    image_rgb: Vec<f32>,
+    control: Vec<u32>,
+    stamps: Vec<u32>,
+}
+
+/// An oracle's bandwidths must cover the `width` x `height` render pixels.
+fn check_oracle(oracle: Option<&[f64]>, width: usize, height: usize) -> Result<(), GpuError> {
+    match oracle {
+        Some(oracle) if oracle.len() != width * height => Err(render::Error::Invalid(format!(
+            "an oracle of {} values for {width} x {height} render pixels",
+            oracle.len()
+        ))
+        .into()),
+        _ => Ok(()),
+    }
+}
+
 /// The samples the host allocated for a frame: their total, `shade_blocks`' items and the list's
 /// targets ([`parts`]).
 struct HostSamples {
@@ -419,15 +513,7 @@ impl Renderer {
         let settings = &render::adaptive::check_settings(settings, material, lighting)?;
         let geometry = self.adaptive_geometry(settings.supersample)?;
         let (width, height) = geometry.render_size();
-        if let Some(oracle) = options.oracle
-            && oracle.len() != width * height
-        {
-            return Err(render::Error::Invalid(format!(
-                "an oracle of {} values for {width} x {height} render pixels",
-                oracle.len()
-            ))
-            .into());
-        }
+        check_oracle(options.oracle, width, height)?;
         self.adaptive_state(&geometry, settings, material, lighting)?;
         let borrowed = self.adaptive.borrow();
         let state = borrowed.as_ref().expect("made above");
@@ -435,27 +521,7 @@ impl Renderer {
         let (out_width, out_height) = geometry.size();
         let clock = std::time::Instant::now();
         let lap = || clock.elapsed().as_secs_f64() * 1e3;
-
-        // The frame's samples: on the GPU under the area allocation, where 32-bit words hold the
-        // budget and 64-bit sums of shifts its products (module docs); otherwise on the host.
-        let budget = u64::from(settings.spp) * state.covered_output;
-        let on_gpu =
-            settings.allocation == Allocation::Area && budget <= u64::from(u32::MAX) && settings.max_spp <= 1 << 16;
-        let stride = slot_stride(self.frame_stride);
-        let base = AdaptivePass {
-            depth_sigma: settings.depth_sigma as f32,
-            rescue_below: settings.rescue_below as f32,
-            n_rows: if settings.lobe_weight { state.base.n_rows } else { 0 },
-            oracle: u32::from(options.oracle.is_some()),
-            budget: budget.min(u64::from(u32::MAX)) as u32,
-            max_spp: settings.max_spp,
-            allocate: u32::from(on_gpu),
-            ..state.base
-        };
-        let candidates: u32 = state.candidates_per_level.iter().sum();
-        let chunks = candidates.div_ceil(CHUNK).max(1);
-        let out_pixels = (out_width * out_height) as u64;
-        let pipelines = self.adaptive_pipelines()?;
+        let budget = Budget::new(settings, state.covered_output);
         // The shading uniform of the frame's passes with `items` items (the prediction's, then
         // `shade_blocks`' parts): the estimator, the seed, the pre-convolved estimator's layers.
         let shade_uniform = |items: u32| super::ShadeUniform {
@@ -467,71 +533,44 @@ impl Renderer {
                 &render::Settings { mode: settings.mode, spp: 1, frames: 1, seed: settings.seed },
             )
         };
-        let passes = Passes { renderer: self, state, pipelines, stride, top, out_pixels };
+        let passes = Passes {
+            renderer: self,
+            state,
+            pipelines: self.adaptive_pipelines()?,
+            stride: slot_stride(self.frame_stride),
+            top,
+            out_pixels: (out_width * out_height) as u64,
+        };
 
-        // Submission 1: prediction, levels, pyramids, plan, the list of shaded blocks in the
-        // plan's order; on the GPU also the samples and all of submission 2.
-        let control_bytes = 4 * u64::from(CONTROL_CHUNKS);
-        let read = capture_errors(&self.device, || {
-            self.progress.set(None);
-            self.write_predict_uniform(prediction, settings);
-            self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade_uniform(state.n_items)));
-            self.queue.write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&super::FrameUniform::default()));
-            if let Some(oracle) = options.oracle {
-                let values: Vec<f32> = oracle.iter().map(|&b| b as f32).collect();
-                self.queue.write_buffer(&state.buffers.bandwidths, 0, bytemuck::cast_slice(&values));
-            }
-            let uniform = passes.uniform(base, candidates);
-            self.queue.write_buffer(&state.uniform, 0, &uniform);
-            passes.encode(prediction, candidates, chunks, on_gpu)
-        })
-        .and_then(|encoder| {
-            let image = if on_gpu { 16 * out_pixels } else { 0 };
-            let stamps = match &state.clock {
-                Some(clock) if on_gpu => (&clock.resolved, CLOCK_BYTES),
-                _ => (&state.buffers.control, 0),
-            };
-            let sources = [(&self.accumulation, image), (&state.buffers.control, control_bytes), stamps];
-            // The image's RGB, the control words, the timestamps.
-            self.submit_and_map(encoder, &sources, &state.readback, |bytes| {
-                let (image, rest) = bytes.split_at(image as usize);
-                let words: Vec<u32> = bytemuck::pod_collect_to_vec(rest);
-                let (control, stamps) = words.split_at(CONTROL_CHUNKS as usize);
-                (super::rgb_of(image, 1.0), control.to_vec(), stamps.to_vec())
-            })
-        })?;
+        let first = passes.submit_first(prediction, settings, options.oracle, budget, shade_uniform(state.n_items))?;
         let predict_ms = lap();
-        let (image_rgb, control, stamps) = read;
-        let n_shaded = control[CONTROL_SHADED as usize];
-        let counts = &control[CONTROL_COUNTS as usize..][..=top];
-        let shaded_per_level: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
-        if control[CONTROL_STATUS as usize] != 0 {
-            render::adaptive::check_budget(u64::from(n_shaded), budget)?;
+        let n_shaded = first.control[CONTROL_SHADED as usize];
+        let counts = &first.control[CONTROL_COUNTS as usize..][..=top];
+        if first.control[CONTROL_STATUS as usize] != 0 {
+            render::adaptive::check_budget(u64::from(n_shaded), budget.total)?;
         }
-
-        let (rgb, samples, plan_ms) = if on_gpu {
-            (image_rgb, u64::from(control[CONTROL_SAMPLES as usize]), predict_ms)
+        let (rgb, samples, plan_ms) = if budget.on_gpu {
+            (first.image_rgb, u64::from(first.control[CONTROL_SAMPLES as usize]), predict_ms)
         } else {
             // The host: the samples, then submission 2: shading, estimates in place,
             // up-sampling, output.
-            let samples = passes.allocate_on_host(n_shaded, budget, settings, (width, height))?;
+            let samples = passes.allocate_on_host(n_shaded, budget.total, settings, (width, height))?;
             let plan_ms = lap();
             let rgb = passes.shade_on_host(&samples, n_shaded, &shade_uniform)?;
             (rgb, samples.total, plan_ms)
         };
         let shade_ms = lap();
-        let image = Image { width: out_width, height: out_height, rgb, covered: geometry.output_coverage().to_vec() };
-        let details = if options.details { Some(self.adaptive_details(state, n_shaded, budget)?) } else { None };
+        let details = if options.details { Some(self.adaptive_details(state, n_shaded, budget.total)?) } else { None };
         Ok(Adaptive {
-            image,
+            image: Image { width: out_width, height: out_height, rgb, covered: geometry.output_coverage().to_vec() },
             width,
             height,
             shadeable: state.shadeable,
-            shaded_per_level,
+            shaded_per_level: counts.iter().map(|&n| n as usize).collect(),
             samples,
-            budget,
+            budget: budget.total,
             timings: frame_timings(
-                on_gpu.then_some((&stamps[..], self.queue.get_timestamp_period())),
+                budget.on_gpu.then_some((&first.stamps[..], self.queue.get_timestamp_period())),
                 geometry.millis(),
                 (predict_ms, plan_ms, shade_ms),
             ),

@@ -12,8 +12,8 @@ use render::{Lighting, Material};
 
 use super::*;
 use crate::context::check_buffer_fits;
+use crate::device::capture_errors;
 use crate::error::GpuError;
-use crate::merl_lookup::capture_errors;
 use crate::preview::Renderer;
 use crate::preview::setup::{
     Shading, bind_group_layout, count_storage_buffers, render_entries, storage_entry, uniform_entry,
@@ -166,14 +166,7 @@ impl Renderer {
         let (at, of_pixel) = render::adaptive::prediction_pixels(&shadeable, (width, height), l);
         let levels = level_sizes((width, height), top)?;
         let blocks = levels.last().map_or(0, |&(w, h, first)| first + w * h);
-        // The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
-        // (`check_settings` holds the rows in range where the lobe weight is on).
-        let sharpness: Vec<f32> = match lighting.exponents.is_empty() {
-            true => vec![0.0; material.view_layers.len()],
-            false => {
-                material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect()
-            }
-        };
+        let sharpness = lobe_sharpness(material, lighting);
         let p = (width * height) as u32;
         let (candidates, candidates_per_level) = candidates(&shadeable, &levels);
         let n_candidates = candidates.len() as u32;
@@ -207,12 +200,11 @@ impl Renderer {
                 contents: bytemuck::cast_slice(if items.is_empty() { &[[0u32; 4]][..] } else { &items }),
                 usage: wgpu::BufferUsages::COPY_SRC,
             });
-            let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("adaptive passes"),
-                size: slot_stride(self.frame_stride) * slots(top),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let uniform = crate::device::uniform_buffer(
+                &self.device,
+                "adaptive passes",
+                slot_stride(self.frame_stride) * slots(top),
+            );
             let group = buffers.group(&self.device, state_layout, &uniform);
             let out_pixels = (geometry.size().0 * geometry.size().1) as u64;
             let readback = self.readback_buffer(
@@ -220,12 +212,12 @@ impl Renderer {
             );
             let clock =
                 self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Clock::new(&self.device));
-            let indirect = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("adaptive indirect dispatches"),
-                size: 24,
-                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let indirect = crate::device::buffer(
+                &self.device,
+                "adaptive indirect dispatches",
+                24,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            );
             State {
                 readback,
                 indirect,
@@ -247,6 +239,15 @@ impl Renderer {
         })?;
         *self.adaptive.borrow_mut() = Some(state);
         Ok(())
+    }
+}
+
+/// The lobe weight's sharpness per view row, as `render::adaptive::render_with` reads it
+/// (`check_settings` holds the rows in range where the lobe weight is on).
+fn lobe_sharpness(material: &Material, lighting: &Lighting) -> Vec<f32> {
+    match lighting.exponents.is_empty() {
+        true => vec![0.0; material.view_layers.len()],
+        false => material.view_layers.iter().map(|&x| render::layer_exponent(&lighting.exponents, x) as f32).collect(),
     }
 }
 
@@ -363,12 +364,7 @@ impl Buffers {
             })
         };
         let empty = |label: &str, bytes: u64| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
-                mapped_at_creation: false,
-            })
+            crate::device::buffer(device, label, bytes.max(16), U::STORAGE | U::COPY_SRC | U::COPY_DST)
         };
         let idle: Vec<u32> = [u32::MAX, 0, 0, 0].repeat(blocks as usize);
         Buffers {
@@ -410,12 +406,12 @@ impl Clock {
                 ty: wgpu::QueryType::Timestamp,
                 count: 4,
             }),
-            resolved: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("adaptive stages"),
-                size: CLOCK_BYTES,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
+            resolved: crate::device::buffer(
+                device,
+                "adaptive stages",
+                CLOCK_BYTES,
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            ),
         }
     }
 }
