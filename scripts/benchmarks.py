@@ -32,7 +32,7 @@ BENCHMARKS = [
         "text",
     ),
     ("prefilter", "The prefilter against the brute-force convolution", "cargo bench -p prefilter --bench prefilter", "text"),
-    ("atlas", "The bandwidth atlas of one material", "cargo bench -p brdf-atlas --bench atlas", "text"),
+    ("atlas", "The bandwidth atlas of one material", "cargo bench -p bandwidth-atlas --bench atlas", "text"),
     ("stages", "The stages of one bake", "cargo bench -p bake --bench stages", "text"),
     (
         "table1",

@@ -40,7 +40,7 @@ fn read_rows(path: &Path) -> asset::BandwidthRows {
     }
 }
 
-/// The full atlas texture the rows stand for, as `data-schema/brdf-atlas.md` tells a renderer to
+/// The full atlas texture the rows stand for, as `data-schema/bandwidth-atlas.md` tells a renderer to
 /// expand it: texel `(x, y)` is texel `(x mod tile, y mod tile)` of row `y / tile`'s tile.
 fn expand(rows: &asset::BandwidthRows) -> Vec<f32> {
     let (t, width) = (rows.tile as usize, (rows.lobes_x * rows.tile) as usize);
@@ -143,7 +143,7 @@ fn the_report_names_the_lobes_at_the_grid_limit() {
 }
 
 /// With the defaults (1024 x 1024), no lobe of a `merl-synth` table of Phong n = 1000
-/// reaches the analysis grid's limit (the `brdf-atlas` test `phong_1000_is_resolved_at_the_default_size`
+/// reaches the analysis grid's limit (the `bandwidth-atlas` test `phong_1000_is_resolved_at_the_default_size`
 /// says what read it before: 192 lobes at 512, 64 at 1024 before the table's cells below the
 /// horizon were continued).
 #[test]

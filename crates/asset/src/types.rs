@@ -499,7 +499,7 @@ impl PrefilteredEnvmap {
 }
 
 /// How the lobes of a bandwidth atlas were analysed: shared by [`BandwidthAtlas`] and
-/// [`BandwidthPca`]. `data-schema/brdf-atlas.md` defines the parameterizations by name.
+/// [`BandwidthPca`]. `data-schema/bandwidth-atlas.md` defines the parameterizations by name.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BandwidthAnalysis {
     /// The lobe and incident-grid parameterization, e.g. `incidence-plane-equidistant`.
@@ -550,7 +550,7 @@ pub const MAX_LAYER_HEIGHT: u32 = 8192;
 impl BandwidthAnalysis {
     /// The largest bandwidth a payload of this analysis may hold, in cycles per radian: twice the
     /// grid's limit, the finest level's `c / 2` cycles per pixel at `n / 2` pixels per radian on
-    /// the horizon (`brdf_atlas`, "Units and the grid's limit"; the atlas reaches the limit, the
+    /// the horizon (`bandwidth_atlas`, "Units and the grid's limit"; the atlas reaches the limit, the
     /// factor 2 leaves a margin). A bandwidth past it is no measurement of this analysis.
     pub fn bandwidth_bound(&self) -> f64 {
         self.c * f64::from(self.analysis_size) / 2.0
@@ -598,7 +598,7 @@ pub struct BandwidthRows {
 }
 
 /// The most columns a [`BandwidthRows`] payload may stand for: the largest side of an incident
-/// grid the atlas builder accepts (`brdf_atlas::Config`, 4096). Expanding rows to the full grid
+/// grid the atlas builder accepts (`bandwidth_atlas::Config`, 4096). Expanding rows to the full grid
 /// multiplies the stored texels by at most this.
 pub const MAX_ROWS_COLUMNS: u32 = 4096;
 
@@ -708,7 +708,7 @@ impl BandwidthPca {
 }
 
 /// Which Phong layer of a pre-convolved environment serves each view elevation of a material
-/// (payload of [`AssetKind::LayerSelection`], written by `brdf-bake`; crate `brdf-atlas`,
+/// (payload of [`AssetKind::LayerSelection`], written by `brdf-bake`; crate `bandwidth-atlas`,
 /// module `view`). The material's lobes and the layers' own Phong lobes were measured with the
 /// same analysis (`analysis`, `reduction`); a view uses the layer whose bandwidth is nearest on a
 /// log scale. `data-schema/README.md` says how a renderer reads it.

@@ -13,9 +13,9 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use bake::stage::{atlas, env_bandwidth, importance, layers, prefilter};
+use bake::stage::{self, env_bandwidth, importance, layer_selection, prefilter};
 use bake::{BakeConfig, Program, Source};
-use brdf_atlas::{Analyser, LuminanceTable};
+use bandwidth_atlas::{Analyser, LuminanceTable};
 
 const RUNS: usize = 5;
 const MATERIAL: &str = "gold-paint";
@@ -118,12 +118,18 @@ fn main() {
         "bandwidth atlas",
         &measure(|| {
             let analyser = Analyser::new(&config.atlas);
-            atlas::run(&LuminanceTable::new(&table), &analyser, &source, &PROGRAM, &|_| {}).expect("the atlas")
+            stage::bandwidth_atlas::run(&LuminanceTable::new(&table), &analyser, &source, &PROGRAM, &|_| {})
+                .expect("the atlas")
         }),
     );
-    let (_, build) =
-        atlas::run(&LuminanceTable::new(&table), &Analyser::new(&config.atlas), &source, &PROGRAM, &|_| {})
-            .expect("the atlas");
+    let (_, build) = stage::bandwidth_atlas::run(
+        &LuminanceTable::new(&table),
+        &Analyser::new(&config.atlas),
+        &source,
+        &PROGRAM,
+        &|_| {},
+    )
+    .expect("the atlas");
     print("read the map", &measure(|| envmap::load(&map_path).expect("the map")));
     let map = envmap::load(&map_path).expect("the map");
     print(
@@ -138,8 +144,9 @@ fn main() {
     print(
         "layer selection",
         &measure(|| {
-            let selection = layers::select(&build, &config.atlas, exponents, config.layer_reduction).expect("layers");
-            layers::run(&selection, &config.atlas, &build, &source, &PROGRAM).expect("layers")
+            let selection =
+                layer_selection::select(&build, &config.atlas, exponents, config.layer_reduction).expect("layers");
+            layer_selection::run(&selection, &config.atlas, &build, &source, &PROGRAM).expect("layers")
         }),
     );
     drop((table, build, map));

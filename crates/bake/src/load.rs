@@ -155,7 +155,7 @@ pub(crate) fn assemble(
                 ),
             ));
         }
-        view_layers = brdf_atlas::view::view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth);
+        view_layers = bandwidth_atlas::view::view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth);
         Some(render::Lighting::new(mips, layers, prefiltered.exponents).map_err(|e| Error::read(&mips_path, e))?)
     } else {
         None
@@ -172,7 +172,7 @@ fn bandwidths(file: &Outputs) -> Result<render::adaptive::Bandwidths, Error> {
     let environment = render::adaptive::EnvBandwidth::new(image.width, image.height, grey)
         .map_err(|e| Error::read(&bandwidth_path, e))?;
     let (atlas_path, atlas_bytes) = file("bandwidth-atlas")?;
-    let brdf = crate::stage::atlas::from_payload(read_payload(&atlas_path, &atlas_bytes)?)
+    let brdf = crate::stage::bandwidth_atlas::from_payload(read_payload(&atlas_path, &atlas_bytes)?)
         .map_err(|e| Error::read(&atlas_path, e))?;
     Ok(render::adaptive::Bandwidths { environment, brdf })
 }

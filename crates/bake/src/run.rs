@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use asset::{BakeManifest, SourceFile, Tool};
 use serde_json::json;
 
-use crate::stage::{atlas, engine, env_bandwidth, fit, importance, layers, pca, prefilter, wavelet_brdf};
+use crate::stage::{self, engine, env_bandwidth, fit, importance, layer_selection, pca, prefilter, wavelet_brdf};
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
 /// The manifest's file name in a bake's folder.
@@ -22,7 +22,7 @@ pub struct BakeConfig {
     /// The folder the bake writes (created if missing: the folder itself, its parent must exist).
     pub out_dir: PathBuf,
     pub importance: ::importance::Config,
-    pub atlas: brdf_atlas::Config,
+    pub atlas: bandwidth_atlas::Config,
     /// Fit a PCA model of the atlas with the fewest components within this relative RMSE.
     pub pca_max_error: Option<f64>,
     /// Encode the material in Haar wavelets (`brdf-wavelet`) with these settings.
@@ -36,7 +36,7 @@ pub struct BakeConfig {
     pub env_reading: env_bandwidth::ReadingChoice,
     pub prefilter: ::prefilter::Config,
     /// How a view's lobe and a layer's lobe become the numbers the layer selection compares.
-    pub layer_reduction: brdf_atlas::view::ViewReduction,
+    pub layer_reduction: bandwidth_atlas::view::ViewReduction,
     /// With an environment, also write the engine textures (`stage::engine`): what the
     /// estimators read, as KTX2 data textures for engines.
     pub engine_textures: bool,
@@ -52,14 +52,14 @@ impl BakeConfig {
             environment,
             out_dir,
             importance: ::importance::Config::default(),
-            atlas: brdf_atlas::Config::default(),
+            atlas: bandwidth_atlas::Config::default(),
             pca_max_error: None,
             wavelet_brdf: None,
             fit: None,
             env_bandwidth: env_bandwidth::Settings::default(),
             env_reading: env_bandwidth::ReadingChoice::Auto,
             prefilter: ::prefilter::Config::default(),
-            layer_reduction: layers::DEFAULT_REDUCTION,
+            layer_reduction: layer_selection::DEFAULT_REDUCTION,
             engine_textures: false,
             force: false,
         }
@@ -288,15 +288,20 @@ pub fn run_bake(
         let now = done.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed) + n as u64;
         work(now, lobes);
     };
-    let analyser = brdf_atlas::Analyser::new(&config.atlas);
-    let (staged, atlas_build) =
-        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &analyser, &material_source, program, &tick)?;
+    let analyser = bandwidth_atlas::Analyser::new(&config.atlas);
+    let (staged, atlas_build) = stage::bandwidth_atlas::run(
+        &bandwidth_atlas::LuminanceTable::new(&table),
+        &analyser,
+        &material_source,
+        program,
+        &tick,
+    )?;
     let atlas_source = staged.file("bandwidth-atlas").map(|f| Source::of_bytes(Path::new(&f.name), &f.bytes));
     record(staged, &mut manifest)?;
     if let Some(max_error) = config.pca_max_error {
         begin("bandwidth pca");
         let source = atlas_source.ok_or_else(|| Error::Internal("the atlas stage wrote no atlas".into()))?;
-        let components = brdf_atlas::Components::MaxRelativeRmse(max_error);
+        let components = bandwidth_atlas::Components::MaxRelativeRmse(max_error);
         record(pca::run(&atlas_build.atlas, &source, program, components)?, &mut manifest)?;
     }
     if let Some(settings) = config.wavelet_brdf {
@@ -319,7 +324,7 @@ pub fn run_bake(
         // The layer selection is made first: the reading of the environment's bandwidth follows
         // the material's lobes (`env_bandwidth::ReadingChoice`).
         let selection =
-            layers::select(&atlas_build, &config.atlas, &config.prefilter.exponents, config.layer_reduction)?;
+            layer_selection::select(&atlas_build, &config.atlas, &config.prefilter.exponents, config.layer_reduction)?;
         let settings = env_bandwidth::Settings {
             config: bandwidth::Config {
                 reading: config.env_reading.resolve(&selection),
@@ -333,7 +338,10 @@ pub fn run_bake(
             prefilter::run(map, source, program, &config.prefilter, &work).map_err(of_map(path))?;
         record(staged, &mut manifest)?;
         begin("layer selection");
-        record(layers::run(&selection, &config.atlas, &atlas_build, &material_source, program)?, &mut manifest)?;
+        record(
+            layer_selection::run(&selection, &config.atlas, &atlas_build, &material_source, program)?,
+            &mut manifest,
+        )?;
         if config.engine_textures {
             begin("engine textures");
             let file = |role: &str| -> Result<(PathBuf, Vec<u8>), Error> {

@@ -1,4 +1,4 @@
 //! The bake crate's tests, one binary: a module per topic.
 
-mod atlas;
-mod layers;
+mod bandwidth_atlas;
+mod layer_selection;

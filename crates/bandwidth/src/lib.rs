@@ -187,7 +187,7 @@
 //! pixel's sum in its own order. The loops are compiled for AVX-512 or AVX2 where the processor
 //! has them (the same bits). Nothing is allocated per pixel. [`Workspace`] keeps every buffer
 //! between estimates of images of one size, and [`Workspace::levels_top_left`] estimates only a
-//! corner of an image given row by row ([`dwt::Rows`]: the BRDF atlas's continued lobe images,
+//! corner of an image given row by row ([`dwt::Rows`]: the bandwidth atlas's continued lobe images,
 //! whose rows below the lobe are made as they are read), each pixel as in the whole map.
 //! `cargo bench -p bandwidth --bench bandwidth` times a real 1024 x 512 map against one D4
 //! decomposition of it (its last report is in `docs/benchmarks.md`).

@@ -9,7 +9,7 @@
 //!   header made consistent ([`fix_up_asset`]: magic, version, a known kind, the section lengths
 //!   and the checksum) so that the fuzzer reaches the payload decoders behind the checksum. The
 //!   container checks every kind's payload as it decodes it; an atlas of either kind is also
-//!   read back as the tools read it ([`bake::stage::atlas::from_payload`]).
+//!   read back as the tools read it ([`bake::stage::bandwidth_atlas::from_payload`]).
 //! - [`envmap_exr`] and [`envmap_hdr`] run [`envmap::read_image_from_memory`] and
 //!   [`envmap::load_from_memory`] with [`env_limits`] (1024 x 512), on inputs that start with the
 //!   format's magic (`76 2f 31 01`, `#?`): two targets, so that each format gets its own inputs.
@@ -140,7 +140,7 @@ fn read_asset(bytes: &[u8]) {
     let Ok(decoded) = asset::decode(bytes) else { return };
     match decoded.payload {
         payload @ (asset::Payload::BandwidthAtlas(_) | asset::Payload::BandwidthRows(_)) => {
-            let _ = bake::stage::atlas::from_payload(payload);
+            let _ = bake::stage::bandwidth_atlas::from_payload(payload);
         }
         asset::Payload::WaveletBrdf(payload) => {
             // Decode it as the previewer does, and evaluate it at a few direction pairs.

@@ -192,7 +192,7 @@ fn legitimate_inputs_keep_the_bound() {
     }
     for (name, bytes) in full_size_atlases() {
         let payload = asset::decode(&bytes).expect("a valid asset").payload;
-        assert!(bake::stage::atlas::from_payload(payload).is_ok(), "{name}: the tools read it back");
+        assert!(bake::stage::bandwidth_atlas::from_payload(payload).is_ok(), "{name}: the tools read it back");
         let (outcome, peak) = run(&alone, fuzzing::asset, &bytes);
         eprintln!("{name}: {} bytes, peak {peak} bytes", bytes.len());
         if let Err(problem) = outcome {

@@ -316,7 +316,7 @@ pub struct Material {
     pub samples: SampleSet,
     /// For [`Mode::Prefiltered`]: where each of `R` view elevations, in equal steps of
     /// `cos theta_o`, falls among the Phong layers of [`Lighting::layers`], as a layer coordinate
-    /// (`brdf_atlas::view::view_coordinates`: the layer of twice the view's bandwidth, `k + t`
+    /// (`bandwidth_atlas::view::view_coordinates`: the layer of twice the view's bandwidth, `k + t`
     /// blending layer `k` and `k + 1` by `t`, up to the number of layers: the smooth map itself
     /// past the sharpest). Row
     /// `r` is for `1 - cos theta_o = (r + 1/2) / R`; a pixel interpolates the rows around it

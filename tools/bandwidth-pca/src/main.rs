@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use bake::{Program, Source};
-use brdf_atlas::Components;
+use bandwidth_atlas::Components;
 use clap::{ArgGroup, Parser};
 
 /// Compress a bandwidth atlas (from brdf-bandwidth) by PCA: each distinct tile is one vector; the
@@ -72,6 +72,6 @@ fn run(args: Args) -> Result<ExitCode> {
 }
 
 /// The full atlas of the asset `brdf-bandwidth` wrote (either kind).
-fn read_atlas(bytes: &[u8]) -> Result<brdf_atlas::Atlas> {
-    bake::stage::atlas::from_payload(asset::decode(bytes)?.payload).map_err(|e| anyhow!(e))
+fn read_atlas(bytes: &[u8]) -> Result<bandwidth_atlas::Atlas> {
+    bake::stage::bandwidth_atlas::from_payload(asset::decode(bytes)?.payload).map_err(|e| anyhow!(e))
 }

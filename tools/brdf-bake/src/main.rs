@@ -80,7 +80,7 @@ struct Args {
     /// Pixels per side of the images each lobe is analysed on, for the bandwidth atlas and the
     /// layer selection (a power of two from 16 to 4096; 256 or more tells the default layers
     /// apart, and 512 resolves Phong lobes up to n = 1000).
-    #[arg(long = "analysis-size", value_name = "N", default_value_t = brdf_atlas::Config::default().analysis_size, value_parser = cli::parse_count)]
+    #[arg(long = "analysis-size", value_name = "N", default_value_t = bandwidth_atlas::Config::default().analysis_size, value_parser = cli::parse_count)]
     analysis_size: usize,
 
     /// Also write the environment's layers and mip chain as KTX2 cube maps for engines

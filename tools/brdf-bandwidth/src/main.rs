@@ -1,12 +1,12 @@
 //! `brdf-bandwidth`: the angular-bandwidth atlas of a MERL BRDF (`000` section 2.4). Argument
-//! parsing and printing around `bake::stage::atlas`.
+//! parsing and printing around `bake::stage::bandwidth_atlas`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use bake::{Program, Source};
-use brdf_atlas::{Analyser, Config};
+use bandwidth_atlas::{Analyser, Config};
 use clap::Parser;
 
 /// Build the angular-bandwidth atlas of a MERL BRDF: for each incident direction of a
@@ -20,7 +20,7 @@ use clap::Parser;
 /// tile per row, when every tile of a row is the same, as for every MERL table; else kind
 /// bandwidth-atlas, every tile), bandwidth-atlas.exr (the full lobes tile x lobes tile texture
 /// for renderers, one float channel Y) and bandwidth-atlas.png (false colour, log scale).
-/// Parameterizations and layout: data-schema/brdf-atlas.md.
+/// Parameterizations and layout: data-schema/bandwidth-atlas.md.
 ///
 /// Exit status: 0 ok, 1 most lobes reach the analysis grid's limit (a validation problem: the
 /// files are written, and the problem says which analysis size resolves more), 2 error.
@@ -77,7 +77,7 @@ fn run(args: Args) -> Result<ExitCode> {
             let bytes = merl::read_bytes(&args.material).with_context(read)?;
             let (source, luminance) = rayon::join(
                 || Source::of_bytes(&args.material, &bytes),
-                || merl::MerlTable::parse(&bytes).map(|table| brdf_atlas::LuminanceTable::new(&table)),
+                || merl::MerlTable::parse(&bytes).map(|table| bandwidth_atlas::LuminanceTable::new(&table)),
             );
             Ok((source, luminance.with_context(read)?))
         },
@@ -89,7 +89,7 @@ fn run(args: Args) -> Result<ExitCode> {
     let done = std::sync::atomic::AtomicU64::new(0);
     let tick =
         |n: usize| progress.work(done.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed) + n as u64, total);
-    let (staged, _) = bake::stage::atlas::run(&luminance, &analyser, &source, &PROGRAM, &tick)?;
+    let (staged, _) = bake::stage::bandwidth_atlas::run(&luminance, &analyser, &source, &PROGRAM, &tick)?;
     progress.finish();
     let dir = &args.out_dir;
     staged.write(dir)?;

@@ -20,7 +20,7 @@ mod common;
 use common::shared;
 use std::time::Instant;
 
-use brdf_atlas::view::{ViewReduction, select_layers_of_table, view_coordinates};
+use bandwidth_atlas::view::{ViewReduction, select_layers_of_table, view_coordinates};
 use render::{Camera, Lighting, Material, Mode, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
@@ -119,17 +119,17 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
     }
     println!(" {:>8}", "mean");
     for &size in sizes {
-        let config = brdf_atlas::Config { analysis_size: size, ..brdf_atlas::Config::default() };
+        let config = bandwidth_atlas::Config { analysis_size: size, ..bandwidth_atlas::Config::default() };
         // One atlas per material and size, shared by its two environments and every reduction.
         let mut selections: Vec<Vec<Vec<f32>>> = Vec::new();
         for pair in cases.chunks(ENVIRONMENTS.len()) {
-            let build = brdf_atlas::build_atlas(&pair[0].table, &config, &|_| {}).expect("atlas");
+            let build = bandwidth_atlas::build_atlas(&pair[0].table, &config, &|_| {}).expect("atlas");
             selections.push(
                 reductions
                     .iter()
                     .map(|&r| {
                         let selection =
-                            brdf_atlas::view::select_layers(&build, &config, exponents, r).expect("selection");
+                            bandwidth_atlas::view::select_layers(&build, &config, exponents, r).expect("selection");
                         view_coordinates(&selection.view_bandwidth, &selection.layer_bandwidth)
                     })
                     .collect(),
@@ -164,10 +164,10 @@ fn modes(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene, exponents: &[u32]) {
         "{:<32} {:<12} {:>5} {:>7} {:>9} {:>10} {:>12} {:>10}",
         "case", "mode", "spp", "frames", "PSNR dB", "rel. error", "mean lum.", "ms/frame"
     );
-    let config = brdf_atlas::Config::default();
+    let config = bandwidth_atlas::Config::default();
     for pair in cases.chunks(ENVIRONMENTS.len()) {
         let selection =
-            select_layers_of_table(&pair[0].table, &config, exponents, bake::stage::layers::DEFAULT_REDUCTION)
+            select_layers_of_table(&pair[0].table, &config, exponents, bake::stage::layer_selection::DEFAULT_REDUCTION)
                 .expect("selection");
         for case in pair {
             let material = Material::new(

@@ -27,7 +27,7 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///                sample's footprint
 ///
 ///   adaptive     bandwidth-driven multi-resolution shading (001 sections 2-3): the bake's
-///                environment bandwidth and BRDF atlas predict each pixel's image bandwidth and
+///                environment bandwidth and bandwidth atlas predict each pixel's image bandwidth and
 ///                variance; only the pixels the prediction asks for are shaded (reference
 ///                estimator) with a budget of --spp samples per pixel on average (--allocation),
 ///                the rest is up-sampled (crate render, module adaptive, is the specification)

@@ -11,7 +11,7 @@ use bandwidth::{
     BandwidthMap, Config, Image, Reading, WindowedFftConfig, compare_maps, latlong_bandwidth, local_bandwidth,
     local_bandwidth_zero_padded, log1p_luminance, wavelet_at_windows, windowed_fft_bandwidth,
 };
-use brdf_atlas::view::LayerSelection;
+use bandwidth_atlas::view::LayerSelection;
 use serde_json::json;
 
 use crate::{Error, OutFile, Staged, object};
@@ -372,7 +372,7 @@ mod tests {
 
     fn selection(view_bandwidth: Vec<f64>) -> LayerSelection {
         LayerSelection {
-            reduction: brdf_atlas::view::ViewReduction::BandQuantile(0.99),
+            reduction: bandwidth_atlas::view::ViewReduction::BandQuantile(0.99),
             exponents: vec![16, 256, 4096],
             layer_bandwidth: vec![0.45, 1.7, 6.8],
             view_layer: vec![2; view_bandwidth.len()],

@@ -1,12 +1,12 @@
 //! One module per stage. Each takes its inputs in memory (a stage that reads a file names it in
 //! its errors), computes everything, and returns a [`crate::Staged`] without touching the disk.
 
-pub mod atlas;
+pub mod bandwidth_atlas;
 pub mod engine;
 pub mod env_bandwidth;
 pub mod fit;
 pub mod importance;
-pub mod layers;
+pub mod layer_selection;
 pub mod material_info;
 pub mod pca;
 pub mod prefilter;
@@ -19,9 +19,9 @@ pub fn is_output_name(name: &str) -> bool {
     const NAMES: [&str; 34] = [
         importance::ASSET,
         importance::PICTURE,
-        atlas::ASSET,
-        atlas::EXR,
-        atlas::PICTURE,
+        bandwidth_atlas::ASSET,
+        bandwidth_atlas::EXR,
+        bandwidth_atlas::PICTURE,
         pca::ASSET,
         pca::PICTURE,
         wavelet_brdf::ASSET,
@@ -40,7 +40,7 @@ pub fn is_output_name(name: &str) -> bool {
         prefilter::engine::GGX_CUBE_KTX2,
         prefilter::engine::DFG_KTX2,
         prefilter::engine::DFG_PNG,
-        layers::ASSET,
+        layer_selection::ASSET,
         engine::MERL_KTX2,
         engine::BRDF_TABLES_KTX2,
         engine::VIEW_LAYERS_KTX2,

@@ -11,11 +11,11 @@
 //! (`size_ratio`: what PCA saves over storing each tile once) and against the full grid
 //! (`size_ratio_full_grid`: what it saves over the 1024 x 1024 texture).
 
-use brdf_atlas::{Atlas, Components, PcaModel, evaluate, fit};
+use bandwidth_atlas::{Atlas, Components, PcaModel, evaluate, fit};
 use serde_json::json;
 
-use crate::stage::atlas::analysis_of;
-use crate::stage::atlas::picture as atlas_picture;
+use crate::stage::bandwidth_atlas::analysis_of;
+use crate::stage::bandwidth_atlas::picture as atlas_picture;
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
 pub const ASSET: &str = "bandwidth-pca.asset";

@@ -393,11 +393,11 @@ impl Renderer {
     }
 
     /// Uploads the bandwidths the prediction of adaptive frames reads (the environment's and the
-    /// BRDF atlas), replacing any set before; [`Renderer::render_adaptive`] and
+    /// bandwidth atlas), replacing any set before; [`Renderer::render_adaptive`] and
     /// [`Renderer::predict_blocks`] need them.
     pub fn set_bandwidths(&mut self, bandwidths: &render::adaptive::Bandwidths) -> Result<(), GpuError> {
         let (environment, atlas) = (&bandwidths.environment, &bandwidths.brdf);
-        atlas.check().map_err(|e| render::Error::Invalid(format!("the BRDF atlas: {e}")))?;
+        atlas.check().map_err(|e| render::Error::Invalid(format!("the bandwidth atlas: {e}")))?;
         let texels: Vec<f32> = environment.values().iter().chain(&atlas.data).copied().collect();
         check_buffer_fits(&self.device.limits(), &self.adapter_info, 4 * texels.len() as u64, "the bandwidths")?;
         let predict_layout = &self.adaptive_pipelines()?.predict_layout;

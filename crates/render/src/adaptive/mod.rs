@@ -40,7 +40,7 @@
 //! - the reflection operator of eq. 3, `R = P_x C_-c S B_{t,rho} C_c P_i`, with the matrices of
 //!   Fig. 4 exactly as printed: `C_c` shears `[0, nu_a]` to `[c nu_a, nu_a]`; `B` keeps the
 //!   spatial part (`t = 0`: no texture) and limits the angular one to `m = min(rho, nu_a)`,
-//!   `rho` the BRDF's bandwidth for `(wi, wo)` from the atlas ([`brdf_atlas::Atlas::lookup`]);
+//!   `rho` the BRDF's bandwidth for `(wi, wo)` from the atlas ([`bandwidth_atlas::Atlas::lookup`]);
 //!   `S`, `C_-c` and `P_x = diag(1 / cos theta_x, 1)` follow; `c` is the G-buffer's curvature
 //!   (its magnitude: the sign of the shear is lost with it, the conservative side);
 //! - the transport to the eye `T_d'` with `d'` the pixel's depth. The angular bandwidth at the
@@ -202,7 +202,7 @@
 //! view ([`Material::view_layers`], crate docs "The estimators"), the map itself past the
 //! sharpest at most, and no layer sharper than a sample's footprint among the block's. That
 //! selection was chosen for the full-resolution pre-filtered mode at 16 samples per pixel (crate
-//! `bake`, `stage::layers`), where a sharper layer's noise costs about what its blur saves. A
+//! `bake`, `stage::layer_selection`), where a sharper layer's noise costs about what its blur saves. A
 //! shaded block takes tens to hundreds of samples, the budget of the pixels it stands for, and
 //! there the blur dominates: the default shift is one layer ([`LAYER_SHIFT`]). Measured at
 //! 512 x 512, brdf-preview's defaults and default camera, PSNR of the whole picture against
@@ -302,7 +302,7 @@ impl EnvBandwidth {
 pub struct Bandwidths {
     pub environment: EnvBandwidth,
     /// The material's bandwidth atlas (the full grid; `bake` expands stored rows).
-    pub brdf: brdf_atlas::Atlas,
+    pub brdf: bandwidth_atlas::Atlas,
 }
 
 /// How an adaptive frame is rendered (module docs).

@@ -1,5 +1,5 @@
 //! The prediction of an adaptive frame (`render::adaptive`, "The bandwidth buffer"): group 3, the
-//! environment bandwidth and the BRDF atlas, and each prediction pixel's image bandwidth and
+//! environment bandwidth and the bandwidth atlas, and each prediction pixel's image bandwidth and
 //! variance (entry point `predict_blocks`).
 
 // Group 3: what the prediction of an adaptive frame reads besides the bake (`render::adaptive`,
@@ -10,8 +10,8 @@ struct Predict {
     // The environment bandwidth's lat-long grid, first in `bandwidth_texels`.
     env_width: u32,
     env_height: u32,
-    // The BRDF atlas after it: `lobes_y` rows of `lobes_x` tiles of `tile x tile` texels,
-    // row-major like `brdf_atlas::Atlas::data`.
+    // The bandwidth atlas after it: `lobes_y` rows of `lobes_x` tiles of `tile x tile` texels,
+    // row-major like `bandwidth_atlas::Atlas::data`.
     lobes_x: u32,
     lobes_y: u32,
     tile: u32,
@@ -40,14 +40,14 @@ fn env_bandwidth(uv: vec2<f32>) -> f32 {
     return bandwidth_texels[y * predict.env_width + x];
 }
 
-// `brdf_atlas::Atlas::lookup`'s `column`: floor(x n) clamped to [0, n - 1].
+// `bandwidth_atlas::Atlas::lookup`'s `column`: floor(x n) clamped to [0, n - 1].
 fn atlas_column(x: f32, n: u32) -> u32 {
     return min(u32(max(floor(x * f32(n)), 0.0)), n - 1u);
 }
 
-// `brdf_atlas::Atlas::lookup`: the bandwidth of the lobe of `wi` towards `wo` (tangent frame),
+// `bandwidth_atlas::Atlas::lookup`: the bandwidth of the lobe of `wi` towards `wo` (tangent frame),
 // the nearest texel: the tile from `wi`'s azimuth and elevation, the texel from `wo` turned into
-// the plane of incidence and projected by `brdf_atlas::LobeMap::uv`.
+// the plane of incidence and projected by `bandwidth_atlas::LobeMap::uv`.
 fn atlas_lookup(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let phi_i = merl_atan2(wi.y, wi.x);
     // rem_euclid(2 pi) of an angle in (-pi, pi].

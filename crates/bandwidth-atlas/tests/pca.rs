@@ -1,7 +1,7 @@
 //! Test 5 (crate part): PCA with all components reproduces the atlas; fewer components trade
 //! error for size as the eigenvalues predict; bad requests are errors.
 
-use brdf_atlas::{Atlas, Components, Config, Error, Parameterization, build_atlas, evaluate, fit};
+use bandwidth_atlas::{Atlas, Components, Config, Error, Parameterization, build_atlas, evaluate, fit};
 use rand::{Rng, SeedableRng, rngs::StdRng};
 
 use crate::phong;

@@ -1,11 +1,11 @@
 //! Prints `view::KNOWN_LAYER_BANDWIDTHS`: the bandwidth the default analysis measures for each
 //! default Phong layer under the bake's default reduction, as the bits of the f64, so that a bake
 //! reads them instead of measuring eight lobes it measured before (they depend on neither the
-//! material nor the map). `cargo run --release -p brdf-atlas --example layer-bandwidths`; a test
+//! material nor the map). `cargo run --release -p bandwidth-atlas --example layer-bandwidths`; a test
 //! holds the table to the measurement.
 
-use brdf_atlas::Config;
-use brdf_atlas::view::{KNOWN_LAYER_REDUCTION, ViewReduction, layer_bandwidth};
+use bandwidth_atlas::Config;
+use bandwidth_atlas::view::{KNOWN_LAYER_REDUCTION, ViewReduction, layer_bandwidth};
 
 fn main() {
     let config = Config::default();

@@ -8,21 +8,22 @@
 //! of a row's band energy and of its view bandwidth (the bake's default reduction), and the rows
 //! whose Phong layer (the default layers) differs. The crate docs ("Angles") quote it.
 //!
-//! `cargo run --release -p brdf-atlas --example analysis-difference -- TABLE.binary ...`
+//! `cargo run --release -p bandwidth-atlas --example analysis-difference -- TABLE.binary ...`
 //! Exit status 1 if a tile or a layer differs.
 
 use std::process::ExitCode;
 
-use brdf_atlas::view::{KNOWN_LAYER_BANDWIDTHS, KNOWN_LAYER_REDUCTION, band_energy, nearest_layer};
-use brdf_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
+use bandwidth_atlas::view::{KNOWN_LAYER_BANDWIDTHS, KNOWN_LAYER_REDUCTION, band_energy, nearest_layer};
+use bandwidth_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
 use rayon::prelude::*;
 
 /// `view::band_energy` as the crate computed it before its partial sums: the squares of a
 /// level's coefficients at or above the noise floor, added one after another (the three
 /// orientations in turn, each row-major).
 fn sequential_band_energy(image: &[f64], n: usize, relative_noise_floor: f64) -> Vec<f64> {
-    let tiling = brdf_atlas::mirror_tiling(image, n);
-    let decomposition = dwt::wavedec2(&tiling, dwt::Wavelet::D4, brdf_atlas::analysis_levels(n)).expect("a lobe image");
+    let tiling = bandwidth_atlas::mirror_tiling(image, n);
+    let decomposition =
+        dwt::wavedec2(&tiling, dwt::Wavelet::D4, bandwidth_atlas::analysis_levels(n)).expect("a lobe image");
     let peak = image.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut energy = Vec::new();
     for (i, level) in decomposition.details.iter().enumerate() {

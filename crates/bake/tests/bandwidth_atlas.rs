@@ -6,9 +6,9 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use asset::{AssetKind, Payload};
-use bake::stage::{atlas, pca};
+use bake::stage::{self, pca};
 use bake::{Program, Source, Staged};
-use brdf_atlas::{Atlas, AtlasBuild, Components, Config, evaluate, fit};
+use bandwidth_atlas::{Atlas, AtlasBuild, Components, Config, evaluate, fit};
 use merl::analytic::Analytic;
 
 const PROGRAM: Program = Program { name: "bake-tests", version: "0" };
@@ -27,8 +27,15 @@ fn ggx_stage() -> &'static (Staged, AtlasBuild) {
     STAGE.get_or_init(|| {
         let table = Analytic::Ggx { alpha: 0.2, f0: [0.9, 0.6, 0.3] }.table(merl::Dims::MERL);
         let source = Source::of_bytes(Path::new("ggx.binary"), b"ggx");
-        let analyser = brdf_atlas::Analyser::new(&config());
-        atlas::run(&brdf_atlas::LuminanceTable::new(&table), &analyser, &source, &PROGRAM, &|_| {}).unwrap()
+        let analyser = bandwidth_atlas::Analyser::new(&config());
+        stage::bandwidth_atlas::run(
+            &bandwidth_atlas::LuminanceTable::new(&table),
+            &analyser,
+            &source,
+            &PROGRAM,
+            &|_| {},
+        )
+        .unwrap()
     })
 }
 
@@ -60,7 +67,7 @@ fn an_analytic_table_is_stored_once_per_row() {
     assert_eq!(staged.figures["isotropic"], true);
     assert_eq!(figure(staged, "stored_texels") as usize, LOBES * 256);
 
-    let expanded = atlas::from_payload(Payload::BandwidthRows(rows)).unwrap();
+    let expanded = stage::bandwidth_atlas::from_payload(Payload::BandwidthRows(rows)).unwrap();
     assert_eq!((expanded.lobes_x, expanded.lobes_y, expanded.tile), (LOBES, LOBES, 16));
     let bits = |a: &Atlas| a.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert!(bits(&expanded) == bits(&build.atlas), "the expanded rows differ from the atlas");
@@ -73,21 +80,23 @@ fn an_analytic_table_is_stored_once_per_row() {
 #[test]
 fn either_kind_reads_back_and_oversized_rows_are_refused() {
     let (_, build) = ggx_stage();
-    let full = atlas::from_payload(Payload::BandwidthAtlas(atlas::to_asset(&build.atlas))).unwrap();
+    let full =
+        stage::bandwidth_atlas::from_payload(Payload::BandwidthAtlas(stage::bandwidth_atlas::to_asset(&build.atlas)))
+            .unwrap();
     assert_eq!(full, build.atlas);
-    let mut huge = atlas::to_rows_asset(&build.atlas);
+    let mut huge = stage::bandwidth_atlas::to_rows_asset(&build.atlas);
     (huge.lobes_x, huge.lobes_y, huge.tile, huge.data) = (1 << 31, 1, 1, vec![0.5]);
-    let err = atlas::from_payload(Payload::BandwidthRows(huge)).unwrap_err();
+    let err = stage::bandwidth_atlas::from_payload(Payload::BandwidthRows(huge)).unwrap_err();
     assert!(err.contains("exceeds the limit of 1073741824 texels"), "{err}");
     let source = Source::of_bytes(Path::new("a"), b"a");
     let model = decoded(&pca::run(&build.atlas, &source, &PROGRAM, Components::Count(1)).unwrap(), "bandwidth-pca");
-    let err = atlas::from_payload(model.payload).unwrap_err();
+    let err = stage::bandwidth_atlas::from_payload(model.payload).unwrap_err();
     assert_eq!(err, "expected a bandwidth-atlas or bandwidth-rows asset (from brdf-bandwidth), found bandwidth-pca");
 }
 
 /// The PCA of an isotropic atlas is fitted on its 16 rows: a model one lobe wide, the relative
 /// RMSE of a fit on the full grid with as many components (equal to 1e-6: the two fits have
-/// the same components, see `brdf-atlas`'s test), a size against the distinct tiles exactly 16
+/// the same components, see `bandwidth-atlas`'s test), a size against the distinct tiles exactly 16
 /// times its size against the full grid, and the same error bound met with the same K.
 #[test]
 fn the_pca_of_rows_is_the_full_grid_fit_and_reports_both_sizes() {

@@ -1,7 +1,7 @@
 //! `view::layer_coordinate`: the blend between the two layers around a view's bandwidth agrees
 //! with the nearest layer and moves continuously with the bandwidth.
 
-use brdf_atlas::view::{LAYER_OVER_VIEW_BANDWIDTH, layer_coordinate, nearest_layer, view_coordinates};
+use bandwidth_atlas::view::{LAYER_OVER_VIEW_BANDWIDTH, layer_coordinate, nearest_layer, view_coordinates};
 
 /// The default layers' bandwidths at an analysis size of 256 (`bake`'s layer test prints them).
 const LAYERS: [f64; 7] = [0.2909, 0.3176, 0.4484, 0.8741, 1.7171, 3.3612, 6.3283];
@@ -71,12 +71,12 @@ fn layers_that_do_not_increase_blend_nothing() {
 }
 
 /// The layer bandwidths a bake reads instead of measuring are the measurement, bit for bit
-/// (`cargo run --release -p brdf-atlas --example layer-bandwidths` prints them again).
+/// (`cargo run --release -p bandwidth-atlas --example layer-bandwidths` prints them again).
 #[test]
 fn the_known_layer_bandwidths_are_the_measured_ones() {
-    let config = brdf_atlas::Config::default();
-    for (n, bits) in brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS {
-        let measured = brdf_atlas::view::layer_bandwidth(&config, n, brdf_atlas::view::KNOWN_LAYER_REDUCTION);
+    let config = bandwidth_atlas::Config::default();
+    for (n, bits) in bandwidth_atlas::view::KNOWN_LAYER_BANDWIDTHS {
+        let measured = bandwidth_atlas::view::layer_bandwidth(&config, n, bandwidth_atlas::view::KNOWN_LAYER_REDUCTION);
         assert_eq!(measured.to_bits(), bits, "n = {n}: measured {measured}, known {}", f64::from_bits(bits));
     }
 }

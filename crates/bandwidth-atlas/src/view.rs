@@ -138,7 +138,7 @@ pub const KNOWN_LAYER_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.9
 /// [`layer_bandwidth`] of the default configuration under [`KNOWN_LAYER_REDUCTION`] for the
 /// default Phong exponents, `(n, bits of the f64)`: they depend on neither the material nor the
 /// map, so a bake reads them rather than measuring the eight lobes again. Printed by
-/// `cargo run --release -p brdf-atlas --example layer-bandwidths`; a test holds them to the
+/// `cargo run --release -p bandwidth-atlas --example layer-bandwidths`; a test holds them to the
 /// measurement.
 pub const KNOWN_LAYER_BANDWIDTHS: [(u32, u64); 8] = [
     (1, 0x3fd3609ce95d2754),

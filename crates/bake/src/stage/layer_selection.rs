@@ -1,5 +1,5 @@
 //! Which Phong layer serves each view of a material (`001` sections 2.5 and 4.3; crate
-//! `brdf-atlas`, module `view`): the material's lobes and the layers' own lobes measured with the
+//! `bandwidth-atlas`, module `view`): the material's lobes and the layers' own lobes measured with the
 //! same analysis, as an asset of kind `layer-selection` that the renderers read.
 //!
 //! How often the 20 shared real-derived materials select each layer (views per layer over the 64
@@ -8,15 +8,15 @@
 //! 502. Six of them (black-obsidian, blue-acrylic, brass, chrome, red-metallic-paint, steel)
 //! select n = 16384 at every view: their lobes carry a cusp at the mirror direction (the neural
 //! fits' `sqrt(theta_h)` input), whose fine detail the band quantile counts, and the renderers
-//! read them sharper still (`brdf_atlas::view::view_coordinates`: past the sharpest layer, the
+//! read them sharper still (`bandwidth_atlas::view::view_coordinates`: past the sharpest layer, the
 //! map itself); the diffuse-looking ones (pink-fabric, silver-metallic-paint) stay at n = 16 to
 //! 256, most rows at 16 and 64.
 
-use brdf_atlas::view::{LayerSelection, ViewReduction, select_layers};
-use brdf_atlas::{AtlasBuild, Config};
+use bandwidth_atlas::view::{LayerSelection, ViewReduction, select_layers};
+use bandwidth_atlas::{AtlasBuild, Config};
 use serde_json::json;
 
-use crate::stage::atlas::analysis_of;
+use crate::stage::bandwidth_atlas::analysis_of;
 use crate::{Error, OutFile, Program, Source, Staged, object};
 
 pub const ASSET: &str = "layer-selection.asset";
@@ -37,7 +37,7 @@ pub const ASSET: &str = "layer-selection.asset";
 /// layers for every view (real-derived lobes reach the grid's limit at the mirror direction) and
 /// leaves the noise of few samples. The band quantiles agree within 0.15 dB and are flat from
 /// 128 up; 0.99 is best or within 0.1 dB of it everywhere. The analysis size therefore follows the
-/// atlas's own needs (`brdf_atlas::Config`, 512); 256 or more is needed to tell the default layers
+/// atlas's own needs (`bandwidth_atlas::Config`, 512); 256 or more is needed to tell the default layers
 /// apart (at 128, n = 1024 and 4096 measure within 10% of each other).
 pub const DEFAULT_REDUCTION: ViewReduction = ViewReduction::BandQuantile(0.99);
 

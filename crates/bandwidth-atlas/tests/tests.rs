@@ -1,4 +1,4 @@
-//! Integration tests of the `brdf-atlas` crate, one binary with a module per topic. Every test
+//! Integration tests of the `bandwidth-atlas` crate, one binary with a module per topic. Every test
 //! with a tolerance states it and why; measured numbers are printed (`--nocapture`).
 
 mod atlas;

@@ -221,7 +221,7 @@ impl Atlas {
 
     /// The bandwidth of the lobe of `wi` in the direction `wo` (unit vectors of the tangent
     /// frame, `z >= 0`), in cycles per radian: the nearest texel, exactly as
-    /// `data-schema/brdf-atlas.md` ("Looking up a bandwidth") tells a renderer to read it. The
+    /// `data-schema/bandwidth-atlas.md` ("Looking up a bandwidth") tells a renderer to read it. The
     /// lobe's column comes from `wi`'s own azimuth, and `wo` is turned into the frame of that
     /// plane of incidence.
     pub fn lookup(&self, wi: DVec3, wo: DVec3) -> f32 {

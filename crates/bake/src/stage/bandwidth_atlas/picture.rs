@@ -6,7 +6,7 @@
 //! larger one reduced by a whole factor, each pixel the maximum of the texels it covers (like the
 //! atlas itself, so that no peak disappears), and the title says which.
 
-use brdf_atlas::Atlas;
+use bandwidth_atlas::Atlas;
 use picture::colormap::{Scale, viridis};
 use picture::layout::{Axis, Grid, caption, heat_map, stack};
 use picture::legend::Legend;
@@ -123,7 +123,7 @@ pub fn tile_notes(atlas: &Atlas) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use brdf_atlas::Parameterization;
+    use bandwidth_atlas::Parameterization;
     use picture::INK;
 
     fn atlas(lobes: usize, tile: usize, value: impl Fn(usize, usize) -> f32) -> Atlas {

@@ -10,7 +10,7 @@
 
 pub(crate) mod picture;
 
-use brdf_atlas::{Analyser, Atlas, AtlasBuild, Config, LuminanceTable, build_atlas_with};
+use bandwidth_atlas::{Analyser, Atlas, AtlasBuild, Config, LuminanceTable, build_atlas_with};
 use serde_json::json;
 
 use crate::{Error, OutFile, Program, Source, Staged, object};
@@ -283,18 +283,18 @@ pub fn from_payload(payload: asset::Payload) -> Result<Atlas, String> {
     }
 }
 
-fn parameterization_of(analysis: &asset::BandwidthAnalysis) -> Result<brdf_atlas::Parameterization, String> {
+fn parameterization_of(analysis: &asset::BandwidthAnalysis) -> Result<bandwidth_atlas::Parameterization, String> {
     let name = analysis.parameterization.as_str();
-    brdf_atlas::Parameterization::from_name(name).ok_or_else(|| {
+    bandwidth_atlas::Parameterization::from_name(name).ok_or_else(|| {
         format!(
             "unknown parameterization {name:?}: this build knows {:?}",
-            brdf_atlas::Parameterization::IncidencePlaneEquidistant.name()
+            bandwidth_atlas::Parameterization::IncidencePlaneEquidistant.name()
         )
     })
 }
 
 /// The full atlas of a rows asset: the rows checked as an atlas one lobe wide, then expanded to
-/// `lobes_x` columns ([`Atlas::expand_rows`] refuses a grid above [`brdf_atlas::MAX_TEXELS`]
+/// `lobes_x` columns ([`Atlas::expand_rows`] refuses a grid above [`bandwidth_atlas::MAX_TEXELS`]
 /// before allocating it).
 fn from_rows_asset(r: asset::BandwidthRows) -> Result<Atlas, String> {
     let rows = atlas_of(1, r.lobes_y, r.tile, r.data, &r.analysis)?;

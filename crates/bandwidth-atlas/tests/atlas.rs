@@ -2,7 +2,7 @@
 //! shortcut (one analysis per row of the incident grid, the table being isotropic) gives the
 //! tiles a direct analysis of each lobe gives.
 
-use brdf_atlas::{
+use bandwidth_atlas::{
     Analyser, Atlas, Config, Error, IncidentGrid, LobeMap, LuminanceTable, MAX_TEXELS, Parameterization, build_atlas,
     lobe_image_from_fn, to_incidence_frame,
 };
@@ -63,12 +63,13 @@ fn one_thread_and_two_give_the_same_bits() {
     // the band energies, the statistics and the layer selection, bit for bit.
     let table = phong(300.0);
     let config = Config { lobes: 8, tile: 8, analysis_size: 64, ..Config::default() };
-    let reduction = brdf_atlas::view::ViewReduction::BandQuantile(0.99);
+    let reduction = bandwidth_atlas::view::ViewReduction::BandQuantile(0.99);
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let build = build_atlas(&table, &config, &|_| {}).unwrap();
-            let selection = brdf_atlas::view::select_layers(&build, &config, &[1, 16, 256, 4096], reduction).unwrap();
+            let selection =
+                bandwidth_atlas::view::select_layers(&build, &config, &[1, 16, 256, 4096], reduction).unwrap();
             (build, selection)
         })
     };
@@ -230,7 +231,7 @@ fn expanding_rows_checks_the_size_first() {
 /// hemisphere texel's centre (turned into the tangent frame) read that texel.
 #[test]
 fn lookup_reads_the_texel_of_a_pair_of_directions() {
-    use brdf_atlas::LobeMap;
+    use bandwidth_atlas::LobeMap;
     let atlas = atlas_of(4, 3, |i, j, t| ((j * 4 + i) * 16 + t) as f32);
     let map = LobeMap::new(4);
     let grid_phi = |i: usize| std::f64::consts::TAU * (i as f64 + 0.3) / 4.0;

@@ -204,7 +204,7 @@
 //! continuation's and the band energies' mirror tiling, with their rows made on demand) a
 //! little less, eq. 7 with its per-level maxima about a tenth (`perf record
 //! target/release/brdf-bandwidth target/merl/gold-paint.binary --out-dir DIR`). `cargo bench -p
-//! brdf-atlas --bench atlas` times the build (`make bench BENCH=atlas` writes its report into
+//! bandwidth-atlas --bench atlas` times the build (`make bench BENCH=atlas` writes its report into
 //! `docs/benchmarks.md`).
 //!
 //! # Angles
@@ -231,7 +231,7 @@
 //! their `m` terms (`u = 2^-53`).
 //!
 //! On the 20 shared materials at the default settings, against libm's lookups and one sum after
-//! another (`cargo run --release -p brdf-atlas --example analysis-difference --
+//! another (`cargo run --release -p bandwidth-atlas --example analysis-difference --
 //! target/merl/*.binary`, after `make test-data`): every pixel of every row's lobe image within
 //! 5e-14 of the lobe's peak, every band energy within 2e-13 and every view bandwidth within
 //! 5e-14 (relative); **no texel of any atlas differs** (a pixel's level moves only where a

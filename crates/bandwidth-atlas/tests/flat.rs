@@ -2,7 +2,7 @@
 //! frequency, and in particular none may read the rounding noise of the lookups and the
 //! transform as signal. The noise floor (relative to each lobe's peak) is what makes it so.
 
-use brdf_atlas::{Config, build_atlas};
+use bandwidth_atlas::{Config, build_atlas};
 use merl::Dims;
 use merl::analytic::Analytic;
 

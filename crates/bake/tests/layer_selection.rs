@@ -1,8 +1,8 @@
 //! The layer selection: a Phong material of a layer's own exponent selects that layer at every
 //! view, and a sharper material never selects a broader layer.
 
-use brdf_atlas::Config;
-use brdf_atlas::view::select_layers_of_table;
+use bandwidth_atlas::Config;
+use bandwidth_atlas::view::select_layers_of_table;
 use merl::analytic::Analytic;
 
 /// Layers a factor 4 apart, the default's but the sharpest (`n = 16384`, whose lobe the
@@ -29,7 +29,7 @@ fn phong(n: u32) -> merl::MerlTable {
 #[test]
 fn phong_tables_select_their_own_layer_at_every_view() {
     let config = config();
-    let reduction = bake::stage::layers::DEFAULT_REDUCTION;
+    let reduction = bake::stage::layer_selection::DEFAULT_REDUCTION;
     let mut failures = Vec::new();
     for (k, &n) in EXPONENTS.iter().enumerate() {
         let selection = select_layers_of_table(&phong(n), &config, &EXPONENTS, reduction).unwrap();
@@ -51,7 +51,7 @@ fn layer_bandwidths_grow_like_sqrt_n() {
     let config = config();
     let b: Vec<f64> = EXPONENTS
         .iter()
-        .map(|&n| brdf_atlas::view::layer_bandwidth(&config, n, bake::stage::layers::DEFAULT_REDUCTION))
+        .map(|&n| bandwidth_atlas::view::layer_bandwidth(&config, n, bake::stage::layer_selection::DEFAULT_REDUCTION))
         .collect();
     println!("layer bandwidths {b:.4?}");
     for k in 3..b.len() {
@@ -68,18 +68,18 @@ fn layer_bandwidths_grow_like_sqrt_n() {
 fn a_lambertian_table_selects_the_broadest_layer_at_every_view() {
     let table = Analytic::Lambertian { albedo: [0.8, 0.5, 0.2] }.table(merl::Dims::MERL);
     let selection =
-        select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layers::DEFAULT_REDUCTION).unwrap();
+        select_layers_of_table(&table, &config(), &EXPONENTS, bake::stage::layer_selection::DEFAULT_REDUCTION).unwrap();
     println!("lambertian: view bandwidths {:.3?}", selection.view_bandwidth);
     assert!(selection.view_bandwidth.iter().all(|&b| b == 0.0), "{:?}", selection.view_bandwidth);
     assert!(selection.view_layer.iter().all(|&l| l == 0), "{:?}", selection.view_layer);
 }
 
-/// A default bake reads its layers' bandwidths from `brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS`:
+/// A default bake reads its layers' bandwidths from `bandwidth_atlas::view::KNOWN_LAYER_BANDWIDTHS`:
 /// they were measured for the bake's default reduction and Phong exponents (otherwise every bake
 /// would measure them again: right, but slower).
 #[test]
 fn the_known_layer_bandwidths_serve_the_default_bake() {
-    assert_eq!(bake::stage::layers::DEFAULT_REDUCTION, brdf_atlas::view::KNOWN_LAYER_REDUCTION);
-    let known: Vec<u32> = brdf_atlas::view::KNOWN_LAYER_BANDWIDTHS.iter().map(|(n, _)| *n).collect();
+    assert_eq!(bake::stage::layer_selection::DEFAULT_REDUCTION, bandwidth_atlas::view::KNOWN_LAYER_REDUCTION);
+    let known: Vec<u32> = bandwidth_atlas::view::KNOWN_LAYER_BANDWIDTHS.iter().map(|(n, _)| *n).collect();
     assert_eq!(known, prefilter::DEFAULT_EXPONENTS.to_vec());
 }

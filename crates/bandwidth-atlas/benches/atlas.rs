@@ -28,10 +28,10 @@ fn main() {
         start.elapsed()
     });
     let table = merl::read_file(&path).unwrap();
-    let config = brdf_atlas::Config::default();
+    let config = bandwidth_atlas::Config::default();
     let build = median(&mut || {
         let start = Instant::now();
-        std::hint::black_box(brdf_atlas::build_atlas(&table, &config, &|_| {}).unwrap());
+        std::hint::black_box(bandwidth_atlas::build_atlas(&table, &config, &|_| {}).unwrap());
         start.elapsed()
     });
     println!("material: gold-paint (real-derived); {} threads", rayon::current_num_threads());

@@ -9,7 +9,7 @@
 //! 256 x 256 pixels (steps near n = 4, 20, 70, 300), slope 0.44; the tolerance 0.5 +- 0.15 is
 //! a bit more than half a step of the staircase over the fitted range.
 
-use brdf_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
+use bandwidth_atlas::{Analyser, Config, IncidentGrid, LuminanceTable};
 use glam::DVec3;
 
 use crate::{phong, slope};
@@ -84,9 +84,9 @@ fn the_atlas_counts_the_lobes_at_the_limit() {
     // (fwhm 2 px at 64 x 64) reaches the limit in every lobe, a broad one (fwhm 19 px) in none
     // away from grazing incidence.
     let config = Config { lobes: 8, analysis_size: 64, ..Config::default() };
-    let sharp = brdf_atlas::build_atlas(&phong(1000.0), &config, &|_| {}).unwrap();
+    let sharp = bandwidth_atlas::build_atlas(&phong(1000.0), &config, &|_| {}).unwrap();
     assert_eq!(sharp.stats.nyquist_lobes(), 64, "{:?}", sharp.stats.nyquist_pixels);
-    let broad = brdf_atlas::build_atlas(&phong(6.0), &config, &|_| {}).unwrap();
+    let broad = bandwidth_atlas::build_atlas(&phong(6.0), &config, &|_| {}).unwrap();
     let grid = IncidentGrid::new(8);
     for j in 0..8 {
         for i in 0..8 {
@@ -128,7 +128,8 @@ fn phong_1000_is_resolved_at_the_default_size() {
     for j in 0..64 {
         let theta_i = grid.theta_i(j);
         let wi = merl::spherical_dir(theta_i, 0.0);
-        let analytic = analyser.analyse_image(brdf_atlas::lobe_image_from_fn(analyser.map(), |wo| Some(lobe(wi, wo))));
+        let analytic =
+            analyser.analyse_image(bandwidth_atlas::lobe_image_from_fn(analyser.map(), |wo| Some(lobe(wi, wo))));
         let tabulated = if j >= 56 { analyser.analyse(&table, theta_i).nyquist_count() } else { 0 };
         let counts = (analytic.nyquist_count(), tabulated);
         if counts != (0, 0) {
