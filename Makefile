@@ -173,7 +173,7 @@ three-cases: setup test-data
 	$(CARGO) test --test tests -- --ignored three::three_js_equals_brdf_preview_on_the_six_cases --nocapture
 
 ## demo: bake a built-in material (a synthetic GGX copper) under a built-in environment (the
-## procedural calibration sky), then render previews (pre-convolved; reference, validated against
+## procedural calibration sky), then render previews (prefiltered; reference, validated against
 ## the CPU) and a contact sheet of the bake.
 demo: setup-gpu build
 	@mkdir -p $(DEMO)

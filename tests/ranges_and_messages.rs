@@ -24,7 +24,7 @@ fn preview(args: &[&str]) -> Command {
 }
 
 /// Each value no option should take is refused at once with one line that names the option and
-/// says what it accepts; the work options name the ceiling and how to lift it.
+/// says what it accepts; the work options name the limit and how to raise it.
 #[test]
 fn numeric_options_are_refused_outside_their_range() {
     let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
@@ -41,7 +41,7 @@ fn numeric_options_are_refused_outside_their_range() {
         (preview(&["--out", png, "--spp", "0"]), "'--spp <N>': expected a whole number from 1 to 4294967295"),
         (preview(&["--out", png, "--spp", "0", "--frames", "1"]), "--spp <N>"),
         // Work without a bound.
-        (preview(&["--out", png, "--frames", "4294967295"]), "above the ceiling of 4294967296 (--max-samples)"),
+        (preview(&["--out", png, "--frames", "4294967295"]), "above the limit of 4294967296 (--max-samples)"),
         (preview(&["--out", png, "--converged", "4294967295"]), "raise --max-samples for a deliberate long run"),
         (preview(&["--out", png, "--mode", "adaptive", "--spp", "4294967295"]), "(--max-samples)"),
         (preview(&["--out", png, "--size", "8192x8192"]), "(--max-samples)"),

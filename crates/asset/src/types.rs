@@ -56,7 +56,7 @@ pub enum AssetKind {
     BandwidthAtlas = 4,
     /// [`BandwidthPca`]: a bandwidth atlas compressed by PCA.
     BandwidthPca = 5,
-    /// [`LayerSelection`]: which Phong layer of a pre-convolved environment serves each view of a
+    /// [`LayerSelection`]: which Phong layer of a prefiltered environment serves each view of a
     /// material.
     LayerSelection = 6,
     /// [`BandwidthRows`]: a bandwidth atlas whose tiles repeat along each row (an isotropic
@@ -707,7 +707,7 @@ impl BandwidthPca {
     }
 }
 
-/// Which Phong layer of a pre-convolved environment serves each view elevation of a material
+/// Which Phong layer of a prefiltered environment serves each view elevation of a material
 /// (payload of [`AssetKind::LayerSelection`], written by `brdf-bake`; crate `bandwidth-atlas`,
 /// module `view`). The material's lobes and the layers' own Phong lobes were measured with the
 /// same analysis (`analysis`, `reduction`); a view uses the layer whose bandwidth is nearest on a

@@ -1,7 +1,7 @@
 //! One bandwidth per view direction, and the Phong layer it selects (`001` sections 2.5 and 4.3:
 //! "look up pre-filtered illumination ... according to the maximum frequency of the BRDF").
 //!
-//! A renderer that shades a pixel with a pre-convolved environment needs one number per view
+//! A renderer that shades a pixel with a prefiltered environment needs one number per view
 //! direction, where the atlas holds a tile per incident direction. By reciprocity the lobe the
 //! atlas holds for incidence `wi` is also the lobe a renderer integrates over when it looks along
 //! `wo = wi`, so row `j` of the atlas serves the views whose `cos theta_o` lies in that row.

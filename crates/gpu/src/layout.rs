@@ -1,13 +1,14 @@
 //! Every struct the host writes into a buffer the WGSL reads as a struct, held to the WGSL's
-//! declaration in one table: the WGSL struct is parsed from the shader source, its layout computed
-//! by WGSL's rules (each member at the next multiple of its alignment; scalars 4 bytes, `vec2` 8,
-//! `vec3` 12 aligned to 16, `vec4` 16; the struct's size rounded up to its largest alignment),
-//! and every member's offset, in order, and the size compared with the Rust struct's `offset_of!`
-//! and `size_of`. A member added, removed, reordered or retyped on one side fails here.
+//! declaration of the same name in one table: the WGSL struct is parsed from the shader source,
+//! its layout computed by WGSL's rules (each member at the next multiple of its alignment;
+//! scalars 4 bytes, `vec2` 8, `vec3` 12 aligned to 16, `vec4` 16; the struct's size rounded up to
+//! its largest alignment), and every member's offset, in order, and the size compared with the
+//! Rust struct's `offset_of!` and `size_of`. A member added, removed, reordered or retyped on one
+//! side, or a struct renamed on one side, fails here.
 
 use std::mem::{offset_of, size_of};
 
-use crate::merl_lookup::{DirPair, GpuSample, MerlDimsUniform};
+use crate::merl_lookup::{MerlDimsUniform, MerlDirPair, MerlSample};
 use crate::preview::adaptive::{AdaptivePass, RecordLobe, RecordSurface};
 use crate::preview::present::PresentUniform;
 use crate::preview::uniforms::{FrameUniform, PredictUniform, ShadeUniform, WaveletUniform};
@@ -15,8 +16,8 @@ use crate::wgsl::{
     ADAPTIVE_PREDICT, ADAPTIVE_STATE, MERL_LOOKUP, MERL_LOOKUP_BATCH, PREVIEW_BINDINGS, PREVIEW_PRESENT, WAVELET_BRDF,
 };
 
-/// A host struct: the WGSL source and struct it mirrors, its size, and its members' WGSL names
-/// with their Rust offsets, in order (a nested Rust struct's members flattened, as the WGSL has
+/// A host struct: the WGSL source that declares the struct of the same name, its size, and its
+/// members' WGSL names with their Rust offsets, in order (a nested Rust struct's members flattened, as the WGSL has
 /// them).
 struct Shared {
     wgsl: &'static str,
@@ -26,10 +27,10 @@ struct Shared {
 }
 
 macro_rules! shared {
-    ($wgsl:expr, $name:literal, $ty:ty { $($member:literal => $($field:ident).+),* $(,)? }) => {
+    ($wgsl:expr, $ty:ident { $($member:literal => $($field:ident).+),* $(,)? }) => {
         Shared {
             wgsl: $wgsl,
-            name: $name,
+            name: stringify!($ty),
             size: size_of::<$ty>(),
             members: vec![$(($member, offset_of!($ty, $($field).+))),*],
         }
@@ -67,16 +68,16 @@ fn wgsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
 
 fn shared_structs() -> Vec<Shared> {
     vec![
-        shared!(MERL_LOOKUP.source, "MerlDims", MerlDimsUniform {
+        shared!(MERL_LOOKUP.source, MerlDimsUniform {
             "n_theta_h" => n_theta_h, "n_theta_d" => n_theta_d, "n_phi_d" => n_phi_d, "phi_d_range" => phi_d_range,
         }),
-        shared!(MERL_LOOKUP_BATCH.source, "MerlDirPair", DirPair { "wi" => wi, "wo" => wo }),
-        shared!(MERL_LOOKUP_BATCH.source, "MerlSample", GpuSample { "rgb" => rgb, "cell" => cell }),
-        shared!(WAVELET_BRDF.source, "WaveletParams", WaveletUniform {
+        shared!(MERL_LOOKUP_BATCH.source, MerlDirPair { "wi" => wi, "wo" => wo }),
+        shared!(MERL_LOOKUP_BATCH.source, MerlSample { "rgb" => rgb, "cell" => cell }),
+        shared!(WAVELET_BRDF.source, WaveletUniform {
             "side" => side, "levels" => levels, "enabled" => enabled, "lod" => lod, "mean" => mean,
             "epsilon" => epsilon,
         }),
-        shared!(PREVIEW_BINDINGS.source, "Shade", ShadeUniform {
+        shared!(PREVIEW_BINDINGS.source, ShadeUniform {
             "eye" => eye, "ray_forward" => ray_forward, "ray_right" => ray_right, "ray_up" => ray_up,
             "width" => width, "height" => height, "seed" => seed, "mode" => mode, "spp" => spp,
             "n_slices" => n_slices, "n_vectors" => n_vectors, "n_samples" => n_samples, "n_levels" => n_levels,
@@ -88,23 +89,23 @@ fn shared_structs() -> Vec<Shared> {
             "peak_marginal" => tables.peak_marginal, "peak_conditional" => tables.peak_conditional,
             "items" => items, "filter_samples" => filter_samples, "_pad1" => _pad1, "_pad2" => _pad2, "diffuse" => diffuse,
         }),
-        shared!(PREVIEW_BINDINGS.source, "Frame", FrameUniform { "index" => index }),
-        shared!(ADAPTIVE_STATE.source, "RecordSurface", RecordSurface {
+        shared!(PREVIEW_BINDINGS.source, FrameUniform { "index" => index }),
+        shared!(ADAPTIVE_STATE.source, RecordSurface {
             "depth" => depth, "cos_o" => cos_o, "screen_normal" => screen_normal,
         }),
-        shared!(ADAPTIVE_STATE.source, "RecordLobe", RecordLobe { "mirror" => mirror, "prediction" => prediction }),
-        shared!(ADAPTIVE_PREDICT.source, "Predict", PredictUniform {
+        shared!(ADAPTIVE_STATE.source, RecordLobe { "mirror" => mirror, "prediction" => prediction }),
+        shared!(ADAPTIVE_PREDICT.source, PredictUniform {
             "n_b" => n_b, "env_width" => env_width, "env_height" => env_height, "lobes_x" => lobes_x,
             "lobes_y" => lobes_y, "tile" => tile, "radians_per_pixel" => radians_per_pixel, "_pad" => _pad,
         }),
-        shared!(ADAPTIVE_STATE.source, "AdaptivePass", AdaptivePass {
+        shared!(ADAPTIVE_STATE.source, AdaptivePass {
             "level" => level, "top" => top, "width" => width, "height" => height, "out_width" => out_width,
             "out_height" => out_height, "ss" => ss, "count" => count, "level_table" => level_table,
             "sharpness" => sharpness, "n_rows" => n_rows, "oracle" => oracle, "depth_sigma" => depth_sigma,
             "rescue_below" => rescue_below, "candidates" => candidates, "budget" => budget, "max_spp" => max_spp,
             "capacity" => capacity, "allocate" => allocate, "_pad" => _pad,
         }),
-        shared!(PREVIEW_PRESENT.source, "Present", PresentUniform {
+        shared!(PREVIEW_PRESENT.source, PresentUniform {
             "image_size" => image_size, "frames" => frames, "view" => view, "exposure" => exposure,
             "srgb_target" => srgb_target, "n_indices" => n_indices, "_pad" => _pad, "origin" => origin,
             "scale" => scale, "_pad2" => _pad2,

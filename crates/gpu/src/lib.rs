@@ -24,4 +24,4 @@ pub mod wgsl;
 
 pub use context::Gpu;
 pub use error::GpuError;
-pub use merl_lookup::{GpuSample, MerlDimsUniform, MerlLookup, gpu_table_values};
+pub use merl_lookup::{MerlDimsUniform, MerlLookup, MerlSample, gpu_table_values};

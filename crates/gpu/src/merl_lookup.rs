@@ -57,14 +57,14 @@ pub fn gpu_table_values(table: &MerlTable) -> Vec<f32> {
 /// One looked-up pair, as the shader wrote it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuSample {
+pub struct MerlSample {
     /// BRDF in 1/sr; negative in every channel where the table holds no data.
     pub rgb: [f32; 3],
     /// Flat index of the cell within a channel, as `merl::Dims::index` numbers them.
     pub cell: u32,
 }
 
-impl GpuSample {
+impl MerlSample {
     pub fn has_data(&self) -> bool {
         self.rgb.iter().all(|v| *v >= 0.0)
     }
@@ -73,13 +73,13 @@ impl GpuSample {
 /// `MerlDirPair` of the WGSL.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub(crate) struct DirPair {
+pub(crate) struct MerlDirPair {
     pub(crate) wi: [f32; 4],
     pub(crate) wo: [f32; 4],
 }
 
-const PAIR_BYTES: u64 = size_of::<DirPair>() as u64;
-const SAMPLE_BYTES: u64 = size_of::<GpuSample>() as u64;
+const PAIR_BYTES: u64 = size_of::<MerlDirPair>() as u64;
+const SAMPLE_BYTES: u64 = size_of::<MerlSample>() as u64;
 
 /// Bytes of a table as the WGSL reads it.
 pub(crate) fn table_bytes(dims: Dims) -> u64 {
@@ -169,7 +169,7 @@ impl MerlLookup {
 
     /// Looks up every `(wi, wo)` pair: the value of its nearest cell and that cell, in order.
     /// Directions must satisfy what `merl::half_diff` asks (unit vectors, `wi + wo != 0`).
-    pub fn evaluate(&self, pairs: &[([f32; 3], [f32; 3])]) -> Result<Vec<GpuSample>, GpuError> {
+    pub fn evaluate(&self, pairs: &[([f32; 3], [f32; 3])]) -> Result<Vec<MerlSample>, GpuError> {
         let mut samples = Vec::with_capacity(pairs.len());
         if pairs.is_empty() {
             return Ok(samples);
@@ -186,9 +186,9 @@ impl MerlLookup {
         })?;
         for batch in pairs.chunks(capacity as usize) {
             let n = batch.len() as u64;
-            let packed: Vec<DirPair> = batch
+            let packed: Vec<MerlDirPair> = batch
                 .iter()
-                .map(|(wi, wo)| DirPair { wi: [wi[0], wi[1], wi[2], 0.0], wo: [wo[0], wo[1], wo[2], 0.0] })
+                .map(|(wi, wo)| MerlDirPair { wi: [wi[0], wi[1], wi[2], 0.0], wo: [wo[0], wo[1], wo[2], 0.0] })
                 .collect();
             capture_errors(&self.device, || {
                 self.queue.write_buffer(&pair_buffer, 0, bytemuck::cast_slice(&packed));
@@ -215,7 +215,7 @@ impl MerlLookup {
                 encoder.copy_buffer_to_buffer(&sample_buffer, 0, &readback, 0, n * SAMPLE_BYTES);
                 self.queue.submit([encoder.finish()]);
             })?;
-            samples.extend(read_back::<GpuSample>(&self.device, &readback, n * SAMPLE_BYTES)?);
+            samples.extend(read_back::<MerlSample>(&self.device, &readback, n * SAMPLE_BYTES)?);
         }
         Ok(samples)
     }

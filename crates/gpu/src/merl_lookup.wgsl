@@ -10,7 +10,7 @@
 const PI: f32 = 3.14159265358979;
 const HALF_PI: f32 = 1.5707963267948966;
 
-struct MerlDims {
+struct MerlDimsUniform {
     n_theta_h: u32,
     n_theta_d: u32,
     n_phi_d: u32,
@@ -26,7 +26,7 @@ struct MerlHalfDiff {
     phi_d: f32,
 }
 
-@group(0) @binding(0) var<uniform> merl_dims: MerlDims;
+@group(0) @binding(0) var<uniform> merl_dims: MerlDimsUniform;
 // Channel-major like the file (all red, then all green, then all blue) and already multiplied by
 // `merl::SCALE`, so in 1/sr. A cell without data is negative in every channel.
 @group(0) @binding(1) var<storage, read> merl_table: array<f32>;
@@ -76,7 +76,7 @@ fn merl_half_diff(wi: vec3<f32>, wo: vec3<f32>) -> MerlHalfDiff {
 // Continuous grid coordinates (theta_h, theta_d, phi_d): sample i sits at coordinate i, the lower
 // edge of cell i.
 // `merl::Dims::grid_coords`.
-fn merl_grid_coords(dims: MerlDims, hd: MerlHalfDiff) -> vec3<f32> {
+fn merl_grid_coords(dims: MerlDimsUniform, hd: MerlHalfDiff) -> vec3<f32> {
     let x_h = sqrt(max(hd.theta_h, 0.0) / HALF_PI) * f32(dims.n_theta_h);
     let x_d = hd.theta_d / HALF_PI * f32(dims.n_theta_d);
     var phi_d = hd.phi_d;
@@ -95,7 +95,7 @@ fn merl_axis_index(x: f32, n: u32) -> u32 {
 }
 
 // Flat index of the cell within a channel, in the MERL order (`merl::Dims::index`).
-fn merl_nearest_cell(dims: MerlDims, hd: MerlHalfDiff) -> u32 {
+fn merl_nearest_cell(dims: MerlDimsUniform, hd: MerlHalfDiff) -> u32 {
     let x = merl_grid_coords(dims, hd);
     let i_h = merl_axis_index(x.x, dims.n_theta_h);
     let i_d = merl_axis_index(x.y, dims.n_theta_d);

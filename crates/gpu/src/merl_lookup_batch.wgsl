@@ -12,7 +12,7 @@ struct MerlDirPair {
     wo: vec4<f32>,
 }
 
-// 16 bytes: vec3 then u32 in its fourth slot, the layout of `gpu::GpuSample`.
+// 16 bytes: vec3 then u32 in its fourth slot, the layout of `gpu::MerlSample`.
 struct MerlSample {
     rgb: vec3<f32>,
     cell: u32,

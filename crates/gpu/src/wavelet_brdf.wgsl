@@ -4,7 +4,7 @@
 //! `material_brdf` is what the previewer's estimators call: the wavelet when one is bound
 //! (`wavelet.enabled`), else the table's nearest lookup with no data as 0.
 
-struct WaveletParams {
+struct WaveletUniform {
     // `n`, cells per angle of the sphere grid, and `log2 n`.
     side: u32,
     levels: u32,
@@ -17,7 +17,7 @@ struct WaveletParams {
     epsilon: f32,
 }
 
-@group(0) @binding(2) var<uniform> wavelet: WaveletParams;
+@group(0) @binding(2) var<uniform> wavelet: WaveletUniform;
 // Per coefficient position, its slice in `wavelet_slices`; 0 is the shared zero slice.
 @group(0) @binding(3) var<storage, read> wavelet_map: array<u32>;
 // The zero slice then the stored slices, each n^2 outgoing cells x 3 channels.

@@ -241,7 +241,7 @@ mod tests {
             assert!(shade.contains(name), "preview_shade.wgsl declares {name}: {shade:?}");
         }
         let bindings = declared(super::PREVIEW_BINDINGS.source);
-        for name in ["Shade", "MODE_REFERENCE", "samples", "accumulation", "gbuffer_triangle"] {
+        for name in ["ShadeUniform", "MODE_REFERENCE", "samples", "accumulation", "gbuffer_triangle"] {
             assert!(bindings.contains(name), "preview_bindings.wgsl declares {name}: {bindings:?}");
         }
     }

@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use gpu::{GpuSample, MerlLookup};
+use gpu::{MerlLookup, MerlSample};
 use merl::analytic::Analytic;
 use merl::{Cell, Dims, HalfDiff, MerlTable, half_diff, spherical_dir};
 use rand::{Rng, SeedableRng, rngs::StdRng};
@@ -225,7 +225,7 @@ fn check_against_cpu(name: &str, table: &MerlTable, pairs: &[([f32; 3], [f32; 3]
 /// rounding of the upload (relative 6e-8; 1e-6 leaves room, none for a neighbouring cell of a
 /// table that varies). The absolute floor covers values below f32's normal range, which a
 /// driver may flush to zero.
-fn check_value(table: &MerlTable, sample: &GpuSample) -> Result<(), String> {
+fn check_value(table: &MerlTable, sample: &MerlSample) -> Result<(), String> {
     match table.cell_value(sample.cell as usize) {
         None if sample.has_data() => Err(format!("cpu: no data, gpu: {:?}", sample.rgb)),
         None => Ok(()),

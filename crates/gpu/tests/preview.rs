@@ -613,7 +613,7 @@ struct AdaptiveCase {
     oracle: bool,
     allocation: render::adaptive::Allocation,
     max_spp: u32,
-    /// The frames the picture averages (the pre-convolved blocks' footprints).
+    /// The frames the picture averages (the prefiltered blocks' footprints).
     frames: u32,
 }
 
@@ -745,7 +745,7 @@ fn check_adaptive_frame_on(on: &Gpu, case: AdaptiveCase) {
     }
 }
 
-/// The cases below cover the reference and the pre-convolved estimators, 2 x 2 anti-aliasing, the
+/// The cases below cover the reference and the prefiltered estimators, 2 x 2 anti-aliasing, the
 /// lobe weight, the oracle's bandwidths, the allocations on the GPU (area) and on the host
 /// (variance, standard deviation), blocks capped at one vector and blocks of several vectors (at
 /// 256 spp parts of 128 samples, each across two vectors), and the sphere filling the image, so

@@ -1,4 +1,4 @@
-//! Pre-convolved environment maps for real-time shading of measured materials (Bagher et al.
+//! Prefiltered environment maps for real-time shading of measured materials (Bagher et al.
 //! 2013, sections 2.5 and 4.3: "pre-convolve the environment map with Phong lobes of various
 //! exponents and assemble them into an array of textures"): for each exponent `n`, the map
 //! convolved with the normalized Phong lobe around every direction `r`,

@@ -227,7 +227,7 @@ impl Inputs<'_> {
         let Inputs { request, loaded, settings, .. } = *self;
         let (sum, n) = (&frames.sum, settings.frames);
         let aa = settings.supersample * settings.supersample;
-        // The pre-convolved estimator's layers, where they are not the bake's.
+        // The prefiltered estimator's layers, where they are not the bake's.
         let layers = match (settings.mode, settings.layer_shift) {
             (Estimator::Prefiltered, k) if k > 0 => format!(" ({k} layer{} sharper)", if k == 1 { "" } else { "s" }),
             _ => String::new(),

@@ -1,4 +1,4 @@
-//! What the previews share: the scene a request names, the ceiling on its work, the checks of a
+//! What the previews share: the scene a request names, the limit on its work, the checks of a
 //! render (finite values, a PSNR under the request's minimum, the converged estimate), tone
 //! mapping and captioned pictures.
 
@@ -60,7 +60,7 @@ pub(crate) fn check_output_folder(path: &Path) -> Result<(), Error> {
 }
 
 /// The work the arguments ask for, `(what, samples)` by part, within --max-samples; otherwise an
-/// error that gives the parts and how to lift the ceiling.
+/// error that gives the parts and how to raise the limit.
 pub(crate) fn check_work(request: &Request, parts: &[(&str, u128)]) -> Result<(), Error> {
     let total: u128 = parts.iter().map(|(_, n)| n).sum();
     if total <= u128::from(request.max_samples) {
@@ -69,7 +69,7 @@ pub(crate) fn check_work(request: &Request, parts: &[(&str, u128)]) -> Result<()
     let listed: Vec<String> = parts.iter().filter(|(_, n)| *n > 0).map(|(what, n)| format!("{n} {what}")).collect();
     bail!(
         "this run would take {total} samples ({}; --size, --spp, --frames and --converged set them), above the \
-         ceiling of {} (--max-samples): ask for less, or raise --max-samples for a deliberate long run",
+         limit of {} (--max-samples): ask for less, or raise --max-samples for a deliberate long run",
         listed.join(", "),
         request.max_samples
     )

@@ -28,7 +28,7 @@ use crate::checks::{
 };
 
 /// An error that stops a preview: the request's own (a bake that cannot serve it, work over the
-/// ceiling), a file's, or the renderers'. Messages are one lower-case line naming the file.
+/// limit), a file's, or the renderers'. Messages are one lower-case line naming the file.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The request cannot be served as asked.

@@ -205,7 +205,7 @@ struct Args {
     #[arg(long, value_name = "DB", allow_negative_numbers = true, value_parser = parse_psnr)]
     min_psnr: Option<f64>,
 
-    /// The most samples this run may take, a ceiling against runaway work (a mistyped --frames or
+    /// The most samples this run may take, a limit against runaway work (a mistyped --frames or
     /// --converged): pixels x spp x frames on the GPU (twice with --brdf wavelet-brdf), the same again
     /// on the CPU with --validate, and pixels x 3 x N for the converged estimate (--converged N;
     /// --validate in the adaptive modes takes 256). From 1; the default, 2^32, is about a minute

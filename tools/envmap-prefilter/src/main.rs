@@ -1,5 +1,5 @@
 //! `envmap-prefilter`: an environment map convolved with normalized Phong lobes of several
-//! exponents (pre-convolved shading) and its mip chain (filtered importance sampling). Argument
+//! exponents (prefiltered shading) and its mip chain (filtered importance sampling). Argument
 //! parsing and printing around `bake::stage::prefilter`.
 
 use std::path::PathBuf;

@@ -21,7 +21,7 @@ use crate::{Error, OutFile, Program, Source, Staged, object};
 
 pub const ASSET: &str = "layer-selection.asset";
 
-/// The reduction `brdf-bake` uses, chosen by what the pre-convolved mode renders against the
+/// The reduction `brdf-bake` uses, chosen by what the `prefiltered` mode renders against the
 /// converged estimate (`cargo bench -p brdf-preview --bench preview`: six cases, white-paint,
 /// gold-paint and chrome under potsdamer_platz and quarry_01, a 128 x 128 sphere, 16 samples per
 /// pixel, one frame; mean PSNR over the six cases in dB):

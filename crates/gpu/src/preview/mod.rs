@@ -599,7 +599,7 @@ impl Renderer {
         pass
     }
 
-    /// Binds groups 0 to 2 for an estimator's pass (frame 0's slot of `Frame`).
+    /// Binds groups 0 to 2 for an estimator's pass (frame 0's slot of `FrameUniform`).
     fn bind_estimator_groups(&self, pass: &mut wgpu::ComputePass) {
         pass.set_bind_group(0, &self.table_group, &[]);
         pass.set_bind_group(1, &self.bake_group, &[]);
@@ -677,7 +677,7 @@ impl Renderer {
         self.camera.view_proj(self.width as f32 / self.height as f32)
     }
 
-    /// The `Shade` uniform of a render with `settings` in `MODE_*` `mode`.
+    /// The `ShadeUniform` of a render with `settings` in `MODE_*` `mode`.
     fn shade_uniform(&self, mode: u32, settings: &Settings) -> ShadeUniform {
         let camera = &self.camera;
         // `render::Camera::ray`'s basis, in f64 like the CPU, rounded once.

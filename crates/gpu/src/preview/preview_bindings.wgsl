@@ -1,6 +1,6 @@
 //! What the previewer's shading module binds and every part of it shares: the constants (the
 //! modes, the rasterizer's), group 1 (what the scene, material and lighting upload once) and
-//! group 2 (the render: `Shade`, `Frame`, the G-buffer, the accumulation, the backdrop).
+//! group 2 (the render: `ShadeUniform`, `FrameUniform`, the G-buffer, the accumulation, the backdrop).
 
 
 // The host rounds the image up to whole workgroups of this size (`SHADE_WORKGROUP` in Rust; a
@@ -53,12 +53,12 @@ const SUBPIXELS: f32 = 256.0;
 @group(1) @binding(4) var<storage, read> mesh_vertices: array<f32>;
 @group(1) @binding(5) var<storage, read> mesh_indices: array<u32>;
 // The CDF tables the estimators sample, f32 as the CPU samples them (`render::SampleSet::tables`,
-// `render::Lighting::environment` and the peaks' `sampling`), where `Shade` says they start.
+// `render::Lighting::environment` and the peaks' `sampling`), where `ShadeUniform` says they start.
 @group(1) @binding(6) var<storage, read> sampling_tables: array<f32>;
 
 // Group 2: the render.
 
-struct Shade {
+struct ShadeUniform {
     // The camera: the eye, and the pixel ray's basis as `render::Camera::ray` builds it,
     // `forward`, `right tan(fov_y / 2) aspect` and `up tan(fov_y / 2)`.
     eye: vec4<f32>,
@@ -113,16 +113,16 @@ struct Shade {
     diffuse: vec4<f32>,
 }
 
-// `Shade::peak_map` where the environment has no peaks.
+// `ShadeUniform::peak_map` where the environment has no peaks.
 const NO_MAP: u32 = 0xffffffffu;
 
 // Its own uniform, at a dynamic offset: one command buffer holds many frames.
-struct Frame {
+struct FrameUniform {
     index: u32,
 }
 
-@group(2) @binding(0) var<uniform> shade: Shade;
-@group(2) @binding(1) var<uniform> frame: Frame;
+@group(2) @binding(0) var<uniform> shade: ShadeUniform;
+@group(2) @binding(1) var<uniform> frame: FrameUniform;
 // The index plus one of the triangle that covers the pixel centre, 0 where none does.
 @group(2) @binding(2) var gbuffer_triangle: texture_2d<u32>;
 // Per pixel: the sum of the frames' radiance, and in w whether a triangle covers it.

@@ -21,7 +21,7 @@ const VIEW_SLICE: u32 = 3u;
 const BACKGROUND: vec3<f32> = vec3<f32>(0.125, 0.125, 0.125);
 const NO_TABLE: vec3<f32> = vec3<f32>(0.5, 0.5, 0.5);
 
-struct Present {
+struct PresentUniform {
     image_size: vec2<u32>,
     // The accumulation holds the sum of this many frames; 0: nothing to show.
     frames: u32,
@@ -39,7 +39,7 @@ struct Present {
     _pad2: f32,
 }
 
-@group(0) @binding(0) var<uniform> present: Present;
+@group(0) @binding(0) var<uniform> present: PresentUniform;
 // Viridis at 0, 1/255, ..., 1 (`picture::colormap::viridis`), encoded sRGB in [0, 1].
 @group(0) @binding(1) var<uniform> palette: array<vec4<f32>, 256>;
 // `Renderer`'s accumulation: per pixel the sum of the frames and, in w, whether a triangle covers it.

@@ -269,7 +269,7 @@ fn table_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, material: 
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("merl table"), layout, entries: &entries })
 }
 
-/// Group 2: the render's uniforms (`Shade`, and `Frame` one slot per frame of a submission), the
+/// Group 2: the render's uniforms (`ShadeUniform`, and `FrameUniform` one slot per frame of a submission), the
 /// G-buffer, the accumulation and the backdrop.
 struct RenderGroup {
     group: wgpu::BindGroup,
@@ -453,7 +453,7 @@ fn bake_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
     std::array::from_fn(|binding| storage_entry(binding as u32, wgpu::ShaderStages::COMPUTE, true))
 }
 
-/// Group 2: the render (`preview_bindings.wgsl`): `Shade`, `Frame` at a dynamic offset, the
+/// Group 2: the render (`preview_bindings.wgsl`): `ShadeUniform`, `FrameUniform` at a dynamic offset, the
 /// G-buffer, the accumulation and the backdrop.
 pub(super) fn render_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
     let compute = wgpu::ShaderStages::COMPUTE;

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use render::Mode;
 
-/// `WaveletParams` of `wavelet_brdf.wgsl`.
+/// The wavelet BRDF decoder's uniform, as `wavelet_brdf.wgsl` declares it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct WaveletUniform {
@@ -35,8 +35,8 @@ impl WaveletUniform {
     }
 }
 
-/// `Frame` of the WGSL: the index of the frame a dispatch shades, one slot per frame of a
-/// submission at the dynamic-offset alignment.
+/// The frame's uniform (`preview_bindings.wgsl`): the index of the frame a dispatch shades, one
+/// slot per frame of a submission at the dynamic-offset alignment.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct FrameUniform {
@@ -50,7 +50,7 @@ pub(crate) const SHADE_WORKGROUP: u32 = 8;
 /// position, normal (`preview_geometry.wgsl`).
 pub(crate) const VERTEX_FLOATS: u64 = 12;
 
-/// `Shade` of the WGSL.
+/// The shading uniform, as `preview_bindings.wgsl` declares it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct ShadeUniform {
@@ -115,7 +115,7 @@ pub(crate) struct TableLayout {
     pub(crate) peak_conditional: u32,
 }
 
-/// `Predict` of the WGSL.
+/// The prediction's uniform, as `adaptive/predict.wgsl` declares it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct PredictUniform {

@@ -68,7 +68,7 @@
 //!
 //! The predicted variance (eq. 9) is `sum_i (nu_env(wi) + rho_i) g_i^2 / pdf_i / n_b` with
 //! `g_i = L(wi) f(wi, wo) cos theta_i` the integrand, the angular bandwidths of the light and
-//! the BRDF at `wi` bounding the spectrum of their product; for the pre-convolved estimator
+//! the BRDF at `wi` bounding the spectrum of their product; for the prefiltered estimator
 //! (eq. 10) `sum_i 2 rho_i g_i^2 / pdf_i / n_b`: the layer holds no detail beyond the BRDF's.
 //!
 //! # Grading
@@ -189,14 +189,14 @@
 //! points); a block of more samples (a power of two, so a multiple of `N`) with `spp = N` and
 //! `count / N` frames, the first `count / N` vectors' worth of its pixel's walk through its
 //! `V N` points (crate docs, "Samples"): all distinct, as the cap keeps `count <= V N`.
-//! The pre-convolved estimator sizes the block's footprints for `count` times
+//! The prefiltered estimator sizes the block's footprints for `count` times
 //! [`Settings::frames`], the frames the picture averages, as the full-resolution mode sizes
 //! them for `spp` times its frames: each frame's block draws other points. Measured against the
 //! converged estimate (chrome under studio_small_03, the Mitsuba benchmark's camera 82.8, 43.1,
 //! 128 x 128, 8 frames), footprints for `count` alone left the picture 0.21 levels too bright on
 //! average (7x7 bias p99 1.88) where those for `8 count` leave it 0.05 (p99 0.88).
 //!
-//! The pre-convolved estimator (`001` section 2.5: samples of the illumination "pre-filtered
+//! The prefiltered estimator (`001` section 2.5: samples of the illumination "pre-filtered
 //! ... at the level given by the maximum frequency of the BRDF") reads the Phong layers
 //! [`Settings::layer_shift`] layers sharper than the coordinate the bake's selection gives the
 //! view ([`Material::view_layers`], crate docs "The estimators"), the map itself past the
@@ -348,7 +348,7 @@ pub struct Settings {
     pub layer_shift: u32,
     /// The frames the picture averages, each planned and shaded with its own seed
     /// ([`render_frames`] renders and averages them; a previewer may loop over [`render`]):
-    /// the pre-convolved estimator sizes a shaded block's footprints for its samples times
+    /// the prefiltered estimator sizes a shaded block's footprints for its samples times
     /// these, as [`crate::Settings::filter_samples`] counts `spp` times the frames (module docs,
     /// "Shading"). From 1; default 1.
     pub frames: u32,

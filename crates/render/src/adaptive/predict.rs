@@ -16,7 +16,7 @@ use super::*;
 pub struct Prediction {
     /// Image-space bandwidth, cycles per pixel (eq. 5-6).
     pub bandwidth: f64,
-    /// The variance bound (eq. 9, or eq. 10 for the pre-convolved estimator).
+    /// The variance bound (eq. 9, or eq. 10 for the prefiltered estimator).
     pub variance: f64,
     /// The pyramid level the pixel may be shaded at (eq. 11); -1 when it is not shadeable.
     pub level: i32,

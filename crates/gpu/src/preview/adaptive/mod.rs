@@ -523,7 +523,7 @@ impl Renderer {
         let lap = || clock.elapsed().as_secs_f64() * 1e3;
         let budget = Budget::new(settings, state.covered_output);
         // The shading uniform of the frame's passes with `items` items (the prediction's, then
-        // `shade_blocks`' parts): the estimator, the seed, the pre-convolved estimator's layers.
+        // `shade_blocks`' parts): the estimator, the seed, the prefiltered estimator's layers.
         let shade_uniform = |items: u32| super::ShadeUniform {
             layer_shift: settings.layer_shift,
             items,

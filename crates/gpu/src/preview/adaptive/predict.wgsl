@@ -4,7 +4,7 @@
 
 // Group 3: what the prediction of an adaptive frame reads besides the bake (`render::adaptive`,
 // "The bandwidth buffer"), set by `Renderer::set_bandwidths`.
-struct Predict {
+struct PredictUniform {
     // Incident directions per prediction (`n_b`), at most the samples per vector.
     n_b: u32,
     // The environment bandwidth's lat-long grid, first in `bandwidth_texels`.
@@ -20,7 +20,7 @@ struct Predict {
     _pad: u32,
 }
 
-@group(3) @binding(0) var<uniform> predict: Predict;
+@group(3) @binding(0) var<uniform> predict: PredictUniform;
 
 // `render::adaptive::PREDICTION_SALT`: mixed into the seed of the vector each prediction reads.
 const PREDICTION_SALT: u32 = 0x9e3779b9u;
@@ -85,7 +85,7 @@ fn bandwidth_at_eye(nu_env: f32, rho: f32, c: f32, depth: f32, cos_x: f32) -> f3
 
 // `render::adaptive::predict::predict_pixel` at the shadeable pixel (x, y) of G-buffer curvature
 // `curvature` (the CPU's, a camera's: `render::adaptive::Geometry`): the image bandwidth (cycles
-// per pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the pre-convolved estimator) from
+// per pixel, eq. 5-6) and the variance (eq. 9, or eq. 10 for the prefiltered estimator) from
 // the first `n_b` samples of the pixel's vector; (-1, -1) where the pixel is not shadeable.
 fn predict_pixel(x: u32, y: u32, curvature: f32) -> vec2<f32> {
     let me = surface_at(i32(x), i32(y));
