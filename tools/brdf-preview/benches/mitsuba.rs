@@ -462,6 +462,27 @@ struct Compared {
     picture: Vec<bool>,
     /// The sphere's pixels among them (both renderers cover them).
     sphere: Vec<bool>,
+    /// The pixels our rasterizer covers.
+    covered: Vec<bool>,
+    /// How many pixels only one renderer covers.
+    coverage_differs: usize,
+    /// How many of our pixels are seen at grazing angles.
+    grazing: usize,
+}
+
+impl Compared {
+    /// The pixels of `scene` the figures take, given those Mitsuba's render covers (`theirs`).
+    fn new(scene: &Scene, theirs: &[bool]) -> Compared {
+        let n = scene.width * scene.height;
+        let (covered, grazing) = coverage(scene);
+        Compared {
+            picture: (0..n).map(|i| covered[i] == theirs[i] && !grazing[i]).collect(),
+            sphere: (0..n).map(|i| covered[i] && theirs[i] && !grazing[i]).collect(),
+            coverage_differs: covered.iter().zip(theirs).filter(|(a, b)| a != b).count(),
+            grazing: grazing.iter().filter(|g| **g).count(),
+            covered,
+        }
+    }
 }
 
 /// How an image compares with Mitsuba's.
@@ -536,271 +557,430 @@ fn save_png(path: &Path, canvas: &Canvas) {
     write(path, &png);
 }
 
+impl Options {
+    fn wanted(&self, case: &str) -> bool {
+        self.cases.is_empty() || self.cases.iter().any(|c| case.contains(c.as_str()))
+    }
+}
+
+/// A material's bake under a map, and what its cases share.
+struct Baked {
+    material: &'static str,
+    map: &'static str,
+    loaded: bake::Loaded,
+    /// The bake's wall time, seconds.
+    seconds: f64,
+    /// The one exposure of every picture of the map (`metrics::auto_tone_mapping`).
+    preview: envmap::ToneMapping,
+}
+
+impl Baked {
+    fn new(material: &'static str, map: &'static str) -> Baked {
+        let start = Instant::now();
+        let loaded = bake(material, map);
+        let seconds = start.elapsed().as_secs_f64();
+        let lighting = loaded.lighting.as_ref().expect("the bake has an environment");
+        let preview = metrics::auto_tone_mapping(lighting.mips.level(0));
+        Baked { material, map, loaded, seconds, preview }
+    }
+
+    fn lighting(&self) -> &Lighting {
+        self.loaded.lighting.as_ref().expect("the bake has an environment")
+    }
+
+    fn level0(&self) -> &EnvMap {
+        self.lighting().mips.level(0)
+    }
+}
+
+/// The Python BSDF's check against crate merl's lookup of a material ([`check_lookup`]).
+struct Lookup {
+    material: &'static str,
+    pairs: u64,
+    /// The pairs whose values differ.
+    differ: u64,
+}
+
+/// What a case measured: its rows of the report and its entries of report.json.
+struct Measured {
+    name: String,
+    /// The camera's azimuth and elevation, radians.
+    azimuth: f32,
+    elevation: f32,
+    /// Pixels only one renderer covers, and pixels left out as grazing ([`Compared`]).
+    coverage_differs: usize,
+    grazing: usize,
+    /// Our background against Mitsuba's image of the map alone.
+    background_psnr_db: f64,
+    background_relative_error: f64,
+    /// Mitsuba's renders at seeds 0 and 1, and their wall time, seconds (this process's).
+    mitsuba: [Mitsuba; 2],
+    mitsuba_s: f64,
+    /// The wall time of our images, seconds.
+    ours_s: f64,
+    /// Mitsuba's seed 1 against its seed 0.
+    floor: Figures,
+    /// Each of our images against Mitsuba's seed 0: its mode, the figures, its seconds.
+    ours: Vec<(&'static str, Figures, f64)>,
+}
+
+/// Everything the cases measured.
+struct Measurements {
+    cases: Vec<Measured>,
+    /// The BSDF's check against crate merl, once per material.
+    lookups: Vec<Lookup>,
+    /// What our modes' settings were, for the report's header (the same for every case's bake).
+    defaults: String,
+}
+
 fn main() {
     let options = options();
     let started = Instant::now();
-    // What the cases' settings were, for the report's header (the same for every case's bake).
-    let mut defaults_described = String::new();
-    let size = options.size;
     std::fs::create_dir_all(work()).expect("creating target/bench-mitsuba");
     let names: Vec<String> = MATERIALS
         .iter()
         .flat_map(|m| MAPS.iter().flat_map(move |e| VIEWS.iter().map(move |v| format!("{m} / {e} / {v}"))))
         .collect();
-    let wanted = |name: &str| options.cases.is_empty() || options.cases.iter().any(|c| name.contains(c.as_str()));
-    if !names.iter().any(|n| wanted(n)) {
+    if !names.iter().any(|n| options.wanted(n)) {
         panic!("--cases {:?} matches none of: {}", options.cases.join(","), names.join(", "));
     }
-    let Stamp { commit, host, cores } = Stamp::now();
+    let stamp = Stamp::now();
+    let measurements = measure(&options);
+    let wall_s = started.elapsed().as_secs_f64();
+    let report = report(&options, &stamp, &measurements, wall_s);
+    print!("{report}");
+    std::fs::write(work().join("report.md"), &report).expect("writing report.md");
+    let value = report_json(&options, &stamp, &measurements, wall_s);
+    std::fs::write(work().join("report.json"), serde_json::to_string_pretty(&value).expect("json"))
+        .expect("writing report.json");
+    eprintln!("report written to {}", work().join("report.md").display());
+}
 
-    let mut rows: Vec<Value> = Vec::new();
-    let mut checks: Vec<Value> = Vec::new();
-    let mut table = String::new();
-    let mut background_table = String::new();
-    let mut variant = String::new();
-    // (material, pairs, pairs whose values differ) of the BSDF's check against crate merl.
-    let mut checked: Vec<(&str, u64, u64)> = Vec::new();
-    for map_name in MAPS {
-        for material_name in MATERIALS {
-            if !VIEWS.iter().any(|v| wanted(&format!("{material_name} / {map_name} / {v}"))) {
+/// Every wanted case, bake by bake.
+fn measure(options: &Options) -> Measurements {
+    let mut measurements = Measurements { cases: Vec::new(), lookups: Vec::new(), defaults: String::new() };
+    for map in MAPS {
+        for material in MATERIALS {
+            if !VIEWS.iter().any(|v| options.wanted(&format!("{material} / {map} / {v}"))) {
                 continue;
             }
-            let start = Instant::now();
-            let loaded = bake(material_name, map_name);
-            let bake_s = start.elapsed().as_secs_f64();
-            let lighting = loaded.lighting.as_ref().expect("the bake has an environment");
-            let level0 = lighting.mips.level(0);
-            let preview = metrics::auto_tone_mapping(level0);
+            let baked = Baked::new(material, map);
+            measurements.defaults = defaults(&baked.loaded.material);
             for view in VIEWS {
-                let name = format!("{material_name} / {map_name} / {view}");
-                if !wanted(&name) {
-                    continue;
+                if options.wanted(&format!("{material} / {map} / {view}")) {
+                    let measured = measure_case(options, &baked, view, &mut measurements.lookups);
+                    measurements.cases.push(measured);
                 }
-                let (azimuth, elevation) = view_angles(level0, view);
-                let scene = scene(azimuth, elevation, size);
-                let dir = work().join(format!("{material_name}-{map_name}-{view}-{size}"));
-                let scene_file = export(&dir, &scene, level0, &table_path(material_name));
-                if !checked.iter().any(|(m, _, _)| *m == material_name) {
-                    let (pairs, differ) = check_lookup(&scene_file, &loaded.material.table, &options);
-                    checked.push((material_name, pairs, differ));
-                }
-
-                // The map's orientation and the camera: the background alone.
-                let back = mitsuba(&scene_file, size, 1, 0, true, &options);
-                let ours_back = background(&scene, level0);
-                let full = |rgb: Vec<f32>| Image { width: size, height: size, rgb, covered: vec![true; size * size] };
-                let (ours_back, their_back) = (full(ours_back), full(back.rgb));
-                let back_psnr =
-                    metrics::psnr_db(&metrics::tonemap(&ours_back, &preview), &metrics::tonemap(&their_back, &preview));
-                let back_relative = metrics::relative_error(&ours_back.rgb, &their_back.rgb);
-                let (a, b) = (metrics::tonemap(&ours_back, &preview), metrics::tonemap(&their_back, &preview));
-                let mut grid = Grid::new(3);
-                grid.title(format!("background, {map_name} / {view}: our renderer against Mitsuba's envmap"));
-                grid.add(panel(&a, size), "ours").add(panel(&b, size), "mitsuba");
-                grid.add(panel(&metrics::difference_rgb8(&a, &b), size), format!("|diff| x4, {back_psnr:.1} dB"));
-                save_png(&work().join(format!("background-{map_name}-{view}-{size}.png")), &grid.render());
-
-                // Mitsuba's two seeds.
-                let start = Instant::now();
-                let seeds = [0, 1].map(|seed| mitsuba(&scene_file, size, options.spp, seed, false, &options));
-                let mitsuba_s = start.elapsed().as_secs_f64();
-                variant = seeds[0].info["variant"].as_str().unwrap_or("?").to_string();
-
-                let start = Instant::now();
-                let bandwidths = loaded.bandwidths.as_ref().expect("the bake has an environment");
-                let images = ours(&scene, &loaded.material, lighting, bandwidths, options.converged);
-                defaults_described = Mode::ALL
-                    .iter()
-                    .map(|&mode| {
-                        let settings = Settings::previewer(mode, &loaded.material.samples, None, None, 0);
-                        format!("{} {} spp x {} frames", mode.name(), settings.spp, settings.frames)
-                    })
-                    .collect::<Vec<_>>()
-                    .join(", ")
-                    + &format!(
-                        ", adaptive and adaptive-prefiltered {} spp x {} frames (predict level 2, area allocation)",
-                        adaptive::SPP,
-                        adaptive::FRAMES
-                    );
-                let ours_s = start.elapsed().as_secs_f64();
-                for (mode, image, _) in &images {
-                    let planes: [Vec<f32>; 3] =
-                        std::array::from_fn(|c| image.rgb.iter().skip(c).step_by(3).copied().collect());
-                    let channels = [("R", &planes[0][..]), ("G", &planes[1][..]), ("B", &planes[2][..])];
-                    let exr =
-                        envmap::encode_exr(size, size, &channels, envmap::SampleType::F32).expect("encoding an exr");
-                    write(&dir.join(format!("ours-{mode}.exr")), &exr);
-                }
-                let (covered, grazing) = coverage(&scene);
-                let coverage_differs = covered.iter().zip(&seeds[0].covered).filter(|(a, b)| a != b).count();
-                let compared = Compared {
-                    picture: (0..size * size).map(|i| covered[i] == seeds[0].covered[i] && !grazing[i]).collect(),
-                    sphere: (0..size * size).map(|i| covered[i] && seeds[0].covered[i] && !grazing[i]).collect(),
-                };
-                let grazing = grazing.iter().filter(|g| **g).count();
-                let [m0, m1] = [0, 1].map(|i| Image {
-                    width: size,
-                    height: size,
-                    rgb: seeds[i].rgb.clone(),
-                    covered: covered.clone(),
-                });
-                let floor = compare(&m1, &m0, &compared, &preview);
-
-                writeln!(
-                    background_table,
-                    "| {name} | {:.1}, {:.1} | {coverage_differs} | {grazing} | {} | {back_relative:.2e} | {} | {ours_s:.0} |",
-                    azimuth.to_degrees(),
-                    elevation.to_degrees(),
-                    if back_psnr.is_finite() { format!("{back_psnr:.2}") } else { "identical".into() },
-                    // The script's own time (the renders, not the start-up), or where they were reused.
-                    match seeds.iter().map(|s| s.info["seconds"].as_f64()).sum::<Option<f64>>() {
-                        Some(t) if !seeds.iter().any(|s| s.cached) => format!("{t:.0}"),
-                        Some(t) => format!("{t:.0} (reused)"),
-                        None => "?".into(),
-                    },
-                )
-                .unwrap();
-                checks.push(json!({
-                    "case": name,
-                    "camera_deg": [azimuth.to_degrees(), elevation.to_degrees()],
-                    "coverage_differs": coverage_differs,
-                    "grazing_pixels_left_out": grazing,
-                    "background_psnr_db": db_json(back_psnr),
-                    "background_relative_error": back_relative,
-                }));
-
-                let picture_m0 = metrics::tonemap(&m0, &preview);
-                let mut grid = Grid::new(1 + images.len());
-                grid.title(format!(
-                    "{name}: Mitsuba ({} spp) and ours; below, |difference| x4 against Mitsuba's seed 0",
-                    options.spp
-                ));
-                grid.add(panel(&picture_m0, size), "mitsuba seed 0");
-                for (mode, image, _) in &images {
-                    grid.add(panel(&metrics::tonemap(image, &preview), size), *mode);
-                }
-                let picture_m1 = metrics::tonemap(&m1, &preview);
-                grid.add(
-                    panel(&metrics::difference_rgb8(&picture_m1, &picture_m0), size),
-                    format!("seed 1: {:.1} dB", floor.psnr_db),
-                );
-                let mut figures = Vec::new();
-                for (mode, image, seconds) in &images {
-                    let f = compare(image, &m0, &compared, &preview);
-                    let picture = metrics::tonemap(image, &preview);
-                    grid.add(
-                        panel(&metrics::difference_rgb8(&picture, &picture_m0), size),
-                        format!("{:.1} dB", f.psnr_db),
-                    );
-                    writeln!(
-                        table,
-                        "| {name} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} / {:.2} | {:.2} | {:.2} | {:.4} | {:.2} / {:.2} | {seconds:.1} |",
-                        f.psnr_db,
-                        f.psnr_sphere_db,
-                        f.luminance_ratio,
-                        f.channel_ratio[0],
-                        f.channel_ratio[1],
-                        f.channel_ratio[2],
-                        f.bias.p99,
-                        f.bias.max,
-                        floor.psnr_db,
-                        floor.psnr_sphere_db,
-                        floor.luminance_ratio,
-                        floor.bias.p99,
-                        floor.bias.max,
-                    )
-                    .unwrap();
-                    figures.push(json!({ "mode": mode, "seconds": seconds, "against_mitsuba": f.json() }));
-                }
-                save_png(&work().join(format!("{material_name}-{map_name}-{view}-{size}.png")), &grid.render());
-                eprintln!(
-                    "{name}: bake {bake_s:.1} s, Mitsuba {mitsuba_s:.1} s{}, ours {ours_s:.1} s",
-                    if seeds.iter().all(|s| s.cached) { " (reused)" } else { "" }
-                );
-                rows.push(json!({
-                    "case": name,
-                    "camera_deg": [azimuth.to_degrees(), elevation.to_degrees()],
-                    "mitsuba": seeds.iter().map(|s| json!({ "info": s.info, "reused": s.cached })).collect::<Vec<_>>(),
-                    "floor": floor.json(),
-                    "ours": figures,
-                    "seconds": { "mitsuba": mitsuba_s, "ours": ours_s },
-                }));
             }
         }
     }
+    measurements
+}
 
-    let wall_s = started.elapsed().as_secs_f64();
-    let mut report = String::new();
-    let mut out = |line: String| {
-        println!("{line}");
-        report.push_str(&line);
-        report.push('\n');
-    };
-    out("# Mitsuba 3 against the CPU renderer".into());
-    out(String::new());
-    out(format!(
-        "Commit {commit}, {host} ({cores} cores); Mitsuba {variant}, path integrator (max_depth 2), {} spp; ours: converged {} per \
-         strategy, each mode at brdf-preview's defaults (render::Settings::previewer: {}); {size} x {size}. Wall time {wall_s:.0} s.",
-        options.spp, options.converged, defaults_described
-    ));
-    out(String::new());
-    out("## The map's orientation and the camera".into());
-    out(String::new());
-    out(format!(
-        "Mitsuba's image of the map alone (1 spp through the pixel centres) against our renderer's background; pixels whose \
-         coverage differs between our rasterizer and Mitsuba's ray casts; pixels of the sphere seen at grazing angles (cos \
-         theta_o < {GRAZING_COS}). Both kinds are left out of the figures. The wall times of Mitsuba's two renders (as \
-         its script measured them) and of our six images."
-    ));
-    out(String::new());
-    out("| case | camera az, el (deg) | coverage differs | grazing pixels left out | background PSNR dB | background rel. error \
+/// Our modes' settings as [`ours`] renders them, in words.
+fn defaults(material: &Material) -> String {
+    Mode::ALL
+        .iter()
+        .map(|&mode| {
+            let settings = Settings::previewer(mode, &material.samples, None, None, 0);
+            format!("{} {} spp x {} frames", mode.name(), settings.spp, settings.frames)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+        + &format!(
+            ", adaptive and adaptive-prefiltered {} spp x {} frames (predict level 2, area allocation)",
+            adaptive::SPP,
+            adaptive::FRAMES
+        )
+}
+
+/// One case: its scene exported, the BSDF's check (once per material), the background's check,
+/// Mitsuba's two seeds and our images, compared; our images to CASE/ours-MODE.exr, the pictures
+/// to CASE.png.
+fn measure_case(options: &Options, baked: &Baked, view: &'static str, lookups: &mut Vec<Lookup>) -> Measured {
+    let (material, map, size) = (baked.material, baked.map, options.size);
+    let name = format!("{material} / {map} / {view}");
+    let (azimuth, elevation) = view_angles(baked.level0(), view);
+    let scene = scene(azimuth, elevation, size);
+    let dir = work().join(format!("{material}-{map}-{view}-{size}"));
+    let scene_file = export(&dir, &scene, baked.level0(), &table_path(material));
+    if !lookups.iter().any(|l| l.material == material) {
+        let (pairs, differ) = check_lookup(&scene_file, &baked.loaded.material.table, options);
+        lookups.push(Lookup { material, pairs, differ });
+    }
+    let (background_psnr_db, background_relative_error) = background_check(options, baked, view, &scene, &scene_file);
+
+    let start = Instant::now();
+    let seeds = [0, 1].map(|seed| mitsuba(&scene_file, size, options.spp, seed, false, options));
+    let mitsuba_s = start.elapsed().as_secs_f64();
+
+    let start = Instant::now();
+    let bandwidths = baked.loaded.bandwidths.as_ref().expect("the bake has an environment");
+    let images = ours(&scene, &baked.loaded.material, baked.lighting(), bandwidths, options.converged);
+    let ours_s = start.elapsed().as_secs_f64();
+    write_exrs(&dir, &images, size);
+
+    let compared = Compared::new(&scene, &seeds[0].covered);
+    let [m0, m1] = [0, 1].map(|i| Image {
+        width: size,
+        height: size,
+        rgb: seeds[i].rgb.clone(),
+        covered: compared.covered.clone(),
+    });
+    let floor = compare(&m1, &m0, &compared, &baked.preview);
+    let ours: Vec<(&'static str, Figures, f64)> = (images.iter())
+        .map(|(mode, image, seconds)| (*mode, compare(image, &m0, &compared, &baked.preview), *seconds))
+        .collect();
+    let grid = case_grid(&name, options.spp, [&m0, &m1], &images, floor, &ours, &baked.preview);
+    save_png(&work().join(format!("{material}-{map}-{view}-{size}.png")), &grid.render());
+    eprintln!(
+        "{name}: bake {:.1} s, Mitsuba {mitsuba_s:.1} s{}, ours {ours_s:.1} s",
+        baked.seconds,
+        if seeds.iter().all(|s| s.cached) { " (reused)" } else { "" }
+    );
+    Measured {
+        name,
+        azimuth,
+        elevation,
+        coverage_differs: compared.coverage_differs,
+        grazing: compared.grazing,
+        background_psnr_db,
+        background_relative_error,
+        mitsuba: seeds,
+        mitsuba_s,
+        ours_s,
+        floor,
+        ours,
+    }
+}
+
+/// The map's orientation and the camera: Mitsuba's image of the map alone against our renderer's
+/// background, as PSNR and relative error; the pictures to background-MAP-VIEW-SIZE.png.
+fn background_check(options: &Options, baked: &Baked, view: &str, scene: &Scene, scene_file: &Path) -> (f64, f64) {
+    let size = options.size;
+    let back = mitsuba(scene_file, size, 1, 0, true, options);
+    let ours_back = background(scene, baked.level0());
+    let full = |rgb: Vec<f32>| Image { width: size, height: size, rgb, covered: vec![true; size * size] };
+    let (ours_back, their_back) = (full(ours_back), full(back.rgb));
+    let (a, b) = (metrics::tonemap(&ours_back, &baked.preview), metrics::tonemap(&their_back, &baked.preview));
+    let psnr = metrics::psnr_db(&a, &b);
+    let relative = metrics::relative_error(&ours_back.rgb, &their_back.rgb);
+    let mut grid = Grid::new(3);
+    grid.title(format!("background, {} / {view}: our renderer against Mitsuba's envmap", baked.map));
+    grid.add(panel(&a, size), "ours").add(panel(&b, size), "mitsuba");
+    grid.add(panel(&metrics::difference_rgb8(&a, &b), size), format!("|diff| x4, {psnr:.1} dB"));
+    save_png(&work().join(format!("background-{}-{view}-{size}.png", baked.map)), &grid.render());
+    (psnr, relative)
+}
+
+/// Our images as EXR beside the case's scene: DIR/ours-MODE.exr.
+fn write_exrs(dir: &Path, images: &[(&str, Image, f64)], size: usize) {
+    for (mode, image, _) in images {
+        let planes: [Vec<f32>; 3] = std::array::from_fn(|c| image.rgb.iter().skip(c).step_by(3).copied().collect());
+        let channels = [("R", &planes[0][..]), ("G", &planes[1][..]), ("B", &planes[2][..])];
+        let exr = envmap::encode_exr(size, size, &channels, envmap::SampleType::F32).expect("encoding an exr");
+        write(&dir.join(format!("ours-{mode}.exr")), &exr);
+    }
+}
+
+/// A case's pictures: Mitsuba's seed 0 and ours; below, each one's difference (x4) from seed 0,
+/// seed 1's first, captioned with its PSNR (`floor`, `ours`).
+fn case_grid(
+    name: &str,
+    spp: u32,
+    [m0, m1]: [&Image; 2],
+    images: &[(&str, Image, f64)],
+    floor: Figures,
+    ours: &[(&str, Figures, f64)],
+    preview: &envmap::ToneMapping,
+) -> Grid {
+    let size = m0.width;
+    let picture_m0 = metrics::tonemap(m0, preview);
+    let mut grid = Grid::new(1 + images.len());
+    grid.title(format!("{name}: Mitsuba ({spp} spp) and ours; below, |difference| x4 against Mitsuba's seed 0"));
+    grid.add(panel(&picture_m0, size), "mitsuba seed 0");
+    for (mode, image, _) in images {
+        grid.add(panel(&metrics::tonemap(image, preview), size), *mode);
+    }
+    let picture_m1 = metrics::tonemap(m1, preview);
+    grid.add(
+        panel(&metrics::difference_rgb8(&picture_m1, &picture_m0), size),
+        format!("seed 1: {:.1} dB", floor.psnr_db),
+    );
+    for ((_, image, _), (_, f, _)) in images.iter().zip(ours) {
+        let picture = metrics::tonemap(image, preview);
+        grid.add(panel(&metrics::difference_rgb8(&picture, &picture_m0), size), format!("{:.1} dB", f.psnr_db));
+    }
+    grid
+}
+
+/// The report (markdown): the header and the three tables.
+fn report(options: &Options, stamp: &Stamp, measurements: &Measurements, wall_s: f64) -> String {
+    let Stamp { commit, host, cores } = stamp;
+    let size = options.size;
+    let variant = (measurements.cases.last()).map_or("", |c| c.mitsuba[0].info["variant"].as_str().unwrap_or("?"));
+    let mut lines = vec![
+        "# Mitsuba 3 against the CPU renderer".to_string(),
+        String::new(),
+        format!(
+            "Commit {commit}, {host} ({cores} cores); Mitsuba {variant}, path integrator (max_depth 2), {} spp; ours: converged {} per \
+             strategy, each mode at brdf-preview's defaults (render::Settings::previewer: {}); {size} x {size}. Wall time {wall_s:.0} s.",
+            options.spp, options.converged, measurements.defaults
+        ),
+        String::new(),
+    ];
+    lines.extend(background_table(&measurements.cases));
+    lines.push(String::new());
+    lines.extend(lookup_table(&measurements.lookups));
+    lines.push(String::new());
+    lines.extend(mitsuba_table(&measurements.cases));
+    lines.iter().map(|l| format!("{l}\n")).collect()
+}
+
+/// Per case, the background's check and the pixels left out.
+fn background_table(cases: &[Measured]) -> Vec<String> {
+    let mut lines = vec![
+        "## The map's orientation and the camera".to_string(),
+        String::new(),
+        format!(
+            "Mitsuba's image of the map alone (1 spp through the pixel centres) against our renderer's background; pixels whose \
+             coverage differs between our rasterizer and Mitsuba's ray casts; pixels of the sphere seen at grazing angles (cos \
+             theta_o < {GRAZING_COS}). Both kinds are left out of the figures. The wall times of Mitsuba's two renders (as \
+             its script measured them) and of our six images."
+        ),
+        String::new(),
+        "| case | camera az, el (deg) | coverage differs | grazing pixels left out | background PSNR dB | background rel. error \
          | Mitsuba s (2 seeds) | ours s (6 images) |"
-        .into());
-    out("|---|---|---:|---:|---:|---:|---:|---:|".into());
-    out(background_table.trim_end().to_string());
-    out(String::new());
-    out("## The Python BSDF against crate merl's nearest lookup".into());
-    out(String::new());
-    out("Direction pairs (half of them within a degree of the mirror configuration, all rounded to f32) where the BSDF's \
+            .to_string(),
+        "|---|---|---:|---:|---:|---:|---:|---:|".to_string(),
+    ];
+    for c in cases {
+        let psnr = c.background_psnr_db;
+        // The script's own time (the renders, not the start-up), or where they were reused.
+        let mitsuba_s = match c.mitsuba.iter().map(|s| s.info["seconds"].as_f64()).sum::<Option<f64>>() {
+            Some(t) if !c.mitsuba.iter().any(|s| s.cached) => format!("{t:.0}"),
+            Some(t) => format!("{t:.0} (reused)"),
+            None => "?".into(),
+        };
+        lines.push(format!(
+            "| {} | {:.1}, {:.1} | {} | {} | {} | {:.2e} | {mitsuba_s} | {:.0} |",
+            c.name,
+            c.azimuth.to_degrees(),
+            c.elevation.to_degrees(),
+            c.coverage_differs,
+            c.grazing,
+            if psnr.is_finite() { format!("{psnr:.2}") } else { "identical".into() },
+            c.background_relative_error,
+            c.ours_s,
+        ));
+    }
+    lines
+}
+
+/// Per material, the Python BSDF against crate merl's lookup.
+fn lookup_table(lookups: &[Lookup]) -> Vec<String> {
+    let mut lines = vec![
+        "## The Python BSDF against crate merl's nearest lookup".to_string(),
+        String::new(),
+        "Direction pairs (half of them within a degree of the mirror configuration, all rounded to f32) where the BSDF's \
          value differs from crate merl's by more than 1e-3 in a channel: a different cell, which only rounding at a cell's edge \
          should cause."
-        .into());
-    out(String::new());
-    out("| material | pairs | differing |".into());
-    out("|---|---:|---:|".into());
-    for (material, pairs, differ) in &checked {
-        out(format!("| {material} | {pairs} | {differ} |"));
-    }
-    out(String::new());
-    out("## Against Mitsuba's seed 0".into());
-    out(String::new());
-    out("PSNR on the 8-bit pictures (the whole picture, and the sphere alone, less the pixels left out); mean luminance and \
+            .to_string(),
+        String::new(),
+        "| material | pairs | differing |".to_string(),
+        "|---|---:|---:|".to_string(),
+    ];
+    lines.extend(lookups.iter().map(|l| format!("| {} | {} | {} |", l.material, l.pairs, l.differ)));
+    lines
+}
+
+/// Per case and mode, our image against Mitsuba's seed 0, beside the floor.
+fn mitsuba_table(cases: &[Measured]) -> Vec<String> {
+    let mut lines = vec![
+        "## Against Mitsuba's seed 0".to_string(),
+        String::new(),
+        "PSNR on the 8-bit pictures (the whole picture, and the sphere alone, less the pixels left out); mean luminance and \
          per-channel means of the sphere's, ours over Mitsuba's; the floor is Mitsuba's seed 1 against its seed 0, the same \
          figures (an image without error scores about 3 dB above its PSNR; its luminance ratio is how far Mitsuba's own mean \
          can be trusted: a light reflected in chrome is a few pixels hundreds of times brighter than the rest, and carries the \
          mean). The 7x7 bias: the signed difference of the 8-bit pictures averaged over each sphere pixel's 7 x 7 window \
          (the sphere's pixels only), its 99th percentile and largest magnitude, in levels: structure, with the noise \
          averaged out."
-        .into());
-    out(String::new());
-    out("| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | 7x7 bias p99 / max | floor dB | floor sphere dB \
+            .to_string(),
+        String::new(),
+        "| case | mode | PSNR dB | sphere dB | luminance ratio | R G B ratio | 7x7 bias p99 / max | floor dB | floor sphere dB \
          | floor luminance | floor 7x7 bias p99 / max | ours s |"
-        .into());
-    out("|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|".into());
-    out(table.trim_end().to_string());
-    std::fs::write(work().join("report.md"), &report).expect("writing report.md");
-    let value = json!({
-        "commit": commit,
-        "machine": { "host": host, "cores": cores },
-        "size": size,
+            .to_string(),
+        "|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|".to_string(),
+    ];
+    for c in cases {
+        let floor = &c.floor;
+        for (mode, f, seconds) in &c.ours {
+            lines.push(format!(
+                "| {} | {mode} | {:.2} | {:.2} | {:.4} | {:.3} {:.3} {:.3} | {:.2} / {:.2} | {:.2} | {:.2} | {:.4} | {:.2} / {:.2} | {seconds:.1} |",
+                c.name,
+                f.psnr_db,
+                f.psnr_sphere_db,
+                f.luminance_ratio,
+                f.channel_ratio[0],
+                f.channel_ratio[1],
+                f.channel_ratio[2],
+                f.bias.p99,
+                f.bias.max,
+                floor.psnr_db,
+                floor.psnr_sphere_db,
+                floor.luminance_ratio,
+                floor.bias.p99,
+                floor.bias.max,
+            ));
+        }
+    }
+    lines
+}
+
+/// report.json: what the report shows, with the figures at full precision and what Mitsuba's
+/// script said.
+fn report_json(options: &Options, stamp: &Stamp, measurements: &Measurements, wall_s: f64) -> Value {
+    let camera_deg = |c: &Measured| [c.azimuth.to_degrees(), c.elevation.to_degrees()];
+    let checks: Vec<Value> = (measurements.cases.iter())
+        .map(|c| {
+            json!({
+                "case": c.name,
+                "camera_deg": camera_deg(c),
+                "coverage_differs": c.coverage_differs,
+                "grazing_pixels_left_out": c.grazing,
+                "background_psnr_db": db_json(c.background_psnr_db),
+                "background_relative_error": c.background_relative_error,
+            })
+        })
+        .collect();
+    let cases: Vec<Value> = (measurements.cases.iter())
+        .map(|c| {
+            let ours: Vec<Value> = (c.ours.iter())
+                .map(|(mode, f, seconds)| json!({ "mode": mode, "seconds": seconds, "against_mitsuba": f.json() }))
+                .collect();
+            json!({
+                "case": c.name,
+                "camera_deg": camera_deg(c),
+                "mitsuba": c.mitsuba.iter().map(|s| json!({ "info": s.info, "reused": s.cached })).collect::<Vec<_>>(),
+                "floor": c.floor.json(),
+                "ours": ours,
+                "seconds": { "mitsuba": c.mitsuba_s, "ours": c.ours_s },
+            })
+        })
+        .collect();
+    let lookup: Vec<Value> = (measurements.lookups.iter())
+        .map(|l| json!({ "material": l.material, "pairs": l.pairs, "differ": l.differ }))
+        .collect();
+    json!({
+        "commit": stamp.commit,
+        "machine": { "host": stamp.host, "cores": stamp.cores },
+        "size": options.size,
         "mitsuba_spp": options.spp,
         "converged_samples_per_strategy": options.converged,
         "wall_seconds": wall_s,
         "checks": checks,
-        "lookup": checked.iter().map(|(m, p, d)| json!({ "material": m, "pairs": p, "differ": d })).collect::<Vec<_>>(),
-        "cases": rows,
-    });
-    std::fs::write(work().join("report.json"), serde_json::to_string_pretty(&value).expect("json"))
-        .expect("writing report.json");
-    eprintln!("report written to {}", work().join("report.md").display());
+        "lookup": lookup,
+        "cases": cases,
+    })
 }
