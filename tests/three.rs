@@ -79,7 +79,7 @@ const ENGINE_TEXTURES: [&str; 6] = [
     "engine-layers.ktx2",
 ];
 
-fn read_data(path: &Path) -> prefilter::ktx::DecodedData {
+fn read_data(path: &Path) -> prefilter::ktx::Ktx2Data {
     prefilter::ktx::decode_data(&std::fs::read(path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 

@@ -246,9 +246,10 @@ pub fn view_coordinates(view_bandwidth: &[f64], layer_bandwidth: &[f64]) -> Vec<
         .collect()
 }
 
-/// Which Phong layer serves each view elevation of a material.
+/// Which Phong layer serves each view elevation of a material (the `bake` stage
+/// `layer_selection` writes it as the asset `layer-selection`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct LayerSelection {
+pub struct ViewLayers {
     pub reduction: ViewReduction,
     pub exponents: Vec<u32>,
     /// Each layer's measured bandwidth ([`layer_bandwidth`]), cycles per radian.
@@ -260,7 +261,7 @@ pub struct LayerSelection {
     pub view_layer: Vec<u32>,
 }
 
-impl LayerSelection {
+impl ViewLayers {
     /// How many rows select each layer.
     pub fn histogram(&self) -> Vec<usize> {
         let mut counts = vec![0; self.exponents.len()];
@@ -279,7 +280,7 @@ pub fn select_layers(
     config: &Config,
     exponents: &[u32],
     reduction: ViewReduction,
-) -> Result<LayerSelection, Error> {
+) -> Result<ViewLayers, Error> {
     config.check()?;
     let atlas = &build.atlas;
     if (atlas.lobes_y, atlas.tile, atlas.analysis_size) != (config.lobes, config.tile, config.analysis_size) {
@@ -301,7 +302,7 @@ pub fn select_layers(
         .map(|j| reduction.reduce(&atlas.tile_of(atlas.lobe_index(0, j)), &build.band_energy[j], config))
         .collect();
     let view_layer = view_bandwidth.iter().map(|&nu| nearest_layer(nu, &layer_bandwidth) as u32).collect();
-    Ok(LayerSelection { reduction, exponents: exponents.to_vec(), layer_bandwidth, view_bandwidth, view_layer })
+    Ok(ViewLayers { reduction, exponents: exponents.to_vec(), layer_bandwidth, view_bandwidth, view_layer })
 }
 
 /// Convenience for tests and tools that have only the table: builds the atlas and selects.
@@ -310,7 +311,7 @@ pub fn select_layers_of_table(
     config: &Config,
     exponents: &[u32],
     reduction: ViewReduction,
-) -> Result<LayerSelection, Error> {
+) -> Result<ViewLayers, Error> {
     let build = crate::build_atlas(table, config, &|_| {})?;
     select_layers(&build, config, exponents, reduction)
 }

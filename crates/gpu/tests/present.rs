@@ -10,7 +10,7 @@ use envmap::{EnvMap, MipChain, ToneMap, ToneMapping};
 use gpu::preview::{Presenter, Renderer, View};
 use merl::Dims;
 use merl::analytic::Analytic;
-use render::{Camera, Image, Lighting, Material, Mesh, Mode, SampleSet, Scene, Settings};
+use render::{Camera, Estimator, Image, Lighting, Material, Mesh, SampleSet, Scene, Settings};
 
 use crate::support::{gpu, log};
 
@@ -60,7 +60,7 @@ fn renderer() -> Renderer {
 }
 
 fn settings(frames: u32) -> Settings {
-    Settings { mode: Mode::Reference, spp: 16, frames, seed: 3 }
+    Settings { estimator: Estimator::Reference, spp: 16, frames, seed: 3 }
 }
 
 fn bits(image: &Image) -> Vec<u32> {

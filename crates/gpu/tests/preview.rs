@@ -16,7 +16,7 @@ use gpu::{Gpu, GpuError};
 use merl::Dims;
 use merl::analytic::Analytic;
 use render::metrics::{psnr_db, relative_error, tonemap};
-use render::{Camera, Image, Lighting, Material, Mesh, Mode, SampleSet, Scene, Settings};
+use render::{Camera, Estimator, Image, Lighting, Material, Mesh, SampleSet, Scene, Settings};
 
 use crate::fixtures::bandwidths;
 use crate::support::{gl_gpu, gpu, log};
@@ -113,8 +113,8 @@ fn sphere_scene(size: usize) -> Scene {
     Scene { mesh: Mesh::sphere(1.0, 48, 24), camera: Camera::default(), width: size, height: size }
 }
 
-fn settings(mode: Mode) -> Settings {
-    Settings { mode, spp: 16, frames: 2, seed: 7 }
+fn settings(mode: Estimator) -> Settings {
+    Settings { estimator: mode, spp: 16, frames: 2, seed: 7 }
 }
 
 fn renderer(scene: &Scene, material: &Material, lighting: &Lighting) -> Renderer {
@@ -165,12 +165,12 @@ fn coverage_mismatches(a: &[bool], b: &[bool], width: usize) -> Vec<(usize, usiz
 }
 
 /// One GPU render against the CPU's with the same inputs.
-fn check_against_cpu(name: &str, material: &Material, mode: Mode) {
+fn check_against_cpu(name: &str, material: &Material, mode: Estimator) {
     check_against_cpu_on(gpu(), name, material, mode);
 }
 
 /// [`check_against_cpu`] on the device `on`.
-fn check_against_cpu_on(on: &Gpu, name: &str, material: &Material, mode: Mode) {
+fn check_against_cpu_on(on: &Gpu, name: &str, material: &Material, mode: Estimator) {
     let scene = sphere_scene(SIZE);
     let lighting = sky_lighting();
     let settings = settings(mode);
@@ -199,47 +199,47 @@ fn check_against_cpu_on(on: &Gpu, name: &str, material: &Material, mode: Mode) {
 
 #[test]
 fn lambertian_reference_matches_the_cpu() {
-    check_against_cpu("lambertian", lambertian(), Mode::Reference);
+    check_against_cpu("lambertian", lambertian(), Estimator::Reference);
 }
 
 #[test]
 fn lambertian_fis_matches_the_cpu() {
-    check_against_cpu("lambertian", lambertian(), Mode::Fis);
+    check_against_cpu("lambertian", lambertian(), Estimator::Fis);
 }
 
 #[test]
 fn lambertian_prefiltered_matches_the_cpu() {
-    check_against_cpu("lambertian", lambertian(), Mode::Prefiltered);
+    check_against_cpu("lambertian", lambertian(), Estimator::Prefiltered);
 }
 
 #[test]
 fn phong_reference_matches_the_cpu() {
-    check_against_cpu("phong", phong(), Mode::Reference);
+    check_against_cpu("phong", phong(), Estimator::Reference);
 }
 
 #[test]
 fn phong_fis_matches_the_cpu() {
-    check_against_cpu("phong", phong(), Mode::Fis);
+    check_against_cpu("phong", phong(), Estimator::Fis);
 }
 
 #[test]
 fn phong_prefiltered_matches_the_cpu() {
-    check_against_cpu("phong", phong(), Mode::Prefiltered);
+    check_against_cpu("phong", phong(), Estimator::Prefiltered);
 }
 
 #[test]
 fn ggx_reference_matches_the_cpu() {
-    check_against_cpu("ggx", ggx(), Mode::Reference);
+    check_against_cpu("ggx", ggx(), Estimator::Reference);
 }
 
 #[test]
 fn ggx_fis_matches_the_cpu() {
-    check_against_cpu("ggx", ggx(), Mode::Fis);
+    check_against_cpu("ggx", ggx(), Estimator::Fis);
 }
 
 #[test]
 fn ggx_prefiltered_matches_the_cpu() {
-    check_against_cpu("ggx", ggx(), Mode::Prefiltered);
+    check_against_cpu("ggx", ggx(), Estimator::Prefiltered);
 }
 
 /// The GGX material with its BRDF read from a Haar wavelet encoding of its table (16 x 16 grid,
@@ -254,25 +254,25 @@ fn ggx_wavelet() -> &'static Material {
         let config = wavelet_brdf::Config { keep: wavelet_brdf::Keep::Ratio(4), quantize: true, ..Default::default() };
         let encoded = wavelet_brdf::encode(&resampled, config).expect("a valid config");
         let brdf = wavelet_brdf::Decoded::from_payload(&encoded.payload).expect("a valid payload");
-        Material { wavelet_brdf: Some(render::WaveletBrdf { brdf, lod: 0.5 }), ..material.clone() }
+        Material { wavelet_brdf: Some(render::WaveletBrdfLod { brdf, lod: 0.5 }), ..material.clone() }
     })
 }
 
 #[test]
 fn wavelet_reference_matches_the_cpu() {
-    check_against_cpu("ggx-wavelet", ggx_wavelet(), Mode::Reference);
+    check_against_cpu("ggx-wavelet", ggx_wavelet(), Estimator::Reference);
 }
 
 #[test]
 fn wavelet_prefiltered_matches_the_cpu() {
-    check_against_cpu("ggx-wavelet", ggx_wavelet(), Mode::Prefiltered);
+    check_against_cpu("ggx-wavelet", ggx_wavelet(), Estimator::Prefiltered);
 }
 
 /// The wavelet render is not the table's: the comparison sees the encoding's error.
 #[test]
 fn a_wavelet_render_differs_from_the_table_render() {
     let scene = sphere_scene(SIZE);
-    let settings = settings(Mode::Reference);
+    let settings = settings(Estimator::Reference);
     let wavelet = render_gpu(&mut renderer(&scene, ggx_wavelet(), sky_lighting()), &settings);
     let table = render_cpu(&scene, ggx(), sky_lighting(), &settings);
     let (psnr, relative) = compare(&wavelet, &table);
@@ -287,7 +287,7 @@ fn a_wavelet_render_differs_from_the_table_render() {
 #[test]
 fn a_render_with_another_seed_fails_the_comparison() {
     let scene = sphere_scene(SIZE);
-    let settings = Settings { spp: 4, frames: 1, ..settings(Mode::Reference) };
+    let settings = Settings { spp: 4, frames: 1, ..settings(Estimator::Reference) };
     let gpu =
         render_gpu(&mut renderer(&scene, ggx(), sky_lighting()), &Settings { seed: settings.seed + 1, ..settings });
     let cpu = render_cpu(&scene, ggx(), sky_lighting(), &settings);
@@ -302,8 +302,8 @@ fn a_render_with_another_seed_fails_the_comparison() {
 #[test]
 fn a_render_in_another_mode_fails_the_comparison() {
     let scene = sphere_scene(SIZE);
-    let gpu = render_gpu(&mut renderer(&scene, ggx(), sky_lighting()), &settings(Mode::Fis));
-    let cpu = render_cpu(&scene, ggx(), sky_lighting(), &settings(Mode::Reference));
+    let gpu = render_gpu(&mut renderer(&scene, ggx(), sky_lighting()), &settings(Estimator::Fis));
+    let cpu = render_cpu(&scene, ggx(), sky_lighting(), &settings(Estimator::Reference));
     let (psnr, relative) = compare(&gpu, &cpu);
     log(&format!("ggx fis against reference: psnr {psnr:.1} dB, relative error {relative:.2e}"));
     assert!(
@@ -318,7 +318,7 @@ fn a_render_in_another_mode_fails_the_comparison() {
 fn moving_the_camera_is_setting_up_with_that_camera() {
     let scene = sphere_scene(SIZE);
     let camera = Camera::orbit(glam::Vec3::ZERO, 2.5, 1.0, 0.4, 50f32.to_radians()).expect("a valid camera");
-    let settings = settings(Mode::Prefiltered);
+    let settings = settings(Estimator::Prefiltered);
     let mut moved = renderer(&scene, phong(), sky_lighting());
     let before = render_gpu(&mut moved, &settings);
     moved.set_camera(&camera).expect("moving the camera");
@@ -329,7 +329,8 @@ fn moving_the_camera_is_setting_up_with_that_camera() {
     assert!(after != before, "the camera did not move");
 
     // The adaptive frames' G-buffer, made once per camera, is made again for the new one.
-    let adaptive = render::adaptive::Settings { max_spp: 64, ..render::adaptive::Settings::new(Mode::Reference, 4) };
+    let adaptive =
+        render::adaptive::Settings { max_spp: 64, ..render::adaptive::Settings::new(Estimator::Reference, 4) };
     let frame = |r: &mut Renderer| {
         r.set_bandwidths(&bandwidths()).unwrap();
         r.render_adaptive(phong(), sky_lighting(), &adaptive, details()).unwrap()
@@ -350,7 +351,7 @@ fn moving_the_camera_is_setting_up_with_that_camera() {
 fn renders_are_deterministic() {
     let scene = sphere_scene(SIZE);
     let mut renderer = renderer(&scene, ggx(), sky_lighting());
-    let settings = Settings { frames: 3, ..settings(Mode::Fis) };
+    let settings = Settings { frames: 3, ..settings(Estimator::Fis) };
     let first = render_gpu(&mut renderer, &settings);
     let second = render_gpu(&mut renderer, &settings);
     let third = render_gpu(&mut self::renderer(&scene, ggx(), sky_lighting()), &settings);
@@ -462,8 +463,8 @@ fn a_lambertian_sphere_under_a_constant_sky_reflects_its_albedo() {
     let scene = sphere_scene(SIZE);
     let mut renderer = renderer(&scene, lambertian(), &lighting);
     let albedo = [0.5, 0.4, 0.3];
-    for mode in Mode::ALL {
-        let image = render_gpu(&mut renderer, &Settings { mode, spp: 64, frames: 16, seed: 3 });
+    for mode in Estimator::ALL {
+        let image = render_gpu(&mut renderer, &Settings { estimator: mode, spp: 64, frames: 16, seed: 3 });
         let (mut worst, mut sum, mut shaded) = (0.0f64, 0.0f64, 0usize);
         for (rgb, covered) in image.rgb.chunks_exact(3).zip(&image.covered) {
             // Silhouette pixels whose interpolated normal faces away are black by the rules.
@@ -515,7 +516,7 @@ fn the_background_shows_the_sky_up_and_the_camera_orientation() {
     let lighting = Lighting::new(MipChain::new(&map), vec![], vec![]).expect("a valid map");
     // A small sphere, so that the corners show the background.
     let scene = Scene { mesh: Mesh::sphere(0.3, 16, 8), camera: Camera::default(), width: 32, height: 32 };
-    let image = render_gpu(&mut renderer(&scene, lambertian(), &lighting), &settings(Mode::Reference));
+    let image = render_gpu(&mut renderer(&scene, lambertian(), &lighting), &settings(Estimator::Reference));
     let pixel = |x: usize, y: usize| {
         let i = 3 * (y * scene.width + x);
         [image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]]
@@ -533,10 +534,10 @@ fn inconsistent_settings_are_rejected_like_the_cpu_rejects_them() {
     let no_layers = Lighting { layers: vec![], exponents: vec![], ..sky_lighting().clone() };
     let mut renderer = renderer(&scene, lambertian(), &no_layers);
     let cases = [
-        Settings { spp: 3, ..settings(Mode::Reference) },
-        Settings { spp: 128, ..settings(Mode::Reference) },
-        Settings { frames: 0, ..settings(Mode::Fis) },
-        settings(Mode::Prefiltered),
+        Settings { spp: 3, ..settings(Estimator::Reference) },
+        Settings { spp: 128, ..settings(Estimator::Reference) },
+        Settings { frames: 0, ..settings(Estimator::Fis) },
+        settings(Estimator::Prefiltered),
     ];
     for case in cases {
         let cpu = render::render(&scene, lambertian(), &no_layers, &case).expect_err("the cpu rejects it");
@@ -562,9 +563,12 @@ fn inconsistent_settings_are_rejected_like_the_cpu_rejects_them() {
 fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
     let (material, lighting, bandwidths) = (phong(), sky_lighting(), bandwidths());
     let scene = sphere_scene(SIZE);
-    for (mode, supersample, predict_level) in
-        [(Mode::Reference, 1, 0), (Mode::Prefiltered, 1, 0), (Mode::Reference, 2, 1), (Mode::Reference, 1, 2)]
-    {
+    for (mode, supersample, predict_level) in [
+        (Estimator::Reference, 1, 0),
+        (Estimator::Prefiltered, 1, 0),
+        (Estimator::Reference, 2, 1),
+        (Estimator::Reference, 1, 2),
+    ] {
         let settings = render::adaptive::Settings {
             supersample,
             predict_level,
@@ -606,7 +610,7 @@ fn adaptive_predictions_on_the_gpu_equal_the_cpu() {
 struct AdaptiveCase {
     /// The sphere filling the image rather than the default view.
     filled: bool,
-    mode: Mode,
+    mode: Estimator,
     supersample: usize,
     spp: u32,
     lobe_weight: bool,
@@ -621,7 +625,7 @@ struct AdaptiveCase {
 const ONE_VECTOR: u32 = 64;
 
 impl AdaptiveCase {
-    fn new(mode: Mode, spp: u32) -> AdaptiveCase {
+    fn new(mode: Estimator, spp: u32) -> AdaptiveCase {
         AdaptiveCase {
             filled: false,
             mode,
@@ -753,57 +757,57 @@ fn check_adaptive_frame_on(on: &Gpu, case: AdaptiveCase) {
 /// search for a parent already counted must not take its unwritten slots for block 0).
 #[test]
 fn adaptive_reference_frame_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase::new(Mode::Reference, 8));
+    check_adaptive_frame(AdaptiveCase::new(Estimator::Reference, 8));
 }
 
 #[test]
 fn adaptive_prefiltered_frame_equals_the_cpu() {
     // One frame of 8 averaged: the blocks' footprints are sized for 8 times their samples.
-    check_adaptive_frame(AdaptiveCase { frames: 8, ..AdaptiveCase::new(Mode::Prefiltered, 4) });
+    check_adaptive_frame(AdaptiveCase { frames: 8, ..AdaptiveCase::new(Estimator::Prefiltered, 4) });
 }
 
 #[test]
 fn adaptive_anti_aliased_frame_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase { supersample: 2, ..AdaptiveCase::new(Mode::Reference, 4) });
+    check_adaptive_frame(AdaptiveCase { supersample: 2, ..AdaptiveCase::new(Estimator::Reference, 4) });
 }
 
 #[test]
 fn adaptive_frame_with_the_lobe_weight_and_the_variance_allocation_equals_the_cpu() {
     let allocation = render::adaptive::Allocation::Variance;
-    check_adaptive_frame(AdaptiveCase { lobe_weight: true, allocation, ..AdaptiveCase::new(Mode::Reference, 8) });
+    check_adaptive_frame(AdaptiveCase { lobe_weight: true, allocation, ..AdaptiveCase::new(Estimator::Reference, 8) });
 }
 
 #[test]
 fn adaptive_frame_with_the_oracle_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase { oracle: true, ..AdaptiveCase::new(Mode::Reference, 8) });
+    check_adaptive_frame(AdaptiveCase { oracle: true, ..AdaptiveCase::new(Estimator::Reference, 8) });
 }
 
 #[test]
 fn adaptive_frame_of_a_large_budget_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase::new(Mode::Reference, 64));
+    check_adaptive_frame(AdaptiveCase::new(Estimator::Reference, 64));
 }
 
 #[test]
 fn adaptive_prefiltered_frame_with_the_std_dev_allocation_equals_the_cpu() {
     let allocation = render::adaptive::Allocation::StdDev;
-    check_adaptive_frame(AdaptiveCase { allocation, ..AdaptiveCase::new(Mode::Prefiltered, 4) });
+    check_adaptive_frame(AdaptiveCase { allocation, ..AdaptiveCase::new(Estimator::Prefiltered, 4) });
 }
 
 #[test]
 fn adaptive_frame_of_blocks_across_vectors_equals_the_cpu() {
     let max_spp = render::adaptive::MAX_SPP;
-    check_adaptive_frame(AdaptiveCase { max_spp, ..AdaptiveCase::new(Mode::Reference, 256) });
+    check_adaptive_frame(AdaptiveCase { max_spp, ..AdaptiveCase::new(Estimator::Reference, 256) });
 }
 
 #[test]
 fn adaptive_prefiltered_frame_of_blocks_across_vectors_equals_the_cpu() {
     let (allocation, max_spp) = (render::adaptive::Allocation::StdDev, render::adaptive::MAX_SPP);
-    check_adaptive_frame(AdaptiveCase { allocation, max_spp, ..AdaptiveCase::new(Mode::Prefiltered, 32) });
+    check_adaptive_frame(AdaptiveCase { allocation, max_spp, ..AdaptiveCase::new(Estimator::Prefiltered, 32) });
 }
 
 #[test]
 fn adaptive_frame_filling_the_image_equals_the_cpu() {
-    check_adaptive_frame(AdaptiveCase { filled: true, oracle: true, ..AdaptiveCase::new(Mode::Reference, 8) });
+    check_adaptive_frame(AdaptiveCase { filled: true, oracle: true, ..AdaptiveCase::new(Estimator::Reference, 8) });
 }
 
 /// Every render pixel at level 0 (an oracle at the Nyquist rate) with 2 x 2 anti-aliasing shades
@@ -821,7 +825,7 @@ fn an_adaptive_budget_below_a_sample_per_block_is_an_error() {
             supersample: 2,
             max_spp: 64,
             allocation,
-            ..render::adaptive::Settings::new(Mode::Reference, 1)
+            ..render::adaptive::Settings::new(Estimator::Reference, 1)
         };
         let options = gpu::preview::FrameOptions { oracle: Some(&nyquist), details: false };
         let error = renderer.render_adaptive(material, lighting, &settings, options).expect_err("over budget");
@@ -834,7 +838,7 @@ fn an_adaptive_budget_below_a_sample_per_block_is_an_error() {
 fn an_adaptive_frame_without_bandwidths_is_an_error() {
     let (material, lighting) = (phong(), sky_lighting());
     let renderer = renderer(&sphere_scene(SIZE), material, lighting);
-    let settings = render::adaptive::Settings::new(Mode::Reference, 4);
+    let settings = render::adaptive::Settings::new(Estimator::Reference, 4);
     let error = renderer.render_adaptive(material, lighting, &settings, details()).expect_err("no bandwidths");
     assert!(error.to_string().contains("set_bandwidths"), "{error}");
 }
@@ -850,11 +854,11 @@ fn details() -> gpu::preview::FrameOptions<'static> {
 #[test]
 fn every_mode_on_mesa_gl_equals_the_cpu() {
     let gl = gl_gpu(&|limits| limits);
-    for mode in [Mode::Reference, Mode::Fis, Mode::Prefiltered] {
+    for mode in [Estimator::Reference, Estimator::Fis, Estimator::Prefiltered] {
         check_against_cpu_on(&gl, "ggx on gl", ggx(), mode);
     }
-    check_adaptive_frame_on(&gl, AdaptiveCase::new(Mode::Reference, 8));
-    check_adaptive_frame_on(&gl, AdaptiveCase::new(Mode::Prefiltered, 4));
+    check_adaptive_frame_on(&gl, AdaptiveCase::new(Estimator::Reference, 8));
+    check_adaptive_frame_on(&gl, AdaptiveCase::new(Estimator::Prefiltered, 4));
 }
 
 /// An adapter short of storage buffers per shader stage fails with one line that names the limit,
@@ -877,7 +881,7 @@ fn an_adapter_short_of_storage_buffers_names_the_limit_and_the_modes_it_runs() {
 
     let twelve = Gpu::with_backends(wgpu::Backends::all(), &capped(12)).unwrap();
     let mut renderer = renderer_on(&twelve, &scene, material, lighting);
-    let image = render_gpu(&mut renderer, &settings(Mode::Prefiltered));
+    let image = render_gpu(&mut renderer, &settings(Estimator::Prefiltered));
     assert!(image.covered.iter().any(|&c| c), "the shading modes run with 12");
     let error = renderer.set_bandwidths(&bandwidths()).expect_err("an adaptive frame needs 13");
     let message = error.to_string();

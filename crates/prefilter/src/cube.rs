@@ -49,7 +49,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::Error;
-use crate::ktx::{self, Encoded, Shape, Storage};
+use crate::ktx::{self, Ktx2File, Shape, Storage};
 
 /// The faces in storage order.
 pub const FACES: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
@@ -99,7 +99,7 @@ pub fn face_size(width: usize) -> usize {
 
 /// The layers as one KTX2 cube-map array (`layerCount` = the number of layers, 6 faces each, one
 /// level), faces of [`face_size`] of the layers' width.
-pub fn encode_layers(layers: &[&EnvMap], storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_layers(layers: &[&EnvMap], storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let Some(first) = layers.first() else { return Err(Error::InvalidConfig("a cube array needs a layer".into())) };
     let n = face_size(first.width());
     let images: Vec<Vec<f32>> = layers.iter().flat_map(|layer| faces(layer, n)).collect();
@@ -110,7 +110,7 @@ pub fn encode_layers(layers: &[&EnvMap], storage: Storage, writer: &str) -> Resu
 /// A mip chain as one KTX2 cube map: level `l` has faces of `max(1, n >> l)` texels, `n` the
 /// [`face_size`] of level 0's width, resampled from the chain's level `l`; as many levels as the
 /// chain has, down to faces of one texel.
-pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let n = face_size(chain.level(0).width());
     let levels: Vec<&EnvMap> = chain.levels().iter().take(n.ilog2() as usize + 1).collect();
     encode_levels(&levels, storage, writer)
@@ -119,7 +119,7 @@ pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Res
 /// Lat-long levels (each half the size of the one before) as one KTX2 cube map with a level
 /// each: level `l` has faces of `max(1, n >> l)` texels, `n` the [`face_size`] of level 0's width.
 /// At most `log2 n + 1` levels.
-pub fn encode_levels(levels: &[&EnvMap], storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_levels(levels: &[&EnvMap], storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let Some(first) = levels.first() else { return Err(Error::InvalidConfig("a cube map needs a level".into())) };
     let n = face_size(first.width());
     let images: Vec<Vec<Vec<f32>>> =

@@ -138,7 +138,7 @@ impl Shape {
 
 /// A KTX2 file in memory and how its texels were stored.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Encoded {
+pub struct Ktx2File {
     pub bytes: Vec<u8>,
     pub format: TexelFormat,
     /// Values clamped to 65504 ([`Storage::ClampHalf`] only).
@@ -146,7 +146,7 @@ pub struct Encoded {
 }
 
 /// A 2D array texture of one level, one layer per map. The maps must all have the same size.
-pub fn encode_array(layers: &[&EnvMap], storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_array(layers: &[&EnvMap], storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let Some(first) = layers.first() else { return Err(Error::InvalidConfig("an array needs a layer".into())) };
     let (w, h) = (first.width(), first.height());
     if let Some(other) = layers.iter().find(|l| (l.width(), l.height()) != (w, h)) {
@@ -162,7 +162,7 @@ pub fn encode_array(layers: &[&EnvMap], storage: Storage, writer: &str) -> Resul
 
 /// A 2D texture with the levels of a mip chain (`envmap`'s chain stops at the first odd height,
 /// so it may hold fewer levels than a full chain down to 1 x 1; KTX2 allows that).
-pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let level0 = chain.level(0);
     let levels: Vec<Vec<&[f32]>> = chain.levels().iter().map(|level| vec![level.rgb()]).collect();
     encode(Shape { width: level0.width(), height: level0.height(), layers: 0, faces: 1 }, &levels, storage, writer)
@@ -170,7 +170,7 @@ pub fn encode_mip_chain(chain: &MipChain, storage: Storage, writer: &str) -> Res
 
 /// The general writer: `levels[l]` holds the [`Shape::images`] images of level `l` (layer-major,
 /// then face) as interleaved RGB of [`Shape::level_size`]; alpha is 1.
-pub fn encode(shape: Shape, levels: &[Vec<&[f32]>], storage: Storage, writer: &str) -> Result<Encoded, Error> {
+pub fn encode(shape: Shape, levels: &[Vec<&[f32]>], storage: Storage, writer: &str) -> Result<Ktx2File, Error> {
     let invalid = |message: String| Err(Error::InvalidConfig(message));
     let Shape { width, height, layers: layer_count, faces } = shape;
     if width == 0 || height == 0 || levels.is_empty() {
@@ -236,7 +236,7 @@ pub fn encode(shape: Shape, levels: &[Vec<&[f32]>], storage: Storage, writer: &s
         }
     }
     debug_assert_eq!(bytes.len(), at);
-    Ok(Encoded { bytes, format, clamped })
+    Ok(Ktx2File { bytes, format, clamped })
 }
 
 /// The shape of a data texture ([`encode_data`]): 2D (`depth` 0, `layers` 0), a 2D array
@@ -321,7 +321,7 @@ pub fn encode_data(shape: DataShape, values: &[f32], writer: &str) -> Result<Vec
 
 /// A data texture of ours read back ([`decode_data`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct DecodedData {
+pub struct Ktx2Data {
     pub shape: DataShape,
     /// In [`encode_data`]'s order.
     pub values: Vec<f32>,
@@ -330,7 +330,7 @@ pub struct DecodedData {
 /// Reads a data texture ([`encode_data`]: `R32_SFLOAT` or `R32G32B32A32_SFLOAT`, one level, 2D,
 /// 2D array or 3D) with the `ktx2` crate, checking every size against the bytes before
 /// allocating. The error says what is wrong.
-pub fn decode_data(bytes: &[u8]) -> Result<DecodedData, String> {
+pub fn decode_data(bytes: &[u8]) -> Result<Ktx2Data, String> {
     let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a ktx2 file: {e:?}"))?;
     let header = reader.header();
     let channels = match header.format {
@@ -377,7 +377,7 @@ pub fn decode_data(bytes: &[u8]) -> Result<DecodedData, String> {
         ));
     }
     let values = level.data.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-    Ok(DecodedData { shape, values })
+    Ok(Ktx2Data { shape, values })
 }
 
 /// What a file's header says besides its levels.
@@ -463,7 +463,7 @@ fn container(header: &Header, writer: &str, level_bytes: &[usize]) -> Vec<u8> {
 /// A KTX2 file of ours read back: its shape and format, and `levels[l][image]` as interleaved
 /// RGB `f32` (alpha dropped), images layer-major then face.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Decoded {
+pub struct Ktx2Texture {
     pub shape: Shape,
     pub format: TexelFormat,
     pub levels: Vec<Vec<Vec<f32>>>,
@@ -471,7 +471,7 @@ pub struct Decoded {
 
 /// Reads a float RGBA KTX2 file (either format, any shape [`encode`] writes) with the `ktx2`
 /// crate, checking every size against the bytes before allocating. The error says what is wrong.
-pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
+pub fn decode(bytes: &[u8]) -> Result<Ktx2Texture, String> {
     let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a ktx2 file: {e:?}"))?;
     let header = reader.header();
     let format = match header.format {
@@ -529,7 +529,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             .collect();
         levels.push(images);
     }
-    Ok(Decoded { shape, format, levels })
+    Ok(Ktx2Texture { shape, format, levels })
 }
 
 /// The data format descriptor of float texels of `type_size` bytes per channel with `samples`

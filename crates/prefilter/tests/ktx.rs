@@ -6,7 +6,7 @@
 use envmap::{EnvMap, MipChain, SampleType};
 use ktx2::dfd::Basic;
 use ktx2::{ColorModel, ColorPrimaries, Format, Reader, TransferFunction};
-use prefilter::ktx::{self, Encoded, Shape, Storage, TexelFormat};
+use prefilter::ktx::{self, Ktx2File, Shape, Storage, TexelFormat};
 use prefilter::{Config, prefilter};
 
 use crate::real_map;
@@ -41,7 +41,7 @@ fn linear_descriptor(format: Format) -> (Basic, u32) {
 
 /// The parts every file of ours shares: format, descriptor, key/value data (only standard keys:
 /// no hidden scale), alignment.
-fn check_common(reader: &Reader<&[u8]>, encoded: &Encoded) {
+fn check_common(reader: &Reader<&[u8]>, encoded: &Ktx2File) {
     let header = reader.header();
     let format = match encoded.format {
         TexelFormat::Rgba16f => Format::R16G16B16A16_SFLOAT,

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use render::{Mode as Estimator, Scene, metrics};
+use render::{Estimator, Scene, metrics};
 use serde_json::{Value, json};
 
 use crate::checks::{
@@ -228,7 +228,7 @@ impl Inputs<'_> {
         let (sum, n) = (&frames.sum, settings.frames);
         let aa = settings.supersample * settings.supersample;
         // The prefiltered estimator's layers, where they are not the bake's.
-        let layers = match (settings.mode, settings.layer_shift) {
+        let layers = match (settings.estimator, settings.layer_shift) {
             (Estimator::Prefiltered, k) if k > 0 => format!(" ({k} layer{} sharper)", if k == 1 { "" } else { "s" }),
             _ => String::new(),
         };

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use envmap::ToneMapping;
-use render::{Image, Lighting, Mode as Estimator, Scene, Settings, metrics};
+use render::{Estimator, Image, Lighting, Scene, Settings, metrics};
 use serde_json::json;
 
 use crate::checks::{
@@ -244,7 +244,7 @@ fn set_wavelet_brdf(request: &Request, loaded: &mut bake::Loaded) -> Result<(), 
             path.display()
         );
     }
-    loaded.material.wavelet_brdf = Some(render::WaveletBrdf { brdf, lod: request.wavelet_brdf_lod });
+    loaded.material.wavelet_brdf = Some(render::WaveletBrdfLod { brdf, lod: request.wavelet_brdf_lod });
     Ok(())
 }
 
@@ -368,7 +368,7 @@ impl EstimatorRender<'_> {
     ) -> Result<(), Error> {
         let (scene, settings) = (self.scene, self.settings);
         let table_material = render::Material { wavelet_brdf: None, ..loaded.material.clone() };
-        host.step(format!("{} from the table on the GPU", settings.mode.name()));
+        host.step(format!("{} from the table on the GPU", settings.estimator.name()));
         let table = gpu::preview::Renderer::new(gpu, scene, &table_material, lighting)?.render_frames(settings)?;
         check_finite(request, &table.rgb, "the GPU render from the table")?;
         let table_picture = metrics::tonemap(&table, self.tone_mapping);
@@ -398,7 +398,7 @@ impl EstimatorRender<'_> {
         step: &mut Rendered,
     ) -> Result<(), Error> {
         let scene = self.scene;
-        host.step(format!("{} on the CPU (--validate)", self.settings.mode.name()));
+        host.step(format!("{} on the CPU (--validate)", self.settings.estimator.name()));
         let cpu = render::render_with_progress(scene, &loaded.material, lighting, self.settings, &|done, all| {
             host.work(done, all)
         })?;

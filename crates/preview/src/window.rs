@@ -19,7 +19,7 @@ use std::time::Instant;
 
 use gpu::preview::{Presenter, Renderer, View};
 use gpu::surface::{Display, WindowSurface};
-use render::{Camera, Mode, Settings};
+use render::{Camera, Estimator, Settings};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
@@ -183,7 +183,7 @@ struct State {
     orbit: Orbit,
     /// The orbit the renderer's G-buffer was drawn for.
     drawn: Orbit,
-    mode: Mode,
+    mode: Estimator,
     view: View,
     exposure_ev: f32,
     /// The cursor's last position, and whether the left button drags it.
@@ -288,7 +288,7 @@ impl App<'_> {
             home,
             orbit: home,
             drawn: home,
-            mode: self.inputs.settings.mode,
+            mode: self.inputs.settings.estimator,
             view: View::Shaded,
             exposure_ev: self.inputs.tone_mapping.exposure_ev,
             cursor: None,
@@ -358,7 +358,7 @@ impl State {
         let frames = self.frames_per_redraw.min(target - done);
         // The settings' frames size the fis estimator's footprints (`render::Settings::
         // filter_samples`), as they do for `--out`; the window goes on averaging past them.
-        let settings = Settings { mode: self.mode, ..*settings };
+        let settings = Settings { estimator: self.mode, ..*settings };
         let start = Instant::now();
         self.renderer.accumulate(&settings, self.view, frames)?;
         self.gpu.wait()?;
@@ -383,9 +383,9 @@ impl State {
             Key::Named(NamedKey::Escape) => return KeyOutcome::Quit,
             Key::Character(c) => match c.as_str() {
                 "q" | "Q" => return KeyOutcome::Quit,
-                "1" => self.set_mode(Mode::Reference, material, lighting),
-                "2" => self.set_mode(Mode::Fis, material, lighting),
-                "3" => self.set_mode(Mode::Prefiltered, material, lighting),
+                "1" => self.set_mode(Estimator::Reference, material, lighting),
+                "2" => self.set_mode(Estimator::Fis, material, lighting),
+                "3" => self.set_mode(Estimator::Prefiltered, material, lighting),
                 "d" | "D" => {
                     let i = View::ALL.iter().position(|&v| v == self.view).unwrap_or(0);
                     self.view = View::ALL[(i + 1) % View::ALL.len()];
@@ -418,8 +418,8 @@ impl State {
 
     /// Switches to `mode` unless the bake cannot render it; returns whether it changed (and the
     /// accumulation has to start again).
-    fn set_mode(&mut self, mode: Mode, material: &render::Material, lighting: &render::Lighting) -> bool {
-        if mode == Mode::Prefiltered && (lighting.layers.is_empty() || material.view_layers.is_empty()) {
+    fn set_mode(&mut self, mode: Estimator, material: &render::Material, lighting: &render::Lighting) -> bool {
+        if mode == Estimator::Prefiltered && (lighting.layers.is_empty() || material.view_layers.is_empty()) {
             eprintln!(
                 "prefiltered: the bake has no prefiltered layers or no view-layer table; staying in {}",
                 self.mode.name()

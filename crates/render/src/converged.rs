@@ -1,4 +1,4 @@
-//! The converged estimate: the same integral as [`crate::Mode::Reference`],
+//! The converged estimate: the same integral as [`crate::Estimator::Reference`],
 //! `L_o = int f(wi, wo) L(wi) cos theta_i dwi` with `f` the table's nearest lookup and `L` level
 //! 0 of the environment, bilinear, over the same G-buffer and shading frame, estimated without
 //! any baked table by multiple importance sampling of three strategies with the balance

@@ -92,7 +92,7 @@
 //! (module [`adaptive`]), and `merl-importance` shows them. The price is a table lookup per
 //! sample in place of a texel read: two binary searches, over 91 row edges and 129 sector edges.
 //!
-//! # The estimators ([`Mode`])
+//! # The estimators ([`Estimator`])
 //!
 //! Every mode sums, per frame, over the pixel's `spp` points: point `n` gives one direction from
 //! the BRDF's strategy (`wi_b` of density `p_b`, the slice's table) and, where the mode samples
@@ -113,16 +113,16 @@
 //! weights sum to 1 wherever either density is positive. The table's density is positive over
 //! the whole upper hemisphere (its defensive share), so `M` is integrated without bias. The BRDF
 //! is the table's nearest lookup (`merl::MerlTable::lookup` with `Interp::Nearest`, the lookup
-//! the WGSL ports), 0 where the table holds no data; or, when the material carries a [`WaveletBrdf`],
+//! the WGSL ports), 0 where the table holds no data; or, when the material carries a [`WaveletBrdfLod`],
 //! its reconstruction at the wavelet's level of detail (`wavelet_brdf::Decoded::eval`: bilinear
 //! over the 4 x 4 surrounding cell pairs of the sphere grid, Haar synthesis of each, in the log
 //! domain; the WGSL `wavelet_brdf.wgsl` ports it). The modes differ in `F` and `M`:
 //!
-//! - [`Mode::Reference`]: `F = 0`, `M` the environment's level 0, bilinear
+//! - [`Estimator::Reference`]: `F = 0`, `M` the environment's level 0, bilinear
 //!   (`envmap::EnvMap::lookup`), `p_l` its importance sampling ([`Lighting::environment`]: texels
 //!   by the luminance of their bilinear reconstruction times `sin theta`). Unbiased: it estimates
 //!   `int f L cos` with level 0 as the renderers read it, the converged estimate's integral.
-//! - [`Mode::Fis`] (filtered importance sampling, `002`): `F` the mip chain of the environment's
+//! - [`Estimator::Fis`] (filtered importance sampling, `002`): `F` the mip chain of the environment's
 //!   smooth part ([`Lighting::smooth_mips`]), trilinear at `lod = max(log4(w h / (N p_b 2 pi^2))
 //!   + FIS_LOD_BIAS, 0)` (`envmap::MipChain::lod_solid_angle`, `w x h` the level-0 size: the
 //!   level a footprint of solid angle `1 / (N p_b)` gets at the equator, wherever it lies;
@@ -138,7 +138,7 @@
 //!   environment's peaks, `p_l` theirs ([`Peaks`]). The BRDF split as in the
 //!   prefiltered mode (below): the diffuse part read from the cosine layer at the normal, the rest
 //!   `f - f_d` in the `F` term.
-//! - [`Mode::Prefiltered`] (`001` section 2.5, "ASFPCS"), with the BRDF split in two: its
+//! - [`Estimator::Prefiltered`] (`001` section 2.5, "ASFPCS"), with the BRDF split in two: its
 //!   diffuse part `f_d` ([`diffuse_split`]: the table's least value within 60 degrees of the
 //!   normal, [`diffuse_part`],
 //!   where the first layer is the cosine lobe `n = 1`; else 0) and the rest. The diffuse part's
@@ -239,7 +239,7 @@
 //! vector drawn uniformly over the cells of the MERL grid (uniform in `sqrt(theta_h / (pi / 2))`
 //! and `phi_h`: dense near the normal, where mirror-like tables keep their energy, whatever the
 //! material). Same BRDF lookup, same visibility and frame, and the same `L` as
-//! [`Mode::Reference`] (level 0, bilinear) for every strategy, so it estimates exactly the
+//! [`Estimator::Reference`] (level 0, bilinear) for every strategy, so it estimates exactly the
 //! reference mode's expectation; the environment's density is evaluated exactly for every
 //! direction, so reading `L` bilinearly costs no bias (the texel weights are the luminance of the
 //! bilinear reconstruction averaged over each texel, which keeps that density positive wherever
@@ -314,7 +314,7 @@ impl SampleSet {
 pub struct Material {
     pub table: MerlTable,
     pub samples: SampleSet,
-    /// For [`Mode::Prefiltered`]: where each of `R` view elevations, in equal steps of
+    /// For [`Estimator::Prefiltered`]: where each of `R` view elevations, in equal steps of
     /// `cos theta_o`, falls among the Phong layers of [`Lighting::layers`], as a layer coordinate
     /// (`bandwidth_atlas::view::view_coordinates`: the layer of twice the view's bandwidth, `k + t`
     /// blending layer `k` and `k + 1` by `t`, up to the number of layers: the smooth map itself
@@ -323,12 +323,12 @@ pub struct Material {
     /// ([`view_layer`]).
     pub view_layers: Vec<f32>,
     /// The table's diffuse part `f_d` (1/sr per channel, [`diffuse_part`]), which the filtered
-    /// modes ([`Mode::Fis`], [`Mode::Prefiltered`]) read from the cosine layer at the normal
+    /// modes ([`Estimator::Fis`], [`Estimator::Prefiltered`]) read from the cosine layer at the normal
     /// (crate documentation, "The estimators").
     pub diffuse: [f32; 3],
     /// When set, the renderers evaluate `f` from this wavelet encoding of the table instead of
     /// the table (`brdf-preview --brdf wavelet-brdf`): see "The BRDF" in the crate docs.
-    pub wavelet_brdf: Option<WaveletBrdf>,
+    pub wavelet_brdf: Option<WaveletBrdfLod>,
 }
 
 impl Material {
@@ -343,7 +343,7 @@ impl Material {
 /// A wavelet encoding of the material (asset kind `wavelet-brdf`, crate `wavelet_brdf`) and the
 /// level of detail it is read at.
 #[derive(Clone, Debug)]
-pub struct WaveletBrdf {
+pub struct WaveletBrdfLod {
     pub brdf: wavelet_brdf::Decoded,
     /// In `[0, log2 n]`: 0 is full resolution (`wavelet_brdf::Decoded::eval`).
     pub lod: f64,
@@ -351,21 +351,21 @@ pub struct WaveletBrdf {
 
 /// Which estimator shades the covered pixels (see the crate documentation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Mode {
+pub enum Estimator {
     Reference,
     Fis,
     Prefiltered,
 }
 
-impl Mode {
-    pub const ALL: [Mode; 3] = [Mode::Reference, Mode::Fis, Mode::Prefiltered];
+impl Estimator {
+    pub const ALL: [Estimator; 3] = [Estimator::Reference, Estimator::Fis, Estimator::Prefiltered];
 
     /// The name on the command line and in JSON.
     pub fn name(self) -> &'static str {
         match self {
-            Mode::Reference => "reference",
-            Mode::Fis => "fis",
-            Mode::Prefiltered => "prefiltered",
+            Estimator::Reference => "reference",
+            Estimator::Fis => "fis",
+            Estimator::Prefiltered => "prefiltered",
         }
     }
 }
@@ -373,7 +373,7 @@ impl Mode {
 /// How many samples a render takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Settings {
-    pub mode: Mode,
+    pub estimator: Estimator,
     /// Samples per pixel and frame: a power of two that divides [`SampleSet::n_samples`].
     pub spp: u32,
     /// Frames averaged.
@@ -383,19 +383,25 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// The previewer's settings for `mode` where a user sets nothing: `spp` samples per pixel
-    /// and frame (default 64 for the reference mode, 16 for the filtered ones) and `frames` frames
-    /// (default: for the reference mode enough to use every point of a pixel's `V N` once,
-    /// [`frames_to_exhaust`]; for the filtered modes 8, which average prefiltered's noise, not
+    /// The previewer's settings for `estimator` where a user sets nothing: `spp` samples per pixel
+    /// and frame (default 64 for the reference estimator, 16 for the filtered ones) and `frames` frames
+    /// (default: for the reference estimator enough to use every point of a pixel's `V N` once,
+    /// [`frames_to_exhaust`]; for the filtered estimators 8, which average prefiltered's noise, not
     /// its bias, and narrow fis's footprints, [`Settings::filter_samples`]). `spp` must not be 0
-    /// where `frames` is left to the default of the reference mode.
-    pub fn previewer(mode: Mode, samples: &SampleSet, spp: Option<u32>, frames: Option<u32>, seed: u32) -> Settings {
-        let spp = spp.unwrap_or(if mode == Mode::Reference { 64 } else { 16 });
-        let frames = frames.unwrap_or_else(|| match mode {
-            Mode::Reference => frames_to_exhaust(samples.n_vectors, samples.n_samples, spp),
-            Mode::Fis | Mode::Prefiltered => 8,
+    /// where `frames` is left to the default of the reference estimator.
+    pub fn previewer(
+        estimator: Estimator,
+        samples: &SampleSet,
+        spp: Option<u32>,
+        frames: Option<u32>,
+        seed: u32,
+    ) -> Settings {
+        let spp = spp.unwrap_or(if estimator == Estimator::Reference { 64 } else { 16 });
+        let frames = frames.unwrap_or_else(|| match estimator {
+            Estimator::Reference => frames_to_exhaust(samples.n_vectors, samples.n_samples, spp),
+            Estimator::Fis | Estimator::Prefiltered => 8,
         });
-        Settings { mode, spp, frames, seed }
+        Settings { estimator, spp, frames, seed }
     }
 
     /// The samples a picture averages, `spp` times `frames` (at most `u32::MAX`): the fis

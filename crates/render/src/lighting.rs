@@ -20,8 +20,8 @@ pub struct Lighting {
     /// Level 0's importance sampling: texels weighted by [`EnvMap::bilinear_luminance`] (so the
     /// density is positive wherever the bilinear lookup is) times `sin theta`.
     pub environment: LatLong,
-    /// The environment's peaks and the smooth rest, for [`crate::Mode::Fis`] and
-    /// [`crate::Mode::Prefiltered`]; `None` where no texel stands out.
+    /// The environment's peaks and the smooth rest, for [`crate::Estimator::Fis`] and
+    /// [`crate::Estimator::Prefiltered`]; `None` where no texel stands out.
     pub peaks: Option<Peaks>,
 }
 

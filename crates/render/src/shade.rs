@@ -11,8 +11,8 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::raster::{self, GBuffer, Hit};
 use crate::{
-    Camera, Lighting, Material, Mesh, Mode, Rays, SampleSet, Scene, Settings, pixel_sequences, point, sample_range,
-    view_layer,
+    Camera, Estimator, Lighting, Material, Mesh, Rays, SampleSet, Scene, Settings, pixel_sequences, point,
+    sample_range, view_layer,
 };
 
 /// A rendered image: linear RGB radiance, interleaved, row-major with row 0 at the top, and
@@ -232,22 +232,22 @@ pub(crate) fn shade(
     // The light a filtered estimator reads (`Some` in fis and prefiltered) and the light that
     // multiple importance sampling of the BRDF's and a light's strategy takes: level 0 whole in
     // the reference mode, the peaks in the filtered modes (crate documentation).
-    let filtered = match settings.mode {
-        Mode::Reference => None,
-        Mode::Fis => Some(Source::Mips(lighting.smooth_mips())),
-        Mode::Prefiltered => {
+    let filtered = match settings.estimator {
+        Estimator::Reference => None,
+        Estimator::Fis => Some(Source::Mips(lighting.smooth_mips())),
+        Estimator::Prefiltered => {
             let past = lighting.smooth_layers().len() as f64;
             Some(Source::Layers(
                 (view_layer(&material.view_layers, frame.cos_o) + f64::from(block.layer_shift)).min(past),
             ))
         }
     };
-    let sampled = match (settings.mode, &lighting.peaks) {
-        (Mode::Reference, _) => Some((&lighting.environment, lighting.mips.level(0))),
+    let sampled = match (settings.estimator, &lighting.peaks) {
+        (Estimator::Reference, _) => Some((&lighting.environment, lighting.mips.level(0))),
         (_, Some(peaks)) => Some((&peaks.sampling, &peaks.map)),
         (_, None) => None,
     };
-    let (diffuse, diffuse_radiance) = diffuse_term(frame, material, lighting, settings.mode);
+    let (diffuse, diffuse_radiance) = diffuse_term(frame, material, lighting, settings.estimator);
     let mut total = [0.0f64; 3];
     let mut add = |f: [f64; 3], radiance: [f32; 3], weight: f64| {
         for c in 0..3 {
@@ -305,10 +305,15 @@ pub(crate) fn shade(
 /// The diffuse part the filtered estimators take out of the BRDF, and its integral against the
 /// smooth light, `pi f_d L_1(n)` (crate documentation, "The estimators"): `(f_d, radiance)`, both
 /// 0 in the reference mode. A diffuse part is never 0 without a cosine layer to read.
-fn diffuse_term(frame: &ShadingFrame, material: &Material, lighting: &Lighting, mode: Mode) -> ([f64; 3], [f64; 3]) {
+fn diffuse_term(
+    frame: &ShadingFrame,
+    material: &Material,
+    lighting: &Lighting,
+    mode: Estimator,
+) -> ([f64; 3], [f64; 3]) {
     let diffuse = match mode {
-        Mode::Reference => return ([0.0; 3], [0.0; 3]),
-        Mode::Fis | Mode::Prefiltered => crate::diffuse_split(material, lighting).map(f64::from),
+        Estimator::Reference => return ([0.0; 3], [0.0; 3]),
+        Estimator::Fis | Estimator::Prefiltered => crate::diffuse_split(material, lighting).map(f64::from),
     };
     if diffuse == [0.0; 3] {
         return (diffuse, [0.0; 3]);
@@ -413,7 +418,7 @@ pub fn check_settings(
     if settings.frames == 0 {
         return Err(Error::Invalid("frames must be at least 1".into()));
     }
-    if settings.mode == Mode::Prefiltered {
+    if settings.estimator == Estimator::Prefiltered {
         if n_layers == 0 {
             return Err(Error::Invalid("prefiltered mode needs at least one prefiltered layer".into()));
         }

@@ -4,7 +4,7 @@
 
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use render::adaptive::{self, Action, Prediction};
-use render::{Mode, Settings};
+use render::{Estimator, Settings};
 
 use crate::fixtures::bandwidths;
 use crate::support::{phong, sky_lighting, sphere_scene};
@@ -32,7 +32,7 @@ fn frames_average_the_noise_of_the_shaded_blocks() {
     // predictions and samples) is nearer the converged estimate than one frame. A Phong lobe
     // under the sky at 4 samples per pixel: one frame's error is mostly noise.
     let (scene, material, lighting, bandwidths) = (sphere_scene(48, 48), phong(0), sky_lighting(), bandwidths());
-    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Mode::Reference, 4) };
+    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Estimator::Reference, 4) };
     let one = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap().image;
     assert_eq!(adaptive::render_frames(&scene, material, &lighting, &bandwidths, &settings).unwrap(), one);
     let settings = adaptive::Settings { frames: 8, ..settings };
@@ -186,7 +186,7 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
     let mut coarse_levels = 0;
     // Each allocation twice.
     let allocations = [adaptive::Allocation::Variance, adaptive::Allocation::StdDev, adaptive::Allocation::Area];
-    let cases = [(Mode::Reference, 1, 8), (Mode::Prefiltered, 1, 2), (Mode::Reference, 2, 4)];
+    let cases = [(Estimator::Reference, 1, 8), (Estimator::Prefiltered, 1, 2), (Estimator::Reference, 2, 4)];
     for (i, (mode, supersample, spp)) in cases.into_iter().enumerate() {
         for predict_level in [0, 1] {
             let allocation = allocations[(2 * i + predict_level) % 3];
@@ -211,8 +211,11 @@ fn every_pixel_is_shaded_at_its_level_or_upsampled_from_shaded_parents() {
 
     // With 003's lobe weight and a rescue threshold the invariants hold too, and blocks whose
     // weights sum to little are shaded rather than up-sampled.
-    let settings =
-        adaptive::Settings { lobe_weight: true, rescue_below: 0.3, ..adaptive::Settings::new(Mode::Prefiltered, 4) };
+    let settings = adaptive::Settings {
+        lobe_weight: true,
+        rescue_below: 0.3,
+        ..adaptive::Settings::new(Estimator::Prefiltered, 4)
+    };
     let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
     check_plan(&frame, &settings);
     let rescued = frame
@@ -233,7 +236,7 @@ fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
     // own layer: no shift).
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
     let scene = sphere_scene(40, 30);
-    for mode in [Mode::Reference, Mode::Prefiltered] {
+    for mode in [Estimator::Reference, Estimator::Prefiltered] {
         let settings = adaptive::Settings {
             max_level: Some(0),
             max_spp: 8,
@@ -242,7 +245,9 @@ fn a_plan_that_may_not_coarsen_is_the_full_resolution_renderer() {
             ..adaptive::Settings::new(mode, 8)
         };
         let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
-        let full = render::render(&scene, material, &lighting, &Settings { mode, spp: 8, frames: 1, seed: 3 }).unwrap();
+        let full =
+            render::render(&scene, material, &lighting, &Settings { estimator: mode, spp: 8, frames: 1, seed: 3 })
+                .unwrap();
         assert_eq!(frame.image.covered, full.covered);
         assert_eq!(frame.image.rgb, full.rgb, "{}", mode.name());
         assert_eq!(frame.shaded_fraction(), 1.0);
@@ -259,7 +264,7 @@ fn a_block_of_more_samples_than_a_vector_reads_whole_vectors() {
     let samples = render::SampleSet { n_samples: 8, n_vectors: s.n_vectors * s.n_samples / 8, ..s.clone() };
     let material = render::Material { samples, ..phong.clone() };
     let scene = sphere_scene(40, 30);
-    for mode in [Mode::Reference, Mode::Prefiltered] {
+    for mode in [Estimator::Reference, Estimator::Prefiltered] {
         let settings = adaptive::Settings {
             max_level: Some(0),
             max_spp: 32,
@@ -269,17 +274,21 @@ fn a_block_of_more_samples_than_a_vector_reads_whole_vectors() {
         };
         let frame = adaptive::render(&scene, &material, &lighting, &bandwidths, &settings).unwrap();
         let full =
-            render::render(&scene, &material, &lighting, &Settings { mode, spp: 8, frames: 4, seed: 3 }).unwrap();
+            render::render(&scene, &material, &lighting, &Settings { estimator: mode, spp: 8, frames: 4, seed: 3 })
+                .unwrap();
         assert_eq!(frame.image.rgb, full.rgb, "{}", mode.name());
         // Not the first frame's vector four times over.
         let first =
-            render::render(&scene, &material, &lighting, &Settings { mode, spp: 8, frames: 1, seed: 3 }).unwrap();
+            render::render(&scene, &material, &lighting, &Settings { estimator: mode, spp: 8, frames: 1, seed: 3 })
+                .unwrap();
         assert_ne!(frame.image.rgb, first.rgb);
     }
     // A coarse plan with the default cap spends its budget: its coarse blocks take many vectors
     // (a cap of one vector, as before, left all but 8 samples a block of it unspent).
-    let settings =
-        adaptive::Settings { allocation: adaptive::Allocation::Area, ..adaptive::Settings::new(Mode::Reference, 64) };
+    let settings = adaptive::Settings {
+        allocation: adaptive::Allocation::Area,
+        ..adaptive::Settings::new(Estimator::Reference, 64)
+    };
     let frame = adaptive::render(&scene, &material, &lighting, &bandwidths, &settings).unwrap();
     let counts: Vec<u32> = frame
         .details()
@@ -304,7 +313,7 @@ fn the_block_cap_is_max_spp_within_a_slice() {
     let s = &phong.samples;
     let three =
         render::SampleSet { n_vectors: 3, n_samples: 8, texels: s.texels[..s.n_slices * 24].to_vec(), ..s.clone() };
-    let settings = adaptive::Settings::new(Mode::Reference, 4);
+    let settings = adaptive::Settings::new(Estimator::Reference, 4);
     assert_eq!(settings.max_spp, adaptive::MAX_SPP);
     // 3 vectors of 8: 24 samples a slice, 16 the largest power of two within them.
     assert_eq!(settings.block_cap(&three), 16);
@@ -345,7 +354,7 @@ fn pre_convolved_blocks_read_the_layer_layer_shift_sharper() {
             max_spp: 8,
             seed: 3,
             layer_shift: shift,
-            ..adaptive::Settings::new(Mode::Prefiltered, 8)
+            ..adaptive::Settings::new(Estimator::Prefiltered, 8)
         };
         let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
         let layer = shift.min(3);
@@ -355,7 +364,7 @@ fn pre_convolved_blocks_read_the_layer_layer_shift_sharper() {
             &scene,
             &moved,
             &lighting,
-            &Settings { mode: Mode::Prefiltered, spp: 8, frames: 1, seed: 3 },
+            &Settings { estimator: Estimator::Prefiltered, spp: 8, frames: 1, seed: 3 },
         )
         .unwrap();
         assert_eq!(frame.image.rgb, full.rgb, "shift {shift}");
@@ -382,7 +391,7 @@ fn the_exact_shader_gives_the_plans_ceiling() {
     // up-samples between them, and a reference too small is an error naming the pixel.
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
     let scene = sphere_scene(80, 60);
-    let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+    let settings = Settings { estimator: Estimator::Reference, spp: 1, frames: 1, seed: 0 };
     let full = render::render(&scene, material, &lighting, &settings).unwrap();
     let reference = render::Image { rgb: (0..full.rgb.len()).map(|i| (i / 3 * 7919 % 1000) as f32).collect(), ..full };
     let render_exact = |settings: &adaptive::Settings, reference: &render::Image| {
@@ -396,12 +405,13 @@ fn the_exact_shader_gives_the_plans_ceiling() {
             adaptive::Hooks { shader: Some(&mut exact), ..Default::default() },
         )
     };
-    let fine = adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Mode::Reference, 8) };
+    let fine =
+        adaptive::Settings { max_level: Some(0), max_spp: 8, ..adaptive::Settings::new(Estimator::Reference, 8) };
     let frame = render_exact(&fine, &reference).unwrap();
     for i in (0..80 * 60).filter(|&i| frame.details().predictions[i].level >= 0) {
         assert_eq!(frame.image.rgb[3 * i], reference.rgb[3 * i], "pixel {i}");
     }
-    let coarse = adaptive::Settings::new(Mode::Reference, 8);
+    let coarse = adaptive::Settings::new(Estimator::Reference, 8);
     let frame = render_exact(&coarse, &reference).unwrap();
     let is_exact = |i: usize| frame.image.rgb[3 * i] == reference.rgb[3 * i];
     let from =
@@ -423,7 +433,7 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
     let scene = sphere_scene(40, 30);
     let frame = |predict_level: usize| {
-        let settings = adaptive::Settings { predict_level, ..adaptive::Settings::new(Mode::Reference, 4) };
+        let settings = adaptive::Settings { predict_level, ..adaptive::Settings::new(Estimator::Reference, 4) };
         adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap()
     };
     let top = frame(4);
@@ -454,7 +464,7 @@ fn a_prediction_level_above_the_pyramid_is_its_top() {
 fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
     let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
     let settings =
-        adaptive::Settings { max_level: Some(0), supersample: 4, ..adaptive::Settings::new(Mode::Reference, 1) };
+        adaptive::Settings { max_level: Some(0), supersample: 4, ..adaptive::Settings::new(Estimator::Reference, 1) };
     let error = adaptive::render(&sphere_scene(16, 16), material, &lighting, &bandwidths, &settings).unwrap_err();
     assert!(error.to_string().contains("raise spp"), "{error}");
 }
@@ -464,7 +474,7 @@ fn a_budget_below_one_sample_per_shaded_pixel_is_refused() {
 #[test]
 fn the_settings_are_checked_before_the_scene() {
     let (material, lighting, bandwidths) = (phong(0), sky_lighting(), bandwidths());
-    let settings = adaptive::Settings { supersample: 3, ..adaptive::Settings::new(Mode::Reference, 1) };
+    let settings = adaptive::Settings { supersample: 3, ..adaptive::Settings::new(Estimator::Reference, 1) };
     let error = adaptive::render(&sphere_scene(0, 0), material, &lighting, &bandwidths, &settings).unwrap_err();
     assert!(error.to_string().contains("supersample (3) 1, 2 or 4"), "{error}");
 }
@@ -535,7 +545,7 @@ fn a_predictor_replaces_the_prediction_and_is_checked() {
     // wrong pixels or with values that are no bandwidth is an error naming what is wrong.
     let (material, lighting, bandwidths) = (phong(1), sky_lighting(), bandwidths());
     let scene = sphere_scene(40, 30);
-    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Mode::Reference, 4) };
+    let settings = adaptive::Settings { predict_level: 1, ..adaptive::Settings::new(Estimator::Reference, 4) };
     let frame = adaptive::render(&scene, material, &lighting, &bandwidths, &settings).unwrap();
     let with = |predictor: adaptive::Predictor| {
         let hooks = adaptive::Hooks { predictor: Some(predictor), ..Default::default() };

@@ -8,7 +8,7 @@
 //! bake's samples) but far from a single degree of freedom, so the ratio stays well within 3.
 
 use render::converged::converged;
-use render::{Image, Material, Mode, Settings, metrics};
+use render::{Estimator, Image, Material, Settings, metrics};
 
 use crate::support::{self, AlbedoCurve, L};
 
@@ -87,7 +87,7 @@ fn check_sky(materials: [&Material; 2]) {
     let (estimate, estimate_noise) = (mean(&a, &b), distance(&a, &b) / 2.0);
     // Two bakes and two render seeds: the reference's noise includes its bake's own error.
     let [a, b] = [0, 1].map(|i| {
-        let settings = Settings { mode: Mode::Reference, spp: 64, frames: 64, seed: i as u32 };
+        let settings = Settings { estimator: Estimator::Reference, spp: 64, frames: 64, seed: i as u32 };
         covered(&render::render(&scene, materials[i], &lighting, &settings).expect("valid inputs"))
     });
     let (reference, reference_noise) = (mean(&a, &b), distance(&a, &b) / 2.0);
@@ -121,7 +121,7 @@ fn background_is_the_environment() {
     let scene = support::sphere_scene(SIZE, SIZE);
     let lighting = support::sky_lighting();
     let image = converged(&scene, support::lambertian(0), &lighting, 1, 0).expect("valid inputs");
-    let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+    let settings = Settings { estimator: Estimator::Reference, spp: 1, frames: 1, seed: 0 };
     let rendered = render::render(&scene, support::lambertian(0), &lighting, &settings).expect("valid inputs");
     assert_eq!(image.covered, rendered.covered);
     for (i, (a, b)) in image.rgb.chunks_exact(3).zip(rendered.rgb.chunks_exact(3)).enumerate() {

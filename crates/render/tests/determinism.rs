@@ -1,7 +1,7 @@
 //! Renders are functions of their inputs: the same bytes twice, whatever the number of threads.
 
 use render::converged::converged;
-use render::{Image, Mode, Settings};
+use render::{Estimator, Image, Settings};
 
 use crate::support;
 
@@ -18,8 +18,8 @@ fn renders_do_not_depend_on_the_thread_count() {
     let scene = support::sphere_scene(24, 20);
     let lighting = support::sky_lighting();
     let material = support::phong(0);
-    for mode in Mode::ALL {
-        let settings = Settings { mode, spp: 16, frames: 3, seed: 11 };
+    for mode in Estimator::ALL {
+        let settings = Settings { estimator: mode, spp: 16, frames: 3, seed: 11 };
         let render = || render::render(&scene, material, &lighting, &settings).expect("valid inputs");
         let first = render();
         assert_eq!(bits(&first), bits(&render()), "{mode:?}: two renders differ");
@@ -40,7 +40,7 @@ fn seeds_give_different_renders() {
     let lighting = support::sky_lighting();
     let material = support::phong(0);
     let render = |seed| {
-        let settings = Settings { mode: Mode::Reference, spp: 16, frames: 8, seed };
+        let settings = Settings { estimator: Estimator::Reference, spp: 16, frames: 8, seed };
         bits(&render::render(&scene, material, &lighting, &settings).expect("valid inputs"))
     };
     let images: Vec<Vec<u32>> = (0..4).map(render).collect();

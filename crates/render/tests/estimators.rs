@@ -5,7 +5,7 @@
 use envmap::{EnvMap, MipChain};
 use glam::Vec3;
 use render::converged::converged;
-use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings, metrics};
+use render::{Camera, Estimator, Image, Lighting, Material, Scene, Settings, metrics};
 
 use crate::support;
 
@@ -48,7 +48,8 @@ fn the_reference_modes_error_carries_no_structure() {
     let config = importance::Config { n_vectors: 2, n_samples: 64, ..importance::Config::default() };
     let samples = render::SampleSet::new(&importance::build(&table, &config).expect("a valid config"));
     let material = &Material::new(table, samples, vec![0.0]);
-    let settings = Settings { mode: Mode::Reference, spp: 64, frames: render::frames_to_exhaust(2, 64, 64), seed: 1 };
+    let settings =
+        Settings { estimator: Estimator::Reference, spp: 64, frames: render::frames_to_exhaust(2, 64, 64), seed: 1 };
     let image = render::render(&scene, material, &lighting, &settings).expect("valid inputs");
     let truth = converged(&scene, material, &lighting, 256, 9).expect("valid inputs");
     let residual: Vec<f64> = luminance(&image).iter().zip(luminance(&truth)).map(|(a, b)| a - b).collect();
@@ -118,8 +119,8 @@ fn the_filtered_modes_hold_the_light_of_a_small_bright_source() {
                 metrics::mean_luminance(&converged(&scene, &material, lighting, 256, 3).expect("valid inputs"))
             };
             let (truth_sunny, truth_plain) = (truth(&sunny), truth(&plain));
-            for mode in [Mode::Fis, Mode::Prefiltered] {
-                let settings = Settings { mode, spp: 16, frames: 8, seed: 4 };
+            for mode in [Estimator::Fis, Estimator::Prefiltered] {
+                let settings = Settings { estimator: mode, spp: 16, frames: 8, seed: 4 };
                 let mean = |lighting: &Lighting| {
                     metrics::mean_luminance(
                         &render::render(&scene, &material, lighting, &settings).expect("valid inputs"),
@@ -154,7 +155,7 @@ fn the_prefiltered_mode_leaves_no_seam_where_the_layer_changes() {
     let lighting = Lighting::new(MipChain::new(&layer(1.0)), vec![layer(1.0), layer(2.0)], vec![1, 4]).expect("valid");
     let material = Material { view_layers: vec![0.0, 1.0], diffuse: [0.0; 3], ..support::lambertian(0).clone() };
     let scene = support::sphere_scene(64, 64);
-    let settings = Settings { mode: Mode::Prefiltered, spp: 64, frames: 4, seed: 2 };
+    let settings = Settings { estimator: Estimator::Prefiltered, spp: 64, frames: 4, seed: 2 };
     let image = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
     let light = luminance(&image);
     let y = 32;
@@ -187,12 +188,12 @@ fn the_prefiltered_mode_reads_the_smooth_map_past_the_sharpest_layer_and_no_shar
     let scene = support::sphere_scene(32, 32);
     let albedo_light = |settings: &Settings| {
         let image = render::render(&scene, &material, &lighting, settings).expect("valid inputs");
-        let settings = Settings { mode: Mode::Reference, spp: 16, frames: 8, seed: 1 };
+        let settings = Settings { estimator: Estimator::Reference, spp: 16, frames: 8, seed: 1 };
         let reference = render::render(&scene, &material, &support::constant_lighting(), &settings).expect("valid");
         metrics::mean_luminance(&image) / metrics::mean_luminance(&reference)
     };
-    let many = albedo_light(&Settings { mode: Mode::Prefiltered, spp: 16, frames: 8, seed: 1 });
-    let one = albedo_light(&Settings { mode: Mode::Prefiltered, spp: 1, frames: 1, seed: 1 });
+    let many = albedo_light(&Settings { estimator: Estimator::Prefiltered, spp: 16, frames: 8, seed: 1 });
+    let one = albedo_light(&Settings { estimator: Estimator::Prefiltered, spp: 1, frames: 1, seed: 1 });
     println!("light read: {many:.3} L with 128 samples per pixel, {one:.3} L with one");
     assert!((many / 3.0 - 1.0).abs() < 0.02, "128 samples read {many:.3} L, not level 0's 3 L");
     assert!((one / 2.0 - 1.0).abs() < 0.02, "one sample reads {one:.3} L, not layer 1's 2 L");
@@ -276,7 +277,7 @@ fn the_prefiltered_lambertian_reads_its_diffuse_part_at_the_normal() {
     let material = Material { view_layers: vec![0.0; 8], ..support::lambertian(0).clone() };
     assert!(material.diffuse.iter().all(|&v| (f64::from(v) - 0.5 / std::f64::consts::PI).abs() < 1e-6));
     let truth = converged(&scene, &material, &lighting, 1024, 5).expect("valid inputs");
-    let settings = Settings { mode: Mode::Prefiltered, spp: 16, frames: 8, seed: 6 };
+    let settings = Settings { estimator: Estimator::Prefiltered, spp: 16, frames: 8, seed: 6 };
     let split = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
     let unsplit_material = Material { diffuse: [0.0; 3], ..material.clone() };
     let unsplit = render::render(&scene, &unsplit_material, &lighting, &settings).expect("valid inputs");
@@ -294,7 +295,8 @@ fn the_prefiltered_lambertian_reads_its_diffuse_part_at_the_normal() {
     );
     assert!(split_lower.abs() < 0.01 && split_all.abs() < 0.01, "split: {split_lower:+.4} / {split_all:+.4}");
     // Filtered importance sampling splits the BRDF the same way.
-    let fis = render::render(&scene, &material, &lighting, &Settings { mode: Mode::Fis, ..settings }).expect("valid");
+    let fis = render::render(&scene, &material, &lighting, &Settings { estimator: Estimator::Fis, ..settings })
+        .expect("valid");
     let (fis_lower, fis_all) = off(&fis);
     println!("fis: {fis_lower:+.4} / {fis_all:+.4}");
     assert!(fis_lower.abs() < 0.01 && fis_all.abs() < 0.01, "fis: {fis_lower:+.4} / {fis_all:+.4}");
@@ -317,7 +319,7 @@ fn no_covered_pixel_is_black_at_the_silhouette() {
         .count();
     assert!(turned > 0, "no pixel's normal turns away from the eye: the test shows nothing");
     let material = Material { view_layers: vec![0.0; 8], ..support::lambertian(0).clone() };
-    let settings = Settings { mode: Mode::Prefiltered, spp: 1, frames: 1, seed: 0 };
+    let settings = Settings { estimator: Estimator::Prefiltered, spp: 1, frames: 1, seed: 0 };
     let image = render::render(&scene, &material, &lighting, &settings).expect("valid inputs");
     let expected = support::L.map(|l| 0.5 * f64::from(l));
     let wrong: Vec<usize> = (0..512 * 512)
@@ -355,7 +357,7 @@ fn fis_footprints_are_sized_for_the_frames() {
     let scene = support::sphere_scene(64, 64);
     let material = support::phong(0);
     let mean = |spp: u32, frames: u32| {
-        let settings = Settings { mode: Mode::Fis, spp, frames, seed: 8 };
+        let settings = Settings { estimator: Estimator::Fis, spp, frames, seed: 8 };
         metrics::mean_luminance(&render::render(&scene, material, &lighting, &settings).expect("valid inputs"))
     };
     let (frames, whole, one) = (mean(16, 8), mean(128, 1), mean(16, 1));

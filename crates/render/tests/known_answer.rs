@@ -9,7 +9,7 @@ use std::f64::consts::{E, FRAC_PI_2, PI};
 
 use merl::albedo::{Quadrature, hemisphere_integral};
 use merl::{Interp, luminance};
-use render::{Image, Material, Mode, Settings, raster};
+use render::{Estimator, Image, Material, Settings, raster};
 
 use crate::support::{self, AlbedoCurve, L};
 
@@ -26,7 +26,7 @@ const FRAMES: u32 = 16;
 /// independent: `Var X = sum_s (int g^2 p_s / (p_b + p_e)^2 - (int g p_s / (p_b + p_e))^2)`. A
 /// constant map's `p_e` is `1 / (4 pi)` within 1% away from the poles (texels weighted by
 /// `sin theta` at their row centres).
-fn round_spread(material: &Material, mode: Mode) -> Vec<f64> {
+fn round_spread(material: &Material, mode: Estimator) -> Vec<f64> {
     let p_e = 1.0 / (4.0 * PI);
     material
         .samples
@@ -48,8 +48,8 @@ fn round_spread(material: &Material, mode: Mode) -> Vec<f64> {
                 Quadrature { nodes_per_cell: 2, n_phi_h: 360 },
             );
             let variance = match mode {
-                Mode::Reference => second_b - mean_b * mean_b + second_e - mean_e * mean_e,
-                Mode::Fis | Mode::Prefiltered => second - mu * mu,
+                Estimator::Reference => second_b - mean_b * mean_b + second_e - mean_e * mean_e,
+                Estimator::Fis | Estimator::Prefiltered => second - mu * mu,
             };
             variance.max(0.0).sqrt() / mu
         })
@@ -71,7 +71,13 @@ fn noise_tolerance(spread: f64) -> f64 {
 
 /// Holds every covered pixel of `image` (rendered in `mode`) to `expected(theta_o)`, per pixel
 /// and on average; checks that uncovered pixels are `L` exactly and that black pixels are black.
-fn check(image: &Image, mode: Mode, material: &Material, expected: impl Fn(f64) -> Option<[f64; 3]>, systematic: f64) {
+fn check(
+    image: &Image,
+    mode: Estimator,
+    material: &Material,
+    expected: impl Fn(f64) -> Option<[f64; 3]>,
+    systematic: f64,
+) {
     let scene = support::sphere_scene(SIZE, SIZE);
     let gbuffer = raster::rasterize(&scene.mesh, scene.camera.view_proj(1.0), SIZE, SIZE).expect("valid scene");
     let theta_o = support::theta_o(&gbuffer, &scene.camera);
@@ -119,15 +125,15 @@ fn check_all_modes(material: &Material, expected: impl Fn(f64) -> Option<[f64; 3
     let scene = support::sphere_scene(SIZE, SIZE);
     let lighting = support::constant_lighting();
     let render = |mode| {
-        let settings = Settings { mode, spp: SPP, frames: FRAMES, seed: 7 };
+        let settings = Settings { estimator: mode, spp: SPP, frames: FRAMES, seed: 7 };
         render::render(&scene, material, &lighting, &settings).expect("valid inputs")
     };
-    let (fis, prefiltered) = (render(Mode::Fis), render(Mode::Prefiltered));
+    let (fis, prefiltered) = (render(Estimator::Fis), render(Estimator::Prefiltered));
     // Every lookup of a constant map returns the constant: the filtered modes cannot differ, both
     // reading the diffuse part from the cosine layer at the normal and the rest in the lookups.
     assert_eq!(fis, prefiltered, "prefiltered differs from fis under a constant map");
-    check(&fis, Mode::Fis, material, expected, systematic);
-    check(&render(Mode::Reference), Mode::Reference, material, expected, systematic);
+    check(&fis, Estimator::Fis, material, expected, systematic);
+    check(&render(Estimator::Reference), Estimator::Reference, material, expected, systematic);
 }
 
 #[test]

@@ -2,12 +2,12 @@
 
 use glam::Vec3;
 use render::converged::converged;
-use render::{Camera, Error, Lighting, Material, Mesh, Mode, SampleSet, Scene, Settings};
+use render::{Camera, Error, Estimator, Lighting, Material, Mesh, SampleSet, Scene, Settings};
 
 use crate::support;
 
-fn settings(mode: Mode, spp: u32, frames: u32) -> Settings {
-    Settings { mode, spp, frames, seed: 0 }
+fn settings(mode: Estimator, spp: u32, frames: u32) -> Settings {
+    Settings { estimator: mode, spp, frames, seed: 0 }
 }
 
 fn expect_invalid(result: Result<render::Image, Error>, says: &str) {
@@ -23,11 +23,11 @@ fn settings_must_fit_the_samples() {
     let lighting = support::constant_lighting();
     let material = support::lambertian(0);
     let render = |s: Settings| render::render(&scene, material, &lighting, &s);
-    expect_invalid(render(settings(Mode::Reference, 3, 1)), "spp 3 must be a power of two");
-    expect_invalid(render(settings(Mode::Reference, 0, 1)), "spp 0");
-    expect_invalid(render(settings(Mode::Reference, 1024, 1)), "dividing the 512 samples");
-    expect_invalid(render(settings(Mode::Fis, 4, 0)), "frames must be at least 1");
-    assert!(render(settings(Mode::Reference, 512, 1)).is_ok());
+    expect_invalid(render(settings(Estimator::Reference, 3, 1)), "spp 3 must be a power of two");
+    expect_invalid(render(settings(Estimator::Reference, 0, 1)), "spp 0");
+    expect_invalid(render(settings(Estimator::Reference, 1024, 1)), "dividing the 512 samples");
+    expect_invalid(render(settings(Estimator::Fis, 4, 0)), "frames must be at least 1");
+    assert!(render(settings(Estimator::Reference, 512, 1)).is_ok());
 }
 
 fn with_samples(material: &Material, samples: SampleSet) -> Material {
@@ -40,7 +40,7 @@ fn sample_sets_must_be_consistent() {
     let lighting = support::constant_lighting();
     let material = support::lambertian(0);
     let s = &material.samples;
-    let render = |m: &Material| render::render(&scene, m, &lighting, &settings(Mode::Reference, 4, 1));
+    let render = |m: &Material| render::render(&scene, m, &lighting, &settings(Estimator::Reference, 4, 1));
     let short = SampleSet { texels: s.texels[1..].to_vec(), ..s.clone() };
     expect_invalid(render(&with_samples(material, short)), "texels, expected");
     let odd = SampleSet { n_samples: 384, n_vectors: s.n_vectors * 4 / 3, ..s.clone() };
@@ -57,11 +57,11 @@ fn prefiltered_mode_needs_layers() {
     let scene = support::sphere_scene(8, 8);
     let material = support::lambertian(0);
     let lighting = support::constant_lighting();
-    let prefiltered = settings(Mode::Prefiltered, 4, 1);
+    let prefiltered = settings(Estimator::Prefiltered, 4, 1);
     let no_layers = Lighting { layers: Vec::new(), exponents: Vec::new(), ..lighting.clone() };
     expect_invalid(render::render(&scene, material, &no_layers, &prefiltered), "at least one prefiltered layer");
     // Other modes do not read the layers.
-    assert!(render::render(&scene, material, &no_layers, &settings(Mode::Fis, 4, 1)).is_ok());
+    assert!(render::render(&scene, material, &no_layers, &settings(Estimator::Fis, 4, 1)).is_ok());
     let mismatch = Lighting { exponents: vec![1, 4], ..lighting.clone() };
     expect_invalid(render::render(&scene, material, &mismatch, &prefiltered), "1 prefiltered layers but 2 exponents");
     let no_rows = Material { view_layers: Vec::new(), ..material.clone() };
@@ -80,7 +80,7 @@ fn prefiltered_mode_needs_layers() {
 fn scenes_must_be_valid() {
     let material = support::lambertian(0);
     let lighting = support::constant_lighting();
-    let s = settings(Mode::Reference, 4, 1);
+    let s = settings(Estimator::Reference, 4, 1);
     let scene = support::sphere_scene(8, 8);
     let render = |scene: &Scene| render::render(scene, material, &lighting, &s);
     expect_invalid(render(&Scene { width: 0, ..scene.clone() }), "empty image");

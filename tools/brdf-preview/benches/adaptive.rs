@@ -66,7 +66,7 @@ use std::time::Instant;
 
 use bandwidth::Reading;
 use render::adaptive::{self, Bandwidths, EnvBandwidth};
-use render::{Camera, Image, Lighting, Material, Mode, Scene, Settings, metrics};
+use render::{Camera, Estimator, Image, Lighting, Material, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["gold-paint", "white-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k", "quarry_01_1k"];
@@ -335,11 +335,11 @@ impl Options {
 
     /// The brute force's frame at `spp`.
     fn brute_settings(&self, spp: u32) -> Settings {
-        Settings { mode: Mode::Reference, spp, frames: 1, seed: self.seed.wrapping_add(11) }
+        Settings { estimator: Estimator::Reference, spp, frames: 1, seed: self.seed.wrapping_add(11) }
     }
 
     /// An adaptive frame of the main table: `mode` at `spp` under `variant`.
-    fn adaptive_settings(&self, mode: Mode, spp: u32, variant: &Variant) -> adaptive::Settings {
+    fn adaptive_settings(&self, mode: Estimator, spp: u32, variant: &Variant) -> adaptive::Settings {
         adaptive::Settings {
             predict_level: self.predict_level,
             allocation: self.allocation,
@@ -666,7 +666,7 @@ fn equal_quality(
     results: &mut Results,
 ) {
     for (mode, label, budgets) in
-        [(Mode::Reference, "adaptive", [4u32, 16]), (Mode::Prefiltered, "adaptive-prefiltered", [2, 8])]
+        [(Estimator::Reference, "adaptive", [4u32, 16]), (Estimator::Prefiltered, "adaptive-prefiltered", [2, 8])]
     {
         for variant in variants {
             if let Some(r) = case.renderer.as_mut() {
@@ -734,7 +734,7 @@ fn correlations(case: &Case, readings: &[Variant], fft: &bandwidth::WindowedFftM
     let size = case.scene.width;
     let measured_variance = one_sample_variance(case);
     for variant in readings {
-        let settings = adaptive::Settings { predict_level: 0, ..adaptive::Settings::new(Mode::Reference, 4) };
+        let settings = adaptive::Settings { predict_level: 0, ..adaptive::Settings::new(Estimator::Reference, 4) };
         let frame =
             adaptive::render(&case.scene, case.baked.material(), case.baked.lighting(), &variant.bandwidths, &settings)
                 .expect("adaptive");
@@ -770,7 +770,7 @@ fn correlations(case: &Case, readings: &[Variant], fft: &bandwidth::WindowedFftM
 fn one_sample_variance(case: &Case) -> Vec<f64> {
     let one_spp: Vec<Image> = (0..16)
         .map(|s| {
-            let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 100 + s };
+            let settings = Settings { estimator: Estimator::Reference, spp: 1, frames: 1, seed: 100 + s };
             render::render(&case.scene, case.baked.material(), case.baked.lighting(), &settings).expect("render")
         })
         .collect();
@@ -802,7 +802,7 @@ fn anti_aliasing(bench: &Bench, case: &mut Case, paper: &Variant) -> AntiAliasin
             supersample,
             predict_level: bench.options.predict_level,
             allocation: bench.options.allocation,
-            ..adaptive::Settings::new(Mode::Reference, 8)
+            ..adaptive::Settings::new(Estimator::Reference, 8)
         };
         match renderer {
             Some(r) => {

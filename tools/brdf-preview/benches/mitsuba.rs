@@ -91,7 +91,7 @@ use std::time::Instant;
 use envmap::EnvMap;
 use picture::Canvas;
 use picture::layout::Grid;
-use render::{Camera, Image, Lighting, Material, Mesh, Mode, Scene, Settings, adaptive, metrics};
+use render::{Camera, Estimator, Image, Lighting, Material, Mesh, Scene, Settings, adaptive, metrics};
 use serde_json::{Value, json};
 
 const MAPS: [&str; 2] = ["quarry_01", "studio_small_03"];
@@ -213,14 +213,14 @@ fn ours(
     let start = Instant::now();
     let image = render::converged::converged(scene, material, lighting, converged, 0).expect("the converged estimate");
     let mut images = vec![("converged", image, start.elapsed().as_secs_f64())];
-    for mode in Mode::ALL {
+    for mode in Estimator::ALL {
         let settings = Settings::previewer(mode, &material.samples, None, None, 0);
         let start = Instant::now();
         let image = render::render(scene, material, lighting, &settings)
             .unwrap_or_else(|e| panic!("rendering {}: {e}", mode.name()));
         images.push((mode.name(), image, start.elapsed().as_secs_f64()));
     }
-    for (name, mode) in [("adaptive", Mode::Reference), ("adaptive-prefiltered", Mode::Prefiltered)] {
+    for (name, mode) in [("adaptive", Estimator::Reference), ("adaptive-prefiltered", Estimator::Prefiltered)] {
         let settings = adaptive::Settings {
             predict_level: 2,
             allocation: adaptive::Allocation::Area,
@@ -679,7 +679,7 @@ fn measure(options: &Options) -> Measurements {
 
 /// Our modes' settings as [`ours`] renders them, in words.
 fn defaults(material: &Material) -> String {
-    Mode::ALL
+    Estimator::ALL
         .iter()
         .map(|&mode| {
             let settings = Settings::previewer(mode, &material.samples, None, None, 0);

@@ -21,7 +21,7 @@ use common::shared;
 use std::time::Instant;
 
 use bandwidth_atlas::view::{ViewReduction, select_layers_of_table, view_coordinates};
-use render::{Camera, Lighting, Material, Mode, Scene, Settings, metrics};
+use render::{Camera, Estimator, Lighting, Material, Scene, Settings, metrics};
 
 const MATERIALS: [&str; 3] = ["white-paint", "gold-paint", "chrome"];
 const ENVIRONMENTS: [&str; 2] = ["potsdamer_platz_1k.hdr", "quarry_01_1k.hdr"];
@@ -140,7 +140,7 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
             let mut sum = 0.0;
             for (c, case) in cases.iter().enumerate() {
                 let view_layers = selections[c / ENVIRONMENTS.len()][r].clone();
-                let psnr = psnr_of(case, scene, view_layers, Mode::Prefiltered, 16, 1);
+                let psnr = psnr_of(case, scene, view_layers, Estimator::Prefiltered, 16, 1);
                 sum += psnr;
                 print!(" {psnr:>24.2}");
             }
@@ -150,10 +150,10 @@ fn calibration(cases: &[Case], scene: &Scene, exponents: &[u32], quick: bool) {
 }
 
 /// PSNR of one CPU render against the case's converged estimate.
-fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<f32>, mode: Mode, spp: u32, frames: u32) -> f64 {
+fn psnr_of(case: &Case, scene: &Scene, view_layers: Vec<f32>, mode: Estimator, spp: u32, frames: u32) -> f64 {
     let material = Material::new(case.table.clone(), case.samples.clone(), view_layers);
-    let image =
-        render::render(scene, &material, &case.lighting, &Settings { mode, spp, frames, seed: 0 }).expect("render");
+    let image = render::render(scene, &material, &case.lighting, &Settings { estimator: mode, spp, frames, seed: 0 })
+        .expect("render");
     metrics::psnr_db(&metrics::tonemap(&image, &case.preview), &case.converged_picture)
 }
 
@@ -177,15 +177,15 @@ fn modes(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene, exponents: &[u32]) {
             );
             let mut renderer = gpu::preview::Renderer::new(gpu, scene, &material, &case.lighting).expect("renderer");
             let runs = [
-                (Mode::Reference, 16, 1),
-                (Mode::Fis, 16, 1),
-                (Mode::Prefiltered, 16, 1),
-                (Mode::Reference, 64, 16),
-                (Mode::Fis, 64, 1),
-                (Mode::Prefiltered, 64, 1),
+                (Estimator::Reference, 16, 1),
+                (Estimator::Fis, 16, 1),
+                (Estimator::Prefiltered, 16, 1),
+                (Estimator::Reference, 64, 16),
+                (Estimator::Fis, 64, 1),
+                (Estimator::Prefiltered, 64, 1),
             ];
             for (mode, spp, frames) in runs {
-                let settings = Settings { mode, spp, frames, seed: 0 };
+                let settings = Settings { estimator: mode, spp, frames, seed: 0 };
                 renderer.render_frames(&Settings { frames: 1, ..settings }).expect("warm-up");
                 let repeats = (16 / frames).max(1);
                 let start = Instant::now();
@@ -227,8 +227,9 @@ fn expectation(gpu: &gpu::Gpu, cases: &[Case], scene: &Scene) {
             let spp = 256;
             let frames = render::frames_to_exhaust(samples.n_vectors, samples.n_samples, spp);
             let start = Instant::now();
-            let image =
-                renderer.render_frames(&Settings { mode: Mode::Reference, spp, frames, seed: 0 }).expect("render");
+            let image = renderer
+                .render_frames(&Settings { estimator: Estimator::Reference, spp, frames, seed: 0 })
+                .expect("render");
             let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(frames);
             let psnr = metrics::psnr_db(&metrics::tonemap(&image, &case.preview), &case.converged_picture);
             let luminance = metrics::mean_luminance(&image) / metrics::mean_luminance(&case.converged);

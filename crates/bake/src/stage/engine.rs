@@ -6,7 +6,7 @@
 //! engine draws with the very numbers `brdf-preview` draws with.
 
 use prefilter::ktx::{self, DataShape};
-use render::{Lighting, Material, Mode, Settings};
+use render::{Estimator, Lighting, Material, Settings};
 use serde_json::json;
 
 use crate::{Error, OutFile, Program, Staged, object};
@@ -122,7 +122,7 @@ pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Resul
         DataShape { width: layer0.width(), height: layer0.height(), depth: 0, layers: layers.len(), channels: 4 };
     add(LAYERS_KTX2, "engine-layers", encode(LAYERS_KTX2, layers_shape, &layer_values)?);
 
-    let defaults = |mode: Mode| {
+    let defaults = |mode: Estimator| {
         let s = Settings::previewer(mode, &material.samples, None, None, 0);
         json!({ "spp": s.spp, "frames": s.frames })
     };
@@ -143,7 +143,10 @@ pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Resul
         ("peak_threshold", json!(lighting.peaks.as_ref().map(|p| p.threshold))),
         ("diffuse", json!(render::diffuse_split(material, lighting))),
         ("exposure_ev", json!(exposure_ev)),
-        ("previewer", json!({ "reference": defaults(Mode::Reference), "prefiltered": defaults(Mode::Prefiltered) })),
+        (
+            "previewer",
+            json!({ "reference": defaults(Estimator::Reference), "prefiltered": defaults(Estimator::Prefiltered) }),
+        ),
     ]);
     let megabytes = files.iter().map(|f| f.bytes.len()).sum::<usize>() as f64 / 1e6;
     let report = vec![

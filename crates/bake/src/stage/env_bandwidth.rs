@@ -11,7 +11,7 @@ use bandwidth::{
     BandwidthMap, Config, Image, Reading, WindowedFftConfig, compare_maps, latlong_bandwidth, local_bandwidth,
     local_bandwidth_zero_padded, log1p_luminance, wavelet_at_windows, windowed_fft_bandwidth,
 };
-use bandwidth_atlas::view::LayerSelection;
+use bandwidth_atlas::view::ViewLayers;
 use serde_json::json;
 
 use crate::{Error, OutFile, Staged, object};
@@ -90,7 +90,7 @@ impl ReadingChoice {
     }
 
     /// The reading for the material whose layer selection is `selection`.
-    pub fn resolve(self, selection: &LayerSelection) -> Reading {
+    pub fn resolve(self, selection: &ViewLayers) -> Reading {
         match self {
             ReadingChoice::Fixed(reading) => reading,
             ReadingChoice::Auto if mirror_like(selection) => Reading::LevelNormalized,
@@ -118,7 +118,7 @@ impl std::str::FromStr for ReadingChoice {
 /// default bake: black-obsidian, blue-acrylic, brass, chrome and steel (least view bandwidth
 /// 17.3 to 21.8 cycles per radian against the sharpest layer's 13.4); red-metallic-paint (9.8)
 /// and white-marble (8.4) are not.
-pub fn mirror_like(selection: &LayerSelection) -> bool {
+pub fn mirror_like(selection: &ViewLayers) -> bool {
     let Some(&sharpest) = selection.layer_bandwidth.last() else { return false };
     !selection.view_bandwidth.is_empty() && selection.view_bandwidth.iter().all(|&b| b >= sharpest)
 }
@@ -370,8 +370,8 @@ fn figures(
 mod tests {
     use super::*;
 
-    fn selection(view_bandwidth: Vec<f64>) -> LayerSelection {
-        LayerSelection {
+    fn selection(view_bandwidth: Vec<f64>) -> ViewLayers {
+        ViewLayers {
             reduction: bandwidth_atlas::view::ViewReduction::BandQuantile(0.99),
             exponents: vec![16, 256, 4096],
             layer_bandwidth: vec![0.45, 1.7, 6.8],

@@ -12,7 +12,7 @@
 //! map itself); the diffuse-looking ones (pink-fabric, silver-metallic-paint) stay at n = 16 to
 //! 256, most rows at 16 and 64.
 
-use bandwidth_atlas::view::{LayerSelection, ViewReduction, select_layers};
+use bandwidth_atlas::view::{ViewLayers, ViewReduction, select_layers};
 use bandwidth_atlas::{AtlasBuild, Config};
 use serde_json::json;
 
@@ -48,14 +48,14 @@ pub fn select(
     config: &Config,
     exponents: &[u32],
     reduction: ViewReduction,
-) -> Result<LayerSelection, Error> {
+) -> Result<ViewLayers, Error> {
     select_layers(build, config, exponents, reduction).map_err(|e| Error::stage("layer selection", e))
 }
 
 /// The stage of `selection` ([`select`] of the atlas build `build`, made with `config`); `source`
 /// is the material.
 pub fn run(
-    selection: &LayerSelection,
+    selection: &ViewLayers,
     config: &Config,
     build: &AtlasBuild,
     source: &Source,

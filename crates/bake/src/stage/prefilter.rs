@@ -107,7 +107,7 @@ fn outputs(
     let layer_maps: Vec<&EnvMap> = prefiltered.layers.iter().map(|layer| &layer.map).collect();
     // The encoders are serial (the EXR and PNG compressors above all): run them side by side.
     let ktx =
-        |result: Result<prefilter::ktx::Encoded, prefilter::Error>, name: &str| result.map_err(|e| encoding(name, &e));
+        |result: Result<prefilter::ktx::Ktx2File, prefilter::Error>, name: &str| result.map_err(|e| encoding(name, &e));
     let ((layers, mips), (exrs, (png, cubes))) = rayon::join(
         || {
             rayon::join(

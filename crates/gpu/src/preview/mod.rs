@@ -35,7 +35,7 @@ use std::sync::Arc;
 
 use bytemuck::Pod;
 use glam::DVec3;
-use render::{Camera, Image, Mode, Settings};
+use render::{Camera, Estimator, Image, Settings};
 use wgpu::util::DeviceExt;
 
 use crate::context::check_buffer_fits;
@@ -110,7 +110,7 @@ impl View {
     }
 
     /// `MODE_*` of the WGSL for this view of a render in `mode`.
-    fn mode_index(self, mode: Mode) -> u32 {
+    fn mode_index(self, mode: Estimator) -> u32 {
         match self {
             View::Shaded => mode_index(mode),
             View::Normal => MODE_DEBUG_NORMAL,
@@ -128,10 +128,11 @@ struct Progress {
     frames: u32,
 }
 
-/// The visible surface at every pixel centre as the shading pass sees it, row-major, row 0 at the
-/// top: for the tests to hold visibility to `render::raster` on its own, before any shading.
+/// The G-buffer read back: the visible surface at every pixel centre as the shading pass sees
+/// it, row-major, row 0 at the top, for the tests to hold visibility to `render::raster` on its
+/// own, before any shading.
 #[derive(Clone, Debug, PartialEq)]
-pub struct GBuffer {
+pub struct GBufferReadback {
     pub width: usize,
     pub height: usize,
     /// The index of the triangle that covers the pixel centre, if any.
@@ -143,7 +144,7 @@ pub struct GBuffer {
     pub normal: Vec<[f32; 3]>,
 }
 
-impl GBuffer {
+impl GBufferReadback {
     /// Whether a triangle covers each pixel centre.
     pub fn coverage(&self) -> Vec<bool> {
         self.triangle.iter().map(Option::is_some).collect()
@@ -283,7 +284,7 @@ impl Renderer {
         })?;
         // Nothing to continue is recorded before the work, so that a failure leaves none.
         self.progress.set(None);
-        let shade = self.shade_uniform(view.mode_index(settings.mode), settings);
+        let shade = self.shade_uniform(view.mode_index(settings.estimator), settings);
         self.shade_frames(&shade, progress.frames, frames, progress.frames == 0)?;
         self.progress.set(Some(Progress { frames: total, ..progress }));
         Ok(total)
@@ -323,12 +324,12 @@ impl Renderer {
     }
 
     /// The visible surface at every pixel centre, as the shading pass interpolates it.
-    pub fn gbuffer(&self) -> Result<GBuffer, GpuError> {
+    pub fn gbuffer(&self) -> Result<GBufferReadback, GpuError> {
         // Any valid sample choice: these modes read no sample.
-        let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
+        let settings = Settings { estimator: Estimator::Reference, spp: 1, frames: 1, seed: 0 };
         let positions = self.run_shading(&self.shade_uniform(MODE_GBUFFER_POSITION, &settings))?;
         let normals = self.run_shading(&self.shade_uniform(MODE_GBUFFER_NORMAL, &settings))?;
-        Ok(GBuffer {
+        Ok(GBufferReadback {
             width: self.width(),
             height: self.height(),
             // The index plus one, exact in f32 up to the 2^24 triangles a mesh may have.
@@ -475,7 +476,7 @@ impl Renderer {
         capture_errors(&self.device, || self.write_predict_uniform(prediction, settings))?;
         let items = prediction_items(pixels, geometry.pixels());
         let pipeline = &self.adaptive_pipelines()?.predict;
-        let values = self.run_items(pipeline, &prediction.group, settings.mode, settings.seed, &items)?;
+        let values = self.run_items(pipeline, &prediction.group, settings.estimator, settings.seed, &items)?;
         Ok(values.iter().map(|v| if v[0] < 0.0 { [0.5, 0.0] } else { [f64::from(v[0]), f64::from(v[1])] }).collect())
     }
 
@@ -497,20 +498,20 @@ impl Renderer {
 
     /// Runs an entry that takes a list of items (`predict_blocks`): the items
     /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
-    /// count in the shade uniform's `items`, with `mode` and `seed`; `group` is group 3. Returns
+    /// count in the shade uniform's `items`, with `estimator` and `seed`; `group` is group 3. Returns
     /// the first `items.len()` entries the pass leaves.
     fn run_items(
         &self,
         pipeline: &wgpu::ComputePipeline,
         group: &wgpu::BindGroup,
-        mode: Mode,
+        estimator: Estimator,
         seed: u32,
         items: &[[u32; 4]],
     ) -> Result<Vec<[f32; 4]>, GpuError> {
         self.progress.set(None);
         let count = items.len() as u32;
-        let settings = Settings { mode, spp: 1, frames: 1, seed };
-        let shade = ShadeUniform { items: count, ..self.shade_uniform(mode_index(mode), &settings) };
+        let settings = Settings { estimator, spp: 1, frames: 1, seed };
+        let shade = ShadeUniform { items: count, ..self.shade_uniform(mode_index(estimator), &settings) };
         let (x, y) = item_groups(count);
         let encoder = capture_errors(&self.device, || {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
@@ -656,8 +657,8 @@ impl Renderer {
             }
             // The environment behind the mesh, the same in every frame of this camera: the
             // shading uniform's camera (the frames write theirs again).
-            let settings = Settings { mode: Mode::Reference, spp: 1, frames: 1, seed: 0 };
-            let shade = self.shade_uniform(mode_index(Mode::Reference), &settings);
+            let settings = Settings { estimator: Estimator::Reference, spp: 1, frames: 1, seed: 0 };
+            let shade = self.shade_uniform(mode_index(Estimator::Reference), &settings);
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(&shade));
             {
                 let mut pass = self.begin_pass(&mut encoder);

@@ -2,7 +2,7 @@
 //! with the tests that hold them to the shader's.
 
 use bytemuck::{Pod, Zeroable};
-use render::Mode;
+use render::Estimator;
 
 /// The wavelet BRDF decoder's uniform, as `wavelet_brdf.wgsl` declares it.
 #[repr(C)]
@@ -17,7 +17,7 @@ pub(crate) struct WaveletUniform {
 }
 
 impl WaveletUniform {
-    pub(crate) fn new(wavelet: Option<&render::WaveletBrdf>) -> WaveletUniform {
+    pub(crate) fn new(wavelet: Option<&render::WaveletBrdfLod>) -> WaveletUniform {
         match wavelet {
             Some(w) => {
                 let grid = w.brdf.grid();
@@ -76,7 +76,7 @@ pub(crate) struct ShadeUniform {
     /// frame's parts); 0 for the passes over pixels.
     pub(crate) items: u32,
     /// The samples the fis estimator's footprints are sized for: `spp` times the frames the
-    /// picture averages (`render`'s crate docs, `Mode::Fis`).
+    /// picture averages (`render`'s crate docs, `Estimator::Fis`).
     pub(crate) filter_samples: u32,
     pub(crate) _pad1: u32,
     pub(crate) _pad2: u32,
@@ -130,11 +130,11 @@ pub(crate) struct PredictUniform {
 }
 
 /// `MODE_*` of the WGSL.
-pub(crate) fn mode_index(mode: Mode) -> u32 {
+pub(crate) fn mode_index(mode: Estimator) -> u32 {
     match mode {
-        Mode::Reference => 0,
-        Mode::Fis => 1,
-        Mode::Prefiltered => 2,
+        Estimator::Reference => 0,
+        Estimator::Fis => 1,
+        Estimator::Prefiltered => 2,
     }
 }
 
@@ -192,9 +192,9 @@ mod tests {
     #[test]
     fn mode_indices_match_the_shader() {
         let modes = [
-            ("REFERENCE", mode_index(Mode::Reference)),
-            ("FIS", mode_index(Mode::Fis)),
-            ("PREFILTERED", mode_index(Mode::Prefiltered)),
+            ("REFERENCE", mode_index(Estimator::Reference)),
+            ("FIS", mode_index(Estimator::Fis)),
+            ("PREFILTERED", mode_index(Estimator::Prefiltered)),
             ("GBUFFER_POSITION", MODE_GBUFFER_POSITION),
             ("GBUFFER_NORMAL", MODE_GBUFFER_NORMAL),
             ("DEBUG_NORMAL", MODE_DEBUG_NORMAL),

@@ -458,7 +458,8 @@ fn shade_blocks(plan: &Plan, frame: &Frame, shader: Option<Shader>) -> Result<Sh
             .map(|&(pixel, samples)| {
                 let local = shading_frame(gbuffer, frame.eye, pixel as usize);
                 let spp = samples.min(n_samples);
-                let shading = crate::Settings { mode: settings.mode, spp, frames: samples / spp, seed: settings.seed };
+                let shading =
+                    crate::Settings { estimator: settings.estimator, spp, frames: samples / spp, seed: settings.seed };
                 let block = BlockFilter { layer_shift: settings.layer_shift, frames: settings.frames };
                 shade(&local, pixel, material, lighting, &shading, block).map(|v| v as f32)
             })

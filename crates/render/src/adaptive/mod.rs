@@ -230,7 +230,7 @@
 //! is the mean of its `s x s` render pixels.
 
 use crate::error::Error;
-use crate::{Lighting, Material, Mode, SampleSet};
+use crate::{Estimator, Lighting, Material, SampleSet};
 
 mod frame;
 mod geometry;
@@ -308,9 +308,9 @@ pub struct Bandwidths {
 /// How an adaptive frame is rendered (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
-    /// The estimator of the shaded pixels: [`Mode::Reference`] (`adaptive`) or
-    /// [`Mode::Prefiltered`] (`adaptive-prefiltered`, eq. 10 for the variance).
-    pub mode: Mode,
+    /// The estimator of the shaded pixels: [`Estimator::Reference`] (`adaptive`) or
+    /// [`Estimator::Prefiltered`] (`adaptive-prefiltered`, eq. 10 for the variance).
+    pub estimator: Estimator,
     /// The budget: mean samples per covered pixel of the output image.
     pub spp: u32,
     /// The most samples one shaded block gets: a power of two. A block with more samples than
@@ -341,7 +341,7 @@ pub struct Settings {
     /// adaptively" where the weights say the parents do not represent it. 0: only when they
     /// all vanish.
     pub rescue_below: f64,
-    /// [`Mode::Prefiltered`]: the shaded blocks read the Phong layer this many layers sharper
+    /// [`Estimator::Prefiltered`]: the shaded blocks read the Phong layer this many layers sharper
     /// than the one [`Material::view_layers`] picks for their view (each layer a lobe half as
     /// wide), the map itself past the sharpest layer at most (module docs, "Shading"). Default
     /// [`LAYER_SHIFT`].
@@ -403,12 +403,12 @@ impl Settings {
         u64::from(self.max_spp).min(slice) as u32
     }
 
-    /// The defaults for a mode and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
+    /// The defaults for an estimator and a budget: `n_b` 16, no anti-aliasing, the full pyramid,
     /// `max_spp` [`MAX_SPP`], depth sigma 0.02, seed 0, a prediction per pixel, samples in
     /// proportion to the variance (the paper's choices where it makes one).
-    pub fn new(mode: Mode, spp: u32) -> Self {
+    pub fn new(estimator: Estimator, spp: u32) -> Self {
         Settings {
-            mode,
+            estimator,
             spp,
             max_spp: MAX_SPP,
             n_b: 16,
@@ -430,10 +430,10 @@ impl Settings {
 /// with: these with [`Settings::max_spp`] lowered to the block cap ([`Settings::block_cap`]).
 /// Both renderers take their frame's settings from here.
 pub fn check_settings(settings: &Settings, material: &Material, lighting: &Lighting) -> Result<Settings, Error> {
-    if !matches!(settings.mode, Mode::Reference | Mode::Prefiltered) {
+    if !matches!(settings.estimator, Estimator::Reference | Estimator::Prefiltered) {
         return Err(Error::Invalid(format!(
             "adaptive shading uses the reference or the prefiltered estimator, not {}",
-            settings.mode.name()
+            settings.estimator.name()
         )));
     }
     if !settings.max_spp.is_power_of_two() {
@@ -442,7 +442,7 @@ pub fn check_settings(settings: &Settings, material: &Material, lighting: &Light
     // A block's samples are read a vector's worth (at most) at a time: the chunks' check.
     let n_samples = material.samples.n_samples;
     let per_frame = settings.max_spp.min(u32::try_from(n_samples).unwrap_or(u32::MAX));
-    let base = crate::Settings { mode: settings.mode, spp: per_frame, frames: 1, seed: settings.seed };
+    let base = crate::Settings { estimator: settings.estimator, spp: per_frame, frames: 1, seed: settings.seed };
     crate::check_settings(&base, n_samples, lighting.layers.len(), &material.view_layers)?;
     if settings.spp == 0 || settings.n_b == 0 || settings.frames == 0 || !matches!(settings.supersample, 1 | 2 | 4) {
         return Err(Error::Invalid(format!(

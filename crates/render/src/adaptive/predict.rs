@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::raster::GBuffer;
 use crate::shade::{brdf, slice_of};
-use crate::{Lighting, Material, Mode, pcg_hash};
+use crate::{Estimator, Lighting, Material, pcg_hash};
 
 use super::*;
 
@@ -188,8 +188,8 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
         let at_eye = bandwidth_at_eye(nu_env, rho, p.curvature, p.depth, shading.cos_o);
         weight += g / pdf;
         weighted += g / pdf * at_eye;
-        variance += match settings.mode {
-            Mode::Prefiltered => 2.0 * rho,
+        variance += match settings.estimator {
+            Estimator::Prefiltered => 2.0 * rho,
             _ => nu_env + rho,
         } * g
             * g

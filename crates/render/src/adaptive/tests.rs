@@ -4,7 +4,7 @@ use super::{
     Action, Allocation, Level, LevelSamples, Pixel, Settings, allocate, allocation, area_allocation, lobe_similarity,
     pixels, shares, upsample_weights, weighted_allocation,
 };
-use crate::Mode;
+use crate::Estimator;
 use crate::shade::visibility;
 use crate::{Camera, Mesh, Scene};
 use glam::DVec3;
@@ -73,7 +73,7 @@ fn a_coarse_block_gets_samples_for_the_pixels_it_stands_for() {
         let levels = [level(0, 3.0), level(1, 0.0), level(2, variance_2)];
         let shade = Action::Shade { samples: 0, rescued: false };
         let mut actions = vec![vec![shade], vec![Action::Skip], vec![shade]];
-        let settings = Settings { allocation, ..Settings::new(Mode::Reference, 1) };
+        let settings = Settings { allocation, ..Settings::new(Estimator::Reference, 1) };
         allocate(&levels, &mut actions, 10, &settings).unwrap();
         let got = [0, 2].map(|k| match actions[k][0] {
             Action::Shade { samples, .. } => samples,
@@ -108,7 +108,7 @@ fn the_area_allocation_per_level_is_the_water_filling_of_every_block() {
             counts.iter().enumerate().flat_map(|(k, &c)| (0..c).map(move |_| (k, 0.0))).collect();
         let weights: Vec<f64> = blocks.iter().map(|&(k, _)| (1u64 << k) as f64).collect();
         let expect = weighted_allocation(&weights, budget, max_spp);
-        let settings = Settings { allocation: Allocation::Area, max_spp, ..Settings::new(Mode::Reference, 1) };
+        let settings = Settings { allocation: Allocation::Area, max_spp, ..Settings::new(Estimator::Reference, 1) };
         let got = allocation(&blocks, budget, &settings).unwrap();
         assert_eq!(got, expect, "counts {counts:?}, budget {budget}, max_spp {max_spp}");
         assert!(got.iter().map(|&s| u64::from(s)).sum::<u64>() <= budget);
@@ -147,7 +147,7 @@ fn a_parent_weighted_below_the_least_weight_does_not_count() {
         max_variance: vec![0.0; width],
     };
     let (child, parent) = (level(0, 2), level(1, 1));
-    let settings = Settings::new(Mode::Reference, 1);
+    let settings = Settings::new(Estimator::Reference, 1);
     for (difference, counts) in [(0.25, false), (0.2, true)] {
         // The child block's pixel is (0, 0); the parent's is (1, 0).
         let pixels = [Some(pixel(1.0)), Some(pixel(1.0 + difference))];

@@ -529,8 +529,8 @@ impl Renderer {
             items,
             filter_samples: settings.frames,
             ..self.shade_uniform(
-                super::mode_index(settings.mode),
-                &render::Settings { mode: settings.mode, spp: 1, frames: 1, seed: settings.seed },
+                super::mode_index(settings.estimator),
+                &render::Settings { estimator: settings.estimator, spp: 1, frames: 1, seed: settings.seed },
             )
         };
         let passes = Passes {
