@@ -92,7 +92,7 @@ fn samples_pass_a_chi_square_test_on_real_derived_materials() {
                 let z: f64 = 1.0 - rng.random::<f64>();
                 let wi = merl::spherical_dir(z.acos(), 2.0 * std::f64::consts::PI * rng.random::<f64>());
                 if let Some(f) = table.lookup(wi, slice.wo(), merl::Interp::Nearest)
-                    && merl::luminance(f) > 0.0
+                    && color::luminance(f) > 0.0
                 {
                     assert!(slice.pdf(wi) > 0.0, "{name} slice {k}: pdf 0 at {wi} where f cos > 0");
                 }

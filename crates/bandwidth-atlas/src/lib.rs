@@ -7,7 +7,7 @@
 //! # Pipeline
 //!
 //! 1. The MERL table becomes one Rec. 709 luminance per cell ([`LuminanceTable`]), read by
-//!    `merl`'s trilinear interpolation (equal to `merl::luminance` of the RGB lookup to 1e-12
+//!    `merl`'s trilinear interpolation (equal to `color::luminance` of the RGB lookup to 1e-12
 //!    wherever the table holds data; the cells below the horizon continued, "Lobe images").
 //! 2. For each row of the incident grid (one `theta_i`), the lobe image: `n x n` pixels
 //!    (`Config::analysis_size`, default 1024) of the hemisphere of `wo` ([`LobeMap`]).

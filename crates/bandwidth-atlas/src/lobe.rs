@@ -47,7 +47,7 @@ impl LuminanceTable {
         let dims = table.dims();
         let mut luminance = (0..dims.cells())
             .into_par_iter()
-            .map(|i| table.cell_value(i).map_or(f64::NAN, merl::luminance))
+            .map(|i| table.cell_value(i).map_or(f64::NAN, color::luminance))
             .collect::<Vec<f64>>();
         continue_below_horizon(dims, &mut luminance);
         let complete = !luminance.iter().any(|v| v.is_nan());
@@ -732,7 +732,7 @@ mod tests {
                 continued += 1;
                 continue;
             }
-            let expect = merl::luminance(table.lookup(wi, wo, Interp::Trilinear).unwrap());
+            let expect = color::luminance(table.lookup(wi, wo, Interp::Trilinear).unwrap());
             assert!((expect - got).abs() <= 1e-12 * expect.abs().max(1e-3), "{wi} {wo}: {expect} {got}");
             compared += 1;
         }

@@ -1,13 +1,9 @@
 //! What the estimator reads of an HDR image.
 
+use color::luminance;
 use dwt::Image;
 
 use crate::Error;
-
-/// Rec. 709 luminance of a linear RGB triple.
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}
 
 /// `ln(1 + Y)` of every pixel of a linear HDR image, `Y` its Rec. 709 luminance clamped at 0
 /// (HDR files carry small negative values from filtering): the image the estimator should read

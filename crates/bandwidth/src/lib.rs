@@ -206,7 +206,7 @@ pub use estimate::{
     BandwidthMap, Config, DEFAULT_C, Reading, Workspace, level_frequency, local_bandwidth, local_bandwidth_zero_padded,
 };
 pub use fft::{WindowedFftConfig, WindowedFftMap, window_spread, windowed_fft_bandwidth};
-pub use hdr::{log1p_luminance, luminance};
+pub use hdr::log1p_luminance;
 pub use latlong::{
     AngularBandwidthMap, latlong_angles, latlong_bandwidth, latlong_direction, latlong_pixels_per_radian,
     latlong_radians_per_pixel,

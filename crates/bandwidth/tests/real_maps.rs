@@ -33,7 +33,7 @@ fn load(file: &str) -> Option<(Image, Image)> {
     let path = crate::shared_data::shared_or_skip(&["data/env"])?.join("data/env").join(file);
     let map = envmap::load(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let (w, h) = (map.width(), map.height());
-    let y = map.texels().iter().map(|p| bandwidth::luminance(p.map(f64::from)).max(0.0)).collect();
+    let y = map.texels().iter().map(|p| color::luminance(p.map(f64::from)).max(0.0)).collect();
     Some((Image::new(w, h, y).unwrap(), log1p_luminance(w, h, map.texels()).unwrap()))
 }
 

@@ -76,8 +76,3 @@ pub use read::{
 pub use write::{
     SampleType, ToneMap, ToneMapping, encode_exr, encode_png_rgb8, tonemap, tonemap_rgb8, write_exr, write_png_rgb8,
 };
-
-/// Rec. 709 luminance of a linear RGB triple (weights 0.2126, 0.7152, 0.0722).
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}

@@ -153,12 +153,12 @@ impl EnvMap {
 
     /// The solid-angle-weighted mean of the Rec. 709 luminance.
     pub fn mean_luminance(&self) -> f64 {
-        crate::luminance(self.mean_radiance())
+        color::luminance(self.mean_radiance())
     }
 
     /// The Rec. 709 luminance of every texel, row-major.
     pub fn luminance(&self) -> Vec<f32> {
-        self.texels().iter().map(|&rgb| crate::luminance(rgb.map(f64::from)) as f32).collect()
+        self.texels().iter().map(|&rgb| color::luminance(rgb.map(f64::from)) as f32).collect()
     }
 
     /// Per texel, the luminance of the bilinear reconstruction ([`EnvMap::lookup_uv`]) averaged

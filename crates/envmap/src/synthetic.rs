@@ -114,7 +114,7 @@ mod tests {
         for y in 0..map.height() {
             let omega = map.texel_solid_angle(y);
             for x in 0..map.width() {
-                let l = crate::luminance(map.texel(x, y).map(f64::from)) * omega;
+                let l = color::luminance(map.texel(x, y).map(f64::from)) * omega;
                 total += l;
                 if l / omega > 1e4 {
                     sun += l;

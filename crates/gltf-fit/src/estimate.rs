@@ -70,7 +70,7 @@ fn nodes() -> (Vec<f64>, Vec<f64>) {
 /// the table holds no data).
 fn backscattering(table: &MerlTable, theta: f64) -> Option<f64> {
     let hd = HalfDiff { theta_h: theta, phi_h: 0.0, theta_d: 0.0, phi_d: 0.0 };
-    table.lookup_half_diff(&hd, Interp::Trilinear).map(merl::luminance)
+    table.lookup_half_diff(&hd, Interp::Trilinear).map(color::luminance)
 }
 
 /// The power iteration on the table's backscattering, then [`ggx_alpha`]. Iterates until the

@@ -525,7 +525,7 @@ pub struct AlbedoRow {
 impl AlbedoRow {
     /// `(fit - measured) / measured` of the luminances (0 where both are 0).
     pub fn relative_error(&self) -> f64 {
-        let (m, f) = (merl::luminance(self.measured), merl::luminance(self.fit));
+        let (m, f) = (color::luminance(self.measured), color::luminance(self.fit));
         if m == 0.0 { if f == 0.0 { 0.0 } else { f64::INFINITY } } else { (f - m) / m }
     }
 }

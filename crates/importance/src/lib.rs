@@ -37,8 +37,9 @@
 
 use std::f64::consts::PI;
 
+use color::luminance;
 use glam::DVec3;
-use merl::{Interp, MerlTable, luminance, spherical_dir};
+use merl::{Interp, MerlTable, spherical_dir};
 use rayon::prelude::*;
 use sampling::{Distribution2D, owen_sobol_vectors};
 
@@ -460,8 +461,9 @@ fn build_slice(table: &MerlTable, config: &Config, rows: &HalfVectorRows, theta_
 /// numbers `merl-importance` reports and the tests bound (relative variance, albedo error, the
 /// mass above the horizon: `tests/importance.rs`).
 pub mod quality {
+    use color::luminance;
     use merl::albedo::{Quadrature, hemisphere_integral};
-    use merl::{Interp, MerlTable, luminance};
+    use merl::{Interp, MerlTable};
 
     use crate::{DirectionSample, Slice};
 

@@ -136,7 +136,7 @@ fn density_is_positive_wherever_the_integrand_is() {
             for _ in 0..20_000 {
                 let wi = spherical_dir((1.0 - rng.random::<f64>()).acos(), 2.0 * PI * rng.random::<f64>());
                 if let Some(f) = table.lookup(wi, slice.wo(), Interp::Nearest)
-                    && merl::luminance(f) * wi.z > 0.0
+                    && color::luminance(f) * wi.z > 0.0
                 {
                     assert!(slice.pdf(wi) > 0.0, "{name} slice {k}: pdf 0 at {wi} where f cos > 0");
                 }

@@ -20,8 +20,3 @@ pub use coords::{HalfDiff, half_diff, spherical_dir};
 pub use error::Error;
 pub use io::{MAX_FILE_BYTES, read_bytes, read_file};
 pub use table::{Cell, Dims, Interp, MerlTable, NO_DATA_RAW, SCALE};
-
-/// Rec. 709 luminance of a linear RGB triple, the one used wherever a scalar is needed.
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}

@@ -117,7 +117,7 @@ pub fn summarize_cells(table: &MerlTable) -> Summary {
         if largest_share.is_none_or(|s: CellShare| share.share > s.share) {
             largest_share = Some(share);
         }
-        let luminance = crate::luminance(rgb);
+        let luminance = color::luminance(rgb);
         if peak.is_none_or(|p| luminance > p.luminance) {
             let cell = dims.cell(index);
             peak = Some(Peak { rgb, luminance, cell, at: dims.sample_point(cell) });

@@ -59,7 +59,7 @@ pub fn mean_luminance(image: &Image) -> f64 {
         .zip(&image.covered)
         .filter(|(_, covered)| **covered)
         .fold((0.0, 0usize), |(sum, count), (rgb, _)| {
-            (sum + envmap::luminance([rgb[0], rgb[1], rgb[2]].map(f64::from)), count + 1)
+            (sum + color::luminance([rgb[0], rgb[1], rgb[2]].map(f64::from)), count + 1)
         });
     if count == 0 { 0.0 } else { sum / count as f64 }
 }

@@ -30,7 +30,7 @@ fn neighbour_correlation(residual: &[f64], covered: &[bool], width: usize) -> f6
 }
 
 fn luminance(image: &Image) -> Vec<f64> {
-    image.rgb.chunks_exact(3).map(|c| envmap::luminance([c[0], c[1], c[2]].map(f64::from))).collect()
+    image.rgb.chunks_exact(3).map(|c| color::luminance([c[0], c[1], c[2]].map(f64::from))).collect()
 }
 
 /// Each pixel draws its own directions, so the reference mode's error at one pixel says nothing

@@ -7,8 +7,9 @@
 
 use std::f64::consts::{E, FRAC_PI_2, PI};
 
+use color::luminance;
+use merl::Interp;
 use merl::albedo::{Quadrature, hemisphere_integral};
-use merl::{Interp, luminance};
 use render::{Estimator, Image, Material, Settings, raster};
 
 use crate::support::{self, AlbedoCurve, L};

@@ -253,7 +253,7 @@ fn picture_fft(image: &Image, preview: &envmap::ToneMapping) -> bandwidth::Windo
     let luminance: Vec<f64> = image
         .rgb
         .chunks_exact(3)
-        .map(|p| bandwidth::luminance([p[0], p[1], p[2]].map(|v| envmap::tonemap(f64::from(v), preview))))
+        .map(|p| color::luminance([p[0], p[1], p[2]].map(|v| envmap::tonemap(f64::from(v), preview))))
         .collect();
     let image = bandwidth::Image::new(image.width, image.height, luminance).unwrap();
     let config = bandwidth::WindowedFftConfig { noise_floor: 1.0 / 255.0 / 12f64.sqrt(), ..Default::default() };
@@ -774,7 +774,7 @@ fn one_sample_variance(case: &Case) -> Vec<f64> {
             render::render(&case.scene, case.baked.material(), case.baked.lighting(), &settings).expect("render")
         })
         .collect();
-    let luminance = |img: &Image, i: usize| bandwidth::luminance([0, 1, 2].map(|c| f64::from(img.rgb[3 * i + c])));
+    let luminance = |img: &Image, i: usize| color::luminance([0, 1, 2].map(|c| f64::from(img.rgb[3 * i + c])));
     (0..case.scene.width * case.scene.height)
         .map(|i| {
             let v: Vec<f64> = one_spp.iter().map(|img| luminance(img, i)).collect();

@@ -185,7 +185,7 @@ fn outgoing_cell(grid: Grid, theta_o: f64) -> usize {
 fn picture(name: &str, original: &Resampled, decoded: &[[f64; 3]], ratio: f64) -> Canvas {
     let grid = original.grid;
     let (n, cells) = (grid.side(), grid.cells());
-    let luminance = |v: &[f64; 3]| merl::luminance(*v);
+    let luminance = |v: &[f64; 3]| color::luminance(*v);
     let peak = original.values.iter().map(luminance).fold(0.0f64, f64::max).max(1e-12);
     let value_scale = Scale::log(peak * 1e-4, peak);
     let error_scale = Scale::log(1e-4, 1.0);

@@ -177,11 +177,11 @@ fn predict_pixel(p: &Pixel, i: usize, frame: &Frame) -> [f64; 2] {
         if !(pdf > 0.0 && wi_local.z > 0.0) {
             continue;
         }
-        let f = merl::luminance(brdf(material, wi_local, shading.wo_local));
+        let f = color::luminance(brdf(material, wi_local, shading.wo_local));
         let wi = shading.to_world(wi_local);
         // One map coordinate for the radiance and the bandwidth: the same texel grid.
         let (u, v) = envmap::uv(wi);
-        let radiance = envmap::luminance(level0.lookup_uv(u, v).map(f64::from));
+        let radiance = color::luminance(level0.lookup_uv(u, v).map(f64::from));
         let g = radiance * f * wi_local.z;
         let nu_env = bandwidths.environment.at_uv(u, v);
         let rho = f64::from(bandwidths.brdf.lookup(wi_local, shading.wo_local));

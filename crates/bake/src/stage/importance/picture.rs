@@ -8,8 +8,9 @@
 //! second row shows every panel again around its peak, enlarged (the factor is in its title).
 //! Under the panels: the colour bar and a caption.
 
+use color::luminance;
 use glam::DVec3;
-use merl::{Interp, MerlTable, luminance};
+use merl::{Interp, MerlTable};
 use picture::colormap::{Scale, inferno};
 use picture::layout::{Grid, caption, stack};
 use picture::legend::Legend;

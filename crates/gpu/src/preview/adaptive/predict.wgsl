@@ -28,7 +28,7 @@ const PREDICTION_SALT: u32 = 0x9e3779b9u;
 // stays within the storage buffers an adapter offers per stage.
 @group(3) @binding(1) var<storage, read> bandwidth_texels: array<f32>;
 
-// `merl::luminance` and `envmap::luminance` (Rec. 709).
+// `color::luminance` (Rec. 709).
 fn luminance(rgb: vec3<f32>) -> f32 {
     return 0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z;
 }
