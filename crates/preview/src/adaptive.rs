@@ -7,10 +7,9 @@ use std::path::Path;
 use render::{Estimator, Scene, metrics};
 use serde_json::{Value, json};
 
-use crate::checks::{
-    Converged, check_finite, check_psnr, check_work, converged, db, json_db, names, png, scene, sibling, tone_mapping,
-    with_caption,
-};
+use crate::checks::{Converged, check_finite, check_psnr, check_work, converged};
+use crate::outputs::{db, json_db, names, png, sibling, tone_mapping, with_caption};
+use crate::scene::scene;
 use crate::{Error, Host, Output, Rendered, Request};
 
 /// The mean of the adaptive frames `request` asks for (`render::adaptive`, "Frames"), written to

@@ -10,10 +10,12 @@
 
 mod adaptive;
 mod checks;
+mod outputs;
+mod scene;
 mod views;
 pub mod window;
 
-pub use checks::mesh;
+pub use scene::mesh;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -22,10 +24,9 @@ use envmap::ToneMapping;
 use render::{Estimator, Image, Lighting, Scene, Settings, metrics};
 use serde_json::json;
 
-use crate::checks::{
-    Converged, check_finite, check_psnr, check_work, contact_sheet, converged, db, json_db, names, png, scene, sibling,
-    tone_mapping, with_caption,
-};
+use crate::checks::{Converged, check_finite, check_psnr, check_work, converged};
+use crate::outputs::{contact_sheet, db, json_db, names, png, sibling, tone_mapping, with_caption};
+use crate::scene::scene;
 
 /// An error that stops a preview: the request's own (a bake that cannot serve it, work over the
 /// limit), a file's, or the renderers'. Messages are one lower-case line naming the file.
