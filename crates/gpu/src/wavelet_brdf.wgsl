@@ -1,6 +1,6 @@
 //! WGSL port of `wavelet_brdf::Decoded::eval` (Claustres et al. 2007, sections 5.3-5.4): the
 //! BRDF reconstructed from its Haar coefficients at a level of detail, step for step in f32.
-//! Compiled after `merl_lookup.wgsl` (for `merl_atan2`); group 0 bindings 2-4 hold the asset.
+//! Compiled after `merl_lookup.wgsl` (for `merl_atan2`); group 0 bindings 2 and 3 hold the asset.
 //! `material_brdf` is what the previewer's estimators call: the wavelet when one is bound
 //! (`wavelet.enabled`), else the table's nearest lookup with no data as 0.
 
@@ -18,10 +18,10 @@ struct WaveletUniform {
 }
 
 @group(0) @binding(2) var<uniform> wavelet: WaveletUniform;
-// Per coefficient position, its slice in `wavelet_slices`; 0 is the shared zero slice.
-@group(0) @binding(3) var<storage, read> wavelet_map: array<u32>;
-// The zero slice then the stored slices, each n^2 outgoing cells x 3 channels.
-@group(0) @binding(4) var<storage, read> wavelet_slices: array<f32>;
+// One buffer, one binding (`Renderer::new` packs it): the map, per coefficient position (n^2 of
+// them) its slice, 0 the shared zero slice; then the zero slice and the stored slices as f32
+// bits, each n^2 outgoing cells x 3 channels.
+@group(0) @binding(3) var<storage, read> wavelet_words: array<u32>;
 
 struct WaveletBilinear {
     cells: vec4<u32>,
@@ -49,8 +49,9 @@ fn wavelet_bilinear(w: vec3<f32>) -> WaveletBilinear {
 
 // Coefficient position `p` of outgoing cell `o` (`wavelet_brdf::Decoded::coefficient`).
 fn wavelet_coefficient(p: u32, o: u32) -> vec3<f32> {
-    let at = (wavelet_map[p] * wavelet.side * wavelet.side + o) * 3u;
-    return vec3<f32>(wavelet_slices[at], wavelet_slices[at + 1u], wavelet_slices[at + 2u]);
+    let cells = wavelet.side * wavelet.side;
+    let at = cells + (wavelet_words[p] * cells + o) * 3u;
+    return bitcast<vec3<f32>>(vec3<u32>(wavelet_words[at], wavelet_words[at + 1u], wavelet_words[at + 2u]));
 }
 
 // `wavelet_brdf::Decoded::log_value`: Haar synthesis of incoming cell `i` of outgoing cell `o`

@@ -862,33 +862,34 @@ fn every_mode_on_mesa_gl_equals_the_cpu() {
 }
 
 /// An adapter short of storage buffers per shader stage fails with one line that names the limit,
-/// what the adapter has and what the work needs: the shading passes bind 12 (groups 0 to 2), so
-/// WebGPU's default of 8 runs no mode; at 12 the shading modes run and an adaptive frame, whose
-/// prediction binds 13, names the modes that do.
+/// what the adapter has and what the work needs: the shading passes bind 8 (groups 0 to 2, their
+/// buffers packed), so WebGPU's default of 8 runs the estimators, equal to the CPU as anywhere, and
+/// an adaptive frame, whose passes bind 11, names the modes that run; at 7 no mode runs.
 #[test]
 fn an_adapter_short_of_storage_buffers_names_the_limit_and_the_modes_it_runs() {
     let capped =
         |n: u32| move |limits: wgpu::Limits| wgpu::Limits { max_storage_buffers_per_shader_stage: n, ..limits };
     let (scene, material, lighting) = (sphere_scene(SIZE), ggx(), sky_lighting());
-    let webgpu_default = Gpu::with_backends(wgpu::Backends::all(), &capped(8)).unwrap();
-    let error = Renderer::new(&webgpu_default, &scene, material, lighting).expect_err("8 storage buffers");
+    let seven = Gpu::with_backends(wgpu::Backends::all(), &capped(7)).unwrap();
+    let error = Renderer::new(&seven, &scene, material, lighting).expect_err("7 storage buffers");
     let message = error.to_string();
     assert!(
-        message.contains("max_storage_buffers_per_shader_stage is 8, shading (every mode) needs 12")
+        message.contains("max_storage_buffers_per_shader_stage is 7, shading (every mode) needs 8")
             && !message.contains('\n'),
         "{message}"
     );
 
-    let twelve = Gpu::with_backends(wgpu::Backends::all(), &capped(12)).unwrap();
-    let mut renderer = renderer_on(&twelve, &scene, material, lighting);
-    let image = render_gpu(&mut renderer, &settings(Estimator::Prefiltered));
-    assert!(image.covered.iter().any(|&c| c), "the shading modes run with 12");
-    let error = renderer.set_bandwidths(&bandwidths()).expect_err("an adaptive frame needs 13");
+    let webgpu_default = Gpu::with_backends(wgpu::Backends::all(), &capped(8)).unwrap();
+    for mode in [Estimator::Reference, Estimator::Fis, Estimator::Prefiltered] {
+        check_against_cpu_on(&webgpu_default, "ggx with 8 storage buffers", ggx(), mode);
+    }
+    let mut renderer = renderer_on(&webgpu_default, &scene, material, lighting);
+    let error = renderer.set_bandwidths(&bandwidths()).expect_err("an adaptive frame needs 11");
     let message = error.to_string();
     assert!(
         message.contains(
-            "max_storage_buffers_per_shader_stage is 12, an adaptive frame (reference, fis and prefiltered run on \
-             this adapter) needs 13"
+            "max_storage_buffers_per_shader_stage is 8, an adaptive frame (reference, fis and prefiltered run on \
+             this adapter) needs 11"
         ) && !message.contains('\n'),
         "{message}"
     );

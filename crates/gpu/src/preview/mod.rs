@@ -28,7 +28,9 @@
 //!
 //! Everything the shaders read lives in storage buffers (the samples, the mip chain and the
 //! prefiltered layers as f32 RGB, the view-layer table) rather than textures: float32 textures
-//! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic.
+//! need not be filterable, and bilinear weights computed by hand are the CPU's arithmetic. Buffers
+//! read together share a binding where they can, so that the estimators' passes bind 8 storage
+//! buffers, WebGPU's default per shader stage (`setup.rs`).
 
 use std::cell::{Cell, OnceCell, RefCell};
 use std::sync::Arc;
@@ -355,7 +357,8 @@ impl Renderer {
             self.queue.write_buffer(&self.shade_uniform, 0, bytemuck::bytes_of(shade));
             let mut encoder = self.device.create_command_encoder(&Default::default());
             if clear {
-                encoder.clear_buffer(&self.accumulation, 0, None);
+                // The sums only: the backdrop behind them is the camera's.
+                encoder.clear_buffer(&self.accumulation, 0, Some(16 * self.pixels()));
             }
             let mut first = first;
             while first < end {
@@ -499,7 +502,8 @@ impl Renderer {
     /// Runs an entry that takes a list of items (`predict_blocks`): the items
     /// go in through the accumulation buffer (so it holds nothing to continue afterwards), their
     /// count in the shade uniform's `items`, with `estimator` and `seed`; `group` is group 3. Returns
-    /// the first `items.len()` entries the pass leaves.
+    /// the first `items.len()` entries the pass leaves. At most a pixel's entry each: the backdrop
+    /// follows the sums.
     fn run_items(
         &self,
         pipeline: &wgpu::ComputePipeline,
@@ -508,6 +512,9 @@ impl Renderer {
         seed: u32,
         items: &[[u32; 4]],
     ) -> Result<Vec<[f32; 4]>, GpuError> {
+        if items.len() as u64 > self.pixels() {
+            return Err(render::Error::Invalid(format!("{} items for {} pixels", items.len(), self.pixels())).into());
+        }
         self.progress.set(None);
         let count = items.len() as u32;
         let settings = Settings { estimator, spp: 1, frames: 1, seed };
@@ -710,8 +717,6 @@ impl Renderer {
             tables: self.tables,
             items: 0,
             filter_samples: settings.filter_samples(),
-            _pad1: 0,
-            _pad2: 0,
             diffuse: [self.diffuse[0], self.diffuse[1], self.diffuse[2], 0.0],
         }
     }

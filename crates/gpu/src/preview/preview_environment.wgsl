@@ -40,7 +40,7 @@ fn env_texel(base: u32, index: u32) -> vec3<f32> {
 // `envmap::EnvMap::lookup_uv` of map `m`: bilinear with texel centres at (x + 1/2) / width, u
 // wrapping, v clamped to the centres of the first and last rows.
 fn env_bilinear(m: u32, uv: vec2<f32>) -> vec3<f32> {
-    let map = env_maps[m];
+    let map = env_map(m);
     let w = map.x;
     let h = map.y;
     let s = uv.x * f32(w) - 0.5;
@@ -77,7 +77,7 @@ fn mip_lod(pdf: f32) -> f32 {
     if (!(pdf > 0.0)) {
         return f32(shade.n_levels - 1u);
     }
-    let level0 = env_maps[shade.mips_first];
+    let level0 = env_map(shade.mips_first);
     let texels = f32(level0.x) * f32(level0.y);
     return max(0.5 * (log2(texels) - log2(f32(shade.filter_samples)) - log2(pdf * 2.0 * PI * PI)) + FIS_LOD_BIAS, 0.0);
 }
@@ -106,9 +106,9 @@ fn view_layer_coordinate(frame: ShadingFrame) -> f32 {
     let s = clamp((1.0 - frame.cos_o) * f32(rows) - 0.5, 0.0, f32(rows - 1u));
     let r = min(u32(floor(s)), rows - 1u);
     let t = s - f32(r);
-    let a = view_layers[r];
+    let a = sampling_tables[shade.view_layers + r];
     if (t > 0.0) {
-        return a + (view_layers[r + 1u] - a) * t;
+        return a + (sampling_tables[shade.view_layers + r + 1u] - a) * t;
     }
     return a;
 }
@@ -123,7 +123,7 @@ fn pixel_layer(frame: ShadingFrame) -> f32 {
 // The exponent of layer `k` (`shade.n_layers` past the sharpest), after the view rows.
 // No Rust twin: the CPU reads `render::Lighting::exponents` and `render::past_exponent`.
 fn layer_exponent_at(k: u32) -> f32 {
-    return view_layers[shade.n_view_rows + k];
+    return sampling_tables[shade.view_layers + shade.n_view_rows + k];
 }
 
 // `render::exponent_layer`: the layer coordinate of exponent `n`.

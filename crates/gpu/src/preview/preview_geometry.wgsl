@@ -144,7 +144,7 @@ fn interpolate_hit(t: u32, x: u32, y: u32) -> Hit {
     var w: vec3<f32>;
     var whole = true;
     for (var k = 0u; k < 3u; k++) {
-        let v = mesh_indices[3u * t + k];
+        let v = mesh_indices_and_maps[3u * t + k];
         p[k] = mesh_position(v);
         n[k] = mesh_normal(v);
         snapped[k] = mesh_snapped(v);

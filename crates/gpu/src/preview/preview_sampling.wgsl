@@ -206,7 +206,7 @@ fn solid_angle_density(pdf_uv: f32, v: f32) -> f32 {
 // over the texel's area.
 // `sampling::Distribution2D::pdf`.
 fn latlong_texel_density(d: LatLong, x: u32, y: u32) -> f32 {
-    let size = env_maps[0];
+    let size = env_map(0);
     let p_row = cdf_width(d.marginal, y);
     let p_texel = cdf_width(d.conditional + y * (size.x + 1u), x);
     return p_row * p_texel * f32(size.x) * f32(size.y);
@@ -214,7 +214,7 @@ fn latlong_texel_density(d: LatLong, x: u32, y: u32) -> f32 {
 
 // `sampling::LatLong::sample` at `u`.
 fn latlong_sample(d: LatLong, u: vec2<f32>) -> LightSample {
-    let size = env_maps[0];
+    let size = env_map(0);
     let y = cdf_bin(d.marginal, size.y, u.y);
     let fy = cdf_fraction(d.marginal, y, u.y);
     let row = d.conditional + y * (size.x + 1u);
@@ -226,7 +226,7 @@ fn latlong_sample(d: LatLong, u: vec2<f32>) -> LightSample {
 
 // `sampling::LatLong::pdf` at `uv` (in [0, 1]^2).
 fn latlong_pdf(d: LatLong, uv: vec2<f32>) -> f32 {
-    let size = env_maps[0];
+    let size = env_map(0);
     let x = min(u32(max(uv.x * f32(size.x), 0.0)), size.x - 1u);
     let y = min(u32(max(uv.y * f32(size.y), 0.0)), size.y - 1u);
     return solid_angle_density(latlong_texel_density(d, x, y), uv.y);

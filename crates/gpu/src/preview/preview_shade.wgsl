@@ -99,7 +99,7 @@ fn shade_backdrop(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= shade.width || gid.y >= shade.height) {
         return;
     }
-    backdrop[gid.y * shade.width + gid.x] = vec4<f32>(env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y))), 0.0);
+    accumulation[backdrop_index(gid.y * shade.width + gid.x)] = vec4<f32>(env_bilinear(0u, env_uv(camera_ray(gid.x, gid.y))), 0.0);
 }
 
 // One frame of every pixel: `render::shade::shade_rows` with `render::shade::shade` (the G-buffer
@@ -138,7 +138,7 @@ fn shade_frame(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     } else {
         // The environment behind the mesh in every mode, so that its orientation can be checked.
-        radiance = backdrop[pixel].xyz;
+        radiance = accumulation[backdrop_index(pixel)].xyz;
     }
     let sum = accumulation[pixel].xyz + radiance;
     accumulation[pixel] = vec4<f32>(sum, select(0.0, 1.0, covered));

@@ -21,13 +21,13 @@ impl Renderer {
     /// a buffer or the image exceeds what the adapter can hold.
     pub fn new(gpu: &Gpu, scene: &Scene, material: &Material, lighting: &Lighting) -> Result<Renderer, GpuError> {
         check_scene(scene, material, lighting)?;
-        let uploads = Uploads::new(material, lighting);
+        let uploads = Uploads::new(scene, material, lighting);
         uploads.check_fits(gpu, scene, material)?;
         let (width, height) = (scene.width as u32, scene.height as u32);
         let device = gpu.device().clone();
         let frame_stride = u64::from(gpu.limits().min_uniform_buffer_offset_alignment).max(16);
         let renderer = capture_errors(&device, || {
-            let raster = Raster::new(&device, scene);
+            let raster = Raster::new(&device, scene, &uploads.words);
             let shading = Shading::new(&device);
             let table_group = table_group(&device, &shading.table, material);
             let bake_group = uploads.bake_group(&device, &shading.bake, material, &raster);
@@ -79,32 +79,33 @@ impl Renderer {
     }
 }
 
-/// What group 1 uploads from the material and the lighting, laid out for the WGSL.
+/// What group 1 uploads from the scene, the material and the lighting, laid out for the WGSL in
+/// as few buffers as the shading passes can read (each binding counts against the adapter's
+/// storage buffers per stage).
 struct Uploads {
-    env_maps: Vec<[u32; 4]>,
+    /// The mesh's indices, then the maps' records ([`MapLayout::records`]): the raster pass reads
+    /// the indices alone.
+    words: Vec<u32>,
     env_texels: Vec<f32>,
     maps: MapLayout,
+    /// The sampling tables, then the view rows' layer coordinates, the layers' exponents and the
+    /// one past the sharpest (`render::past_exponent`).
     tables: Vec<f32>,
     sampling_layout: TableLayout,
-    /// The view rows' layer coordinates, then the layers' exponents and the one past the
-    /// sharpest (`render::past_exponent`). A binding cannot be empty; a table nobody reads (the
-    /// mode check rejects the prefiltered mode without one) holds one unused entry.
-    view_layers: Vec<f32>,
 }
 
 impl Uploads {
-    fn new(material: &Material, lighting: &Lighting) -> Uploads {
-        let (env_maps, env_texels, maps) = env_buffers(lighting);
-        let (tables, sampling_layout) = sampling_tables(material, lighting);
+    fn new(scene: &Scene, material: &Material, lighting: &Lighting) -> Uploads {
+        let indices = &scene.mesh.indices;
+        let (records, env_texels, maps) = env_buffers(lighting, indices.len() as u32);
         let mut view_layers = material.view_layers.clone();
         if !lighting.exponents.is_empty() {
             view_layers.extend(lighting.exponents.iter().map(|&n| n as f32));
             view_layers.push(render::past_exponent(&lighting.exponents) as f32);
         }
-        if view_layers.is_empty() {
-            view_layers.push(0.0);
-        }
-        Uploads { env_maps, env_texels, maps, tables, sampling_layout, view_layers }
+        let (tables, sampling_layout) = sampling_tables(material, lighting, &view_layers);
+        let words = indices.iter().copied().chain(records.iter().flatten().copied()).collect();
+        Uploads { words, env_texels, maps, tables, sampling_layout }
     }
 
     /// Fails with [`GpuError::AdapterLimit`] where the image, a buffer or the shading passes'
@@ -124,20 +125,21 @@ impl Uploads {
         let fits = |bytes: u64, what| check_buffer_fits(&limits, info, bytes, what);
         fits(table_bytes(material.table.dims()), "the MERL table")?;
         if let Some(w) = &material.wavelet_brdf {
-            fits(4 * w.brdf.slices().len() as u64, "the wavelet BRDF's slices")?;
+            fits(4 * (w.brdf.map().len() + w.brdf.slices().len()) as u64, "the wavelet BRDF's map and slices")?;
         }
         fits(16 * material.samples.texels.len() as u64, "the importance samples")?;
         fits(4 * self.env_texels.len() as u64, "the mip chain and the prefiltered layers")?;
-        fits(4 * self.tables.len() as u64, "the sampling tables")?;
-        fits(16 * (scene.width * scene.height) as u64, "the accumulation buffer")?;
+        fits(4 * self.tables.len() as u64, "the sampling tables and the view-layer table")?;
+        fits(2 * 16 * (scene.width * scene.height) as u64, "the accumulation buffer and the backdrop")?;
         // Clip-space positions, positions and normals interleaved: one storage buffer for all
-        // three, one binding of the shading passes' 12 (`Shading::storage_buffers`).
+        // three, one binding of the shading passes' (`Shading::storage_buffers`).
         fits(4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64, "the mesh's vertices")?;
-        fits(4 * scene.mesh.indices.len() as u64, "the mesh's indices")?;
+        fits(4 * self.words.len() as u64, "the mesh's indices and the maps' records")?;
         check_storage_buffers(&limits, info, Shading::storage_buffers(), "shading (every mode)")
     }
 
-    /// Group 1: the samples, every map, the view-layer table, the mesh and the sampling tables.
+    /// Group 1: the samples, the maps' texels, the mesh (its vertices; its indices with the maps'
+    /// records) and the sampling tables with the view-layer table.
     fn bake_group(
         &self,
         device: &wgpu::Device,
@@ -145,15 +147,10 @@ impl Uploads {
         material: &Material,
         raster: &Raster,
     ) -> wgpu::BindGroup {
-        let buffers = [
-            storage(device, "preview samples", bytemuck::cast_slice(&material.samples.texels)),
-            storage(device, "preview env maps", bytemuck::cast_slice(&self.env_maps)),
-            storage(device, "preview env texels", bytemuck::cast_slice(&self.env_texels)),
-            storage(device, "preview view layers", bytemuck::cast_slice(&self.view_layers)),
-        ];
+        let samples = storage(device, "preview samples", bytemuck::cast_slice(&material.samples.texels));
+        let texels = storage(device, "preview env texels", bytemuck::cast_slice(&self.env_texels));
         let tables = storage(device, "preview sampling tables", bytemuck::cast_slice(&self.tables));
-        let resources =
-            [&buffers[0], &buffers[1], &buffers[2], &buffers[3], &raster.vertex_buffer, &raster.index_buffer, &tables];
+        let resources = [&samples, &texels, &raster.vertex_buffer, &raster.index_buffer, &tables];
         let entries: Vec<wgpu::BindGroupEntry> = (0..)
             .zip(resources)
             .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
@@ -184,14 +181,15 @@ struct Raster {
 }
 
 impl Raster {
-    fn new(device: &wgpu::Device, scene: &Scene) -> Raster {
+    /// `words`: the mesh's indices and what follows them in the same buffer ([`Uploads`]).
+    fn new(device: &wgpu::Device, scene: &Scene, words: &[u32]) -> Raster {
         let vertex_buffer = crate::device::buffer(
             device,
             "preview mesh vertices",
             4 * VERTEX_FLOATS * scene.mesh.positions.len() as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
-        let index_buffer = storage(device, "preview mesh indices", bytemuck::cast_slice(&scene.mesh.indices));
+        let index_buffer = storage(device, "preview mesh indices and map records", bytemuck::cast_slice(words));
         let vertex = wgpu::ShaderStages::VERTEX;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview raster"),
@@ -241,8 +239,20 @@ impl Raster {
     }
 }
 
-/// Group 0: the MERL table and the wavelet BRDF. Without a wavelet the shader never reads its
-/// map and slices; a binding cannot be empty.
+/// The wavelet BRDF's map and slices in one buffer, as `wavelet_brdf.wgsl` reads them: the map
+/// (one slice index per coefficient position, `n^2` of them), then the slices' values as `f32`
+/// bits. Without a wavelet the shader never reads it; a binding cannot be empty.
+fn wavelet_words(material: &Material) -> Vec<u32> {
+    match &material.wavelet_brdf {
+        Some(w) => {
+            debug_assert_eq!(w.brdf.map().len(), w.brdf.grid().cells(), "a map entry per coefficient position");
+            w.brdf.map().iter().copied().chain(w.brdf.slices().iter().map(|v| v.to_bits())).collect()
+        }
+        None => vec![0],
+    }
+}
+
+/// Group 0: the MERL table and the wavelet BRDF.
 fn table_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, material: &Material) -> wgpu::BindGroup {
     let table = &material.table;
     let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -256,21 +266,16 @@ fn table_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, material: 
         contents: bytemuck::bytes_of(&WaveletUniform::new(material.wavelet_brdf.as_ref())),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let (map, slices) = match &material.wavelet_brdf {
-        Some(w) => (w.brdf.map(), w.brdf.slices()),
-        None => (&[0u32][..], &[0f32][..]),
-    };
-    let map = storage(device, "wavelet map", bytemuck::cast_slice(map));
-    let slices = storage(device, "wavelet slices", bytemuck::cast_slice(slices));
+    let words = storage(device, "wavelet map and slices", bytemuck::cast_slice(&wavelet_words(material)));
     let entries: Vec<wgpu::BindGroupEntry> = (0..)
-        .zip([&dims, &values, &wavelet, &map, &slices])
+        .zip([&dims, &values, &wavelet, &words])
         .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("merl table"), layout, entries: &entries })
 }
 
-/// Group 2: the render's uniforms (`ShadeUniform`, and `FrameUniform` one slot per frame of a submission), the
-/// G-buffer, the accumulation and the backdrop.
+/// Group 2: the render's uniforms (`ShadeUniform`, and `FrameUniform` one slot per frame of a
+/// submission), the G-buffer, and the accumulation with the backdrop behind it.
 struct RenderGroup {
     group: wgpu::BindGroup,
     shade_uniform: wgpu::Buffer,
@@ -290,13 +295,13 @@ impl RenderGroup {
         let pixels = u64::from(width) * u64::from(height);
         let shade_uniform = uniform("preview shade", size_of::<ShadeUniform>() as u64);
         let frame_uniform = uniform("preview frames", frame_stride * u64::from(FRAMES_PER_SUBMIT));
+        // The sums, then the backdrop (`backdrop_index` in the WGSL): one binding.
         let accumulation = crate::device::buffer(
             device,
-            "preview accumulation",
-            16 * pixels,
+            "preview accumulation and backdrop",
+            2 * 16 * pixels,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
-        let backdrop = crate::device::buffer(device, "preview backdrop", 16 * pixels, wgpu::BufferUsages::STORAGE);
         let frame = wgpu::BufferBinding { buffer: &frame_uniform, offset: 0, size: wgpu::BufferSize::new(16) };
         let triangles = triangle_target.create_view(&Default::default());
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -307,7 +312,6 @@ impl RenderGroup {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Buffer(frame) },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&triangles) },
                 wgpu::BindGroupEntry { binding: 3, resource: accumulation.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: backdrop.as_entire_binding() },
             ],
         });
         RenderGroup { group, shade_uniform, frame_uniform, accumulation }
@@ -435,27 +439,26 @@ pub(super) fn check_storage_buffers(
     Ok(())
 }
 
-/// Group 0: the MERL table's dimensions and values, the wavelet BRDF's parameters, map and slices
-/// (`merl_lookup.wgsl`, `wavelet_brdf.wgsl`).
-fn table_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+/// Group 0: the MERL table's dimensions and values, the wavelet BRDF's parameters, and its map
+/// and slices in one buffer (`merl_lookup.wgsl`, `wavelet_brdf.wgsl`).
+fn table_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
     let compute = wgpu::ShaderStages::COMPUTE;
     [
         uniform_entry(0, compute, false),
         storage_entry(1, compute, true),
         uniform_entry(2, compute, false),
         storage_entry(3, compute, true),
-        storage_entry(4, compute, true),
     ]
 }
 
 /// Group 1: what the scene, material and lighting upload once (`preview_bindings.wgsl`).
-fn bake_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
+fn bake_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
     std::array::from_fn(|binding| storage_entry(binding as u32, wgpu::ShaderStages::COMPUTE, true))
 }
 
-/// Group 2: the render (`preview_bindings.wgsl`): `ShadeUniform`, `FrameUniform` at a dynamic offset, the
-/// G-buffer, the accumulation and the backdrop.
-pub(super) fn render_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+/// Group 2: the render (`preview_bindings.wgsl`): `ShadeUniform`, `FrameUniform` at a dynamic
+/// offset, the G-buffer, and the accumulation with the backdrop behind it.
+pub(super) fn render_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
     let compute = wgpu::ShaderStages::COMPUTE;
     [
         uniform_entry(0, compute, false),
@@ -471,7 +474,6 @@ pub(super) fn render_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
             count: None,
         },
         storage_entry(3, compute, false),
-        storage_entry(4, compute, false),
     ]
 }
 

@@ -78,29 +78,29 @@ pub(crate) struct ShadeUniform {
     /// The samples the fis estimator's footprints are sized for: `spp` times the frames the
     /// picture averages (`render`'s crate docs, `Estimator::Fis`).
     pub(crate) filter_samples: u32,
-    pub(crate) _pad1: u32,
-    pub(crate) _pad2: u32,
     /// `render::diffuse_split` (w unused): the filtered estimators' diffuse part.
     pub(crate) diffuse: [f32; 4],
 }
 
-/// Where the lighting's maps start in the `env_maps` buffer (`Shade::mips_first`, `layers_first`,
-/// `peak_map` of the WGSL): map 0 is level 0 of the environment whole; the chain and the layers
-/// the filtered estimators read are the smooth part's where the environment has peaks
-/// (`render::Lighting::smooth_mips`), then come the peaks' level 0.
+/// Where the lighting's maps start among the map records (`ShadeUniform::mips_first`,
+/// `layers_first`, `peak_map` of the WGSL): map 0 is level 0 of the environment whole; the chain
+/// and the layers the filtered estimators read are the smooth part's where the environment has
+/// peaks (`render::Lighting::smooth_mips`), then come the peaks' level 0. The records themselves
+/// follow the mesh's indices in one buffer, from word `records` on.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct MapLayout {
     pub(crate) mips_first: u32,
     pub(crate) layers_first: u32,
     pub(crate) peak_map: u32,
+    pub(crate) records: u32,
 }
 
-/// `Shade::peak_map` where the environment has no peaks (`NO_MAP` of the WGSL).
+/// `ShadeUniform::peak_map` where the environment has no peaks (`NO_MAP` of the WGSL).
 pub(crate) const NO_MAP: u32 = u32::MAX;
 
-/// Where the sampling tables start in the `tables` buffer (`Shade::brdf_rows` to
-/// `peak_conditional` of the WGSL; [`sampling_tables`]).
+/// Where the sampling tables and the view-layer table start in the `sampling_tables` buffer
+/// (`ShadeUniform::brdf_rows` to `view_layers` of the WGSL; [`sampling_tables`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct TableLayout {
@@ -113,6 +113,7 @@ pub(crate) struct TableLayout {
     pub(crate) env_conditional: u32,
     pub(crate) peak_marginal: u32,
     pub(crate) peak_conditional: u32,
+    pub(crate) view_layers: u32,
 }
 
 /// The prediction's uniform, as `adaptive/predict.wgsl` declares it.

@@ -52,7 +52,7 @@ fn adaptive_upsample(
 }
 
 // The output image into `accumulation`: each output pixel the mean of its ss x ss render
-// pixels (level 0's values, the environment (`backdrop`) where no triangle covers the pixel, black
+// pixels (level 0's values, the environment (`backdrop_index`) where no triangle covers the pixel, black
 // where one covers it without a shading frame), w = 1 where a triangle covers any of them.
 // `render::adaptive::frame::compose`: its render pixels, then `render::adaptive::frame::downsample`.
 @compute @workgroup_size(64)
@@ -76,7 +76,7 @@ fn adaptive_output(
         // The depth alone tells the three apart: the rest of the record is not read.
         let depth = records_surface[p].depth;
         if (depth < 0.0) {
-            sum += backdrop[p].xyz;
+            sum += accumulation[backdrop_index(p)].xyz;
         } else {
             covered = 1.0;
             if (depth > 0.0) {
