@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::brdf_bake::sha256_hex;
-use crate::support::{BAKE_ENV, bake_command, ggx_copper, root, run, shared_or_skip, temp_dir, tool};
+use crate::support::{
+    BAKE_ENV, Run, bake_command, bake_env, ggx_copper, png_decode, reference_bake, root, run, shared_or_skip, temp_dir,
+    tool,
+};
 
 fn synth(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
     let out = dir.join(name);
@@ -286,4 +289,69 @@ fn brdf_fit_refuses_bad_inputs() {
     let mut cmd = tool("brdf-fit");
     cmd.arg(&text).arg("--out-dir").arg(&out).args(["--masking", "ggx"]);
     run(cmd, "").expect_one_error_line("--masking");
+}
+
+/// `brdf-preview --compare-fit` draws the bake's glTF fit with the material's estimator, samples
+/// and camera beside the material: the fit's picture and the difference with its scale, the fit's
+/// PSNR and relative error against the material's render, and its PSNR against the converged
+/// estimate. Known answers at both ends: GGX copper is glTF's own BRDF, which the fit recovers to
+/// the last digits (objective 1e-33), so the two renders are the same numbers; a Lewis Phong lobe
+/// (n 10, ks 0.2, kd 0.8: `merl-synth phong`) is no GGX lobe, so the fit's render differs from
+/// the material's by more than noise and lies farther from the converged estimate. The modes
+/// that read the material's layer selection, and a bake without a fit, are refused in one line.
+#[test]
+fn brdf_preview_compare_fit_draws_the_fit_beside_the_material() {
+    let Some(_) = shared_or_skip(&[BAKE_ENV]) else { return };
+    let dir = temp_dir();
+    let phong = synth(dir.path(), "lewis.binary", &["phong", "-n", "10", "--ks", "0.2", "--kd", "0.8"]);
+    let out = dir.path().join("preview.png");
+    let compare = |table: &Path, mode: &str| -> (Run, PathBuf) {
+        let bake = dir.path().join(table.file_stem().unwrap());
+        let mut cmd = tool("brdf-bake");
+        cmd.arg(table).arg("--env").arg(bake_env()).arg("--out-dir").arg(&bake);
+        cmd.args(["--analysis-size", "128", "--fit", "--quiet"]);
+        run(cmd, "").expect_code(0);
+        let mut cmd = tool("brdf-preview");
+        cmd.arg(&bake).arg("--out").arg(&out).args(["--size", "64x64", "--converged", "16", "--json", "--compare-fit"]);
+        cmd.args(["--mode", mode]);
+        (run(cmd, ""), bake)
+    };
+    let figures = |r: &Run| {
+        let json = Value::Object(r.json_object());
+        let fit = &json["fit"];
+        let relative = fit["relative_error"].as_f64().expect("a relative error");
+        let (fitted, material) =
+            (&fit["against_converged"]["fit_psnr_db"], &fit["against_converged"]["material_psnr_db"]);
+        eprintln!(
+            "relative error {relative:.2e}, PSNR {}; against the converged estimate {fitted} dB (the material's {material})",
+            fit["psnr_db"]
+        );
+        (relative, fitted.as_f64().expect("a finite PSNR"), material.as_f64().expect("a finite PSNR"))
+    };
+
+    let (r, copper) = compare(ggx_copper(), "reference");
+    let r = r.expect_code(0);
+    let (relative, fitted, material) = figures(&r);
+    assert!(relative < 1e-6 && fitted == material, "GGX copper's exact fit renders as the material\n{r}");
+    let (r, _) = compare(&phong, "fis");
+    let r = r.expect_code(0);
+    let (relative, fitted, material) = figures(&r);
+    assert!(relative > 0.01 && fitted < material, "the Phong lobe's GGX fit renders as the material\n{r}");
+    // The fit's picture with its caption below; the difference with its legend and caption.
+    for name in ["preview-fit.png", "preview-fit-difference.png"] {
+        let (width, height) = png_decode(&dir.path().join(name));
+        assert!(width >= 64 && height > 64, "{name}: {width} x {height}");
+    }
+
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(&copper).arg("--out").arg(&out).args(["--compare-fit", "--mode", "prefiltered"]);
+    let r = run(cmd, "").expect_code(2);
+    assert!(
+        r.stderr.contains("--compare-fit renders the reference and fis modes") && r.stderr.lines().count() == 1,
+        "{r}"
+    );
+    let mut cmd = tool("brdf-preview");
+    cmd.arg(&reference_bake().dir).arg("--out").arg(&out).arg("--compare-fit");
+    let r = run(cmd, "").expect_code(2);
+    assert!(r.stderr.contains("has no fit-table output: bake it again with brdf-bake --fit"), "{r}");
 }

@@ -40,7 +40,7 @@ pub mod stage;
 use std::path::{Path, PathBuf};
 
 pub use error::Error;
-pub use load::{Loaded, bake_wavelet_brdf, load, load_wavelet_brdf};
+pub use load::{Loaded, bake_fit_table, bake_wavelet_brdf, load, load_wavelet_brdf};
 pub use run::{BakeConfig, BakeOutcome, MANIFEST, Progress, run_bake, write_stage};
 
 use asset::{FileFormat, StageOutput};

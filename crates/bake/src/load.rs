@@ -189,22 +189,37 @@ pub fn load_wavelet_brdf(path: &Path, loaded: &Loaded) -> Result<wavelet_brdf::D
 /// --wavelet-brdf-ratio R` list it in the manifest), read as [`load`] reads every output, with the path
 /// it was read from.
 pub fn bake_wavelet_brdf(loaded: &Loaded) -> Result<(PathBuf, wavelet_brdf::Decoded), Error> {
-    let Some(output) = loaded.manifest.output("wavelet-brdf") else {
-        return Err(Error::read(
-            &loaded.dir.join(MANIFEST),
-            format!(
-                "the bake has no wavelet-brdf output: add one with brdf-wavelet MATERIAL.binary --out-dir {} (or \
-                 brdf-bake --wavelet-brdf-ratio R), or name an asset with --wavelet-brdf FILE",
-                loaded.dir.display()
-            ),
-        ));
+    let how = format!(
+        "add one with brdf-wavelet MATERIAL.binary --out-dir {} (or brdf-bake --wavelet-brdf-ratio R), or name an \
+         asset with --wavelet-brdf FILE",
+        loaded.dir.display()
+    );
+    let (path, bytes) = bake_output(loaded, "wavelet-brdf", &how)?;
+    let asset = asset::decode(&bytes).map_err(|e| Error::read(&path, e))?;
+    let brdf = wavelet_brdf_of_asset(&path, &asset, loaded)?;
+    Ok((path, brdf))
+}
+
+/// The bake's glTF fit as a MERL table (`brdf-bake --fit`, role `fit-table`: the fitted material
+/// tabulated on the MERL grid, so that every estimator renders it exactly), read as [`load`] reads
+/// every output, with the path it was read from.
+pub fn bake_fit_table(loaded: &Loaded) -> Result<(PathBuf, merl::MerlTable), Error> {
+    let (path, bytes) = bake_output(loaded, "fit-table", "bake it again with brdf-bake --fit")?;
+    let table = merl::MerlTable::parse(&bytes).map_err(|e| Error::read(&path, e))?;
+    Ok((path, table))
+}
+
+/// The output of role `role` of a loaded bake, read as [`load`] reads every output (inside the
+/// folder, no link followed, its size and SHA-256 the manifest's); where the bake has none, an
+/// error that says `how` to add one.
+fn bake_output(loaded: &Loaded, role: &str, how: &str) -> Result<(PathBuf, Vec<u8>), Error> {
+    let Some(output) = loaded.manifest.output(role) else {
+        return Err(Error::read(&loaded.dir.join(MANIFEST), format!("the bake has no {role} output: {how}")));
     };
     let path = loaded.dir.join(&output.path);
     let folder = fsguard::Folder::open(&loaded.dir).map_err(|e| Error::read(&loaded.dir, e))?;
     let bytes = output.read(&folder).map_err(|e| Error::read(&path, e))?;
-    let asset = asset::decode(&bytes).map_err(|e| Error::read(&path, e))?;
-    let brdf = wavelet_brdf_of_asset(&path, &asset, loaded)?;
-    Ok((path, brdf))
+    Ok((path, bytes))
 }
 
 fn wavelet_brdf_of_asset(path: &Path, asset: &asset::Asset, loaded: &Loaded) -> Result<wavelet_brdf::Decoded, Error> {

@@ -7,7 +7,7 @@ use std::path::Path;
 use render::{Estimator, Scene, metrics};
 use serde_json::{Value, json};
 
-use crate::checks::{Converged, check_finite, check_psnr, check_work, converged};
+use crate::checks::{CONVERGED_SAMPLES, Converged, check_finite, check_psnr, check_work, converged};
 use crate::outputs::{db, json_db, names, png, sibling, tone_mapping, with_caption};
 use crate::scene::scene;
 use crate::{Error, Host, Output, Rendered, Request};
@@ -65,7 +65,7 @@ fn check_adaptive_work(request: &Request, scene: &Scene, settings: &render::adap
     let pixels = (scene.width * ss * scene.height * ss) as u128;
     let frame_samples = pixels * u128::from(settings.spp);
     let converged_samples = if request.validate || request.converged.is_some() {
-        (scene.width * scene.height) as u128 * 3 * u128::from(request.converged.unwrap_or(256))
+        (scene.width * scene.height) as u128 * 3 * u128::from(request.converged.unwrap_or(CONVERGED_SAMPLES))
     } else {
         0
     };
@@ -299,7 +299,7 @@ impl Inputs<'_> {
         step: &mut Rendered,
     ) -> Result<(), Error> {
         let Inputs { request, loaded, lighting, bandwidths, host, .. } = *self;
-        let n = request.converged.unwrap_or(256);
+        let n = request.converged.unwrap_or(CONVERGED_SAMPLES);
         let Converged { image: converged, picture: converged_picture, psnr, relative } =
             converged(request, scene, &loaded.material, lighting, n, (image, picture), tone_mapping, host)?;
         step.files.push(Output {

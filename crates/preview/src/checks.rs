@@ -8,6 +8,10 @@ use render::{Scene, metrics};
 
 use crate::{Brdf, Error, Host, Request, bail};
 
+/// Samples per strategy of the converged estimate a check renders where `--converged` does not
+/// say (the adaptive modes' `--validate`, `--compare-fit`).
+pub(crate) const CONVERGED_SAMPLES: u32 = 256;
+
 /// The independent converged estimate of a render, and how far the render is from it.
 pub(crate) struct Converged {
     pub(crate) image: render::Image,

@@ -24,7 +24,7 @@ use envmap::ToneMapping;
 use render::{Estimator, Image, Lighting, Scene, Settings, metrics};
 use serde_json::json;
 
-use crate::checks::{Converged, check_finite, check_psnr, check_work, converged};
+use crate::checks::{CONVERGED_SAMPLES, Converged, check_finite, check_psnr, check_work, converged};
 use crate::outputs::{contact_sheet, db, json_db, names, png, sibling, tone_mapping, with_caption};
 use crate::scene::scene;
 
@@ -129,6 +129,8 @@ pub struct Request {
     pub seed: u32,
     pub validate: bool,
     pub converged: Option<u32>,
+    /// Render the bake's glTF fit (`brdf-bake --fit`) beside the material, with the same estimator.
+    pub compare_fit: bool,
     pub min_psnr: Option<f64>,
     pub max_samples: u64,
     pub sheet: Option<PathBuf>,
@@ -139,7 +141,7 @@ pub struct Request {
 }
 
 /// A picture a preview made: where it goes, what it is (`preview`, `difference`, `converged`,
-/// `table`, `debug-views`, `contact-sheet`) and its PNG bytes.
+/// `table`, `fit`, `fit-difference`, `debug-views`, `contact-sheet`) and its PNG bytes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Output {
     pub path: PathBuf,
@@ -205,6 +207,12 @@ pub fn run(request: &Request, host: &dyn Host) -> Result<Outcome, Error> {
             request.bake.display()
         );
     };
+    if request.compare_fit && (request.window || !matches!(request.mode, Mode::Reference | Mode::Fis)) {
+        bail!(
+            "--compare-fit renders the reference and fis modes to a file: the prefiltered and adaptive modes read the \
+             measured material's layer selection and bandwidth atlas, which the fit has none of"
+        );
+    }
     let step = if request.mode.is_adaptive() {
         if request.window {
             bail!("--window renders the reference, fis and prefiltered modes; the adaptive modes render to a file");
@@ -258,13 +266,21 @@ fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host
     let scene = scene(request)?;
     let pixels = (scene.width * scene.height) as u128;
     let gpu_samples = pixels * u128::from(settings.spp) * u128::from(settings.frames);
-    let renders = if loaded.material.wavelet_brdf.is_some() { 2 } else { 1 };
+    let fit = match request.compare_fit {
+        true => {
+            let (path, table) = bake::bake_fit_table(loaded)?;
+            Some((path, render::Material { table, wavelet_brdf: None, ..loaded.material.clone() }))
+        }
+        false => None,
+    };
+    let renders = 1 + u128::from(loaded.material.wavelet_brdf.is_some()) + u128::from(request.compare_fit);
+    let converged_samples = request.converged.or(request.compare_fit.then_some(CONVERGED_SAMPLES));
     check_work(
         request,
         &[
             ("on the GPU", renders * gpu_samples),
             ("for --validate on the CPU", if request.validate { gpu_samples } else { 0 }),
-            ("for --converged on the CPU", pixels * 3 * u128::from(request.converged.unwrap_or(0))),
+            ("for the converged estimate on the CPU", pixels * 3 * u128::from(converged_samples.unwrap_or(0))),
         ],
     )?;
     let tone_mapping = tone_mapping(request, lighting);
@@ -340,8 +356,15 @@ fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host
     if request.validate {
         render.against_cpu(request, loaded, lighting, host, &mut step)?;
     }
-    if let Some(n) = request.converged {
-        render.against_converged(request, loaded, lighting, n, host, &mut step)?;
+    let converged = match converged_samples {
+        Some(n) => Some((n, render.converged(request, loaded, lighting, n, host)?)),
+        None => None,
+    };
+    if let (Some(_), Some((n, converged))) = (request.converged, &converged) {
+        render.against_converged(*n, converged, request, &mut step)?;
+    }
+    if let (Some(fit), Some(converged)) = (fit, &converged) {
+        render.against_fit(request, &gpu, loaded, lighting, fit, converged, host, &mut step)?;
     }
     Ok(Outcome::Rendered(step))
 }
@@ -427,32 +450,36 @@ impl EstimatorRender<'_> {
         Ok(())
     }
 
-    /// `--converged N`: the converged estimate of `n` samples per strategy on the CPU.
-    fn against_converged(
+    /// The material's converged estimate of `n` samples per strategy on the CPU, and the render
+    /// measured against it.
+    fn converged(
         &self,
         request: &Request,
         loaded: &bake::Loaded,
         lighting: &Lighting,
         n: u32,
         host: &dyn Host,
+    ) -> Result<Converged, Error> {
+        let rendered = (self.image, self.picture);
+        converged(request, self.scene, &loaded.material, lighting, n, rendered, self.tone_mapping, host)
+    }
+
+    /// `--converged N`: the render against the converged estimate of `n` samples per strategy.
+    fn against_converged(
+        &self,
+        n: u32,
+        converged: &Converged,
+        request: &Request,
         step: &mut Rendered,
     ) -> Result<(), Error> {
         let scene = self.scene;
-        let Converged { image: converged, picture: converged_picture, psnr, relative } = converged(
-            request,
-            scene,
-            &loaded.material,
-            lighting,
-            n,
-            (self.image, self.picture),
-            self.tone_mapping,
-            host,
-        )?;
-        let luminance_ratio = metrics::mean_luminance(self.image) / metrics::mean_luminance(&converged);
+        let Converged { image: converged, picture: converged_picture, psnr, relative } = converged;
+        let (psnr, relative) = (*psnr, *relative);
+        let luminance_ratio = metrics::mean_luminance(self.image) / metrics::mean_luminance(converged);
         step.files.push(Output {
             path: sibling(self.out, "converged"),
             role: "converged",
-            bytes: png(&converged_picture, scene.width, scene.height)?,
+            bytes: png(converged_picture, scene.width, scene.height)?,
         });
         step.report.push(format!(
             "against the converged estimate ({n} samples per strategy): PSNR {} dB, relative error {relative:.3}, \
@@ -466,6 +493,78 @@ impl EstimatorRender<'_> {
             "mean_luminance_ratio": luminance_ratio,
         });
         check_psnr(request, "against the converged estimate", psnr, &mut step.problems);
+        Ok(())
+    }
+
+    /// `--compare-fit`: the bake's glTF fit (`brdf-bake --fit`, tabulated on the MERL grid, so that
+    /// the estimator renders the fitted BRDF exactly) with the same estimator, samples and camera:
+    /// its picture (OUT-fit.png), its difference from the material's (OUT-fit-difference.png, with
+    /// its scale), and the PSNR of the fit against the material's render and against its
+    /// converged estimate, beside the render's own (what noise alone costs). The fit is sampled
+    /// with the material's importance samples: each sample weighed by its own density, the
+    /// estimator stays unbiased for the fit (multiple importance sampling with the environment
+    /// covers where the material's table has no density), and both pictures share their samples.
+    #[allow(clippy::too_many_arguments)]
+    fn against_fit(
+        &self,
+        request: &Request,
+        gpu: &gpu::Gpu,
+        loaded: &bake::Loaded,
+        lighting: &Lighting,
+        (path, fit_material): (PathBuf, render::Material),
+        (n, converged): &(u32, Converged),
+        host: &dyn Host,
+        step: &mut Rendered,
+    ) -> Result<(), Error> {
+        let (scene, settings) = (self.scene, self.settings);
+        host.step(format!("{} of the glTF fit on the GPU", settings.estimator.name()));
+        let fit = gpu::preview::Renderer::new(gpu, scene, &fit_material, lighting)?.render_frames(settings)?;
+        check_finite(request, &fit.rgb, "the GPU render of the glTF fit")?;
+        let fit_picture = metrics::tonemap(&fit, self.tone_mapping);
+        let psnr = metrics::psnr_db(self.picture, &fit_picture);
+        let relative = metrics::relative_error(&self.image.rgb, &fit.rgb);
+        let fit_converged = metrics::psnr_db(&fit_picture, &converged.picture);
+        let caption = format!(
+            "glTF fit of {} ({}) | {} | {} spp x {} frames | exposure {:+.2} EV",
+            names(&loaded.manifest),
+            path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            settings.estimator.name(),
+            settings.spp,
+            settings.frames,
+            self.tone_mapping.exposure_ev
+        );
+        let captioned = with_caption(&fit_picture, scene.width, scene.height, &caption);
+        let difference =
+            picture::layout::difference(self.picture, &fit_picture, scene.width, scene.height, "material - glTF fit");
+        step.files.push(Output {
+            path: sibling(self.out, "fit"),
+            role: "fit",
+            bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
+        });
+        step.files.push(Output {
+            path: sibling(self.out, "fit-difference"),
+            role: "fit-difference",
+            bytes: png(&difference.rgb, difference.width, difference.height)?,
+        });
+        step.report.push(format!(
+            "the glTF fit ({}) against the material (same estimator, same samples): PSNR {} dB, relative error \
+             {relative:.2e}; against the material's converged estimate ({n} samples per strategy): the fit {} dB, the \
+             material's render {} dB",
+            path.display(),
+            db(psnr),
+            db(fit_converged),
+            db(converged.psnr)
+        ));
+        step.json["fit"] = json!({
+            "table": path.display().to_string(),
+            "psnr_db": json_db(psnr),
+            "relative_error": relative,
+            "against_converged": {
+                "samples_per_strategy": n,
+                "fit_psnr_db": json_db(fit_converged),
+                "material_psnr_db": json_db(converged.psnr),
+            },
+        });
         Ok(())
     }
 }

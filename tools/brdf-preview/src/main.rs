@@ -64,6 +64,13 @@ use preview::{Brdf, Mode, Outcome, Request};
 ///                sample on the GPU, renders the same image from the table, reports the PSNR and
 ///                relative error of the wavelet image against it and writes OUT-table.png
 ///
+///   --compare-fit
+///                renders the bake's glTF fit (brdf-bake --fit: the closest glTF material, as a
+///                MERL table) with the same estimator, samples and camera, writes OUT-fit.png and
+///                OUT-fit-difference.png (|material - fit| in 8-bit levels, with its scale), and
+///                reports the PSNR of the fit against the material's render and of both against
+///                the material's converged estimate (--converged N, 256 by default)
+///
 ///   --sheet FILE writes a contact sheet of every picture in the bake
 ///
 /// Exit status: 0 ok, 1 --min-psnr was not met, 2 error (including no GPU adapter).
@@ -200,15 +207,22 @@ struct Args {
     #[arg(long, value_name = "N", value_parser = cli::parse_count_u32)]
     converged: Option<u32>,
 
+    /// Also render the bake's glTF fit (brdf-bake --fit) with the same estimator (reference or
+    /// fis), write OUT-fit.png and OUT-fit-difference.png, and report the fit's PSNR against the
+    /// material's render and against its converged estimate (--converged N, 256 by default).
+    #[arg(long)]
+    compare_fit: bool,
+
     /// Exit 1 when a reported PSNR (against the CPU, and against the converged estimate when
     /// asked for) is below this, in dB (a finite number).
     #[arg(long, value_name = "DB", allow_negative_numbers = true, value_parser = parse_psnr)]
     min_psnr: Option<f64>,
 
     /// The most samples this run may take, a limit against runaway work (a mistyped --frames or
-    /// --converged): pixels x spp x frames on the GPU (twice with --brdf wavelet-brdf), the same again
-    /// on the CPU with --validate, and pixels x 3 x N for the converged estimate (--converged N;
-    /// --validate in the adaptive modes takes 256). From 1; the default, 2^32, is about a minute
+    /// --converged): pixels x spp x frames on the GPU (once more with --brdf wavelet-brdf, once
+    /// more with --compare-fit), the same again on the CPU with --validate, and pixels x 3 x N for
+    /// the converged estimate (--converged N; --validate in the adaptive modes and --compare-fit
+    /// take 256 without it). From 1; the default, 2^32, is about a minute
     /// of a GPU or an hour of CPU: raise it for a deliberate long run.
     #[arg(long, value_name = "N", default_value_t = 1 << 32, value_parser = parse_samples)]
     max_samples: u64,
@@ -348,6 +362,7 @@ fn run(args: Args) -> Result<ExitCode> {
         seed: args.seed,
         validate: args.validate,
         converged: args.converged,
+        compare_fit: args.compare_fit,
         min_psnr: args.min_psnr,
         max_samples: args.max_samples,
         sheet: args.sheet,
