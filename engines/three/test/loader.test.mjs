@@ -130,11 +130,13 @@ test('figures of the wrong type or out of range are refused, naming the figure',
         [(f) => { f.exponents = []; }, 'exponents is []'],
         [(f) => { f.diffuse = [0.1, null, 0.1]; }, 'diffuse is [0.1,null,0.1]'],
         [(f) => { f.exposure_ev = 1e308 * 10; }, 'exposure_ev is null'],
+        [(f) => { f.exposure_ev = 1e308; }, 'exposure_ev is 1e+308, expected a finite exposure within 128 EV'],
+        [(f) => { f.previewer.reference.frames = 1e12; }, 'previewer.reference is {"spp":4,"frames":1000000000000}', 'frames from 1 to 65536'],
         [(f) => { f.environment_size = [4, 4]; }, 'environment_size is [4,4], expected a lat-long size'],
         [(f) => { f.previewer.prefiltered.spp = 3; }, 'previewer.prefiltered'],
         [(f) => { f.peaks = 'yes'; }, 'peaks is "yes"'],
     ];
-    for (const [edit, needle] of cases) await refused(load(edit), `${BAKE}manifest.json`, needle);
+    for (const [edit, ...needles] of cases) await refused(load(edit), `${BAKE}manifest.json`, ...needles);
 });
 
 test('textures of the wrong format or shape, or with values out of range, are refused, naming the file', async () => {
@@ -188,6 +190,22 @@ test('values a bake of ours can hold load: subnormals and -0 in every role, up t
             assert.equal(bake.textures[uniform].image.data[1], Math.fround(value), `${role}: ${value}`);
         }
     }
+});
+
+test('a texture served under another role of the same format and shape is caught by its sha256', async () => {
+    // engine-layers and engine-environment are both rgba32f arrays of 4 x 2 x 2 here: the same
+    // size, header and shape, told apart only by the hash their listing gives.
+    const layers = (f, files) => { files['engine-layers'] = textureOf('engine-layers', () => 0.25); };
+    const swap = (m, b) => ({ ...b, 'engine-environment.ktx2': b['engine-layers.ktx2'], 'engine-layers.ktx2': b['engine-environment.ktx2'] });
+    await refused(load(layers, () => {}, swap), `${BAKE}engine-environment.ktx2: not the file the manifest describes (its sha256 differs)`);
+    // The hash binds a file to its listing, role included: a manifest whose listings themselves
+    // swap the two roles describes another bake, consistent in every check, and loads as one.
+    const swapRoles = (m) => {
+        const [environment, layersListing] = ['engine-environment', 'engine-layers'].map((r) => m.stages[0].outputs.find((o) => o.role === r));
+        [environment.role, layersListing.role] = [layersListing.role, environment.role];
+    };
+    const bake = await load(layers, swapRoles);
+    assert.equal(bake.textures.uEnvironment.image.data[0], 0.25);
 });
 
 test('outputs listed wrongly are refused, naming the manifest', async () => {
