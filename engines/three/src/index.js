@@ -26,7 +26,7 @@ import {
 } from './shade.glsl.js';
 
 export { Accumulator } from './live.js';
-export { BakeError, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
+export { BakeError, FLOAT32_MAX, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
 
 /** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
 export const MODES = { reference: 0, prefiltered: 2 };

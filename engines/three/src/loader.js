@@ -25,6 +25,13 @@ export const OUTPUT_LIMIT = 4296015936;
 /** The largest count a figure may give (rows, sectors, slices, samples, texture sides). */
 const COUNT_LIMIT = 1 << 20;
 
+/**
+ * The largest finite single float (FLT_MAX, Rust's `f32::MAX`): the bound of the roles whose
+ * values are radiance or a BRDF, which our Rust side bounds only by being finite f32 (see `roles`).
+ * In a Float32Array every value up to it is finite, so the bound is the finiteness check itself.
+ */
+export const FLOAT32_MAX = 3.4028234663852886e38;
+
 // KTX2 vkFormat codes of the data textures.
 const VK_FORMAT_R32_SFLOAT = 100;
 const VK_FORMAT_R32G32B32A32_SFLOAT = 109;
@@ -166,7 +173,25 @@ export function checkFigures(f) {
 /**
  * What each role's texture must be (data-schema/engine-textures.md, "The files"), from the
  * checked figures: its channels, its kind (2d, array or 3d), its width, height and layers or
- * depth, and the range of its values.
+ * depth, and the range of its values, every one finite.
+ *
+ * The ranges are what a bake of our tools can hold, so that none fails here:
+ * - `engine-brdf-tables`, `engine-light-tables`: CDFs from 0 to 1 and the row edges
+ *   `t = 1 - cos theta_h` of `[0, pi / 2]`, so `[0, 1]`.
+ * - `engine-view-layers`: a layer coordinate from 0 to the number of layers.
+ * - `engine-merl`: a cell's BRDF in 1/sr (0 without data, A 0 or 1). The MERL reader takes any
+ *   finite value (`merl::MerlTable::from_raw`); a bake refuses only a cell that alone reflects
+ *   more than twice the light received (`bake::stage::material_info::UNPHYSICAL_LIMIT`), which
+ *   bounds nothing towards grazing angles or below the horizon, where a cell has no share
+ *   (`merl::summary::cell_share`); the writer casts to f32 (`bake::stage::engine::run`) and
+ *   refuses only what is then not finite (`prefilter::ktx::encode_data`). So up to FLT_MAX.
+ * - `engine-environment`, `engine-layers`: radiance. The map's reader takes any finite
+ *   non-negative f32 (`envmap`'s `check_radiance`), the bake keeps texels above 65504 as single
+ *   floats (`prefilter::ktx::Storage::Auto`) and the writer refuses only what is not finite. So
+ *   up to FLT_MAX.
+ * Subnormal values are accepted: they are finite and in range, the writers' f64 to f32 casts
+ * make them from tiny legitimate values (a CDF's step, a dim texel), and a GPU that flushes them
+ * to 0 (GLSL ES 3.00 allows it) changes a value by less than 1.2e-38.
  */
 function roles(f) {
     const [W, H] = f.environment_size;
@@ -174,12 +199,12 @@ function roles(f) {
     const R = f.rows;
     const C = f.sectors;
     return {
-        'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: f.merl_size, range: [0, Infinity] },
+        'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: f.merl_size, range: [0, FLOAT32_MAX] },
         'engine-brdf-tables': { uniform: 'uBrdfTables', channels: 1, kind: 'array', shape: [Math.max(R, C) + 1, R + 2, f.slices], range: [0, 1] },
         'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [f.view_rows, 1, 1], range: [0, f.exponents.length] },
-        'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [W, H, 2], range: [0, Infinity] },
+        'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [W, H, 2], range: [0, FLOAT32_MAX] },
         'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [Math.max(W, H) + 1, H + 1, 2], range: [0, 1] },
-        'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, Infinity] },
+        'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, FLOAT32_MAX] },
     };
 }
 
@@ -222,11 +247,10 @@ export function dataTexture(bytes, name, expect) {
         const [low, high] = expect.range;
         for (let i = 0; i < data.length; i++) {
             const v = data[i];
-            if (!(v >= low && v <= high)) {
+            if (!(Number.isFinite(v) && v >= low && v <= high)) {
                 const texel = Math.floor(i / channels);
-                throw new BakeError(
-                    `error: ${name}: value ${i} (texel ${texel}, channel ${i % channels}) is ${v}, outside [${low}, ${high}]`,
-                );
+                const why = Number.isFinite(v) ? `outside [${low}, ${high}]` : 'not a finite number';
+                throw new BakeError(`error: ${name}: value ${i} (texel ${texel}, channel ${i % channels}) is ${v}, ${why}`);
             }
         }
     }

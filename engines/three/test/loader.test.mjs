@@ -24,7 +24,7 @@ test('paths that leave the folder are refused', () => {
 // manifest or file is a BakeError naming the file (and the figure, texture or value).
 import { createDefaultContainer, write as writeKtx2 } from 'ktx-parse';
 
-import { MANIFEST_LIMIT, loadBake, sha256Hex } from '../src/index.js';
+import { FLOAT32_MAX, MANIFEST_LIMIT, loadBake, sha256Hex } from '../src/index.js';
 
 const BAKE = new URL('http://127.0.0.1:8000/bakes/synthetic/');
 
@@ -43,6 +43,25 @@ function ktx2(channels, kind, [w, h, n], value = () => 0.5) {
     return writeKtx2(container);
 }
 
+/**
+ * The synthetic bake's textures by role: the uniform each binds, its channels, kind and shape,
+ * and the largest value its role allows (the loader's ranges, all from 0).
+ */
+const TEXTURES = {
+    'engine-merl': { uniform: 'uMerl', channels: 4, kind: '3d', shape: [180, 2, 2], high: FLOAT32_MAX },
+    'engine-brdf-tables': { uniform: 'uBrdfTables', channels: 1, kind: 'array', shape: [3, 4, 2], high: 1 },
+    'engine-view-layers': { uniform: 'uViewLayers', channels: 1, kind: '2d', shape: [2, 1, 1], high: 2 },
+    'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [4, 2, 2], high: FLOAT32_MAX },
+    'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [5, 3, 2], high: 1 },
+    'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [4, 2, 2], high: FLOAT32_MAX },
+};
+
+/** The synthetic bake's texture of `role`, 0.5 everywhere but where `value(i)` says otherwise. */
+function textureOf(role, value = () => 0.5) {
+    const { channels, kind, shape } = TEXTURES[role];
+    return ktx2(channels, kind, shape, value);
+}
+
 /** A small bake's files and its figures: two slices, rows and sectors, a 4 x 2 map, two layers. */
 function syntheticBake() {
     const figures = {
@@ -51,14 +70,7 @@ function syntheticBake() {
         peak_threshold: null, diffuse: [0.1, 0.1, 0.1], exposure_ev: -1,
         previewer: { reference: { spp: 4, frames: 2 }, prefiltered: { spp: 2, frames: 2 } },
     };
-    const files = {
-        'engine-merl': ktx2(4, '3d', [180, 2, 2]),
-        'engine-brdf-tables': ktx2(1, 'array', [3, 4, 2]),
-        'engine-view-layers': ktx2(1, '2d', [2, 1, 1]),
-        'engine-environment': ktx2(4, 'array', [4, 2, 2]),
-        'engine-light-tables': ktx2(1, 'array', [5, 3, 2]),
-        'engine-layers': ktx2(4, 'array', [4, 2, 2]),
-    };
+    const files = Object.fromEntries(Object.keys(TEXTURES).map((role) => [role, textureOf(role)]));
     return { figures, files };
 }
 
@@ -118,11 +130,13 @@ test('figures of the wrong type or out of range are refused, naming the figure',
         [(f) => { f.exponents = []; }, 'exponents is []'],
         [(f) => { f.diffuse = [0.1, null, 0.1]; }, 'diffuse is [0.1,null,0.1]'],
         [(f) => { f.exposure_ev = 1e308 * 10; }, 'exposure_ev is null'],
+        [(f) => { f.exposure_ev = 1e308; }, 'exposure_ev is 1e+308, expected a finite exposure within 128 EV'],
+        [(f) => { f.previewer.reference.frames = 1e12; }, 'previewer.reference is {"spp":4,"frames":1000000000000}', 'frames from 1 to 65536'],
         [(f) => { f.environment_size = [4, 4]; }, 'environment_size is [4,4], expected a lat-long size'],
         [(f) => { f.previewer.prefiltered.spp = 3; }, 'previewer.prefiltered'],
         [(f) => { f.peaks = 'yes'; }, 'peaks is "yes"'],
     ];
-    for (const [edit, needle] of cases) await refused(load(edit), `${BAKE}manifest.json`, needle);
+    for (const [edit, ...needles] of cases) await refused(load(edit), `${BAKE}manifest.json`, ...needles);
 });
 
 test('textures of the wrong format or shape, or with values out of range, are refused, naming the file', async () => {
@@ -137,6 +151,61 @@ test('textures of the wrong format or shape, or with values out of range, are re
         [(f, files) => { files['engine-merl'] = new Uint8Array([1, 2, 3]); }, 'engine-merl.ktx2: not a ktx2 file'],
     ];
     for (const [edit, ...needles] of cases) await refused(load(edit), ...needles);
+});
+
+/** The message's start for value 1 of `role`'s texture (texel 0 channel 1, or texel 1 of one channel). */
+function valueOne(role) {
+    const channels = TEXTURES[role].channels;
+    return `${BAKE}${role}.ktx2: value 1 (texel ${Math.floor(1 / channels)}, channel ${1 % channels}) is `;
+}
+
+test('every role refuses a value that is not finite, negative or above its bound, naming the file and the value', async () => {
+    for (const [role, { high }] of Object.entries(TEXTURES)) {
+        const bad = [
+            [Infinity, 'not a finite number'],
+            [-Infinity, 'not a finite number'],
+            [NaN, 'not a finite number'],
+            [-1, `outside [0, ${high}]`],
+            [-1e-40, `outside [0, ${high}]`], // a negative subnormal is negative
+        ];
+        // Above the bound: 1e30 where it is 1 or K; above FLT_MAX a single float is Infinity, refused above.
+        if (high < 1e30) bad.push([1e30, `outside [0, ${high}]`]);
+        for (const [value, why] of bad) {
+            const edit = (f, files) => { files[role] = textureOf(role, (i) => (i === 1 ? value : 0.5)); };
+            await refused(load(edit), `${valueOne(role)}${Math.fround(value)}, ${why}`);
+        }
+    }
+});
+
+// The ranges are what a bake of ours can hold (loader.js, `roles`): radiance and the BRDF up to
+// the largest float, since our Rust readers bound them only by being finite, and subnormals in
+// every role, being finite and in range.
+test('values a bake of ours can hold load: subnormals and -0 in every role, up to FLT_MAX for radiance and the BRDF', async () => {
+    const subnormal = Math.fround(1e-40);
+    assert.ok(subnormal > 0 && subnormal < 2 ** -126, 'not an f32 subnormal');
+    for (const [role, { uniform, high }] of Object.entries(TEXTURES)) {
+        const values = high === FLOAT32_MAX ? [subnormal, -0, 1e30, FLOAT32_MAX] : [subnormal, -0, high];
+        for (const value of values) {
+            const bake = await load((f, files) => { files[role] = textureOf(role, (i) => (i === 1 ? value : 0.5)); });
+            assert.equal(bake.textures[uniform].image.data[1], Math.fround(value), `${role}: ${value}`);
+        }
+    }
+});
+
+test('a texture served under another role of the same format and shape is caught by its sha256', async () => {
+    // engine-layers and engine-environment are both rgba32f arrays of 4 x 2 x 2 here: the same
+    // size, header and shape, told apart only by the hash their listing gives.
+    const layers = (f, files) => { files['engine-layers'] = textureOf('engine-layers', () => 0.25); };
+    const swap = (m, b) => ({ ...b, 'engine-environment.ktx2': b['engine-layers.ktx2'], 'engine-layers.ktx2': b['engine-environment.ktx2'] });
+    await refused(load(layers, () => {}, swap), `${BAKE}engine-environment.ktx2: not the file the manifest describes (its sha256 differs)`);
+    // The hash binds a file to its listing, role included: a manifest whose listings themselves
+    // swap the two roles describes another bake, consistent in every check, and loads as one.
+    const swapRoles = (m) => {
+        const [environment, layersListing] = ['engine-environment', 'engine-layers'].map((r) => m.stages[0].outputs.find((o) => o.role === r));
+        [environment.role, layersListing.role] = [layersListing.role, environment.role];
+    };
+    const bake = await load(layers, swapRoles);
+    assert.equal(bake.textures.uEnvironment.image.data[0], 0.25);
 });
 
 test('outputs listed wrongly are refused, naming the manifest', async () => {
