@@ -184,11 +184,12 @@ demo: setup-gpu build
 	$(BIN)/brdf-preview $(DEMO)/bake --out $(DEMO)/preview-reference.png --size 384x384 --camera 200,15 --validate
 	@echo "demo outputs are in $(DEMO)/: bake/ (the assets and manifest.json), preview.png, preview-reference.png (reference mode), preview-reference-difference.png (GPU against CPU, with its scale), sheet.png"
 
-## three-example: the demo's bake again with the engine textures (brdf-bake --engine-textures),
-## and engines/three's packages: what the three.js example page (engines/three/index.html) reads.
+## three-example: the demo's material baked with the engine textures (brdf-bake --engine-textures)
+## into its own folder, so that make demo leaves it whole, and engines/three's packages: what the
+## three.js example page (engines/three/index.html) reads.
 three-example: demo setup-node
-	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --engine-textures --out-dir $(DEMO)/bake
-	@echo "serve the repository root (python3 -m http.server) and open http://localhost:8000/engines/three/index.html?bake=/target/demo/bake/"
+	$(BIN)/brdf-bake $(DEMO)/ggx-copper.binary --env $(DEMO)/calibration-sky.exr --pca-max-error 0.02 --engine-textures --out-dir $(DEMO)/three-bake
+	@echo "serve the repository root (python3 -m http.server) and open http://localhost:8000/engines/three/index.html?bake=/target/demo/three-bake/"
 
 ## bake: every MERL table in IN (*.binary) into OUT/<name>/, in parallel with -j; ENV=map.hdr adds
 ## the environment stages. E.g. make -j4 bake IN=target/merl OUT=target/bakes ENV=../shared/data/env/quarry_01_1k.hdr

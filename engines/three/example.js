@@ -19,7 +19,7 @@ const orientation = 'brdf-preview';
 let current = null;
 
 const params = new URLSearchParams(location.search);
-document.getElementById('bake').value = params.get('bake') ?? '/target/demo/bake/';
+document.getElementById('bake').value = params.get('bake') ?? '/target/demo/three-bake/';
 if (params.get('mode')) document.querySelector(`input[name=mode][value=${CSS.escape(params.get('mode'))}]`).checked = true;
 const live = new Accumulator(renderer, { maxFrames: Number(params.get('frames') ?? 256) });
 
