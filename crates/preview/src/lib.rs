@@ -298,50 +298,6 @@ fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host
     check_finite(request, &image.rgb, "the GPU render")?;
     let ms_per_frame = start.elapsed().as_secs_f64() * 1e3 / f64::from(settings.frames);
     let picture = metrics::tonemap(&image, &tone_mapping);
-    let brdf = match &loaded.material.wavelet_brdf {
-        Some(w) => format!("wavelet-brdf {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
-        None => "table".to_string(),
-    };
-    let caption = format!(
-        "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
-        names(&loaded.manifest),
-        mode.name(),
-        settings.spp,
-        settings.frames,
-        scene.width,
-        scene.height,
-        tone_mapping.exposure_ev
-    );
-    let captioned = with_caption(&picture, scene.width, scene.height, &caption);
-    let mut step = Rendered {
-        files: vec![Output {
-            path: out.clone(),
-            role: "preview",
-            bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
-        }],
-        report: vec![format!(
-            "{}: {} on {} ({}), {:.1} ms per frame",
-            out.display(),
-            mode.name(),
-            gpu.adapter_summary(),
-            request.mesh,
-            ms_per_frame
-        )],
-        problems: Vec::new(),
-        json: json!({
-            "bake": request.bake.display().to_string(),
-            "mode": mode.name(),
-            "brdf": match request.brdf { Brdf::Table => "table", Brdf::WaveletBrdf => "wavelet-brdf" },
-            "spp": settings.spp,
-            "frames": settings.frames,
-            "width": scene.width,
-            "height": scene.height,
-            "exposure_ev": tone_mapping.exposure_ev,
-            "adapter": gpu.adapter_summary(),
-            "ms_per_frame": ms_per_frame,
-            "mean_luminance": metrics::mean_luminance(&image),
-        }),
-    };
     let render = EstimatorRender {
         scene: &scene,
         settings: &settings,
@@ -350,6 +306,7 @@ fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host
         image: &image,
         picture: &picture,
     };
+    let mut step = render.rendered(request, loaded, &gpu, ms_per_frame)?;
     if loaded.material.wavelet_brdf.is_some() {
         render.against_table(request, &gpu, loaded, lighting, host, &mut step)?;
     }
@@ -380,6 +337,62 @@ struct EstimatorRender<'a> {
 }
 
 impl EstimatorRender<'_> {
+    /// The captioned picture, the report's line and the JSON of the render.
+    fn rendered(
+        &self,
+        request: &Request,
+        loaded: &bake::Loaded,
+        gpu: &gpu::Gpu,
+        ms_per_frame: f64,
+    ) -> Result<Rendered, Error> {
+        let (scene, settings, tone_mapping, out) = (self.scene, self.settings, self.tone_mapping, self.out);
+        let mode = settings.estimator;
+        let brdf = match &loaded.material.wavelet_brdf {
+            Some(w) => format!("wavelet-brdf {}:1, lod {}", picture::format_number(w.brdf.ratio()), w.lod),
+            None => "table".to_string(),
+        };
+        let caption = format!(
+            "{} | {} | {brdf} | {} spp x {} frames | {}x{} | exposure {:+.2} EV",
+            names(&loaded.manifest),
+            mode.name(),
+            settings.spp,
+            settings.frames,
+            scene.width,
+            scene.height,
+            tone_mapping.exposure_ev
+        );
+        let captioned = with_caption(self.picture, scene.width, scene.height, &caption);
+        Ok(Rendered {
+            files: vec![Output {
+                path: out.to_path_buf(),
+                role: "preview",
+                bytes: png(&captioned.rgb, captioned.width, captioned.height)?,
+            }],
+            report: vec![format!(
+                "{}: {} on {} ({}), {:.1} ms per frame",
+                out.display(),
+                mode.name(),
+                gpu.adapter_summary(),
+                request.mesh,
+                ms_per_frame
+            )],
+            problems: Vec::new(),
+            json: json!({
+                "bake": request.bake.display().to_string(),
+                "mode": mode.name(),
+                "brdf": match request.brdf { Brdf::Table => "table", Brdf::WaveletBrdf => "wavelet-brdf" },
+                "spp": settings.spp,
+                "frames": settings.frames,
+                "width": scene.width,
+                "height": scene.height,
+                "exposure_ev": tone_mapping.exposure_ev,
+                "adapter": gpu.adapter_summary(),
+                "ms_per_frame": ms_per_frame,
+                "mean_luminance": metrics::mean_luminance(self.image),
+            }),
+        })
+    }
+
     /// What the wavelet compression costs: the same render from the table itself.
     fn against_table(
         &self,
