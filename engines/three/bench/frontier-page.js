@@ -1,8 +1,9 @@
 // What engines/three/bench/frontier.mjs calls in the test page (test/page.html): one bake in a
 // y-up three.js scene, drawn by three's MeshStandardMaterial and MeshPhysicalMaterial at fitted
 // parameters, by the glTF material brdf-fit fitted to the table (the bake's material.gltf, read
-// by three's GLTFLoader) and by the bake's material at a few sample counts, timed and compared
-// with the converged estimate (window.frontier).
+// by three's GLTFLoader; beside it the same glTF BRDF drawn exactly, from the fit's own bake) and
+// by the bake's material at a few sample counts, timed and compared with the converged estimate
+// (window.frontier).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { loadBake } from '../src/index.js';
@@ -22,7 +23,7 @@ function camera(aspect) {
 }
 
 
-window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws }) => {
+window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFrames, timingDraws }) => {
     const renderer = pageRenderer(timingSize, timingSize);
     renderer.toneMapping = THREE.NoToneMapping;
     const bake = await loadBake(url);
@@ -91,7 +92,16 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     if (!fitted) throw new Error(`${url}material.gltf holds no mesh`);
     gltf.scene.traverse((o) => o.isMesh && o.geometry.dispose());
     disposables.push(fitted);
-    const fittedPsnr = psnr(linear(fitted), truth);
+    const fittedValues = linear(fitted);
+    const fittedPsnr = psnr(fittedValues, truth);
+    // What three's drawing of the glTF costs, apart from the fit: the same glTF BRDF drawn exactly
+    // (brdf-fit's fit.binary baked with its own engine textures, by the reference estimator as
+    // the truth is drawn), and the factors three read against fit.json's.
+    const fitBake = await loadBake(fitUrl);
+    const fitTruthMaterial = fitBake.createMaterial({ mode: 'reference', spp: 64, frames: truthFrames });
+    disposables.push(fitTruthMaterial, fitBake);
+    const fitTruth = linear(fitTruthMaterial);
+    const record = await (await fetch(`${url}fit.json`)).json();
 
     // The bake's material, one frame at 1, 4 and 16 samples.
     const measured = {};
@@ -127,7 +137,13 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
         pixels: covered.length,
         standard: { params: standard.params, colour: standard.colour, psnr: psnr(standard.values, truth) },
         physical: { params: physical.params, colour: physical.colour, psnr: psnr(physical.values, truth) },
-        gltf: { type: fitted.type, psnr: fittedPsnr },
+        gltf: {
+            type: fitted.type,
+            psnr: fittedPsnr,
+            exactPsnr: psnr(fitTruth, truth),
+            threeAgainstExact: psnr(fittedValues, fitTruth),
+            readBack: factorDifference(fitted, record.material),
+        },
         measured: Object.fromEntries(Object.entries(measured).map(([spp, m]) => [spp, m.psnr])),
         live,
         ms,
@@ -137,6 +153,27 @@ window.frontier = async ({ bake: url, size, timingSize, truthFrames, timingDraws
     renderer.dispose();
     return result;
 };
+
+// The largest difference between the factors of fit.json's `material` and those three's
+// GLTFLoader gave `material` (a MeshStandardMaterial, or a MeshPhysicalMaterial with
+// KHR_materials_specular or KHR_materials_clearcoat; colours in three's linear working space,
+// where glTF's factors are linear): 0 where three reads exactly what the fit wrote.
+function factorDifference(material, fit) {
+    const pairs = [
+        [material.color.toArray(), fit.baseColorFactor],
+        [material.metalness, fit.metallicFactor],
+        [material.roughness, fit.roughnessFactor],
+    ];
+    if (material.isMeshPhysicalMaterial) {
+        pairs.push(
+            [material.specularIntensity, fit.specularFactor],
+            [material.specularColor.toArray(), fit.specularColorFactor],
+            [material.clearcoat, fit.clearcoatFactor],
+            [material.clearcoatRoughness, fit.clearcoatRoughnessFactor],
+        );
+    }
+    return Math.max(...pairs.flatMap(([a, b]) => [a].flat().map((x, i) => Math.abs(x - [b].flat()[i]))));
+}
 
 // Three's materials at fitted parameters, fitted to what the picture shows: the squared
 // error of the tone-mapped values over the sphere's pixels (a fit of linear radiance is ruled

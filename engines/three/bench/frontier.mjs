@@ -15,6 +15,9 @@
 //   map) at parameters fitted to the truth's picture (the page says how);
 // - the glTF material brdf-fit fitted to the table (`brdf-bake --fit`: material.gltf), read by
 //   three's GLTFLoader: what a glTF viewer shows of the fit, fitted to the BRDF, not the picture;
+//   beside it the same glTF BRDF drawn exactly (the fit's fit.binary baked with its own engine
+//   textures, drawn by the reference estimator as the truth is): the fit's own cost, and what
+//   three's image-based lighting adds to it; and the factors three read against fit.json's;
 // - the bake's prefiltered estimator, one frame of 1, 4 and 16 samples, and the live mode after
 //   the time of 8 standard frames.
 // PSNR over the sphere's pixels at --size (128), tone mapped as brdf-preview maps them (Reinhard
@@ -41,6 +44,18 @@ const args = { size: 128, 'timing-size': 512, 'truth-frames': 16, chromium: proc
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
 for (const k of ['size', 'timing-size', 'truth-frames']) args[k] = Number(args[k]);
 
+// `brdf-bake TABLE --env ENV --out-dir DIR --engine-textures EXTRA`; exit 1 is a validation
+// problem (the bake is written), anything else an error.
+function runBake(table, env, dir, extra, what) {
+    try {
+        execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', ...extra, '--quiet'], {
+            stdio: ['ignore', 'ignore', 'inherit'],
+        });
+    } catch (e) {
+        if (e.status !== 1) fail(`baking ${what}: exit ${e.status}`);
+    }
+}
+
 const out = join(ROOT, 'target/bench-frontier');
 mkdirSync(out, { recursive: true });
 console.error('building brdf-bake (release)');
@@ -53,15 +68,11 @@ for (const [material, what] of MATERIALS) {
         const dir = join(out, `${material}-${map}`);
         console.error(`baking ${material} under ${map}`);
         const env = join(ROOT, '../shared/data/env', `${map}.hdr`);
-        try {
-            execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', '--fit', '--quiet'], {
-                stdio: ['ignore', 'ignore', 'inherit'],
-            });
-        } catch (e) {
-            // Exit 1 is a validation problem (the bake is written); anything else is an error.
-            if (e.status !== 1) fail(`baking ${material} under ${map}: exit ${e.status}`);
-        }
-        bakes.push({ material, what, map: map.replace(/_1k$/, ''), dir: realpathSync(dir) });
+        runBake(table, env, dir, ['--fit'], `${material} under ${map}`);
+        // The fit as a table, baked under the same map: the glTF BRDF drawn exactly.
+        const fitDir = `${dir}-fit`;
+        runBake(join(dir, 'fit.binary'), env, fitDir, [], `the fit of ${material} under ${map}`);
+        bakes.push({ material, what, map: map.replace(/_1k$/, ''), dir: realpathSync(dir), fitDir: realpathSync(fitDir) });
     }
 }
 
@@ -71,13 +82,14 @@ let renderer = '';
 try {
     for (const bake of bakes) {
         console.error(`drawing ${bake.material} under ${bake.map}`);
-        const server = await serve(bake.dir);
+        const server = await serve(bake.dir, [['/fit-bake/', bake.fitDir]]);
         const origin = `http://127.0.0.1:${server.address().port}`;
         try {
             const { page, errors } = await openPage(browser, `${origin}/engines/three/test/page.html`).catch((e) => fail(e.message));
             const r = await page
                 .evaluate((o) => window.frontier(o), {
                     bake: `${origin}/bake/`,
+                    fitBake: `${origin}/fit-bake/`,
                     size: args.size,
                     timingSize: args['timing-size'],
                     truthFrames: args['truth-frames'],
@@ -120,6 +132,19 @@ for (const { material, what, map, r } of rows) {
             `| ${f(r.ms.measured[1] / s)} / ${f(r.ms.measured[4] / s)} / ${f(r.ms.measured[16] / s)} (${f(s)} ms) ` +
             `| ${f(r.ms.physical / s, 2)} | ${f(r.ms.gltf / s, 2)} | ${r.live.frames}, ${f(r.live.psnr)} |`,
     );
+}
+
+console.log(
+    `\nThe glTF fit apart from three: brdf-fit's material drawn by three (GLTFLoader, PMREM) and the same glTF BRDF drawn ` +
+        `exactly (the fit's fit.binary baked with its own engine textures, drawn by the reference estimator as the truth is), ` +
+        `both against the truth; three's drawing against the exact one (what three's image-based lighting costs, not the fit); ` +
+        `the largest difference between the factors three read and fit.json's.\n`,
+);
+console.log("| material | map | glTF by three dB | glTF exact dB | three against exact dB | factors read back |");
+console.log('|---|---|---:|---:|---:|---:|');
+for (const { material, map, r } of rows) {
+    const g = r.gltf;
+    console.log(`| ${material} | ${map} | ${f(g.psnr)} | ${f(g.exactPsnr)} | ${f(g.threeAgainstExact)} | ${g.readBack === 0 ? 'exact' : g.readBack.toExponential(1)} |`);
 }
 
 // The goal the measured material is held to: worth its cost beside three's own material.

@@ -8,10 +8,13 @@ import { deflateSync } from 'node:zlib';
 
 const packageRoot = resolve(fileURLToPath(new URL('.', import.meta.url)), '..');
 
-/** Serves /bake/ from `bakeDir` and /engines/three/ from this package, nothing else, on a free port of 127.0.0.1. */
-export function serve(bakeDir) {
+/**
+ * Serves /bake/ from `bakeDir`, /engines/three/ from this package and each `[prefix, folder]` of
+ * `more`, nothing else, on a free port of 127.0.0.1.
+ */
+export function serve(bakeDir, more = []) {
     const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json' };
-    const roots = [['/bake/', bakeDir], ['/engines/three/', packageRoot]];
+    const roots = [['/bake/', bakeDir], ['/engines/three/', packageRoot], ...more];
     const server = createServer((request, response) => {
         const path = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
         for (const [prefix, dir] of roots) {
