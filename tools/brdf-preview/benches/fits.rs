@@ -10,7 +10,10 @@
 //! the previewer's tone mapping of the map, over the sphere's pixels only.
 //!
 //! Whether the objective predicts the pictures: per map, how often the variant of least objective
-//! is the one of best PSNR, and what the kept variant loses against the best. The report
+//! is the one of best PSNR, and what the kept variant loses against the best. Which objective
+//! draws the better pictures: each material fitted again with the other objective
+//! (`Objective::LinearCosine` beside the default `LogCosine`), its kept variant's PSNR per map
+//! beside the default's, and per map how often each wins. The report
 //! (markdown) is printed and written to target/bench-fits/report.md; the sorted plot of the kept
 //! variants' PSNRs to docs/brdf-fit-psnr.png, which the report shows.
 //!
@@ -24,7 +27,7 @@ mod common;
 
 use common::{Stamp, material_path, root, shared};
 use envmap::MipChain;
-use gltf_fit::{Settings, Variant};
+use gltf_fit::{Objective, Settings, Variant};
 use merl::MerlTable;
 use picture::layout::{Axis, caption, heat_map, stack};
 use picture::{BACKGROUND, Canvas, INK, TEXT_SCALE};
@@ -114,6 +117,16 @@ struct Row {
     psnr: Vec<f64>,
     /// Per variant ([`VARIANTS`]), its PSNR per map.
     by_variant: Vec<Vec<f64>>,
+    /// The kept variant of the fit with the other objective ([`other_objective`]): its PSNR per map.
+    other: Vec<f64>,
+}
+
+/// The objective the fits are compared with: the one the settings do not use.
+fn other_objective(settings: &Settings) -> Objective {
+    match settings.objective {
+        Objective::LogCosine => Objective::LinearCosine,
+        Objective::LinearCosine => Objective::LogCosine,
+    }
 }
 
 fn main() {
@@ -153,7 +166,15 @@ fn measure(name: &'static str, settings: &Settings, cases: &[Case]) -> Row {
     let chosen = VARIANTS.iter().position(|&v| v == fit.chosen).expect("a variant");
     let albedo = gltf_fit::albedo_rows(&table, &tables[chosen]);
     let measured = material(table);
-    let fitted: Vec<Material> = tables.into_iter().map(material).collect();
+    let mut fitted: Vec<Material> = tables.into_iter().map(material).collect();
+    // The kept variant of the fit with the other objective, drawn after the variants.
+    let other_settings = Settings { objective: other_objective(settings), ..*settings };
+    let other = gltf_fit::fit(&measured.table, &other_settings);
+    fitted.push(material(gltf_fit::fitted_table(
+        &other.variant(other.chosen).material,
+        settings.masking,
+        measured.table.dims(),
+    )));
     // Per case, each variant's PSNR.
     let per_case: Vec<Vec<f64>> = cases
         .iter()
@@ -171,6 +192,7 @@ fn measure(name: &'static str, settings: &Settings, cases: &[Case]) -> Row {
         })
         .collect();
     let by_variant: Vec<Vec<f64>> = (0..VARIANTS.len()).map(|v| per_case.iter().map(|p| p[v]).collect()).collect();
+    let other: Vec<f64> = per_case.iter().map(|p| p[VARIANTS.len()]).collect();
     let psnr = by_variant[chosen].clone();
     eprintln!(
         "{name}: {} {} ({:.1} s)",
@@ -178,7 +200,7 @@ fn measure(name: &'static str, settings: &Settings, cases: &[Case]) -> Row {
         psnr.iter().map(|p| format!("{p:.2} dB")).collect::<Vec<_>>().join(", "),
         start.elapsed().as_secs_f64()
     );
-    Row { name, fit, albedo, psnr, by_variant }
+    Row { name, fit, albedo, psnr, by_variant, other }
 }
 
 /// The report (markdown) of `rows`; with every material (`complete`), it shows the plot.
@@ -203,6 +225,8 @@ fn report(rows: &[Row], settings: &Settings, complete: bool) -> String {
     lines.extend(kept_table(rows));
     lines.push(String::new());
     lines.extend(variant_table(rows));
+    lines.push(String::new());
+    lines.extend(objective_table(rows, settings));
     lines.push(String::new());
     lines.extend(summaries(rows));
     if complete {
@@ -279,6 +303,43 @@ fn variant_table(rows: &[Row]) -> Vec<String> {
             })
             .collect();
         lines.push(format!("| {} | {} |", r.name, cells.join(" | ")));
+    }
+    lines
+}
+
+/// Each material's kept fit under the default objective and under the other, PSNR per map, and
+/// per map how often each draws the better picture.
+fn objective_table(rows: &[Row], settings: &Settings) -> Vec<String> {
+    let (ours, other) = (settings.objective.name(), other_objective(settings).name());
+    let maps = map_names();
+    let mut lines = vec![
+        format!("## The objective against the pictures: {ours} (the default) and {other}"),
+        String::new(),
+        format!(
+            "| material | {} |",
+            maps.iter().map(|m| format!("{m}: {ours} / {other} dB")).collect::<Vec<_>>().join(" | ")
+        ),
+        format!("|---|{}", "---:|".repeat(maps.len())),
+    ];
+    for r in rows {
+        let cells: Vec<String> = (0..maps.len()).map(|k| format!("{:.2} / {:.2}", r.psnr[k], r.other[k])).collect();
+        lines.push(format!("| {} | {} |", r.name, cells.join(" | ")));
+    }
+    lines.push(String::new());
+    for (k, map) in maps.iter().enumerate() {
+        let wins = rows.iter().filter(|r| r.psnr[k] > r.other[k]).count();
+        let mut gain: Vec<f64> = rows.iter().map(|r| r.psnr[k] - r.other[k]).collect();
+        gain.sort_by(f64::total_cmp);
+        if !gain.is_empty() {
+            lines.push(format!(
+                "{map}: {ours} draws the better picture for {wins} of {} materials; its PSNR minus {other}'s: median \
+                 {:+.2} dB, from {:+.2} to {:+.2}.",
+                rows.len(),
+                median(&gain),
+                gain[0],
+                gain[gain.len() - 1]
+            ));
+        }
     }
     lines
 }
