@@ -326,6 +326,14 @@ fn estimator(request: &Request, loaded: &bake::Loaded, lighting: &Lighting, host
     Ok(Outcome::Rendered(step))
 }
 
+/// Another material's render beside an estimator's ([`EstimatorRender::beside`]): its picture,
+/// and its PSNR and relative error against the estimator's render.
+struct Beside {
+    picture: Vec<u8>,
+    psnr: f64,
+    relative: f64,
+}
+
 /// An estimator's render on the GPU, for the checks that compare it.
 struct EstimatorRender<'a> {
     scene: &'a Scene,
@@ -393,6 +401,27 @@ impl EstimatorRender<'_> {
         })
     }
 
+    /// The same render of another `material` on the GPU (`what` names it: "from the table"), its
+    /// picture, and its PSNR and relative error against this render.
+    fn beside(
+        &self,
+        request: &Request,
+        gpu: &gpu::Gpu,
+        material: &render::Material,
+        lighting: &Lighting,
+        what: &str,
+        host: &dyn Host,
+    ) -> Result<Beside, Error> {
+        let settings = self.settings;
+        host.step(format!("{} {what} on the GPU", settings.estimator.name()));
+        let image = gpu::preview::Renderer::new(gpu, self.scene, material, lighting)?.render_frames(settings)?;
+        check_finite(request, &image.rgb, &format!("the GPU render {what}"))?;
+        let picture = metrics::tonemap(&image, self.tone_mapping);
+        let psnr = metrics::psnr_db(self.picture, &picture);
+        let relative = metrics::relative_error(&self.image.rgb, &image.rgb);
+        Ok(Beside { picture, psnr, relative })
+    }
+
     /// What the wavelet compression costs: the same render from the table itself.
     fn against_table(
         &self,
@@ -403,14 +432,10 @@ impl EstimatorRender<'_> {
         host: &dyn Host,
         step: &mut Rendered,
     ) -> Result<(), Error> {
-        let (scene, settings) = (self.scene, self.settings);
+        let scene = self.scene;
         let table_material = render::Material { wavelet_brdf: None, ..loaded.material.clone() };
-        host.step(format!("{} from the table on the GPU", settings.estimator.name()));
-        let table = gpu::preview::Renderer::new(gpu, scene, &table_material, lighting)?.render_frames(settings)?;
-        check_finite(request, &table.rgb, "the GPU render from the table")?;
-        let table_picture = metrics::tonemap(&table, self.tone_mapping);
-        let psnr = metrics::psnr_db(self.picture, &table_picture);
-        let relative = metrics::relative_error(&self.image.rgb, &table.rgb);
+        let Beside { picture: table_picture, psnr, relative } =
+            self.beside(request, gpu, &table_material, lighting, "from the table", host)?;
         step.files.push(Output {
             path: sibling(self.out, "table"),
             role: "table",
@@ -530,12 +555,8 @@ impl EstimatorRender<'_> {
         step: &mut Rendered,
     ) -> Result<(), Error> {
         let (scene, settings) = (self.scene, self.settings);
-        host.step(format!("{} of the glTF fit on the GPU", settings.estimator.name()));
-        let fit = gpu::preview::Renderer::new(gpu, scene, &fit_material, lighting)?.render_frames(settings)?;
-        check_finite(request, &fit.rgb, "the GPU render of the glTF fit")?;
-        let fit_picture = metrics::tonemap(&fit, self.tone_mapping);
-        let psnr = metrics::psnr_db(self.picture, &fit_picture);
-        let relative = metrics::relative_error(&self.image.rgb, &fit.rgb);
+        let Beside { picture: fit_picture, psnr, relative } =
+            self.beside(request, gpu, &fit_material, lighting, "of the glTF fit", host)?;
         let fit_converged = metrics::psnr_db(&fit_picture, &converged.picture);
         let caption = format!(
             "glTF fit of {} ({}) | {} | {} spp x {} frames | exposure {:+.2} EV",
