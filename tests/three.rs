@@ -257,6 +257,9 @@ fn engine_textures_need_an_environment() {
 /// - An orthographic camera draws as a perspective one 4000 units away (rays parallel within
 ///   3e-4 radians): at least 50 dB (measured 58.4; with the eye at the camera's position, as for
 ///   a perspective camera, 30.0).
+/// - `scene.environmentRotation` turns the environment the material reads: a turn about +y against
+///   the unturned scene seen by a camera turned back by as much, at least 60 dB (measured 88.1;
+///   the picture without the turn puts the sun's reflection elsewhere).
 /// - The live mode (`Accumulator`): eight calls, one frame each, average to one draw of the same
 ///   eight frames within 1e-5 relatively (measured: equal), and a moved camera starts again at
 ///   one frame.
@@ -290,6 +293,7 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
         ("mesh scale against geometry scale", "scale_psnr_db"),
         ("an InstancedMesh against separate meshes", "instances_psnr_db"),
         ("a SkinnedMesh against a moved mesh", "skinning_psnr_db"),
+        ("scene.environmentRotation against a camera turned back", "environment_rotation_psnr_db"),
     ] {
         let psnr = figures[key].as_f64().unwrap();
         assert!(psnr >= 60.0, "{what}: {psnr:.2} dB; {where_}");

@@ -17,6 +17,8 @@ import { drawFloats, pageRenderer } from './page-tools.js';
 //   and turned, against the same shape made in its geometry;
 // - instances: an InstancedMesh of 100 against 100 meshes; skinning: a sphere skinned to a bone
 //   against a mesh moved as the bone;
+// - environment-turned: the bake's material under scene.environmentRotation (a turn about +y)
+//   against the unturned scene seen by a camera turned back by as much;
 // - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count
 //   after the camera moved;
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
@@ -29,6 +31,7 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     instances(s);
     skinning(s);
     orthographic(s, mirrorScene);
+    environmentTurned(s);
     const live = liveMode(s);
     const canvases = toneMapped(s, mirrorScene);
     const gl = s.renderer.getContext();
@@ -222,6 +225,28 @@ function orthographic({ draw }, ours) {
     const distant = view(new THREE.PerspectiveCamera((2 * Math.atan(1.2 / far) * 180) / Math.PI, 1, far - 2, far + 2), far);
     draw('orthographic-orthographic', ours, orthographic);
     draw('orthographic-distant', ours, distant);
+}
+
+/**
+ * scene.environmentRotation turns the environment the material reads as three turns its own: a
+ * turn of the environment by `angle` about +y is the unturned environment seen by a camera turned
+ * by `-angle` (three reads a turned map along the inverse turn of each direction). The angle is a
+ * whole number of the sphere's 128 segments, so that the turned view sees the same triangles and
+ * every pixel the same normal and samples; the scene has no background.
+ */
+function environmentTurned({ sphere, material, draw, camera }) {
+    const angle = (22 * 2 * Math.PI) / 128;
+    const turned = new THREE.Scene();
+    turned.environmentRotation.set(0, angle, 0);
+    turned.add(new THREE.Mesh(sphere, material));
+    const plain = new THREE.Scene();
+    plain.add(new THREE.Mesh(sphere, material));
+    const back = camera(30);
+    back.position.applyMatrix4(new THREE.Matrix4().makeRotationY(-angle));
+    back.lookAt(0, 0, 0);
+    back.updateMatrixWorld();
+    draw('environment-turned-scene', turned, camera(30));
+    draw('environment-turned-camera', plain, back);
 }
 
 /**

@@ -17,6 +17,8 @@
 //   skinned to a bone against a mesh moved as the bone (three's chunks in the vertex shader);
 // - orthographic_psnr_db: the material seen by an orthographic camera against a perspective one
 //   4000 units away (rays parallel within 3e-4 radians);
+// - environment_rotation_psnr_db: the material under scene.environmentRotation (a turn about +y)
+//   against the unturned scene seen by a camera turned back by as much;
 // - live_largest_relative_difference, live_frames, live_frames_after_moving: the live mode
 //   (Accumulator): the mean of 8 calls against one draw of the same 8 frames (linear values), the
 //   frames it holds, and after the camera moved;
@@ -155,6 +157,7 @@ try {
     files.push(pair('instances', 'instances-instanced', 'instances-separate'));
     files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
     files.push(pair('orthographic', 'orthographic-orthographic', 'orthographic-distant'));
+    files.push(pair('environment-turned', 'environment-turned-scene', 'environment-turned-camera'));
     files.push(pair('live', 'live-accumulated', 'live-drawn'));
     const linear = result.pictures['mirror-bake'];
     const canvases = Object.fromEntries(
@@ -178,6 +181,7 @@ try {
         instances_psnr_db: psnrDb(pictures['instances-instanced'], pictures['instances-separate']),
         skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
         orthographic_psnr_db: psnrDb(pictures['orthographic-orthographic'], pictures['orthographic-distant']),
+        environment_rotation_psnr_db: psnrDb(pictures['environment-turned-scene'], pictures['environment-turned-camera']),
         live_largest_relative_difference: largestRelativeDifference(result.pictures['live-accumulated'], result.pictures['live-drawn']),
         live_frames: result.live.frames,
         live_frames_after_moving: result.live.framesAfterMoving,
