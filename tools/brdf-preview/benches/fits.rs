@@ -18,8 +18,8 @@
 //! variants' PSNRs to docs/brdf-fit-psnr.png, which the report shows.
 //!
 //! `cargo bench -p brdf-preview --bench fits [-- --only NAME]`. Needs `../shared` (the maps, and
-//! nbrdf2merl.py with numpy for the materials, made once under target/merl/). About 25 s per
-//! material on 2 cores.
+//! nbrdf2merl.py with numpy for the materials, made once under target/merl/). About 50 s per
+//! material on 2 cores (two fits and eight converged renders).
 
 use std::path::PathBuf;
 
