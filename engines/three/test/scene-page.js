@@ -19,6 +19,10 @@ import { drawFloats, pageRenderer } from './page-tools.js';
 //   against a mesh moved as the bone;
 // - environment-turned: the bake's material under scene.environmentRotation (a turn about +y)
 //   against the unturned scene seen by a camera turned back by as much;
+// - morph: a sphere morphed into a squashed one (a morph target of influence 1) against the
+//   squashed shape made in its geometry;
+// - clipping: the material on a sphere with a clipping plane through its centre against the same
+//   material on the sphere's lower half made in its geometry;
 // - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count
 //   after the camera moved;
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
@@ -32,6 +36,8 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     skinning(s);
     orthographic(s, mirrorScene);
     environmentTurned(s);
+    morphTarget(s);
+    clipping(s);
     const live = liveMode(s);
     const canvases = toneMapped(s, mirrorScene);
     const gl = s.renderer.getContext();
@@ -247,6 +253,49 @@ function environmentTurned({ sphere, material, draw, camera }) {
     back.updateMatrixWorld();
     draw('environment-turned-scene', turned, camera(30));
     draw('environment-turned-camera', plain, back);
+}
+
+/**
+ * A sphere with a morph target, the same sphere squashed to (1, 0.4, 1), at influence 1 (three
+ * then draws the target's positions and normals), against the squashed shape made in its
+ * geometry: three's morph chunks in the material's vertex shader.
+ */
+function morphTarget({ bake, sphere, disposables, draw, camera }) {
+    const converged = bake.createMaterial({ mode: 'prefiltered', frames: 32 });
+    const squashed = sphere.clone().applyMatrix4(new THREE.Matrix4().makeScale(1, 0.4, 1));
+    const morphed = sphere.clone();
+    morphed.morphAttributes.position = [squashed.getAttribute('position')];
+    morphed.morphAttributes.normal = [squashed.getAttribute('normal')];
+    disposables.push(converged, squashed, morphed);
+    const mesh = new THREE.Mesh(morphed, converged);
+    mesh.morphTargetInfluences[0] = 1;
+    const byMorph = new THREE.Scene();
+    byMorph.add(mesh);
+    draw('morph-morphed', byMorph, camera(20));
+    const byGeometry = new THREE.Scene();
+    byGeometry.add(new THREE.Mesh(squashed, converged));
+    draw('morph-geometry', byGeometry, camera(20));
+}
+
+/**
+ * The material on the sphere with a clipping plane through its centre that keeps the lower half
+ * (renderer.localClippingEnabled), from 30 degrees above, against the same material on the
+ * sphere's lower half made in its geometry (the sphere's rows end at the equator, so the two hold
+ * the same triangles below it; the bowl's inside shows in both).
+ */
+function clipping({ renderer, bake, sphere, material, disposables, draw, camera }) {
+    const clipped = bake.createMaterial({ mode: 'prefiltered' });
+    clipped.clippingPlanes = [new THREE.Plane(new THREE.Vector3(0, -1, 0), 0)];
+    const bowl = new THREE.SphereGeometry(1, 128, 32, 0, 2 * Math.PI, Math.PI / 2, Math.PI / 2);
+    disposables.push(clipped, bowl);
+    const cut = new THREE.Scene();
+    cut.add(new THREE.Mesh(sphere, clipped));
+    renderer.localClippingEnabled = true;
+    draw('clipping-plane', cut, camera(30));
+    renderer.localClippingEnabled = false;
+    const half = new THREE.Scene();
+    half.add(new THREE.Mesh(bowl, material));
+    draw('clipping-geometry', half, camera(30));
 }
 
 /**

@@ -19,6 +19,10 @@
 //   4000 units away (rays parallel within 3e-4 radians);
 // - environment_rotation_psnr_db: the material under scene.environmentRotation (a turn about +y)
 //   against the unturned scene seen by a camera turned back by as much;
+// - morph_psnr_db: a sphere morphed into a squashed one against the squashed shape in its geometry;
+// - clipping_psnr_db: a sphere under a clipping plane through its centre against its lower half
+//   made in its geometry;
+// (a PSNR of identical pictures is infinite: null in the JSON);
 // - live_largest_relative_difference, live_frames, live_frames_after_moving: the live mode
 //   (Accumulator): the mean of 8 calls against one draw of the same 8 frames (linear values), the
 //   frames it holds, and after the camera moved;
@@ -158,6 +162,8 @@ try {
     files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
     files.push(pair('orthographic', 'orthographic-orthographic', 'orthographic-distant'));
     files.push(pair('environment-turned', 'environment-turned-scene', 'environment-turned-camera'));
+    files.push(pair('morph', 'morph-morphed', 'morph-geometry'));
+    files.push(pair('clipping', 'clipping-plane', 'clipping-geometry'));
     files.push(pair('live', 'live-accumulated', 'live-drawn'));
     const linear = result.pictures['mirror-bake'];
     const canvases = Object.fromEntries(
@@ -182,6 +188,8 @@ try {
         skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
         orthographic_psnr_db: psnrDb(pictures['orthographic-orthographic'], pictures['orthographic-distant']),
         environment_rotation_psnr_db: psnrDb(pictures['environment-turned-scene'], pictures['environment-turned-camera']),
+        morph_psnr_db: psnrDb(pictures['morph-morphed'], pictures['morph-geometry']),
+        clipping_psnr_db: psnrDb(pictures['clipping-plane'], pictures['clipping-geometry']),
         live_largest_relative_difference: largestRelativeDifference(result.pictures['live-accumulated'], result.pictures['live-drawn']),
         live_frames: result.live.frames,
         live_frames_after_moving: result.live.framesAfterMoving,
