@@ -12,6 +12,11 @@ pub(crate) fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu:
     device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
 }
 
+/// A buffer of `size` bytes that a copy fills and the host maps to read ([`read_back`]).
+pub(crate) fn readback_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    buffer(device, label, size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST)
+}
+
 /// A uniform buffer of `size` bytes that the queue writes.
 pub(crate) fn uniform_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     buffer(device, label, size, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)

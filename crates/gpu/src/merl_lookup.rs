@@ -181,7 +181,7 @@ impl MerlLookup {
             (
                 buffer("merl pairs", capacity * PAIR_BYTES, U::STORAGE | U::COPY_DST),
                 buffer("merl samples", capacity * SAMPLE_BYTES, U::STORAGE | U::COPY_SRC),
-                buffer("merl readback", capacity * SAMPLE_BYTES, U::MAP_READ | U::COPY_DST),
+                crate::device::readback_buffer(&self.device, "merl readback", capacity * SAMPLE_BYTES),
             )
         })?;
         for batch in pairs.chunks(capacity as usize) {

@@ -61,7 +61,7 @@ const TONE_MAPPING_EXPOSURE = 1.7;
 
 /**
  * What every check draws with: the renderer, the bake and its map, the sphere and the bake's
- * prefiltered material on brdf-preview's defaults, `draw(name, scene, camera)` into
+ * prefiltered material on brdf-preview's defaults and at 32 frames, `draw(name, scene, camera)` into
  * `pictures[name]`, a camera 3.2 away at an elevation, and what is disposed at the end.
  */
 async function setUp(url, width, height) {
@@ -72,7 +72,11 @@ async function setUp(url, width, height) {
     const target = floatTarget(width, height);
     const sphere = new THREE.SphereGeometry(1, 128, 64);
     const material = bake.createMaterial({ mode: 'prefiltered' });
-    const disposables = [map, target, sphere, material];
+    // Four times brdf-preview's frames, for the checks that draw one shape made two ways (scale,
+    // morph): the two drawings' normals differ by rounding, which moves their samples a little;
+    // with less noise that moves the picture less.
+    const converged = bake.createMaterial({ mode: 'prefiltered', frames: 32 });
+    const disposables = [map, target, sphere, material, converged];
     const pictures = {};
     // RGBA values read back (rows from the bottom) as RGB, rows from the top, each divided by `d`.
     const topDownRgb = (values, d = 1) => {
@@ -96,7 +100,7 @@ async function setUp(url, width, height) {
         c.updateMatrixWorld();
         return c;
     };
-    return { renderer, bake, map, sphere, material, disposables, pictures, draw, camera, topDownRgb, width, height };
+    return { renderer, bake, map, sphere, material, converged, disposables, pictures, draw, camera, topDownRgb, width, height };
 }
 
 /** three's scene.background against the bake's createBackground, unturned and turned. */
@@ -134,11 +138,7 @@ function mirror({ bake, map, sphere, material, disposables, draw, camera }) {
 }
 
 /** A sphere squashed by its mesh's scale against the same shape made in its geometry. */
-function scale({ bake, sphere, disposables, draw, camera }) {
-    // Four times brdf-preview's frames: the two drawings' normals differ by rounding, which moves
-    // their samples a little; with less noise that moves the picture less.
-    const converged = bake.createMaterial({ mode: 'prefiltered', frames: 32 });
-    disposables.push(converged);
+function scale({ sphere, converged, disposables, draw, camera }) {
     const turned = new THREE.Euler(0.4, 0.7, 0.2);
     const squashed = new THREE.Mesh(sphere, converged);
     squashed.scale.set(1, 0.4, 1);
@@ -260,13 +260,12 @@ function environmentTurned({ sphere, material, draw, camera }) {
  * then draws the target's positions and normals), against the squashed shape made in its
  * geometry: three's morph chunks in the material's vertex shader.
  */
-function morphTarget({ bake, sphere, disposables, draw, camera }) {
-    const converged = bake.createMaterial({ mode: 'prefiltered', frames: 32 });
+function morphTarget({ sphere, converged, disposables, draw, camera }) {
     const squashed = sphere.clone().applyMatrix4(new THREE.Matrix4().makeScale(1, 0.4, 1));
     const morphed = sphere.clone();
     morphed.morphAttributes.position = [squashed.getAttribute('position')];
     morphed.morphAttributes.normal = [squashed.getAttribute('normal')];
-    disposables.push(converged, squashed, morphed);
+    disposables.push(squashed, morphed);
     const mesh = new THREE.Mesh(morphed, converged);
     mesh.morphTargetInfluences[0] = 1;
     const byMorph = new THREE.Scene();

@@ -583,12 +583,7 @@ impl Renderer {
 
     /// A buffer to map for reading, of `bytes`.
     fn readback_buffer(&self, bytes: u64) -> wgpu::Buffer {
-        crate::device::buffer(
-            &self.device,
-            "preview readback",
-            bytes.max(4),
-            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        )
+        crate::device::readback_buffer(&self.device, "preview readback", bytes.max(4))
     }
 
     /// A compute pass with the shading pass's groups 0 to 2 set.

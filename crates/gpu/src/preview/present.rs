@@ -238,12 +238,7 @@ impl Presenter {
         let row_bytes = (4 * width).next_multiple_of(ROW_ALIGNMENT);
         let bytes = u64::from(row_bytes) * u64::from(height);
         let readback = capture_errors(&self.device, || {
-            let buffer = crate::device::buffer(
-                &self.device,
-                "preview present readback",
-                bytes,
-                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            );
+            let buffer = crate::device::readback_buffer(&self.device, "preview present readback", bytes);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_texture_to_buffer(
                 texture.as_image_copy(),
