@@ -54,6 +54,7 @@ BENCHMARKS = [
         "markdown",
     ),
     ("frontier", "The three.js material against three.js's own", "node engines/three/bench/frontier.mjs", "markdown"),
+    ("gltf", "brdf-fit's glTF materials in three.js", "node engines/three/bench/gltf.mjs", "markdown"),
 ]
 
 HEADER = """# Benchmarks

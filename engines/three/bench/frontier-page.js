@@ -23,8 +23,17 @@ function camera(aspect) {
 }
 
 
-window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFrames, timingDraws }) => {
-    const renderer = pageRenderer(timingSize, timingSize);
+/**
+ * The sphere at the origin of a y-up scene lit by the bake at `url` (its map as
+ * scene.environment), drawn into a float target of size x size by a renderer on a canvas of
+ * canvasSize x canvasSize without tone mapping: `linear(material)` gives its linear RGBA,
+ * `covered` the sphere's pixels (where a drawing writes alpha 1), `psnr(values, truth)` the PSNR
+ * of the tone-mapped values there (brdf-preview's tone map at the bake's automatic exposure).
+ * What every benchmark page function starts from; `dispose()` frees it all, with whatever was
+ * added to `disposables`.
+ */
+export async function sphereScene(url, size, canvasSize) {
+    const renderer = pageRenderer(canvasSize, canvasSize);
     renderer.toneMapping = THREE.NoToneMapping;
     const bake = await loadBake(url);
     const exposure = 2 ** bake.figures.exposure_ev;
@@ -36,16 +45,13 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
     scene.add(mesh);
     const target = floatTarget(size, size);
     const view = camera(1);
-    const disposables = [map, sphere, target];
+    const white = new THREE.MeshBasicMaterial({ color: 0xffffff });
+    const disposables = [map, sphere, target, white];
 
-    // Linear RGB of `material` on the sphere at size x size, black around it.
     const linear = (material) => {
         mesh.material = material;
         return drawFloats(renderer, target, scene, view);
     };
-    // The sphere's pixels: where a drawing writes alpha 1.
-    const white = new THREE.MeshBasicMaterial({ color: 0xffffff });
-    disposables.push(white);
     const coverage = linear(white);
     const covered = [];
     for (let i = 0; i < size * size; i++) if (coverage[4 * i + 3] > 0.5) covered.push(i);
@@ -58,6 +64,53 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
         return sum;
     };
     const psnr = (values, truth) => 10 * Math.log10((255 * 255) / (toneError(values, truth) / (3 * covered.length)));
+    // The tone-mapped picture as 8-bit RGB, rows from the top, black around the sphere.
+    const picture = (values) => {
+        const rgb = new Array(3 * size * size).fill(0);
+        for (const i of covered) {
+            const [x, y] = [i % size, size - 1 - Math.floor(i / size)];
+            for (let c = 0; c < 3; c++) rgb[3 * (y * size + x) + c] = level(values[4 * i + c], exposure);
+        }
+        return rgb;
+    };
+    const dispose = () => {
+        disposables.forEach((d) => d.dispose());
+        bake.dispose();
+        renderer.dispose();
+    };
+    return { renderer, bake, exposure, scene, mesh, view, linear, covered, toneError, psnr, picture, disposables, dispose };
+}
+
+/**
+ * brdf-fit's material as a glTF viewer reads it: three's GLTFLoader turns the bake's
+ * material.gltf (brdf-bake --fit) into a MeshStandardMaterial, or a MeshPhysicalMaterial with
+ * KHR_materials_specular or KHR_materials_clearcoat, drawn on the sphere of `s`
+ * (sphereScene). Beside it, apart from three, the same glTF BRDF drawn exactly (brdf-fit's
+ * fit.binary baked with its own engine textures at `fitUrl`, drawn by the reference estimator at
+ * 64 samples per strategy x truthFrames frames), and the largest difference between the factors
+ * three read and fit.json's.
+ */
+export async function gltfBeside(url, fitUrl, s, truthFrames) {
+    const gltf = await new GLTFLoader().loadAsync(`${url}material.gltf`);
+    let material = null;
+    gltf.scene.traverse((o) => {
+        if (o.isMesh && !material) material = o.material;
+    });
+    if (!material) throw new Error(`${url}material.gltf holds no mesh`);
+    gltf.scene.traverse((o) => o.isMesh && o.geometry.dispose());
+    s.disposables.push(material);
+    const values = s.linear(material);
+    const fitBake = await loadBake(fitUrl);
+    const exactMaterial = fitBake.createMaterial({ mode: 'reference', spp: 64, frames: truthFrames });
+    s.disposables.push(exactMaterial, fitBake);
+    const exact = s.linear(exactMaterial);
+    const record = await (await fetch(`${url}fit.json`)).json();
+    return { material, values, exact, readBack: factorDifference(material, record.material) };
+}
+
+window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFrames, timingDraws }) => {
+    const s = await sphereScene(url, size, timingSize);
+    const { renderer, bake, exposure, scene, mesh, view, linear, covered, toneError, psnr, disposables } = s;
 
     // The truth: the bake's reference estimator at 64 samples per strategy and truthFrames frames.
     const truthMaterial = bake.createMaterial({ mode: 'reference', spp: 64, frames: truthFrames });
@@ -81,27 +134,8 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
     );
     disposables.push(standard.material, physical.material);
 
-    // brdf-fit's material as a glTF viewer reads it: three's GLTFLoader turns the bake's
-    // material.gltf (brdf-bake --fit) into a MeshStandardMaterial, or a MeshPhysicalMaterial with
-    // KHR_materials_specular or KHR_materials_clearcoat; drawn on the same sphere.
-    const gltf = await new GLTFLoader().loadAsync(`${url}material.gltf`);
-    let fitted = null;
-    gltf.scene.traverse((o) => {
-        if (o.isMesh && !fitted) fitted = o.material;
-    });
-    if (!fitted) throw new Error(`${url}material.gltf holds no mesh`);
-    gltf.scene.traverse((o) => o.isMesh && o.geometry.dispose());
-    disposables.push(fitted);
-    const fittedValues = linear(fitted);
-    const fittedPsnr = psnr(fittedValues, truth);
-    // What three's drawing of the glTF costs, apart from the fit: the same glTF BRDF drawn exactly
-    // (brdf-fit's fit.binary baked with its own engine textures, by the reference estimator as
-    // the truth is drawn), and the factors three read against fit.json's.
-    const fitBake = await loadBake(fitUrl);
-    const fitTruthMaterial = fitBake.createMaterial({ mode: 'reference', spp: 64, frames: truthFrames });
-    disposables.push(fitTruthMaterial, fitBake);
-    const fitTruth = linear(fitTruthMaterial);
-    const record = await (await fetch(`${url}fit.json`)).json();
+    const gltf = await gltfBeside(url, fitUrl, s, truthFrames);
+    const fitted = gltf.material;
 
     // The bake's material, one frame at 1, 4 and 16 samples.
     const measured = {};
@@ -139,18 +173,16 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
         physical: { params: physical.params, colour: physical.colour, psnr: psnr(physical.values, truth) },
         gltf: {
             type: fitted.type,
-            psnr: fittedPsnr,
-            exactPsnr: psnr(fitTruth, truth),
-            threeAgainstExact: psnr(fittedValues, fitTruth),
-            readBack: factorDifference(fitted, record.material),
+            psnr: psnr(gltf.values, truth),
+            exactPsnr: psnr(gltf.exact, truth),
+            threeAgainstExact: psnr(gltf.values, gltf.exact),
+            readBack: gltf.readBack,
         },
         measured: Object.fromEntries(Object.entries(measured).map(([spp, m]) => [spp, m.psnr])),
         live,
         ms,
     };
-    disposables.forEach((d) => d.dispose());
-    bake.dispose();
-    renderer.dispose();
+    s.dispose();
     return result;
 };
 

@@ -24,57 +24,18 @@
 // at the bake's automatic exposure, sRGB); milliseconds per frame at --timing-size (512).
 // Prints the report as markdown, with the goal the material is held to and which cases meet it.
 // Needs target/merl (make test-data), Chromium and engines/three's packages (make setup).
-import { execFileSync } from 'node:child_process';
-import { existsSync, mkdirSync, realpathSync } from 'node:fs';
-import { join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join } from 'node:path';
 
-import { launch, openPage, serve } from '../test/serve.mjs';
+import { launch } from '../test/serve.mjs';
+import { ROOT, bakeWithFit, fail, onBakePage, parseArgs, prepare, rendererName } from './common.mjs';
 
-const ROOT = resolve(fileURLToPath(new URL('.', import.meta.url)), '../../..');
 const MATERIALS = [['gray-plastic', 'a plastic'], ['steel', 'a metal'], ['pink-fabric', 'a felt-like diffuse']];
 const MAPS = ['quarry_01_1k', 'studio_small_03_1k'];
 
-function fail(message) {
-    console.error(`error: ${message}`);
-    process.exit(2);
-}
-
-const args = { size: 128, 'timing-size': 512, 'truth-frames': 16, chromium: process.env.CHROMIUM ?? '/usr/bin/chromium' };
-for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
-for (const k of ['size', 'timing-size', 'truth-frames']) args[k] = Number(args[k]);
-
-// `brdf-bake TABLE --env ENV --out-dir DIR --engine-textures EXTRA`; exit 1 is a validation
-// problem (the bake is written), anything else an error.
-function runBake(table, env, dir, extra, what) {
-    try {
-        execFileSync(join(ROOT, 'target/release/brdf-bake'), [table, '--env', env, '--out-dir', dir, '--engine-textures', ...extra, '--quiet'], {
-            stdio: ['ignore', 'ignore', 'inherit'],
-        });
-    } catch (e) {
-        if (e.status !== 1) fail(`baking ${what}: exit ${e.status}`);
-    }
-}
-
+const args = parseArgs({ size: 128, 'timing-size': 512, 'truth-frames': 16 });
 const out = join(ROOT, 'target/bench-frontier');
-mkdirSync(out, { recursive: true });
-console.error('building brdf-bake (release)');
-execFileSync('cargo', ['build', '--quiet', '--release', '-p', 'brdf-bake'], { cwd: ROOT, stdio: 'inherit' });
-const bakes = [];
-for (const [material, what] of MATERIALS) {
-    const table = join(ROOT, 'target/merl', `${material}.binary`);
-    if (!existsSync(table)) fail(`${table} does not exist: make test-data makes it`);
-    for (const map of MAPS) {
-        const dir = join(out, `${material}-${map}`);
-        console.error(`baking ${material} under ${map}`);
-        const env = join(ROOT, '../shared/data/env', `${map}.hdr`);
-        runBake(table, env, dir, ['--fit'], `${material} under ${map}`);
-        // The fit as a table, baked under the same map: the glTF BRDF drawn exactly.
-        const fitDir = `${dir}-fit`;
-        runBake(join(dir, 'fit.binary'), env, fitDir, [], `the fit of ${material} under ${map}`);
-        bakes.push({ material, what, map: map.replace(/_1k$/, ''), dir: realpathSync(dir), fitDir: realpathSync(fitDir) });
-    }
-}
+prepare(out);
+const bakes = MATERIALS.flatMap(([material, what]) => MAPS.map((map) => ({ ...bakeWithFit(material, map, out), what })));
 
 const browser = await launch(args.chromium).catch((e) => fail(e.message));
 const rows = [];
@@ -82,30 +43,18 @@ let renderer = '';
 try {
     for (const bake of bakes) {
         console.error(`drawing ${bake.material} under ${bake.map}`);
-        const server = await serve(bake.dir, [['/fit-bake/', bake.fitDir]]);
-        const origin = `http://127.0.0.1:${server.address().port}`;
-        try {
-            const { page, errors } = await openPage(browser, `${origin}/engines/three/test/page.html`).catch((e) => fail(e.message));
-            const r = await page
-                .evaluate((o) => window.frontier(o), {
-                    bake: `${origin}/bake/`,
-                    fitBake: `${origin}/fit-bake/`,
-                    size: args.size,
-                    timingSize: args['timing-size'],
-                    truthFrames: args['truth-frames'],
-                    timingDraws: 3,
-                })
-                .catch((e) => fail(`${bake.material} under ${bake.map}: ${e.message}; ${errors.join('; ')}`));
-            renderer ||= await page.evaluate(() => {
-                const gl = document.createElement('canvas').getContext('webgl2');
-                const debug = gl.getExtension('WEBGL_debug_renderer_info');
-                return gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER);
+        const r = await onBakePage(browser, bake, async (page, origin) => {
+            renderer ||= await rendererName(page);
+            return page.evaluate((o) => window.frontier(o), {
+                bake: `${origin}/bake/`,
+                fitBake: `${origin}/fit-bake/`,
+                size: args.size,
+                timingSize: args['timing-size'],
+                truthFrames: args['truth-frames'],
+                timingDraws: 3,
             });
-            await page.close();
-            rows.push({ ...bake, r });
-        } finally {
-            server.close();
-        }
+        });
+        rows.push({ ...bake, r });
     }
 } finally {
     await browser.close();
