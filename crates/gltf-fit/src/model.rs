@@ -66,6 +66,20 @@ impl Material {
     pub fn alpha(&self) -> f64 {
         self.roughness * self.roughness
     }
+
+    /// The dielectric Fresnel term at `v.h = 1` per channel (`KHR_materials_specular`'s
+    /// `dielectric_f0`, see [`brdf`]): `min(0.04 specularColor, 1) specular`.
+    pub fn dielectric_f0(&self) -> [f64; 3] {
+        self.specular_color.map(|c| (DIELECTRIC_F0 * c).min(1.0) * self.specular)
+    }
+
+    /// The albedo of the diffuse lobe where the Fresnel term is its `v.h = 1` value, per channel:
+    /// `(1 - metallic) (1 - max_value(dielectric_f0)) baseColor`, what [`brdf`] weighs
+    /// `baseColor / pi` by there (the weight grows smaller towards grazing `v.h`).
+    pub fn diffuse_albedo(&self) -> [f64; 3] {
+        let f0_max = self.dielectric_f0().into_iter().fold(f64::MIN, f64::max);
+        self.base_color.map(|b| (1.0 - self.metallic) * (1.0 - f0_max) * b)
+    }
 }
 
 /// The masking-shadowing term of the specular BRDF. The specification's Appendix B sample
@@ -185,10 +199,7 @@ pub fn brdf(m: &Material, masking: Masking, g: &Geometry) -> [f64; 3] {
     let alpha = m.alpha();
     let specular_brdf = visibility(masking, alpha, g.n_l, g.n_v) * ggx_d(alpha, g.n_h);
     let fresnel_w = (1.0 - g.v_h.abs()).powi(5);
-    let dielectric_fresnel = m
-        .specular_color
-        .map(|c| (DIELECTRIC_F0 * c).min(1.0) * m.specular)
-        .map(|f0| f0 + (m.specular - f0) * fresnel_w);
+    let dielectric_fresnel = m.dielectric_f0().map(|f0| f0 + (m.specular - f0) * fresnel_w);
     let fresnel_max = dielectric_fresnel.iter().copied().fold(f64::MIN, f64::max);
     let mut out = [0.0; 3];
     for c in 0..3 {
@@ -250,6 +261,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The diffuse lobe's albedo is what [`brdf`] adds per unit of `baseColor / pi` where
+    /// `v.h = 1` (light and viewer along the normal): two dielectrics that differ only in their
+    /// base colour differ there by `diffuse_albedo`'s difference over pi (their specular lobes,
+    /// which do not read the base colour, cancel), for the extension's factors, including a
+    /// specular colour whose `0.04 specularColor` passes 1 and is clamped; a metal has none.
+    #[test]
+    fn the_diffuse_albedo_is_the_weight_brdf_gives_the_base_colour_at_the_normal() {
+        let n = DVec3::Z;
+        for (specular, specular_color) in [(1.0, [1.0; 3]), (0.3, [2.0, 9.0, 40.0]), (0.0, [1.0; 3])] {
+            let with = |base: [f64; 3]| Material { specular, specular_color, ..Material::core(base, 0.0, 0.4) };
+            let (a, b) = (with([0.8, 0.5, 0.2]), with([0.1, 0.1, 0.1]));
+            let (fa, fb) = (eval(&a, Masking::HeightCorrelated, n, n), eval(&b, Masking::HeightCorrelated, n, n));
+            let (da, db) = (a.diffuse_albedo(), b.diffuse_albedo());
+            for c in 0..3 {
+                let expected = (da[c] - db[c]) / PI;
+                assert!((fa[c] - fb[c] - expected).abs() <= 1e-12, "{specular} {specular_color:?}: {fa:?} {fb:?}");
+            }
+        }
+        // The clamped colour: min(0.04 x 40, 1) x 0.3 = 0.3 is the largest f0, so 0.7 of the base.
+        let clamped =
+            Material { specular: 0.3, specular_color: [2.0, 9.0, 40.0], ..Material::core([1.0; 3], 0.0, 0.4) };
+        assert!((clamped.diffuse_albedo()[0] - 0.7).abs() < 1e-15);
+        assert_eq!(Material::core([0.9; 3], 1.0, 0.4).diffuse_albedo(), [0.0; 3]);
     }
 
     /// The separable form is `F D G1(wi) G1(wo) / (4 cos_i cos_o)` with `G1 = 1 / (1 + Lambda)`

@@ -13,7 +13,9 @@
 //! is the one of best PSNR, and what the kept variant loses against the best. Which objective
 //! draws the better pictures: each material fitted again with the other objective
 //! (`Objective::LinearCosine` beside the default `LogCosine`), its kept variant's PSNR per map
-//! beside the default's, and per map how often each wins. The report
+//! beside the default's, and per map how often each wins. Beside a published figure: the kept
+//! fits' roughness and diffuse albedo against Ngan et al. 2005's Lafortune fits of the same
+//! materials (`ngan2005-lafortune.csv`; [`published_table`] says how they are compared). The report
 //! (markdown) is printed and written to target/bench-fits/report.md; the sorted plot of the kept
 //! variants' PSNRs to docs/brdf-fit-psnr.png, which the report shows.
 //!
@@ -229,6 +231,8 @@ fn report(rows: &[Row], settings: &Settings, complete: bool) -> String {
     lines.extend(objective_table(rows, settings));
     lines.push(String::new());
     lines.extend(summaries(rows));
+    lines.push(String::new());
+    lines.extend(published_table(rows));
     if complete {
         lines.push(String::new());
         lines.push("![The fit's PSNR per material and map, sorted](brdf-fit-psnr.png)".into());
@@ -373,6 +377,91 @@ fn summaries(rows: &[Row]) -> Vec<String> {
                 "{map}: min {lo:.2} dB, median {:.2} dB, max {hi:.2} dB over {} materials.",
                 median(&v),
                 v.len()
+            ));
+        }
+    }
+    lines
+}
+
+/// Ngan et al. 2005's one-lobe Lafortune fits of the MERL materials (`ngan2005-lafortune.csv`,
+/// whose comments say where the figures come from): per material, the diffuse albedo and the
+/// lobe's exponent.
+const NGAN_2005: &str = include_str!("ngan2005-lafortune.csv");
+
+/// One material of [`NGAN_2005`]: its name, `rho_d` (RGB) and `n`.
+fn ngan_2005() -> Vec<(String, [f64; 3], f64)> {
+    NGAN_2005
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("material,"))
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let num = |i: usize| cells[i].parse::<f64>().unwrap_or_else(|e| panic!("ngan2005-lafortune.csv: {l}: {e}"));
+            (cells[0].to_string(), [num(1), num(2), num(3)], num(4))
+        })
+        .collect()
+}
+
+/// Beside a published figure: each row's kept fit against Ngan et al. 2005's Lafortune fit of
+/// the same material, where the published set holds it. The lobe: a Lafortune lobe seen from
+/// the normal is `cos^n` of the angle `beta` to the mirror direction (whatever its `C`, once
+/// normalised), `1 - 2 n theta_h^2` near the peak (`beta = 2 theta_h`); GGX's `D` is
+/// `1 - 2 theta_h^2 / alpha^2` there, so the lobes of equal curvature have `alpha = n^(-1/2)`
+/// and glTF roughness `n^(-1/4)`. The diffuse part: Ngan's `rho_d` against the fit's
+/// [`gltf_fit::Material::diffuse_albedo`], both as luminance.
+fn published_table(rows: &[Row]) -> Vec<String> {
+    let published = ngan_2005();
+    let pairs: Vec<(&Row, &(String, [f64; 3], f64))> =
+        rows.iter().filter_map(|r| published.iter().find(|p| p.0 == r.name).map(|p| (r, p))).collect();
+    let mut lines = vec![
+        "## Beside a published figure: Ngan et al. 2005's Lafortune fits".to_string(),
+        String::new(),
+        format!(
+            "Ngan, Durand and Matusik (EGSR 2005) fitted analytic models to each MERL measurement; their one-lobe \
+             Lafortune fits hold {} of these {} materials (tools/brdf-preview/benches/ngan2005-lafortune.csv says \
+             where the figures were read). What differs: the model (a Lafortune lobe around the mirror direction \
+             and a Lambertian term; here glTF's GGX on the half vector with its Fresnel-weighted diffuse lobe), the \
+             data (the MERL measurements; here tables rebuilt from neural fits of them, see \
+             ../shared/data/nbrdf/README.md) and the error minimised (theirs; here ln(1 + f cos) over the cells). \
+             Compared: the lobe's width, Ngan's exponent n as the glTF roughness of a GGX lobe of the same curvature \
+             at the peak seen from the normal (n^(-1/4): cos^n(2 theta_h) and GGX's D both fall as 1 - 2 theta_h^2 \
+             / alpha^2 there when alpha^2 = 1 / n), against the fit's roughness; and the diffuse albedo, Ngan's \
+             rho_d against the fit's diffuse lobe's weight of baseColor where v.h = 1, (1 - metallic)(1 - max \
+             dielectric f0) baseColor, both as luminance.",
+            pairs.len(),
+            rows.len()
+        ),
+        String::new(),
+        "| material | Ngan n | Ngan n^(-1/4) | fit roughness | ratio | Ngan rho_d | fit diffuse albedo | ratio |"
+            .into(),
+        "|---|---:|---:|---:|---:|---:|---:|---:|".into(),
+    ];
+    let mut widths = (Vec::new(), Vec::new());
+    let mut diffuse = (Vec::new(), Vec::new());
+    for (r, (_, rho_d, n)) in &pairs {
+        let m = &r.fit.chosen().material;
+        let (theirs, ours) = (n.powf(-0.25), m.roughness);
+        let (rho, albedo) = (color::luminance(*rho_d), color::luminance(m.diffuse_albedo()));
+        lines.push(format!(
+            "| {} | {n} | {theirs:.3} | {ours:.3} | {:.2} | {rho:.4} | {albedo:.4} | {:.2} |",
+            r.name,
+            ours / theirs,
+            albedo / rho
+        ));
+        widths.0.push(theirs);
+        widths.1.push(ours);
+        diffuse.0.push(rho);
+        diffuse.1.push(albedo);
+    }
+    lines.push(String::new());
+    for (what, (theirs, ours)) in [("roughness", &widths), ("diffuse albedo", &diffuse)] {
+        let mut ratio: Vec<f64> = ours.iter().zip(theirs.iter()).map(|(o, t)| o / t).collect();
+        ratio.sort_by(f64::total_cmp);
+        if let (Some(lo), Some(hi), Some(rank)) = (ratio.first(), ratio.last(), bandwidth::spearman(theirs, ours)) {
+            lines.push(format!(
+                "The {what}: the fit's over Ngan's, median {:.2}, from {lo:.2} to {hi:.2}; Spearman's rank correlation \
+                 over the {} materials {rank:.2}.",
+                median(&ratio),
+                ratio.len()
             ));
         }
     }
