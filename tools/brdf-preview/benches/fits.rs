@@ -388,15 +388,23 @@ fn summaries(rows: &[Row]) -> Vec<String> {
 /// lobe's exponent.
 const NGAN_2005: &str = include_str!("ngan2005-lafortune.csv");
 
-/// One material of [`NGAN_2005`]: its name, `rho_d` (RGB) and `n`.
-fn ngan_2005() -> Vec<(String, [f64; 3], f64)> {
+/// One material of [`NGAN_2005`].
+struct Published {
+    name: String,
+    /// The Lambertian term's albedo, RGB.
+    rho_d: [f64; 3],
+    /// The lobe's exponent.
+    n: f64,
+}
+
+fn ngan_2005() -> Vec<Published> {
     NGAN_2005
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("material,"))
         .map(|l| {
             let cells: Vec<&str> = l.split(',').collect();
             let num = |i: usize| cells[i].parse::<f64>().unwrap_or_else(|e| panic!("ngan2005-lafortune.csv: {l}: {e}"));
-            (cells[0].to_string(), [num(1), num(2), num(3)], num(4))
+            Published { name: cells[0].to_string(), rho_d: [num(1), num(2), num(3)], n: num(4) }
         })
         .collect()
 }
@@ -410,8 +418,8 @@ fn ngan_2005() -> Vec<(String, [f64; 3], f64)> {
 /// [`gltf_fit::Material::diffuse_albedo`], both as luminance.
 fn published_table(rows: &[Row]) -> Vec<String> {
     let published = ngan_2005();
-    let pairs: Vec<(&Row, &(String, [f64; 3], f64))> =
-        rows.iter().filter_map(|r| published.iter().find(|p| p.0 == r.name).map(|p| (r, p))).collect();
+    let pairs: Vec<(&Row, &Published)> =
+        rows.iter().filter_map(|r| published.iter().find(|p| p.name == r.name).map(|p| (r, p))).collect();
     let mut lines = vec![
         "## Beside a published figure: Ngan et al. 2005's Lafortune fits".to_string(),
         String::new(),
@@ -437,7 +445,7 @@ fn published_table(rows: &[Row]) -> Vec<String> {
     ];
     let mut widths = (Vec::new(), Vec::new());
     let mut diffuse = (Vec::new(), Vec::new());
-    for (r, (_, rho_d, n)) in &pairs {
+    for (r, Published { rho_d, n, .. }) in &pairs {
         let m = &r.fit.chosen().material;
         let (theirs, ours) = (n.powf(-0.25), m.roughness);
         let (rho, albedo) = (color::luminance(*rho_d), color::luminance(m.diffuse_albedo()));
