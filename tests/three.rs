@@ -264,9 +264,10 @@ fn engine_textures_need_an_environment() {
 ///   influence 1) against the squashed shape in its geometry, and a sphere under a clipping plane
 ///   through its centre against its lower half made in its geometry: at least 60 dB each
 ///   (measured: identical pictures, an infinite PSNR, null in the JSON).
-/// - The live mode (`Accumulator`): eight calls, one frame each, average to one draw of the same
-///   eight frames within 1e-5 relatively (measured: equal), and a moved camera starts again at
-///   one frame.
+/// - The live mode (`Accumulator`): without its split first frame, eight calls, one frame each,
+///   average to one draw of the same eight frames within 1e-5 relatively (measured: equal), and a
+///   moved camera starts again at one frame; with it (the default), nine calls average to the
+///   split material's frame weighted 4 and those eight frames weighted 1 each, within 1e-5.
 /// - On the canvas under `ACESFilmicToneMapping` and `NoToneMapping`, the material writes three's
 ///   pipeline (its tone mapping formula, exposure 1.7, sRGB) applied to its linear radiance read
 ///   back as floats, within one 8-bit level (measured: 1 and 0).
@@ -310,6 +311,10 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
     assert!(live <= 1e-5, "the live mode's mean of 8 calls against 8 frames drawn at once: {live:e}; {where_}");
     let frames = (figures["live_frames"].as_u64(), figures["live_frames_after_moving"].as_u64());
     assert_eq!(frames, (Some(8), Some(1)), "the live mode's frames, then after the camera moved");
+    let split = figures["live_split_largest_relative_difference"].as_f64().unwrap();
+    assert!(split <= 1e-5, "the live mode with its split first frame against that frame and 8 frames, weighted 4 and 1: {split:e}; {where_}");
+    let weights = (figures["live_split_frames"].as_u64(), figures["live_split_weight"].as_u64());
+    assert_eq!(weights, (Some(9), Some(12)), "the live mode's frames and weight with its split first frame");
     let orthographic = figures["orthographic_psnr_db"].as_f64().unwrap();
     assert!(orthographic >= 50.0, "an orthographic camera against a distant perspective one: {orthographic:.2} dB");
     for (mapping, found) in figures["tone_mapping_levels"].as_object().unwrap() {
@@ -327,12 +332,27 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
 /// naming the file.
 #[test]
 fn the_loader_refuses_what_a_hostile_bake_gives() {
+    node_test("loader.test.mjs");
+}
+
+/// What the split estimator derives at load time (`node --test` on
+/// `engines/three/test/split.test.mjs`) against analytic answers: a Lambertian table's albedo
+/// (within 1%, 2% at the two most grazing views), a Phong lobe's albedo (3%) and exponent (15%),
+/// peak lights' powers (radiance times solid angle) and directions, no power lost when groups
+/// merge, and the smooth part's level 0 averaged down.
+#[test]
+fn the_split_estimator_derives_its_inputs_as_analytic_answers_say() {
+    node_test("split.test.mjs");
+}
+
+/// `node --test` on `engines/three/test/FILE`, which must pass.
+fn node_test(file: &str) {
     assert!(
         root().join("engines/three/node_modules/three").is_dir(),
         "three is not installed: run `make setup` (npm ci in engines/three; needs node and npm)"
     );
     let mut node = Command::new("node");
-    node.arg("--test").arg(root().join("engines/three/test/loader.test.mjs"));
+    node.arg("--test").arg(root().join("engines/three/test").join(file));
     run(node, "").expect_code(0);
 }
 

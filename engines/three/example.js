@@ -1,8 +1,8 @@
 // The example page (index.html): a bake on brdf-preview's sphere, the environment behind it, in
-// the live mode (Accumulator): one frame of the mode's samples per animation frame, averaged
-// while the view is still, up to `?frames=N` (default 256). Drag to orbit (the average starts
-// again), switch modes; the status line gives the frames averaged and the milliseconds of the
-// last one. brdf-preview's axes (+z up) and look: three's Reinhard tone mapping at the bake's
+// the live mode (Accumulator): the split estimator's frame first, then one frame of the mode's
+// samples per animation frame, averaged while the view is still, up to `?frames=N` (default
+// 256). Drag to orbit (the average starts again), switch modes; the status line gives the frames
+// averaged and the milliseconds of the last one. brdf-preview's axes (+z up) and look: three's Reinhard tone mapping at the bake's
 // automatic exposure and sRGB output are brdf-preview's tone map.
 import * as THREE from 'three';
 import { Accumulator, loadBake, orbitCamera, previewSphere, setOrbit } from './src/index.js';
@@ -32,7 +32,14 @@ async function load() {
     status.textContent = `loading ${url} ...`;
     try {
         const bake = await loadBake(url);
-        current?.bake.dispose();
+        if (current) {
+            current.scene.traverse((o) => {
+                o.material?.dispose();
+                // The background's quad is shared by every bake's background (index.js).
+                if (o === current.mesh) o.geometry.dispose();
+            });
+            current.bake.dispose();
+        }
         renderer.toneMappingExposure = 2 ** bake.figures.exposure_ev;
         const scene = new THREE.Scene();
         scene.add(bake.createBackground({ orientation }));
@@ -67,8 +74,9 @@ function tick() {
     const ms = performance.now() - start;
     const m = mode();
     const names = `${bake.manifest.material.name} under ${bake.manifest.environment?.name}`;
+    const frames = m === 'split' ? 'no samples' : `the split, then ${bake.defaults(m).spp} spp x ${live.frames - 1} frames`;
     status.textContent =
-        `${names} | ${m} | ${bake.defaults(m).spp} spp x ${live.frames} frames (live, up to ${live.maxFrames})\n` +
+        `${names} | ${m} | ${frames} (live, up to ${live.maxFrames})\n` +
         `${canvas.width}x${canvas.height} | exposure ${bake.figures.exposure_ev.toFixed(2)} EV\n` +
         `${ms.toFixed(1)} ms per frame | camera ${view.azimuth.toFixed(0)},${view.elevation.toFixed(0)}`;
 }

@@ -7,7 +7,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { loadBake } from '../src/index.js';
-import { floatTarget } from '../src/live.js';
+import { SPLIT_WEIGHT, floatTarget } from '../src/live.js';
 import { drawFloats, pageRenderer } from '../test/page-tools.js';
 import { previewLevel as level } from '../test/tonemap.js';
 
@@ -137,6 +137,11 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
     const gltf = await gltfBeside(url, fitUrl, s, truthFrames);
     const fitted = gltf.material;
 
+    // The live mode's first frame: the split estimator (no samples).
+    const splitMaterial = bake.createMaterial({ mode: 'split' });
+    disposables.push(splitMaterial);
+    const splitValues = linear(splitMaterial);
+
     // The bake's material, one frame at 1, 4 and 16 samples.
     const measured = {};
     for (const spp of [1, 4, 16]) {
@@ -155,15 +160,22 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
         standard: time(standard.material),
         physical: time(physical.material),
         gltf: time(fitted),
+        split: time(splitMaterial),
         measured: Object.fromEntries([1, 4, 16].map((spp) => [spp, time(measured[spp].material)])),
     };
 
-    // The live mode after the time of 8 standard frames: that many 1-sample frames averaged, as
-    // the Accumulator averages them (its mean equals one draw of those frames).
-    const liveFrames = Math.max(1, Math.floor((8 * ms.standard) / ms.measured[1]));
-    const liveMaterial = bake.createMaterial({ mode: 'prefiltered', spp: 1, frames: liveFrames });
-    disposables.push(liveMaterial);
-    const live = { frames: liveFrames, psnr: psnr(linear(liveMaterial), truth) };
+    // The live mode after the time of 8 standard frames: its split frame, then as many 1-sample
+    // frames as the rest of that time holds, averaged as the Accumulator averages them (the split
+    // counted SPLIT_WEIGHT times; its mean of the sampled frames equals one draw of them).
+    const liveFrames = Math.max(0, Math.floor((8 * ms.standard - ms.split) / ms.measured[1]));
+    let liveValues = splitValues;
+    if (liveFrames > 0) {
+        const liveMaterial = bake.createMaterial({ mode: 'prefiltered', spp: 1, frames: liveFrames });
+        disposables.push(liveMaterial);
+        const sampled = linear(liveMaterial);
+        liveValues = splitValues.map((v, i) => (SPLIT_WEIGHT * v + liveFrames * sampled[i]) / (SPLIT_WEIGHT + liveFrames));
+    }
+    const live = { frames: liveFrames, psnr: psnr(liveValues, truth) };
 
     const result = {
         size,
@@ -178,6 +190,7 @@ window.frontier = async ({ bake: url, fitBake: fitUrl, size, timingSize, truthFr
             threeAgainstExact: psnr(gltf.values, gltf.exact),
             readBack: gltf.readBack,
         },
+        split: psnr(splitValues, truth),
         measured: Object.fromEntries(Object.entries(measured).map(([spp, m]) => [spp, m.psnr])),
         live,
         ms,

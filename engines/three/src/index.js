@@ -14,6 +14,7 @@ import * as THREE from 'three';
 
 import { floatTarget } from './live.js';
 import { BakeError, readBake } from './loader.js';
+import { MAX_PEAK_LIGHTS, lobeTable, peakLights, splitLayers } from './split.js';
 
 import {
     BACKGROUND_FRAGMENT,
@@ -25,11 +26,14 @@ import {
     SURFACE_VERTEX,
 } from './shade.glsl.js';
 
-export { Accumulator } from './live.js';
+export { Accumulator, SPLIT_WEIGHT } from './live.js';
 export { BakeError, FLOAT32_MAX, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
 
-/** The estimators, by their names in `brdf-preview --mode`, and their codes in the shader. */
-export const MODES = { reference: 0, prefiltered: 2 };
+/**
+ * The estimators, by their names in `brdf-preview --mode`, and their codes in the shader; and
+ * this engine's own, 'split' (split.js: no samples, biased, the live mode's first frame).
+ */
+export const MODES = { reference: 0, prefiltered: 2, split: 3 };
 
 /**
  * How the world's axes meet the environment map's. `three`: three.js's (+y up; the map read as
@@ -91,6 +95,7 @@ export class Bake {
     createMaterial(options = {}) {
         const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'}`,
+            defines: options.mode === 'split' ? { SPLIT: 1 } : {},
             vertexShader: SURFACE_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             // render::raster culls no back face: at a silhouette a pixel may see one.
@@ -99,7 +104,7 @@ export class Bake {
             uniforms: this.shadingUniforms(options),
         });
         // What the live mode (Accumulator) looks for, and the frame it counts from.
-        material.userData.brdfBake = { firstFrame: options.firstFrame ?? 0 };
+        material.userData.brdfBake = { firstFrame: options.firstFrame ?? 0, mode: options.mode ?? 'reference' };
         material.onBeforeRender = (renderer, scene) => {
             const u = material.uniforms;
             resolution(renderer, u.uResolution.value);
@@ -116,7 +121,7 @@ export class Bake {
     createDeferred(gbuffer, options = {}) {
         const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
-            defines: { DEFERRED: 1 },
+            defines: { DEFERRED: 1, ...(options.mode === 'split' && { SPLIT: 1 }) },
             vertexShader: QUAD_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             depthTest: false,
@@ -133,10 +138,12 @@ export class Bake {
 
     shadingUniforms({ mode = 'reference', spp, frames, firstFrame = 0, divisor, seed = 0 }) {
         if (!(mode in MODES)) {
-            throw new BakeError(`error: unknown mode ${mode}: reference or prefiltered`);
+            throw new BakeError(`error: unknown mode ${mode}: ${Object.keys(MODES).join(', ')}`);
         }
         const f = this.figures;
-        const defaults = this.defaults(mode);
+        const split = this.splitInputs();
+        // The split estimator takes no samples: the sampled estimators' settings stay valid.
+        const defaults = this.defaults(mode === 'split' ? 'prefiltered' : mode);
         spp = spp ?? defaults.spp;
         frames = frames ?? defaults.frames;
         if (!(spp > 0 && (spp & (spp - 1)) === 0 && f.samples % spp === 0)) {
@@ -160,8 +167,59 @@ export class Bake {
             uDivisor: { value: divisor ?? frames },
             uFilterSamples: { value: spp * frames },
             uLayerExponents: { value: layerExponents(f.exponents) },
+            uPeakCount: { value: split.count },
+            uPeakDirections: { value: split.directions },
+            uPeakPowers: { value: split.powers },
+            uPeakSpreads: { value: split.spreads },
             ...rayUniforms(),
         };
+    }
+
+    /**
+     * The split estimator's inputs (split.js), derived once: the lobe table as the texture
+     * `uLobes` among the bake's textures (disposed with them) and the peak lights.
+     */
+    splitInputs() {
+        if (!this.split) {
+            const f = this.figures;
+            const exponents = layerExponents(f.exponents).slice(0, f.exponents.length + 1);
+            const lobes = lobeTable(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
+            const texture = new THREE.DataTexture(lobes, f.view_rows, 3, THREE.RGBAFormat, THREE.FloatType);
+            // Linear along the views (u = 1 - cos_o: the rows' centres at (r + 1/2) / rows), each
+            // row of the texture read at its centre.
+            texture.minFilter = THREE.LinearFilter;
+            texture.magFilter = THREE.LinearFilter;
+            texture.needsUpdate = true;
+            this.textures.uLobes = texture;
+            // The layers again with the smooth part's level 0 as one more layer (splitLayers),
+            // filtered by the GPU (texelFetch, which the sampled estimators read uLayers with,
+            // ignores filtering): one bilinear read where env_bilinear makes four fetches, and no
+            // branch between the layers and level 0. Float32 filtering is WebGL 2's
+            // OES_texture_float_linear.
+            const layers = this.textures.uLayers.image;
+            const environment = this.textures.uEnvironment.image;
+            const extended = splitLayers(layers.data, layers.width, layers.height, layers.depth, environment.data, environment.width, environment.height);
+            const linear = new THREE.DataArrayTexture(extended, layers.width, layers.height, layers.depth + 1);
+            linear.format = THREE.RGBAFormat;
+            linear.type = THREE.FloatType;
+            linear.minFilter = THREE.LinearFilter;
+            linear.magFilter = THREE.LinearFilter;
+            linear.wrapS = THREE.RepeatWrapping;
+            linear.wrapT = THREE.ClampToEdgeWrapping;
+            linear.generateMipmaps = false;
+            linear.flipY = false;
+            linear.needsUpdate = true;
+            this.textures.uLayersLinear = linear;
+            const { width, height, data } = this.textures.uEnvironment.image;
+            const none = {
+                count: 0,
+                directions: new Float32Array(3 * MAX_PEAK_LIGHTS),
+                powers: new Float32Array(3 * MAX_PEAK_LIGHTS),
+                spreads: new Float32Array(MAX_PEAK_LIGHTS),
+            };
+            this.split = f.peaks ? peakLights(data.subarray(4 * width * height, 8 * width * height), width, height) : none;
+        }
+        return this.split;
     }
 
     /**

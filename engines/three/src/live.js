@@ -1,21 +1,24 @@
 // The live mode: a render-loop helper that draws a scene once per call and averages the calls
-// while nothing moves, so that a bake's material shows a usable picture at once (one frame of its
-// spp) and converges while the view is still; anything that moves starts the average again.
+// while nothing moves, so that a bake's material shows a usable picture at once (the split
+// estimator's frame: no samples, no noise) and converges while the view is still (frames of its
+// spp averaged in); anything that moves starts the average again.
 
 import * as THREE from 'three';
 
 import { QUAD_VERTEX } from './shade.glsl.js';
 
 
-// The running sum: the previous sum (none for the first frame) plus this frame, texel by texel.
+// The running sum: the previous sum (none for the first frame) plus this frame times its weight,
+// texel by texel.
 const ADD_FRAGMENT = /* glsl */ `
 uniform sampler2D uSum;
 uniform sampler2D uFrame;
 uniform bool uFirst;
+uniform float uWeight;
 layout(location = 0) out highp vec4 pc_fragColor;
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    pc_fragColor = (uFirst ? vec4(0.0) : texelFetch(uSum, p, 0)) + texelFetch(uFrame, p, 0);
+    pc_fragColor = (uFirst ? vec4(0.0) : texelFetch(uSum, p, 0)) + uWeight * texelFetch(uFrame, p, 0);
 }
 `;
 
@@ -64,12 +67,23 @@ function pass(fragmentShader, uniforms, toneMapped) {
 }
 
 /**
+ * How many sampled frames the live mode's split frame counts as by default: the bias it leaves
+ * after n sampled frames is 4 / (4 + n) of its own.
+ */
+export const SPLIT_WEIGHT = 4;
+
+/**
  * Averages the frames of a scene while it stays still. Each `render(scene, camera)` draws the
  * scene once into a float target, with every bake material (`Bake.createMaterial` in three's
- * output, whose radiance is linear; the accumulator takes over its frames) drawing its next frame
- * of samples (frame `firstFrame + n` of its spp, `n` the frames averaged so far), adds it to the
- * running sum and shows the mean on the canvas through the
- * renderer's tone mapping and output colour space. The average starts again when the drawing
+ * output, whose radiance is linear; the accumulator takes over its frames) drawing its next
+ * frame, adds it to the running sum and shows the mean on the canvas through the renderer's tone
+ * mapping and output colour space. A bake material's first frame is the split estimator's (no
+ * samples: a picture without noise at about twice the cost of a MeshStandardMaterial frame,
+ * biased; split.js), counted as `splitWeight` frames; each frame after it draws the next frame of
+ * the material's samples (frame `firstFrame + n - 1` of its spp, `n` the frames drawn so far), so
+ * the split's bias fades as `splitWeight / (splitWeight + n - 1)` and the mean converges to the
+ * material's. `splitWeight: 0` starts with the samples instead; a material made with mode
+ * 'split' draws the split in every frame. The average starts again when the drawing
  * buffer's size, the camera, any visible object's world matrix (bones and instances included),
  * the scene's environment or background rotation changes, or `reset()` is called (after any other
  * change: a material, a light, a texture). After `maxFrames` frames it only shows the mean.
@@ -78,14 +92,16 @@ function pass(fragmentShader, uniforms, toneMapped) {
  *     renderer.setAnimationLoop(() => live.render(scene, camera));
  */
 export class Accumulator {
-    constructor(renderer, { maxFrames = 4096 } = {}) {
+    constructor(renderer, { maxFrames = 4096, splitWeight = SPLIT_WEIGHT } = {}) {
         this.renderer = renderer;
         this.maxFrames = maxFrames;
+        this.splitWeight = splitWeight;
         this.frames = 0;
+        this.weight = 0;
         this.size = new THREE.Vector2();
         this.targets = null;
         this.signature = [];
-        this.add = pass(ADD_FRAGMENT, { uSum: { value: null }, uFrame: { value: null }, uFirst: { value: true } }, false);
+        this.add = pass(ADD_FRAGMENT, { uSum: { value: null }, uFrame: { value: null }, uFirst: { value: true }, uWeight: { value: 1 } }, false);
         this.show = pass(SHOW_FRAGMENT, { uSum: { value: null }, uCount: { value: 1 } }, true);
     }
 
@@ -94,7 +110,10 @@ export class Accumulator {
         this.frames = 0;
     }
 
-    /** The running sum (a float render target) and the frames in it: the mean is sum / frames. */
+    /**
+     * The running sum (a float render target); the mean is sum / weight, `weight` the frames in
+     * it with the split frame counted `splitWeight` times.
+     */
     get sum() {
         return this.targets?.sum;
     }
@@ -122,25 +141,36 @@ export class Accumulator {
                     if (material.userData?.brdfBake) bakes.push(material);
                 }
             });
+            const split = this.frames === 0 && this.splitWeight > 0;
             for (const material of bakes) {
                 const u = material.uniforms;
-                u.uFirstFrame.value = material.userData.brdfBake.firstFrame + this.frames;
+                const bake = material.userData.brdfBake;
+                const first = split || bake.mode === 'split';
+                if (Boolean(material.defines.SPLIT) !== first) {
+                    if (first) material.defines.SPLIT = 1;
+                    else delete material.defines.SPLIT;
+                    material.needsUpdate = true;
+                }
+                u.uFirstFrame.value = bake.firstFrame + Math.max(this.frames - (this.splitWeight > 0 ? 1 : 0), 0);
                 u.uFrameCount.value = 1;
                 u.uDivisor.value = 1;
             }
+            const weight = split ? this.splitWeight : 1;
             renderer.setRenderTarget(this.targets.frame);
             renderer.clear();
             renderer.render(scene, camera);
             this.add.material.uniforms.uFirst.value = this.frames === 0;
+            this.add.material.uniforms.uWeight.value = weight;
             this.add.material.uniforms.uSum.value = this.targets.sum.texture;
             this.add.material.uniforms.uFrame.value = this.targets.frame.texture;
             renderer.setRenderTarget(this.targets.next);
             renderer.render(this.add.scene, camera);
             [this.targets.sum, this.targets.next] = [this.targets.next, this.targets.sum];
+            this.weight = (this.frames === 0 ? 0 : this.weight) + weight;
             this.frames += 1;
         }
         this.show.material.uniforms.uSum.value = this.targets.sum.texture;
-        this.show.material.uniforms.uCount.value = this.frames;
+        this.show.material.uniforms.uCount.value = this.weight;
         renderer.setRenderTarget(previous);
         renderer.render(this.show.scene, camera);
     }

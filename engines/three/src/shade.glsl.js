@@ -7,7 +7,8 @@
 // filtering by the hardware, the bilinear weights computed as the CPU computes them.
 //
 // Only the reference (mode 0) and prefiltered (mode 2) estimators; the debug and adaptive modes of
-// the WGSL stay in the previewer.
+// the WGSL stay in the previewer. One estimator is this engine's own, with no twin: the split
+// estimator (mode 3, split_estimate; split.js says what it draws), the live mode's first frame.
 
 export const COMMON = /* glsl */ `
 precision highp float;
@@ -226,6 +227,8 @@ export const SURFACE_FRAGMENT = /* glsl */ `
 ${COMMON}
 const uint MODE_REFERENCE = 0u;
 const uint MODE_PREFILTERED = 2u;
+// split.js's MAX_PEAK_LIGHTS.
+#define MAX_PEAK_LIGHTS 8
 
 // engine-merl.ktx2: texel (phi_d, theta_d, theta_h) of the MERL grid, RGB in 1/sr, 0 without data.
 uniform sampler3D uMerl;
@@ -260,6 +263,19 @@ uniform bool uPeaks;
 // render::diffuse_split (the manifest's diffuse): the BRDF's diffuse part f_d, which the
 // prefiltered estimator reads from the cosine layer (the first) at the normal.
 uniform vec3 uDiffuse;
+// The split estimator's inputs (split.js): per view row (1 - cos_o = (r + 1/2) / rows) the albedo
+// of f - f_d (RGB) and the exponent of its Phong lobe (A); the peaks as directional lights, their
+// directions in the environment's frame and their irradiance at normal incidence.
+uniform sampler2D uLobes;
+// engine-layers.ktx2 again and, as one more layer, the smooth part's level 0 at the layers' size
+// (split.js's splitLayers), filtered linearly (u repeating, v clamped): what env_bilinear
+// computes, in one read.
+uniform sampler2DArray uLayersLinear;
+uniform int uPeakCount;
+uniform vec3 uPeakDirections[MAX_PEAK_LIGHTS];
+uniform vec3 uPeakPowers[MAX_PEAK_LIGHTS];
+// Each peak light's spread: the mean 1 - cos between its directions and its own.
+uniform float uPeakSpreads[MAX_PEAK_LIGHTS];
 // The frames this draw sums (first, count), and what the sum is divided by.
 uniform uint uFirstFrame;
 uniform uint uFrameCount;
@@ -741,6 +757,56 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     return sum;
 }
 
+// Row lobe of uLobes (0 the sharper lobe, 1 the broader, 2 their layer coordinates) at the view
+// (split.js's lobeTable), interpolated between the views' centres at 1 - cos_o by the GPU, as
+// view_layer_coordinate reads the view layers.
+vec4 lobe_at(float cos_o, int lobe) {
+    return texture(uLobes, vec2(1.0 - cos_o, (float(lobe) + 0.5) / 3.0));
+}
+
+// The layers at coordinate x (layers_bilinear's blend of layer k and k + 1, past the sharpest the
+// smooth part's level 0) read through uLayersLinear, without a branch.
+vec3 layers_linear(float x, vec2 uv) {
+    float last = float(textureSize(uLayersLinear, 0).z - 1);
+    float k = min(floor(x), last);
+    vec3 a = texture(uLayersLinear, vec3(uv, k)).rgb;
+    vec3 b = texture(uLayersLinear, vec3(uv, min(k + 1.0, last))).rgb;
+    return mix(a, b, x - k);
+}
+
+// The split estimator (no twin; split.js says what it draws and where it is biased): the diffuse
+// part as estimate_sum reads it, the rest as the view's Phong lobe around the mirror direction
+// read from the layer of its exponent, each peak light through the lobe and the diffuse part.
+vec3 split_estimate(ShadingFrame frame) {
+    vec4 sharp = lobe_at(frame.cos_o, 0);
+    vec4 broad = lobe_at(frame.cos_o, 1);
+    vec3 mirror = to_world(frame, vec3(-frame.wo_local.x, 0.0, frame.wo_local.z));
+    vec2 uv = env_uv(mirror);
+    vec4 x = lobe_at(frame.cos_o, 2);
+    float x_sharp = x.x;
+    float x_broad = x.y;
+    vec3 sum = PI * uDiffuse * texture(uLayersLinear, vec3(env_uv(frame.n), 0.0)).rgb + sharp.rgb * layers_linear(x_sharp, uv)
+        + broad.rgb * layers_linear(x_broad, uv);
+    // A light's spread widens the lobes that reflect it: small-angle spreads (the mean 1 - cos,
+    // 1 / (n + 2) for a Phong lobe of exponent n) add.
+    vec2 spread = 1.0 / (vec2(sharp.a, broad.a) + 2.0);
+    for (int i = 0; i < uPeakCount; i++) {
+        vec3 d = uPeakDirections[i];
+        float cos_i = dot(frame.n, d);
+        // The part of the light above the horizon, its angular radius sqrt(2 spread).
+        float radius = sqrt(2.0 * uPeakSpreads[i]);
+        float above = clamp((cos_i + radius) / (2.0 * radius + 1e-6), 0.0, 1.0);
+        if (above > 0.0) {
+            float c = max(dot(mirror, d), 0.0);
+            vec2 n = max(1.0 / (spread + uPeakSpreads[i]) - 2.0, 0.0);
+            vec2 norm = (n + 1.0) / (2.0 * PI);
+            vec3 lobes = sharp.rgb * (norm.x * pow(c, n.x)) + broad.rgb * (norm.y * pow(c, n.y));
+            sum += uPeakPowers[i] * (uDiffuse * max(cos_i, 0.0) + lobes * above);
+        }
+    }
+    return sum;
+}
+
 // shade_frame at pixel p (render::shade::shade_rows): the radiance (rows from the bottom), or
 // where the G-buffer has no triangle the environment behind.
 vec3 shade_pixel(uvec2 p) {
@@ -774,11 +840,18 @@ vec3 shade_pixel(uvec2 p) {
     ShadingFrame frame;
     vec3 radiance = vec3(0.0);
     if (shading_frame(position, n, eye, frame)) {
+#ifdef SPLIT
+        // A program of its own (the define, not uMode): a software GPU runs what a uniform
+        // branch leaves in, and the sampled estimators' code would cost the split frame more than
+        // the split itself (engines/three/bench/frontier.mjs).
+        radiance = split_estimate(frame);
+#else
         vec3 sum = vec3(0.0);
         for (uint f = uFirstFrame; f < uFirstFrame + uFrameCount; f++) {
             sum += estimate_sum(frame, pixel, f, uSpp) / float(uSpp);
         }
         radiance = sum / uDivisor;
+#endif
     }
     return radiance;
 }

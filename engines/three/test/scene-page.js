@@ -23,7 +23,8 @@ import { drawFloats, pageRenderer } from './page-tools.js';
 //   squashed shape made in its geometry;
 // - clipping: the material on a sphere with a clipping plane through its centre against the same
 //   material on the sphere's lower half made in its geometry;
-// - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count
+// - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count;
+//   with the split first frame, 9 calls against the split frame and the 8 weighted alike
 //   after the camera moved;
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
 //   (8 bits; against three's formulas applied to pictures['mirror-bake'] by scene.mjs).
@@ -298,21 +299,27 @@ function clipping({ renderer, bake, sphere, material, disposables, draw, camera 
 }
 
 /**
- * The live mode: eight calls of the accumulator, one frame each, against one draw of the same
- * eight frames; then the camera moves and the average starts again. Returns its frame counts.
+ * The live mode. Without the split first frame (splitWeight 0): eight calls of the accumulator,
+ * one frame each, against one draw of the same eight frames; then the camera moves and the
+ * average starts again. With it (the default): nine calls, the first the split estimator's frame
+ * counted splitWeight (4) times, against that frame and the eight drawn apart, weighted as the
+ * accumulator weighs them. Returns its frame counts and weights.
  */
 function liveMode({ renderer, bake, sphere, disposables, pictures, draw, camera, topDownRgb, width, height }) {
-    const live = new Accumulator(renderer);
+    const live = new Accumulator(renderer, { splitWeight: 0 });
     const liveScene = new THREE.Scene();
     const liveMaterial = bake.createMaterial({ mode: 'prefiltered', frames: 8 });
     disposables.push(liveMaterial, live);
     liveScene.add(new THREE.Mesh(sphere, liveMaterial));
-    renderer.setRenderTarget(null);
-    for (let i = 0; i < 8; i++) live.render(liveScene, camera(30));
-    const sum = new Float32Array(4 * width * height);
-    renderer.readRenderTargetPixels(live.sum, 0, 0, width, height, sum);
+    const accumulate = (accumulator, calls) => {
+        renderer.setRenderTarget(null);
+        for (let i = 0; i < calls; i++) accumulator.render(liveScene, camera(30));
+        const sum = new Float32Array(4 * width * height);
+        renderer.readRenderTargetPixels(accumulator.sum, 0, 0, width, height, sum);
+        return topDownRgb(sum, accumulator.weight);
+    };
+    pictures['live-accumulated'] = accumulate(live, 8);
     const liveFrames = live.frames;
-    pictures['live-accumulated'] = topDownRgb(sum, liveFrames);
     const drawnScene = new THREE.Scene();
     const drawnMaterial = bake.createMaterial({ mode: 'prefiltered', frames: 8 });
     disposables.push(drawnMaterial);
@@ -321,7 +328,18 @@ function liveMode({ renderer, bake, sphere, disposables, pictures, draw, camera,
     renderer.setRenderTarget(null);
     live.render(liveScene, camera(31));
     const liveRestart = live.frames;
-    return { frames: liveFrames, framesAfterMoving: liveRestart };
+
+    const split = new Accumulator(renderer);
+    disposables.push(split);
+    pictures['live-split-accumulated'] = accumulate(split, 9);
+    const splitScene = new THREE.Scene();
+    const splitMaterial = bake.createMaterial({ mode: 'split' });
+    disposables.push(splitMaterial);
+    splitScene.add(new THREE.Mesh(sphere, splitMaterial));
+    draw('live-split-frame', splitScene, camera(30));
+    const w = split.splitWeight;
+    pictures['live-split-expected'] = pictures['live-split-frame'].map((v, i) => (w * v + 8 * pictures['live-drawn'][i]) / (w + 8));
+    return { frames: liveFrames, framesAfterMoving: liveRestart, splitFrames: split.frames, splitWeight: split.weight };
 }
 
 /**

@@ -25,7 +25,10 @@
 // (a PSNR of identical pictures is infinite: null in the JSON);
 // - live_largest_relative_difference, live_frames, live_frames_after_moving: the live mode
 //   (Accumulator): the mean of 8 calls against one draw of the same 8 frames (linear values), the
-//   frames it holds, and after the camera moved;
+//   frames it holds, and after the camera moved; live_split_largest_relative_difference,
+//   live_split_frames, live_split_weight: with the split first frame, 9 calls against the split
+//   frame and the 8 frames weighted as the accumulator weighs them (4 and 1 each), its frames and
+//   total weight;
 // - tone_mapping_levels: the material drawn to the canvas under ACES filmic (exposure 1.7) and no
 //   tone mapping, against three's formulas applied to its linear radiance read back as floats:
 //   the largest difference in 8-bit levels and how many values differ by more than one.
@@ -165,6 +168,7 @@ try {
     files.push(pair('morph', 'morph-morphed', 'morph-geometry'));
     files.push(pair('clipping', 'clipping-plane', 'clipping-geometry'));
     files.push(pair('live', 'live-accumulated', 'live-drawn'));
+    files.push(pair('live-split', 'live-split-accumulated', 'live-split-expected'));
     const linear = result.pictures['mirror-bake'];
     const canvases = Object.fromEntries(
         ['aces', 'none'].map((t) => {
@@ -193,6 +197,9 @@ try {
         live_largest_relative_difference: largestRelativeDifference(result.pictures['live-accumulated'], result.pictures['live-drawn']),
         live_frames: result.live.frames,
         live_frames_after_moving: result.live.framesAfterMoving,
+        live_split_largest_relative_difference: largestRelativeDifference(result.pictures['live-split-accumulated'], result.pictures['live-split-expected']),
+        live_split_frames: result.live.splitFrames,
+        live_split_weight: result.live.splitWeight,
         tone_mapping_levels: canvases,
         files,
     }));
