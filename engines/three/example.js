@@ -1,7 +1,7 @@
 // The example page (index.html): a bake on brdf-preview's sphere, the environment behind it, in
 // the live mode (Accumulator): the split estimator's frame first, then one frame of the mode's
-// samples per animation frame, averaged while the view is still, up to `?frames=N` (default
-// 256). Drag to orbit (the average starts again), switch modes; the status line gives the frames
+// samples per animation frame (`?spp=N` per frame, default 1), averaged while the view is still,
+// up to `?frames=N` (default 256). Drag to orbit (the average starts again), switch modes; the status line gives the frames
 // averaged and the milliseconds of the last one. brdf-preview's axes (+z up) and look: three's Reinhard tone mapping at the bake's
 // automatic exposure and sRGB output are brdf-preview's tone map.
 import * as THREE from 'three';
@@ -22,6 +22,7 @@ const params = new URLSearchParams(location.search);
 document.getElementById('bake').value = params.get('bake') ?? '/target/demo/three-bake/';
 if (params.get('mode')) document.querySelector(`input[name=mode][value=${CSS.escape(params.get('mode'))}]`).checked = true;
 const live = new Accumulator(renderer, { maxFrames: Number(params.get('frames') ?? 256) });
+const spp = Number(params.get('spp') ?? 1);
 
 function mode() {
     return document.querySelector('input[name=mode]:checked').value;
@@ -43,7 +44,7 @@ async function load() {
         renderer.toneMappingExposure = 2 ** bake.figures.exposure_ev;
         const scene = new THREE.Scene();
         scene.add(bake.createBackground({ orientation }));
-        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), orientation }));
+        const mesh = new THREE.Mesh(previewSphere(), bake.createMaterial({ mode: mode(), orientation, spp }));
         scene.add(mesh);
         current = { bake, scene, mesh };
         live.reset();
@@ -56,7 +57,7 @@ function setMode(m) {
     document.querySelector(`input[name=mode][value=${CSS.escape(m)}]`).checked = true;
     if (!current) return;
     current.mesh.material.dispose();
-    current.mesh.material = current.bake.createMaterial({ mode: m, orientation });
+    current.mesh.material = current.bake.createMaterial({ mode: m, orientation, spp });
     live.reset();
 }
 
@@ -74,7 +75,7 @@ function tick() {
     const ms = performance.now() - start;
     const m = mode();
     const names = `${bake.manifest.material.name} under ${bake.manifest.environment?.name}`;
-    const frames = m === 'split' ? 'no samples' : `the split, then ${bake.defaults(m).spp} spp x ${live.frames - 1} frames`;
+    const frames = m === 'split' ? 'no samples' : `the split, then ${spp} spp x ${live.frames - 1} frames`;
     status.textContent =
         `${names} | ${m} | ${frames} (live, up to ${live.maxFrames})\n` +
         `${canvas.width}x${canvas.height} | exposure ${bake.figures.exposure_ev.toFixed(2)} EV\n` +
