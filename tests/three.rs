@@ -253,7 +253,10 @@ fn engine_textures_need_an_environment() {
 /// - A sphere squashed by its mesh's scale is drawn as the same shape made in its geometry: at
 ///   least 60 dB (measured 92.0; with normals turned by the model matrix instead of its inverse
 ///   transpose, 22.6). Likewise an `InstancedMesh` of 100 against 100 meshes (measured 90.3-92.0)
-///   and a sphere skinned to a bone against a mesh moved as the bone (88.1-89.0).
+///   and a sphere skinned to a bone against a mesh moved as the bone (88.1-89.0), a `BatchedMesh`
+///   of 9 spheres of two sizes against 9 meshes, and the bake's sphere cutting through one of
+///   three's drawn by a renderer with a logarithmic depth buffer against one without (which
+///   sphere covers the other where they meet is the depth the material writes).
 /// - An orthographic camera draws as a perspective one 4000 units away (rays parallel within
 ///   3e-4 radians): at least 50 dB (measured 58.4; with the eye at the camera's position, as for
 ///   a perspective camera, 30.0).
@@ -298,6 +301,8 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
         ("mesh scale against geometry scale", "scale_psnr_db"),
         ("an InstancedMesh against separate meshes", "instances_psnr_db"),
         ("a SkinnedMesh against a moved mesh", "skinning_psnr_db"),
+        ("a BatchedMesh against separate meshes", "batched_psnr_db"),
+        ("a logarithmic depth buffer against a linear one", "logarithmic_depth_psnr_db"),
         ("scene.environmentRotation against a camera turned back", "environment_rotation_psnr_db"),
         ("a morph target against the same shape in its geometry", "morph_psnr_db"),
         ("a clipping plane against the half made in its geometry", "clipping_psnr_db"),

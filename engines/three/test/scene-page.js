@@ -23,9 +23,12 @@ import { drawFloats, pageRenderer } from './page-tools.js';
 //   squashed shape made in its geometry;
 // - clipping: the material on a sphere with a clipping plane through its centre against the same
 //   material on the sphere's lower half made in its geometry;
-// - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count;
-//   with the split first frame, 9 calls against the split frame and the 8 weighted alike
-//   after the camera moved;
+// - batched: a BatchedMesh of 9 spheres (two geometries) against 9 meshes; logarithmic-depth:
+//   the bake's sphere cutting through one of three's, drawn by a renderer with a logarithmic
+//   depth buffer against the same scene drawn by one without (the occlusion between the two);
+// - live: the accumulator's mean of 8 calls against one draw of the same 8 frames, and its count
+//   after the camera moved; with the split first frame, 9 calls against the split frame and the
+//   8 weighted alike;
 // - canvases: the mirror scene's bake drawn to the canvas under ACES filmic and no tone mapping
 //   (8 bits; against three's formulas applied to pictures['mirror-bake'] by scene.mjs).
 window.renderScenes = async ({ bake: url, width, height }) => {
@@ -34,6 +37,8 @@ window.renderScenes = async ({ bake: url, width, height }) => {
     const mirrorScene = mirror(s);
     scale(s);
     instances(s);
+    batched(s);
+    logarithmicDepth(s);
     skinning(s);
     orthographic(s, mirrorScene);
     environmentTurned(s);
@@ -181,6 +186,56 @@ function instances({ material, disposables, draw, camera }) {
     draw('instances-instanced', instances, camera(0));
     draw('instances-separate', separate, camera(0));
     instanced.dispose();
+}
+
+/** A BatchedMesh of 9 spheres of two sizes, moved and turned, against 9 meshes with the same matrices. */
+function batched({ material, disposables, draw, camera }) {
+    const shapes = [new THREE.SphereGeometry(0.3, 48, 24), new THREE.SphereGeometry(0.2, 32, 16)];
+    disposables.push(...shapes);
+    const batch = new THREE.BatchedMesh(9, 2 * 48 * 24 * 4, 2 * 48 * 24 * 6, material);
+    const ids = shapes.map((g) => batch.addGeometry(g));
+    const separate = new THREE.Scene();
+    const matrix = new THREE.Matrix4();
+    for (let i = 0; i < 9; i++) {
+        const [col, row] = [i % 3, Math.floor(i / 3)];
+        const quaternion = new THREE.Quaternion().setFromEuler(new THREE.Euler(0.4 * col, 0.3 * row, 0.2 * i));
+        matrix.compose(new THREE.Vector3(0.75 * (col - 1), 0.75 * (row - 1), 0), quaternion, new THREE.Vector3(1, 1, 1));
+        batch.setMatrixAt(batch.addInstance(ids[i % 2]), matrix);
+        const mesh = new THREE.Mesh(shapes[i % 2], material);
+        matrix.decompose(mesh.position, mesh.quaternion, mesh.scale);
+        separate.add(mesh);
+    }
+    const batchedScene = new THREE.Scene();
+    batchedScene.add(batch);
+    draw('batched-batched', batchedScene, camera(10));
+    draw('batched-separate', separate, camera(10));
+    batch.dispose();
+}
+
+/**
+ * The bake's sphere cutting through a MeshStandardMaterial sphere beside it (scene.environment
+ * the map), drawn by a renderer with a logarithmic depth buffer (a second one of the page)
+ * against the same scene drawn by the renderer without: where the two spheres meet, which covers
+ * the other is the depth each material writes.
+ */
+function logarithmicDepth({ bake, map, sphere, material, disposables, pictures, draw, camera, topDownRgb, width, height }) {
+    const scene = new THREE.Scene();
+    scene.environment = map;
+    const ours = new THREE.Mesh(sphere, material);
+    ours.position.set(-0.45, 0, 0);
+    const standard = new THREE.MeshStandardMaterial({ color: 0x808080, roughness: 0.4, metalness: 0.5 });
+    const theirs = new THREE.Mesh(sphere, standard);
+    theirs.position.set(0.45, 0, -0.2);
+    scene.add(ours, theirs);
+    disposables.push(standard);
+    draw('logarithmic-depth-linear', scene, camera(10));
+    const logarithmic = pageRenderer(width, height, { logarithmicDepthBuffer: true });
+    logarithmic.toneMapping = THREE.NoToneMapping;
+    const target = floatTarget(width, height);
+    pictures['logarithmic-depth-logarithmic'] = topDownRgb(drawFloats(logarithmic, target, scene, camera(10)));
+    target.dispose();
+    logarithmic.dispose();
+    void bake;
 }
 
 /** A sphere skinned to one bone, turned and moved, against a mesh moved as the bone. */

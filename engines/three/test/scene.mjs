@@ -15,6 +15,8 @@
 //   geometry, both drawn by the bake's material: the normal matrix;
 // - instances_psnr_db, skinning_psnr_db: an InstancedMesh of 100 against 100 meshes, a sphere
 //   skinned to a bone against a mesh moved as the bone (three's chunks in the vertex shader);
+// - batched_psnr_db, logarithmic_depth_psnr_db: a BatchedMesh of 9 against 9 meshes; the bake's
+//   sphere cutting through one of three's drawn with a logarithmic depth buffer against without;
 // - orthographic_psnr_db: the material seen by an orthographic camera against a perspective one
 //   4000 units away (rays parallel within 3e-4 radians);
 // - environment_rotation_psnr_db: the material under scene.environmentRotation (a turn about +y)
@@ -163,6 +165,8 @@ try {
     files.push(pair('scale', 'scale-mesh', 'scale-geometry'));
     files.push(pair('instances', 'instances-instanced', 'instances-separate'));
     files.push(pair('skinning', 'skinning-skinned', 'skinning-moved'));
+    files.push(pair('batched', 'batched-batched', 'batched-separate'));
+    files.push(pair('logarithmic-depth', 'logarithmic-depth-logarithmic', 'logarithmic-depth-linear'));
     files.push(pair('orthographic', 'orthographic-orthographic', 'orthographic-distant'));
     files.push(pair('environment-turned', 'environment-turned-scene', 'environment-turned-camera'));
     files.push(pair('morph', 'morph-morphed', 'morph-geometry'));
@@ -190,6 +194,8 @@ try {
         scale_psnr_db: psnrDb(pictures['scale-mesh'], pictures['scale-geometry']),
         instances_psnr_db: psnrDb(pictures['instances-instanced'], pictures['instances-separate']),
         skinning_psnr_db: psnrDb(pictures['skinning-skinned'], pictures['skinning-moved']),
+        batched_psnr_db: psnrDb(pictures['batched-batched'], pictures['batched-separate']),
+        logarithmic_depth_psnr_db: psnrDb(pictures['logarithmic-depth-logarithmic'], pictures['logarithmic-depth-linear']),
         orthographic_psnr_db: psnrDb(pictures['orthographic-orthographic'], pictures['orthographic-distant']),
         environment_rotation_psnr_db: psnrDb(pictures['environment-turned-scene'], pictures['environment-turned-camera']),
         morph_psnr_db: psnrDb(pictures['morph-morphed'], pictures['morph-geometry']),
