@@ -228,7 +228,7 @@ ${COMMON}
 const uint MODE_REFERENCE = 0u;
 const uint MODE_PREFILTERED = 2u;
 // split.js's MAX_PEAK_LIGHTS.
-#define MAX_PEAK_LIGHTS 8
+#define MAX_PEAK_LIGHTS 4
 
 // engine-merl.ktx2: texel (phi_d, theta_d, theta_h) of the MERL grid, RGB in 1/sr, 0 without data.
 uniform sampler3D uMerl;

@@ -18,6 +18,12 @@ import { BakeError } from './loader.js';
 /** The most peak lights the split estimator reads (the shader's array size). */
 export const MAX_PEAK_LIGHTS = 4;
 
+/**
+ * The grid over the map (columns, rows) whose cells a peak light stays within: a lamp larger than
+ * a cell becomes a light per cell it covers, a few Gaussians closer to its shape than one.
+ */
+export const PEAK_CELLS = [16, 8];
+
 // merl::half_diff (the shader's merl_half_diff): (theta_h, theta_d, phi_d) of a direction pair.
 function halfDiff(wi, wo) {
     let [hx, hy, hz] = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -154,7 +160,7 @@ function twoLobes(spread) {
 /**
  * The environment's peaks (`peaks`: engine-environment's layer 1, RGBA rows of `width x height`,
  * row 0 at the zenith) as at most MAX_PEAK_LIGHTS directional lights: the peak texels joined where
- * they touch (8 neighbours, u wrapping), each group's irradiance at normal incidence (RGB, the
+ * they touch (8 neighbours) within a cell of PEAK_CELLS, each group's irradiance at normal incidence (RGB, the
  * sum of radiance times solid angle) and its direction (the luminance-weighted mean, +z up); the
  * brightest groups kept, each other group added to the kept one nearest in direction; and each
  * light's spread, the mean of `1 - cos` between its texels' directions and its own (luminance
@@ -164,6 +170,9 @@ function twoLobes(spread) {
 export function peakLights(peaks, width, height) {
     const label = new Int32Array(width * height).fill(-1);
     const groups = [];
+    // The cell of PEAK_CELLS a texel lies in (columns from u = 0, rows from the zenith).
+    const cellOf = (k) =>
+        Math.floor(((k % width) * PEAK_CELLS[0]) / width) + PEAK_CELLS[0] * Math.floor((Math.floor(k / width) * PEAK_CELLS[1]) / height);
     const lit = (k) => peaks[4 * k] > 0 || peaks[4 * k + 1] > 0 || peaks[4 * k + 2] > 0;
     for (let start = 0; start < width * height; start++) {
         if (label[start] >= 0 || !lit(start)) continue;
@@ -190,7 +199,7 @@ export function peakLights(peaks, width, height) {
                 if (ny < 0 || ny >= height) continue;
                 for (let dx = -1; dx <= 1; dx++) {
                     const n = ny * width + ((x + dx + width) % width);
-                    if (label[n] < 0 && lit(n)) {
+                    if (label[n] < 0 && lit(n) && cellOf(n) === cellOf(start)) {
                         label[n] = groups.length;
                         stack.push(n);
                     }

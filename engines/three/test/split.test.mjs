@@ -98,30 +98,34 @@ function peaksImage(texels) {
 }
 const solidAngle = (y) => ((2 * Math.PI) / 64) * (Math.PI / 32) * Math.sin((Math.PI * (y + 0.5)) / 32);
 
-test('touching peak texels make one light, its power their radiance times solid angle', () => {
-    // A 2 x 2 block at rows 8-9 and a lone texel across the seam from another (x 63 and 0 touch).
-    const lights = peakLights(peaksImage([[10, 8, 100], [11, 8, 100], [10, 9, 100], [11, 9, 100], [63, 20, 50], [0, 20, 50]]), 64, 32);
-    assert.equal(lights.count, 2);
+test('touching peak texels within a cell make one light, its power their radiance times solid angle', () => {
+    // A 2 x 2 block at rows 8-9 (one cell of 4 x 4 texels: 64 / 16 by 32 / 8), two touching texels
+    // in one cell at row 20, and two touching texels in two cells (x 7 and 8) at row 26.
+    const image = peaksImage([[10, 8, 100], [11, 8, 100], [10, 9, 100], [11, 9, 100], [5, 20, 50], [6, 20, 50], [7, 26, 30], [8, 26, 30]]);
+    const lights = peakLights(image, 64, 32);
+    assert.equal(lights.count, 4);
     const block = 100 * (2 * solidAngle(8) + 2 * solidAngle(9));
-    const seam = 50 * 2 * solidAngle(20);
+    const pair = 50 * 2 * solidAngle(20);
     assert.ok(Math.abs(lights.powers[0] - block) < 1e-6 * block && Math.abs(lights.powers[1] - 2 * block) < 1e-5 * block);
-    assert.ok(Math.abs(lights.powers[3] - seam) < 1e-6 * seam);
+    assert.ok(Math.abs(lights.powers[3] - pair) < 1e-6 * pair);
+    for (const i of [2, 3]) assert.ok(Math.abs(lights.powers[3 * i] - 30 * solidAngle(26)) < 1e-6, `light ${i}`);
     // The block's direction: between its texels' centres, at u = 11/64, v = 9/32.
     const [u, v] = [11 / 64, 9 / 32];
     const expected = [Math.sin(Math.PI * v) * Math.cos(2 * Math.PI * u), Math.sin(Math.PI * v) * Math.sin(2 * Math.PI * u), Math.cos(Math.PI * v)];
     const cos = expected.reduce((s, e, i) => s + e * lights.directions[i], 0);
     assert.ok(cos > 0.9995, `${cos}`);
-    // The seam's light lies at u = 0 (+x, no y), theta that of row 20 (within 1e-3: the mean of
-    // two directions half a texel either side leans towards the pole); its spread is that of two
-    // texels 1/64 turn apart.
-    const theta = (Math.PI * 20.5) / 32;
-    assert.ok(Math.abs(lights.directions[3] - Math.sin(theta)) < 1e-3 && Math.abs(lights.directions[4]) < 1e-6);
-    assert.ok(Math.abs(lights.directions[5] - Math.cos(theta)) < 1e-3);
+    // The pair's light lies between its texels, at u = 6/64, theta that of row 20 (within 1e-3:
+    // the mean of two directions half a texel either side leans towards the pole); its spread is
+    // that of two texels 1/64 turn apart.
+    const [phi, theta] = [(2 * Math.PI * 6) / 64, (Math.PI * 20.5) / 32];
+    const toward = [Math.sin(theta) * Math.cos(phi), Math.sin(theta) * Math.sin(phi), Math.cos(theta)];
+    for (let c = 0; c < 3; c++) assert.ok(Math.abs(lights.directions[3 + c] - toward[c]) < 1e-3, `${lights.directions.slice(3, 6)}`);
     assert.ok(lights.spreads[1] > 0 && lights.spreads[1] < 1 - Math.cos(Math.PI / 64), `${lights.spreads[1]}`);
 });
 
 test('past the most lights, each group joins the nearest kept one and no power is lost', () => {
-    const texels = Array.from({ length: MAX_PEAK_LIGHTS + 3 }, (_, i) => [4 * i, 16, 10 + i]);
+    // One texel in each of MAX + 3 cells (columns 4 texels wide; rows 16 and 28 in two rows of cells).
+    const texels = Array.from({ length: MAX_PEAK_LIGHTS + 3 }, (_, i) => [4 * (i % 16), i < 16 ? 16 : 28, 10 + i]);
     const lights = peakLights(peaksImage(texels), 64, 32);
     assert.equal(lights.count, MAX_PEAK_LIGHTS);
     const total = texels.reduce((s, [, y, v]) => s + v * solidAngle(y), 0);
