@@ -184,7 +184,7 @@ export class Bake {
             const f = this.figures;
             const exponents = layerExponents(f.exponents).slice(0, f.exponents.length + 1);
             const lobes = lobeTable(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
-            const texture = new THREE.DataTexture(lobes, f.view_rows, 3, THREE.RGBAFormat, THREE.FloatType);
+            const texture = new THREE.DataTexture(lobes, f.view_rows, 2, THREE.RGBAFormat, THREE.FloatType);
             // Linear along the views (u = 1 - cos_o: the rows' centres at (r + 1/2) / rows), each
             // row of the texture read at its centre.
             texture.minFilter = THREE.LinearFilter;

@@ -757,11 +757,37 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     return sum;
 }
 
-// Row lobe of uLobes (0 the sharper lobe, 1 the broader, 2 their layer coordinates) at the view
-// (split.js's lobeTable), interpolated between the views' centres at 1 - cos_o by the GPU, as
-// view_layer_coordinate reads the view layers.
-vec4 lobe_at(float cos_o, int lobe) {
-    return texture(uLobes, vec2(1.0 - cos_o, (float(lobe) + 0.5) / 3.0));
+// The lobes at the view (split.js's lobeTable), interpolated between the views' centres at
+// 1 - cos_o by the GPU, as view_layer_coordinate reads the view layers: row 0 the sharper lobe's
+// albedo (RGB) and exponent, row 1 the broader lobe's albedo over the sharper's (the two share
+// their colour), its exponent and the two lobes' layer coordinates.
+vec4 lobe_at(float cos_o, int row) {
+    return texture(uLobes, vec2(1.0 - cos_o, (float(row) + 0.5) / 2.0));
+}
+
+// env_uv with one inverse cosine for theta (the split estimator's: no twin to match to the bit).
+vec2 split_uv(vec3 w) {
+    float u = merl_atan2(w.y, w.x) / (2.0 * PI);
+    return vec2(u < 0.0 ? u + 1.0 : u, acos(clamp(w.z, -1.0, 1.0)) / PI);
+}
+
+// material_brdf (the nearest cell) with the half and difference frames turned by the half
+// vector's own components rather than by its angles' sines and cosines.
+vec3 split_brdf(vec3 wi, vec3 wo) {
+    ivec3 dims = textureSize(uMerl, 0);
+    vec3 h = normalize(wi + wo);
+    float sin_h = length(h.xy);
+    vec2 phi = sin_h > 1e-7 ? h.xy / sin_h : vec2(1.0, 0.0);
+    vec3 a = vec3(wi.x * phi.x + wi.y * phi.y, wi.y * phi.x - wi.x * phi.y, wi.z);
+    vec3 d = vec3(a.x * h.z - a.z * sin_h, a.y, a.x * sin_h + a.z * h.z);
+    float phi_d = merl_atan2(d.y, d.x);
+    if (phi_d < 0.0) {
+        phi_d += uPhiDRange;
+    }
+    float x_h = sqrt(acos(clamp(h.z, -1.0, 1.0)) / HALF_PI) * float(dims.z);
+    float x_d = acos(clamp(d.z, -1.0, 1.0)) / HALF_PI * float(dims.y);
+    ivec3 cell = ivec3(merl_axis_index(phi_d / uPhiDRange * float(dims.x), dims.x), merl_axis_index(x_d, dims.y), merl_axis_index(x_h, dims.z));
+    return texelFetch(uMerl, cell, 0).rgb;
 }
 
 // The layers at coordinate x (layers_bilinear's blend of layer k and k + 1, past the sharpest the
@@ -781,15 +807,18 @@ vec3 split_estimate(ShadingFrame frame) {
     vec4 sharp = lobe_at(frame.cos_o, 0);
     vec4 broad = lobe_at(frame.cos_o, 1);
     vec3 mirror = to_world(frame, vec3(-frame.wo_local.x, 0.0, frame.wo_local.z));
-    vec2 uv = env_uv(mirror);
-    vec4 x = lobe_at(frame.cos_o, 2);
-    float x_sharp = x.x;
-    float x_broad = x.y;
-    vec3 sum = PI * uDiffuse * texture(uLayersLinear, vec3(env_uv(frame.n), 0.0)).rgb + sharp.rgb * layers_linear(x_sharp, uv)
-        + broad.rgb * layers_linear(x_broad, uv);
+    vec2 uv = split_uv(mirror);
+    vec3 broad_albedo = sharp.rgb * broad.x;
+    vec3 sum = PI * uDiffuse * texture(uLayersLinear, vec3(split_uv(frame.n), 0.0)).rgb + sharp.rgb * layers_linear(broad.z, uv)
+        + broad_albedo * layers_linear(broad.w, uv);
+    // The brightest light through the table itself: the lobes fitted at each view place the
+    // BRDF's broader part around the mirror direction, where a measured table's need not lie (a
+    // metal's haze seen at grazing angles); its sharper lobe stays the fitted one, widened.
+    vec3 wl = to_local(frame, uPeakDirections[0]);
+    vec3 table = uPeakCount > 0 && wl.z > 0.0 ? split_brdf(wl, frame.wo_local) - uDiffuse : vec3(0.0);
     // A light's spread widens the lobes that reflect it: small-angle spreads (the mean 1 - cos,
     // 1 / (n + 2) for a Phong lobe of exponent n) add.
-    vec2 spread = 1.0 / (vec2(sharp.a, broad.a) + 2.0);
+    vec2 spread = 1.0 / (vec2(sharp.a, broad.y) + 2.0);
     for (int i = 0; i < uPeakCount; i++) {
         vec3 d = uPeakDirections[i];
         float cos_i = dot(frame.n, d);
@@ -800,8 +829,11 @@ vec3 split_estimate(ShadingFrame frame) {
             float c = max(dot(mirror, d), 0.0);
             vec2 n = max(1.0 / (spread + uPeakSpreads[i]) - 2.0, 0.0);
             vec2 norm = (n + 1.0) / (2.0 * PI);
-            vec3 lobes = sharp.rgb * (norm.x * pow(c, n.x)) + broad.rgb * (norm.y * pow(c, n.y));
-            sum += uPeakPowers[i] * (uDiffuse * max(cos_i, 0.0) + lobes * above);
+            vec3 sharper = sharp.rgb * (norm.x * pow(c, n.x));
+            // The table less the sharper lobe unwidened, for the brightest; the broader lobe else.
+            vec3 rest = i == 0 ? max(table * max(cos_i, 0.0) - sharp.rgb * ((sharp.a + 1.0) / (2.0 * PI) * pow(c, sharp.a)), vec3(0.0))
+                               : broad_albedo * (norm.y * pow(c, n.y));
+            sum += uPeakPowers[i] * (uDiffuse * max(cos_i, 0.0) + (sharper + rest) * above);
         }
     }
     return sum;

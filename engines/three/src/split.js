@@ -56,16 +56,18 @@ export function merlBrdf(data, size, phiDRange, wi, wo) {
 }
 
 /**
- * Per view row `r` of `rows` (`1 - cos theta_o = (r + 1/2) / rows`, the view layers' rows): the
- * albedo of the BRDF less its diffuse part `diffuse` (RGB, `integral of (f - f_d) cos theta_i`)
- * and the exponent `n` of the normalized Phong lobe around the mirror direction with the same
- * mean `1 - cos alpha` (`1 / (n + 2)`, weighted by that part's luminance times cos theta_i;
- * `alpha` the angle to the mirror direction), as RGBA (A the exponent, from 0 to 1e6). The
- * integral runs over half vectors: theta_h on MERL's square-root spacing (dense at the peak),
- * `phiSteps` azimuths over the half plane the view's symmetry leaves, `dw_i = 4 (wo . h) dw_h`.
+ * Per view `r` of `rows` (`1 - cos theta_o = (r + 1/2) / rows`, the view layers' rows): the BRDF
+ * less its diffuse part `diffuse` as two normalized Phong lobes around the mirror direction
+ * (twoLobes, on the directions weighted by that part's luminance times cos theta_i), its albedo
+ * (RGB, `integral of (f - f_d) cos theta_i`) shared between them. Two rows of RGBA texels: row 0
+ * texel `r` the sharper lobe's albedo (RGB) and exponent (from 0 to 1e6); row 1 texel `r` the
+ * broader lobe's albedo over the sharper's (the two have the same colour), its exponent, and the
+ * two exponents' layer coordinates among `exponents` (layerCoordinate). The integral runs over
+ * half vectors: theta_h on MERL's square-root spacing (dense at the peak), `phiSteps` azimuths
+ * over the half plane the view's symmetry leaves, `dw_i = 4 (wo . h) dw_h`.
  */
 export function lobeTable(merl, size, phiDRange, diffuse, rows, exponents, phiSteps = 64) {
-    const out = new Float32Array(12 * rows);
+    const out = new Float32Array(8 * rows);
     const thetaSteps = size[2];
     for (let r = 0; r < rows; r++) {
         const cosO = 1 - (r + 0.5) / rows;
@@ -97,9 +99,10 @@ export function lobeTable(merl, size, phiDRange, diffuse, rows, exponents, phiSt
             }
         }
         const [w, n1, n2] = twoLobes(spread);
-        out.set([...albedo.map((v) => w * v), n1], 4 * r);
-        out.set([...albedo.map((v) => (1 - w) * v), n2], 4 * (rows + r));
-        out.set([layerCoordinate(n1, exponents), layerCoordinate(n2, exponents), 0, 0], 4 * (2 * rows + r));
+        // The sharper lobe's share at least 1e-6, so that the broader's over it stays finite.
+        const share = Math.max(w, 1e-6);
+        out.set([...albedo.map((v) => share * v), n1], 4 * r);
+        out.set([(1 - share) / share, n2, layerCoordinate(n1, exponents), layerCoordinate(n2, exponents)], 4 * (rows + r));
     }
     return out;
 }

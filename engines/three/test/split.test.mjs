@@ -51,11 +51,12 @@ test("a Lambertian table's albedo is its reflectance, and nothing is left once i
     const all = lobeTable(data, SIZE, Math.PI, [0, 0, 0], rows, exponents);
     const rest = lobeTable(data, SIZE, Math.PI, [rho / Math.PI, rho / Math.PI, rho / Math.PI], rows, exponents);
     for (let r = 0; r < rows; r++) {
-        // The two lobes share the albedo; the quadrature over half vectors is within 1% of the
-        // hemisphere's integral of cos (pi) except at the most grazing views (2%).
-        const albedo = all[4 * r] + all[4 * (rows + r)];
+        // The two lobes share the albedo (the broader's is the sharper's times row 1's first
+        // value); the quadrature over half vectors is within 1% of the hemisphere's integral of
+        // cos (pi) except at the most grazing views (2%).
+        const albedo = all[4 * r] * (1 + all[4 * (rows + r)]);
         assert.ok(Math.abs(albedo - rho) < (r < rows - 2 ? 0.01 : 0.02) * rho, `row ${r}: ${albedo}`);
-        assert.ok(Math.abs(rest[4 * r]) + Math.abs(rest[4 * (rows + r)]) < 1e-6, `row ${r}`);
+        assert.ok(Math.abs(rest[4 * r] * (1 + rest[4 * (rows + r)])) < 1e-6, `row ${r}`);
     }
 });
 
@@ -70,14 +71,16 @@ test("a Phong lobe's albedo and exponent come back at a view where it lies above
     const out = lobeTable(data, SIZE, Math.PI, [0, 0, 0], rows, [1, 4, 16, 64, 256, 1024]);
     // Row 1: 1 - cos theta_o = 3/16, theta_o 36 degrees; the lobe (half width 14 degrees at
     // half its height) lies above the horizon. The nearest-cell table misses a little of the peak.
-    const [w1, w2] = [out[4 * 1], out[4 * (rows + 1)]];
+    const [w1, w2] = [out[4 * 1], out[4 * 1] * out[4 * (rows + 1)]];
     assert.ok(Math.abs(w1 + w2 - albedo) < 0.03 * albedo, `${w1 + w2}`);
     // Each lobe holding a tenth of the albedo or more has the exponent within 15%.
-    for (const [w, exponent] of [[w1, out[4 * 1 + 3]], [w2, out[4 * (rows + 1) + 3]]]) {
+    for (const [w, exponent] of [[w1, out[4 * 1 + 3]], [w2, out[4 * (rows + 1) + 1]]]) {
         if (w > 0.1 * albedo) assert.ok(Math.abs(exponent - n) < 0.15 * n, `${exponent} holding ${w}`);
     }
-    // The layer coordinates of the two lobes are their exponents' (row 2 of the table).
-    assert.ok(Math.abs(out[4 * (2 * rows + 1)] - layerCoordinate(out[4 * 1 + 3], [1, 4, 16, 64, 256, 1024])) < 1e-6);
+    // The layer coordinates of the two lobes are their exponents' (row 1's last two values).
+    const exponents = [1, 4, 16, 64, 256, 1024];
+    assert.ok(Math.abs(out[4 * (rows + 1) + 2] - layerCoordinate(out[4 * 1 + 3], exponents)) < 1e-6);
+    assert.ok(Math.abs(out[4 * (rows + 1) + 3] - layerCoordinate(out[4 * (rows + 1) + 1], exponents)) < 1e-6);
 });
 
 test('the layer coordinate of an exponent interpolates the layers logarithmically', () => {
