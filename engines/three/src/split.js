@@ -1,17 +1,19 @@
 // The split estimator's inputs, derived at load time from the engine textures (as the peaks and
-// the smooth part are: data-schema/engine-textures.md): the BRDF's lobe per view from
-// engine-merl and the environment's peaks as a few directional lights from engine-environment.
+// the smooth part are: data-schema/engine-textures.md): the BRDF's lobes per view from
+// engine-merl, the environment's peaks as a few directional lights from engine-environment, and
+// the layers with the smooth part's level 0 as one more, for the GPU's filtering.
 //
 // The split estimator (mode 'split', the live mode's first frame) draws a pixel without samples,
 // as three's own materials draw theirs: the diffuse part as the prefiltered estimator reads it
 // (pi f_d times the cosine layer at the normal); the rest of the BRDF at the view, `f - f_d`, as
-// one normalized Phong lobe around the mirror direction with the table's albedo and width at that
-// view, read from the Phong layer of that width in the mirror direction (Kautz and McCool's
-// split of a lobe into its albedo and a prefiltered lookup, with the table's own albedo where a
-// split sum has a fitted BRDF's); and each peak light through the same lobe and the diffuse part.
-// It is biased where the lobe is not a Phong lobe around the mirror direction (off-specular
-// peaks towards grazing angles, anisotropic Fresnel colour across the lobe) and where a peak is
-// not small; the live mode averages unbiased frames in after it.
+// two normalized Phong lobes around the mirror direction with the table's albedo and widths at
+// that view, each read from the Phong layer of its width in the mirror direction (the split of a
+// lobe into its albedo and a prefiltered lookup, with the table's own albedo where a split sum
+// has a fitted BRDF's); each peak light through the diffuse part and the lobes widened by the
+// light's spread, the brightest through the table itself in place of the broader lobe. It is
+// biased where the lobes are not Phong lobes around the mirror direction (off-specular peaks
+// towards grazing angles, Fresnel colour changing across a lobe) and where a peak is large or
+// not round; the live mode averages unbiased frames in after it.
 
 import { BakeError } from './loader.js';
 
