@@ -317,7 +317,10 @@ fn the_material_is_at_home_in_a_y_up_three_js_scene() {
     let frames = (figures["live_frames"].as_u64(), figures["live_frames_after_moving"].as_u64());
     assert_eq!(frames, (Some(8), Some(1)), "the live mode's frames, then after the camera moved");
     let split = figures["live_split_largest_relative_difference"].as_f64().unwrap();
-    assert!(split <= 1e-5, "the live mode with its split first frame against that frame and 8 frames, weighted 4 and 1: {split:e}; {where_}");
+    assert!(
+        split <= 1e-5,
+        "the live mode with its split first frame against that frame and 8 frames, weighted 4 and 1: {split:e}; {where_}"
+    );
     let weights = (figures["live_split_frames"].as_u64(), figures["live_split_weight"].as_u64());
     assert_eq!(weights, (Some(9), Some(12)), "the live mode's frames and weight with its split first frame");
     let orthographic = figures["orthographic_psnr_db"].as_f64().unwrap();

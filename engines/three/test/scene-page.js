@@ -162,6 +162,28 @@ function scale({ sphere, converged, disposables, draw, camera }) {
 }
 
 /**
+ * `count` matrices on a grid of `columns` columns `spacing` apart around the origin, each turned
+ * by the Euler angles `turn(col, row, i)` and scaled by `scale(col)`, and a scene of one mesh per
+ * matrix (`geometryOf(i)`, `material`) placed by it: what instanced and batched meshes are drawn
+ * against.
+ */
+function placed(count, columns, spacing, turn, scale, geometryOf, material) {
+    const rows = count / columns;
+    const separate = new THREE.Scene();
+    const matrices = Array.from({ length: count }, (_, i) => {
+        const [col, row] = [i % columns, Math.floor(i / columns)];
+        const position = new THREE.Vector3(spacing * (col - (columns - 1) / 2), spacing * (row - (rows - 1) / 2), 0);
+        const quaternion = new THREE.Quaternion().setFromEuler(new THREE.Euler(...turn(col, row, i)));
+        const matrix = new THREE.Matrix4().compose(position, quaternion, new THREE.Vector3(...scale(col)));
+        const mesh = new THREE.Mesh(geometryOf(i), material);
+        matrix.decompose(mesh.position, mesh.quaternion, mesh.scale);
+        separate.add(mesh);
+        return matrix;
+    });
+    return { matrices, separate };
+}
+
+/**
  * A 10 x 10 InstancedMesh of small spheres, turned and scaled each its own way, against 100
  * meshes with the same matrices.
  */
@@ -169,18 +191,8 @@ function instances({ material, disposables, draw, camera }) {
     const small = new THREE.SphereGeometry(0.14, 32, 16);
     disposables.push(small);
     const instanced = new THREE.InstancedMesh(small, material, 100);
-    const separate = new THREE.Scene();
-    const matrix = new THREE.Matrix4();
-    for (let i = 0; i < 100; i++) {
-        const [col, row] = [i % 10, Math.floor(i / 10)];
-        const position = new THREE.Vector3(0.3 * (col - 4.5), 0.3 * (row - 4.5), 0);
-        const quaternion = new THREE.Quaternion().setFromEuler(new THREE.Euler(0.3 * col, 0.2 * row, 0.1 * i));
-        matrix.compose(position, quaternion, new THREE.Vector3(1, 0.5 + 0.05 * col, 1));
-        instanced.setMatrixAt(i, matrix);
-        const mesh = new THREE.Mesh(small, material);
-        matrix.decompose(mesh.position, mesh.quaternion, mesh.scale);
-        separate.add(mesh);
-    }
+    const { matrices, separate } = placed(100, 10, 0.3, (col, row, i) => [0.3 * col, 0.2 * row, 0.1 * i], (col) => [1, 0.5 + 0.05 * col, 1], () => small, material);
+    matrices.forEach((m, i) => instanced.setMatrixAt(i, m));
     const instances = new THREE.Scene();
     instances.add(instanced);
     draw('instances-instanced', instances, camera(0));
@@ -194,17 +206,8 @@ function batched({ material, disposables, draw, camera }) {
     disposables.push(...shapes);
     const batch = new THREE.BatchedMesh(9, 2 * 48 * 24 * 4, 2 * 48 * 24 * 6, material);
     const ids = shapes.map((g) => batch.addGeometry(g));
-    const separate = new THREE.Scene();
-    const matrix = new THREE.Matrix4();
-    for (let i = 0; i < 9; i++) {
-        const [col, row] = [i % 3, Math.floor(i / 3)];
-        const quaternion = new THREE.Quaternion().setFromEuler(new THREE.Euler(0.4 * col, 0.3 * row, 0.2 * i));
-        matrix.compose(new THREE.Vector3(0.75 * (col - 1), 0.75 * (row - 1), 0), quaternion, new THREE.Vector3(1, 1, 1));
-        batch.setMatrixAt(batch.addInstance(ids[i % 2]), matrix);
-        const mesh = new THREE.Mesh(shapes[i % 2], material);
-        matrix.decompose(mesh.position, mesh.quaternion, mesh.scale);
-        separate.add(mesh);
-    }
+    const { matrices, separate } = placed(9, 3, 0.75, (col, row, i) => [0.4 * col, 0.3 * row, 0.2 * i], () => [1, 1, 1], (i) => shapes[i % 2], material);
+    matrices.forEach((m, i) => batch.setMatrixAt(batch.addInstance(ids[i % 2]), m));
     const batchedScene = new THREE.Scene();
     batchedScene.add(batch);
     draw('batched-batched', batchedScene, camera(10));
