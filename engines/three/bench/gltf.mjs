@@ -9,9 +9,10 @@
 //
 //   node bench/gltf.mjs [--size N] [--truth-frames N] [--only NAME] [--chromium PATH]
 //
-// About 100 s per material (two maps: two bakes each, with the fit) on 2 cores. Prints the report as markdown and writes the
-// sheet of every material's pictures to docs/three-gltf.png. Needs target/merl (make
-// test-data), Chromium, and the packages of engines/three and tests/gltf-validator (make setup).
+// About 100 s per material (two maps, two bakes each with the fit) on 2 cores. Prints the report
+// as markdown and writes the sheet of every material's pictures to docs/three-gltf.png. Needs
+// target/merl (make test-data), Chromium, and the packages of engines/three and
+// tests/gltf-validator (make setup).
 import { execFileSync } from 'node:child_process';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
