@@ -30,8 +30,9 @@ export { Accumulator, SPLIT_WEIGHT } from './live.js';
 export { BakeError, FLOAT32_MAX, MANIFEST_LIMIT, OUTPUT_LIMIT, STAGE, checkFigures, dataTexture, readBake, resolveInside, sha256Hex } from './loader.js';
 
 /**
- * The estimators, by their names in `brdf-preview --mode`, and their codes in the shader; and
- * this engine's own, 'split' (split.js: no samples, biased, the live mode's first frame).
+ * The estimators, by their names in `brdf-preview --mode`, and their codes in the shader (uMode);
+ * and this engine's own, 'split' (split.js: no samples, biased, the live mode's first frame),
+ * which is a program of its own (the define SPLIT) and reads no uMode.
  */
 export const MODES = { reference: 0, prefiltered: 2, split: 3 };
 
@@ -107,6 +108,7 @@ export class Bake {
         material.userData.brdfBake = { firstFrame: options.firstFrame ?? 0, mode: options.mode ?? 'reference' };
         material.onBeforeRender = (renderer, scene) => {
             const u = material.uniforms;
+            this.bindSplit(material);
             resolution(renderer, u.uResolution.value);
             if (material.defines.TURNED) envFromWorld(scene.environmentRotation, u.uEnvFromWorld.value);
         };
@@ -133,6 +135,8 @@ export class Bake {
                 uGScale: { value: gbuffer.scale },
             },
         });
+        // Its defines stay as made (the live mode draws createMaterial's materials only).
+        this.bindSplit(material);
         return fullScreen(material, 'environmentRotation');
     }
 
@@ -141,7 +145,6 @@ export class Bake {
             throw new BakeError(`error: unknown mode ${mode}: ${Object.keys(MODES).join(', ')}`);
         }
         const f = this.figures;
-        const split = this.splitInputs();
         // The split estimator takes no samples: the sampled estimators' settings stay valid.
         const defaults = this.defaults(mode === 'split' ? 'prefiltered' : mode);
         spp = spp ?? defaults.spp;
@@ -167,30 +170,50 @@ export class Bake {
             uDivisor: { value: divisor ?? frames },
             uFilterSamples: { value: spp * frames },
             uLayerExponents: { value: layerExponents(f.exponents) },
-            uPeakCount: { value: split.count },
-            uPeakDirections: { value: split.directions },
-            uPeakPowers: { value: split.powers },
-            uPeakSpreads: { value: split.spreads },
+            // The split estimator's, set by bindSplit where SPLIT is drawn.
+            uLobes: { value: null },
+            uLayersLinear: { value: null },
+            uPeakCount: { value: 0 },
+            uPeakDirections: { value: new Float32Array(3 * MAX_PEAK_LIGHTS) },
+            uPeakPowers: { value: new Float32Array(3 * MAX_PEAK_LIGHTS) },
+            uPeakSpreads: { value: new Float32Array(MAX_PEAK_LIGHTS) },
             ...rayUniforms(),
         };
     }
 
     /**
-     * The split estimator's inputs (split.js), derived once: the lobe table as the texture
-     * `uLobes` among the bake's textures (disposed with them) and the peak lights.
+     * `material`'s split uniforms from splitInputs, before a draw with SPLIT defined (made with
+     * mode 'split', or the live mode's first frame): the inputs are derived at the first such
+     * draw, not for bakes that never draw one.
+     */
+    bindSplit(material) {
+        const u = material.uniforms;
+        if (!material.defines.SPLIT || u.uLobes.value) return;
+        const split = this.splitInputs();
+        u.uLobes.value = split.lobes;
+        u.uLayersLinear.value = split.layers;
+        u.uPeakCount.value = split.count;
+        u.uPeakDirections.value = split.directions;
+        u.uPeakPowers.value = split.powers;
+        u.uPeakSpreads.value = split.spreads;
+    }
+
+    /**
+     * The split estimator's inputs (split.js), derived once: the lobe table (`lobes`), the layers
+     * with the smooth level 0 (`layers`), both textures disposed with the bake, and the peak
+     * lights (`count`, `directions`, `powers`, `spreads`).
      */
     splitInputs() {
         if (!this.split) {
             const f = this.figures;
             const exponents = layerExponents(f.exponents).slice(0, f.exponents.length + 1);
-            const lobes = lobeTable(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
-            const texture = new THREE.DataTexture(lobes, f.view_rows, 2, THREE.RGBAFormat, THREE.FloatType);
+            const table = lobeTable(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
+            const lobes = new THREE.DataTexture(table, f.view_rows, 2, THREE.RGBAFormat, THREE.FloatType);
             // Linear along the views (u = 1 - cos_o: the rows' centres at (r + 1/2) / rows), each
             // row of the texture read at its centre.
-            texture.minFilter = THREE.LinearFilter;
-            texture.magFilter = THREE.LinearFilter;
-            texture.needsUpdate = true;
-            this.textures.uLobes = texture;
+            lobes.minFilter = THREE.LinearFilter;
+            lobes.magFilter = THREE.LinearFilter;
+            lobes.needsUpdate = true;
             // The layers again with the smooth part's level 0 as one more layer (splitLayers),
             // filtered by the GPU (texelFetch, which the sampled estimators read uLayers with,
             // ignores filtering): one bilinear read where env_bilinear makes four fetches, and no
@@ -198,7 +221,8 @@ export class Bake {
             // OES_texture_float_linear.
             const layers = this.textures.uLayers.image;
             const environment = this.textures.uEnvironment.image;
-            const extended = splitLayers(layers.data, layers.width, layers.height, layers.depth, environment.data, environment.width, environment.height);
+            const [width, height] = [environment.width, environment.height];
+            const extended = splitLayers(layers.data, layers.width, layers.height, layers.depth, environment.data, width, height);
             const linear = new THREE.DataArrayTexture(extended, layers.width, layers.height, layers.depth + 1);
             linear.format = THREE.RGBAFormat;
             linear.type = THREE.FloatType;
@@ -209,15 +233,14 @@ export class Bake {
             linear.generateMipmaps = false;
             linear.flipY = false;
             linear.needsUpdate = true;
-            this.textures.uLayersLinear = linear;
-            const { width, height, data } = this.textures.uEnvironment.image;
             const none = {
                 count: 0,
                 directions: new Float32Array(3 * MAX_PEAK_LIGHTS),
                 powers: new Float32Array(3 * MAX_PEAK_LIGHTS),
                 spreads: new Float32Array(MAX_PEAK_LIGHTS),
             };
-            this.split = f.peaks ? peakLights(data.subarray(4 * width * height, 8 * width * height), width, height) : none;
+            const peaks = environment.data.subarray(4 * width * height, 8 * width * height);
+            this.split = { lobes, layers: linear, ...(f.peaks ? peakLights(peaks, width, height) : none) };
         }
         return this.split;
     }
@@ -297,6 +320,8 @@ export class Bake {
 
     dispose() {
         Object.values(this.textures).forEach((t) => t.dispose());
+        this.split?.lobes.dispose();
+        this.split?.layers.dispose();
     }
 }
 

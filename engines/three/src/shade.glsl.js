@@ -8,7 +8,8 @@
 //
 // Only the reference (mode 0) and prefiltered (mode 2) estimators; the debug and adaptive modes of
 // the WGSL stay in the previewer. One estimator is this engine's own, with no twin: the split
-// estimator (mode 3, split_estimate; split.js says what it draws), the live mode's first frame.
+// estimator (split_estimate, compiled where SPLIT is defined; split.js says what it draws), the
+// live mode's first frame.
 
 export const COMMON = /* glsl */ `
 precision highp float;
@@ -263,8 +264,8 @@ uniform bool uPeaks;
 // render::diffuse_split (the manifest's diffuse): the BRDF's diffuse part f_d, which the
 // prefiltered estimator reads from the cosine layer (the first) at the normal.
 uniform vec3 uDiffuse;
-// The split estimator's inputs (split.js): per view row (1 - cos_o = (r + 1/2) / rows) the albedo
-// of f - f_d (RGB) and the exponent of its Phong lobe (A); the peaks as directional lights, their
+// The split estimator's inputs (split.js), read where SPLIT is defined: the two lobes per view
+// (lobeTable; lobe_at says what each texel holds); the peaks as directional lights, their
 // directions in the environment's frame and their irradiance at normal incidence.
 uniform sampler2D uLobes;
 // engine-layers.ktx2 again and, as one more layer, the smooth part's level 0 at the layers' size
@@ -801,8 +802,9 @@ vec3 layers_linear(float x, vec2 uv) {
 }
 
 // The split estimator (no twin; split.js says what it draws and where it is biased): the diffuse
-// part as estimate_sum reads it, the rest as the view's Phong lobe around the mirror direction
-// read from the layer of its exponent, each peak light through the lobe and the diffuse part.
+// part as estimate_sum reads it, the rest as the view's two Phong lobes around the mirror
+// direction, each read from the layer of its exponent, and each peak light through the diffuse
+// part and the widened lobes (the brightest through the table in place of the broader lobe).
 vec3 split_estimate(ShadingFrame frame) {
     vec4 sharp = lobe_at(frame.cos_o, 0);
     vec4 broad = lobe_at(frame.cos_o, 1);
