@@ -31,11 +31,17 @@ use crate::support::{NBRDF, nbrdf_table, root, run, shared, shared_or_skip, tool
 /// hundred pixels, above 60 dB (measured on the six cases: 62.1 to 73.8 dB).
 const MIN_EXACT_PSNR_DB: f64 = 60.0;
 
-/// Drawn forward, the pictures differ by the rim on top: pixels whose centre lies within 1/32
-/// pixel of a silhouette edge, which SwiftShader's 1/16-pixel vertex grid covers otherwise than
-/// brdf-preview's 1/256 (measured: 12 to 15 pixels per case, 37.6 to 45.9 dB over all pixels).
-/// So a forward drawing is held to this: every pixel beyond [`FAR_STEPS`] lies within
-/// [`RIM_PX`] of the sphere's silhouette circle, and the others reach this PSNR (measured 56.5 to
+/// Drawn forward, the pictures differ in two ways, both from where the mesh falls on the pixel
+/// grid. The rim: pixels whose centre lies within 1/32 pixel of a silhouette edge, which
+/// SwiftShader's 1/16-pixel vertex grid covers otherwise than brdf-preview's 1/256 (measured: 11
+/// to 15 pixels per case, 35.4 to 46.7 dB over all pixels). And a pixel just inside the rim,
+/// where the normal turns fastest across the image: the vertices' snapping moves the interpolated
+/// normal a fraction of a pixel's turn, and a metal's grazing reflection changes by tens of levels
+/// per pixel there (steel and chrome under studio_small_03: the pixel 1.17 pixels inside the rim
+/// at (16, 49), 8 and 10 levels off, between its neighbours' 111 and 235). So a forward drawing is
+/// held to this: every pixel beyond [`FAR_STEPS`] lies within [`RIM_PX`] of the sphere's
+/// silhouette circle or between the least and greatest of brdf-preview's 3 x 3 pixels around it
+/// (each channel, widened by [`FAR_STEPS`]), and the others reach this PSNR (measured 56.5 to
 /// 67.2 dB).
 const MIN_FORWARD_OFF_RIM_PSNR_DB: f64 = 50.0;
 
@@ -396,8 +402,9 @@ struct Case {
     psnr_db: f64,
     /// Pixels with a channel more than [`FAR_STEPS`] apart.
     far_pixels: usize,
-    /// Of those, the ones farther than [`RIM_PX`] from the silhouette circle.
-    off_rim: usize,
+    /// Of those, the ones farther than [`RIM_PX`] from the silhouette circle and outside the range
+    /// of brdf-preview's 3 x 3 pixels around them ([`MIN_FORWARD_OFF_RIM_PSNR_DB`]).
+    unexplained: usize,
     /// The PSNR over the other pixels.
     psnr_without_far_db: f64,
     three_ms: f64,
@@ -456,15 +463,16 @@ fn compare(
     let a = picture(&three_png, width, height);
     let b = picture(&preview_png, width, height);
     let psnr = psnr_db(&a, &b);
-    let (mut far_pixels, mut off_rim) = (0, 0);
+    let (mut far_pixels, mut unexplained) = (0, 0);
     let (mut near_a, mut near_b) = (Vec::new(), Vec::new());
     for (i, (p, q)) in a.chunks_exact(3).zip(b.chunks_exact(3)).enumerate() {
         if p.iter().zip(q).any(|(x, y)| x.abs_diff(*y) > FAR_STEPS) {
             far_pixels += 1;
-            let (x, y) = ((i % width) as f64 + 0.5, (i / width) as f64 + 0.5);
-            let r = (x - width as f64 / 2.0).hypot(y - height as f64 / 2.0);
-            if (r - silhouette_radius(height)).abs() > RIM_PX {
-                off_rim += 1;
+            let (x, y) = (i % width, i / width);
+            let r = (x as f64 + 0.5 - width as f64 / 2.0).hypot(y as f64 + 0.5 - height as f64 / 2.0);
+            let on_rim = (r - silhouette_radius(height)).abs() <= RIM_PX;
+            if !on_rim && !between_neighbours(&b, width, height, (x, y), p) {
+                unexplained += 1;
             }
         } else {
             near_a.extend_from_slice(p);
@@ -475,7 +483,7 @@ fn compare(
     let case = Case {
         psnr_db: psnr,
         far_pixels,
-        off_rim,
+        unexplained,
         psnr_without_far_db,
         three_ms: three["render_ms"].as_f64().unwrap(),
         preview,
@@ -490,6 +498,19 @@ fn compare(
     case
 }
 
+/// Whether each channel of `value` lies between the least and greatest of `expected`'s pixels in
+/// the 3 x 3 around `(x, y)` (clipped at the border), widened by [`FAR_STEPS`]: what a sub-pixel
+/// shift of the image there could give.
+fn between_neighbours(expected: &[u8], width: usize, height: usize, (x, y): (usize, usize), value: &[u8]) -> bool {
+    (0..3).all(|c| {
+        let around = (y.saturating_sub(1)..(y + 2).min(height))
+            .flat_map(|v| (x.saturating_sub(1)..(x + 2).min(width)).map(move |u| (u, v)))
+            .map(|(u, v)| expected[3 * (v * width + u) + c]);
+        let (lo, hi) = around.fold((u8::MAX, 0), |(lo, hi), e| (lo.min(e), hi.max(e)));
+        (lo.saturating_sub(FAR_STEPS)..=hi.saturating_add(FAR_STEPS)).contains(&value[c])
+    })
+}
+
 /// What is wrong with a comparison drawn `coverage`, if anything (see [`MIN_EXACT_PSNR_DB`] and
 /// [`MIN_FORWARD_OFF_RIM_PSNR_DB`]).
 fn problem(case: &Case, coverage: &str) -> Option<String> {
@@ -497,9 +518,9 @@ fn problem(case: &Case, coverage: &str) -> Option<String> {
         "exact" if case.psnr_db < MIN_EXACT_PSNR_DB => {
             Some(format!("{:.2} dB, below {MIN_EXACT_PSNR_DB} dB", case.psnr_db))
         }
-        "forward" if case.off_rim > 0 => Some(format!(
-            "{} of {} pixels beyond {FAR_STEPS} steps lie off the silhouette",
-            case.off_rim, case.far_pixels
+        "forward" if case.unexplained > 0 => Some(format!(
+            "{} of {} pixels beyond {FAR_STEPS} steps lie off the silhouette and outside their neighbours' range",
+            case.unexplained, case.far_pixels
         )),
         "forward" if case.psnr_without_far_db < MIN_FORWARD_OFF_RIM_PSNR_DB => {
             Some(format!("{:.2} dB off the rim, below {MIN_FORWARD_OFF_RIM_PSNR_DB} dB", case.psnr_without_far_db))
@@ -508,28 +529,34 @@ fn problem(case: &Case, coverage: &str) -> Option<String> {
     }
 }
 
-/// The CI case: gold-paint under quarry_01 (a sun: the peaks and their sampling tables in use) in
+/// The CI cases: gold-paint under quarry_01 (a sun: the peaks and their sampling tables in use) in
 /// both modes drawn exactly, the prefiltered mode at brdf-preview's defaults (8 frames of 16
 /// samples), the reference mode at 4 of its 32 frames of 64 samples (the same samples as
-/// brdf-preview's first 4 frames, to keep make test short); and the prefiltered mode
-/// drawn forward, as a scene draws the material.
+/// brdf-preview's first 4 frames, to keep make test short); and the prefiltered mode drawn
+/// forward, as a scene draws the material, there and on steel under studio_small_03, a metal's
+/// grazing reflection of an indoor map's lamps, where the image changes fastest inside the rim.
 #[test]
 fn three_js_renders_a_bake_as_brdf_preview_does() {
     let Some(_) = shared_or_skip(&["data/env", NBRDF]) else { return };
-    let dir = bake("gold-paint", "quarry_01_1k");
     let out = root().join("target/test-tmp/three");
-    for (mode, coverage, frames) in
-        [("prefiltered", "exact", None), ("reference", "exact", Some(4)), ("prefiltered", "forward", None)]
-    {
-        let name = format!("gold-paint-quarry-{mode}-{coverage}");
-        let case = compare(&dir, &out, &name, (mode, coverage), frames, &[]);
+    let cases = [
+        ("gold-paint", "quarry_01_1k", "prefiltered", "exact", None),
+        ("gold-paint", "quarry_01_1k", "reference", "exact", Some(4)),
+        ("gold-paint", "quarry_01_1k", "prefiltered", "forward", None),
+        ("steel", "studio_small_03_1k", "prefiltered", "forward", None),
+    ];
+    let mut bakes = std::collections::HashMap::new();
+    for (material, environment, mode, coverage, frames) in cases {
+        let dir = bakes.entry((material, environment)).or_insert_with(|| bake(material, environment));
+        let name = format!("{material}-{}-{mode}-{coverage}", environment.trim_end_matches("_1k"));
+        let case = compare(dir, &out, &name, (mode, coverage), frames, &[]);
         println!(
-            "gold-paint under quarry_01, {mode} drawn {coverage}: {:.2} dB, {} pixels beyond {FAR_STEPS} steps ({} \
-             off the rim), {:.2} dB without them",
-            case.psnr_db, case.far_pixels, case.off_rim, case.psnr_without_far_db
+            "{material} under {environment}, {mode} drawn {coverage}: {:.2} dB, {} pixels beyond {FAR_STEPS} steps \
+             ({} unexplained), {:.2} dB without them",
+            case.psnr_db, case.far_pixels, case.unexplained, case.psnr_without_far_db
         );
         if let Some(problem) = problem(&case, coverage) {
-            panic!("{mode} drawn {coverage}: three.js against brdf-preview: {problem}; pictures in {}", out.display());
+            panic!("{name}: three.js against brdf-preview: {problem}; pictures in {}", out.display());
         }
     }
 }
@@ -566,7 +593,7 @@ fn three_js_equals_brdf_preview_on_the_six_cases() {
             let three_converged = psnr_db(&three, &converged);
             let preview_converged = prefiltered.preview["converged"]["psnr_db"].as_f64().unwrap();
             rows.push(format!(
-                "| {material} | {} | {:.2} | {:.2} | {:.2} ({} rim px; {:.2} without) | {:.2} | {:.2} | {:+.2} | {:.0} \
+                "| {material} | {} | {:.2} | {:.2} | {:.2} ({} px beyond 8 steps; {:.2} without) | {:.2} | {:.2} | {:+.2} | {:.0} \
                  | {:.0} |",
                 environment.trim_end_matches("_1k"),
                 reference.psnr_db,
