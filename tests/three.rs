@@ -76,13 +76,14 @@ fn figures(dir: &Path) -> serde_json::Value {
     stage.expect("an engine-textures stage").clone()
 }
 
-const ENGINE_TEXTURES: [&str; 6] = [
+const ENGINE_TEXTURES: [&str; 7] = [
     "engine-merl.ktx2",
     "engine-brdf-tables.ktx2",
     "engine-view-layers.ktx2",
     "engine-environment.ktx2",
     "engine-light-tables.ktx2",
     "engine-layers.ktx2",
+    "engine-full-layers.ktx2",
 ];
 
 fn read_data(path: &Path) -> prefilter::ktx::Ktx2Data {
@@ -93,7 +94,8 @@ fn read_data(path: &Path) -> prefilter::ktx::Ktx2Data {
 /// --warn-as-error` and `ktx-parse`, has the shape `data-schema/engine-textures.md` gives it, and
 /// holds the bake's numbers: the MERL table's values exactly, level 0 as the bake's `mips.ktx2`
 /// holds it, peaks that are a share of level 0, CDF rows that rise from 0 to 1, layer coordinates
-/// among the layers.
+/// among the layers, the whole environment's layers as the bake's `layers.ktx2` holds them and
+/// the smooth part's below them.
 #[test]
 fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
     let Some(shared) = shared_or_skip(&["data/env", NBRDF]) else { return };
@@ -161,6 +163,7 @@ fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
         (100, n(&f["view_rows"]), 1, 0, 0),
         (109, w, h, 0, 2),
         (100, w.max(h) + 1, h + 1, 0, 2),
+        (109, n(&f["layers_size"][0]), n(&f["layers_size"][1]), 0, layers),
         (109, n(&f["layers_size"][0]), n(&f["layers_size"][1]), 0, layers),
     ];
     for ((json, path), shape) in parsed.iter().zip(&paths).zip(shapes) {
@@ -230,6 +233,20 @@ fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
             let cdf = &layer[row * light_width..row * light_width + len];
             rising(cdf, &format!("distribution {d}, row {row}"));
             assert!((cdf[len - 1] - 1.0).abs() < 1e-6, "distribution {d}, row {row} ends at {}", cdf[len - 1]);
+        }
+    }
+
+    // The whole environment's layers are the bake's layers.ktx2, texel for texel; the smooth
+    // part's lie at or below them (they are the bake's less the peaks' own, clamped at 0).
+    let baked = prefilter::ktx::decode(&std::fs::read(dir.join("layers.ktx2")).unwrap()).unwrap();
+    let full = read_data(&paths[6]).values;
+    let smooth = read_data(&paths[5]).values;
+    let texels = full.len() / 4 / layers;
+    for (k, image) in baked.levels[0].iter().enumerate() {
+        for (i, rgb) in image.chunks_exact(3).enumerate() {
+            let at = 4 * (k * texels + i);
+            assert_eq!(rgb, &full[at..at + 3], "layer {k}, texel {i}");
+            assert!((0..3).all(|c| smooth[at + c] <= full[at + c]), "layer {k}, texel {i}: smooth above the whole");
         }
     }
 }
@@ -351,9 +368,11 @@ fn the_loader_refuses_what_a_hostile_bake_gives() {
 
 /// What the split estimator derives at load time (`node --test` on
 /// `engines/three/test/split.test.mjs`) against analytic answers: a Lambertian table's albedo
-/// (within 1%, 2% at the two most grazing views), a Phong lobe's albedo (3%) and exponent (15%),
-/// peak lights' powers (radiance times solid angle) and directions, no power lost when groups
-/// merge, and the smooth part's level 0 averaged down.
+/// (within 1%, 2% at the two most grazing views), a Phong lobe's albedo (3%) and its weight on
+/// its own layer (above 0.85), the mixture's kernels, the peak lights' corrections (none where
+/// the mixture is the table, within 5% of the lobe's peak; the layers' share below the horizon),
+/// peak lights' powers (radiance times solid angle) and directions, a sun kept apart from a lamp,
+/// no power lost when sources merge, and level 0 averaged down.
 #[test]
 fn the_split_estimator_derives_its_inputs_as_analytic_answers_say() {
     node_test("split.test.mjs");

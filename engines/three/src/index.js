@@ -14,7 +14,7 @@ import * as THREE from 'three';
 
 import { floatTarget } from './live.js';
 import { BakeError, readBake } from './loader.js';
-import { MAX_PEAK_LIGHTS, lobeTable, peakLights, splitLayers } from './split.js';
+import { AZIMUTH_STEPS, KERNEL_STEPS, MAX_PEAK_LIGHTS, effectiveExponents, lightCorrections, lobeMixture, mixtureKernels, mixtureRows, peakLights, splitLayers, texelSpread } from './split.js';
 
 import {
     BACKGROUND_FRAGMENT,
@@ -96,7 +96,7 @@ export class Bake {
     createMaterial(options = {}) {
         const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'}`,
-            defines: options.mode === 'split' ? { SPLIT: 1 } : {},
+            defines: this.defines(options.mode),
             vertexShader: SURFACE_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             // render::raster culls no back face: at a silhouette a pixel may see one.
@@ -123,7 +123,7 @@ export class Bake {
     createDeferred(gbuffer, options = {}) {
         const material = this.shaderMaterial(options, {
             name: `brdf-bake ${options.mode ?? 'reference'} (deferred)`,
-            defines: { DEFERRED: 1, ...(options.mode === 'split' && { SPLIT: 1 }) },
+            defines: { DEFERRED: 1, ...this.defines(options.mode) },
             vertexShader: QUAD_VERTEX,
             fragmentShader: SURFACE_FRAGMENT,
             depthTest: false,
@@ -173,12 +173,22 @@ export class Bake {
             // The split estimator's, set by bindSplit where SPLIT is drawn.
             uLobes: { value: null },
             uLayersLinear: { value: null },
+            uCorrections: { value: null },
             uPeakCount: { value: 0 },
             uPeakDirections: { value: new Float32Array(3 * MAX_PEAK_LIGHTS) },
             uPeakPowers: { value: new Float32Array(3 * MAX_PEAK_LIGHTS) },
-            uPeakSpreads: { value: new Float32Array(MAX_PEAK_LIGHTS) },
+            uPeakNear: { value: new Float32Array(2 * MAX_PEAK_LIGHTS) },
             ...rayUniforms(),
         };
+    }
+
+    /**
+     * A material's defines for `mode`: SPLIT for the split estimator, and in every material
+     * MIX_LAYERS, the split estimator's layers and level 0 (the live mode defines SPLIT on a
+     * sampled material for its first frame).
+     */
+    defines(mode) {
+        return { MIX_LAYERS: this.figures.exponents.length + 1, ...(mode === 'split' && { SPLIT: 1 }) };
     }
 
     /**
@@ -192,34 +202,46 @@ export class Bake {
         const split = this.splitInputs();
         u.uLobes.value = split.lobes;
         u.uLayersLinear.value = split.layers;
+        u.uCorrections.value = split.corrections;
         u.uPeakCount.value = split.count;
         u.uPeakDirections.value = split.directions;
         u.uPeakPowers.value = split.powers;
-        u.uPeakSpreads.value = split.spreads;
+        u.uPeakNear.value = split.near;
     }
 
     /**
-     * The split estimator's inputs (split.js), derived once: the lobe table (`lobes`), the layers
-     * with the smooth level 0 (`layers`), both textures disposed with the bake, and the peak
-     * lights (`count`, `directions`, `powers`, `spreads`).
+     * The split estimator's inputs (split.js), derived once: the lobe mixture (`lobes`) and the
+     * peak lights' corrections (`corrections`), the whole environment's layers with level 0 (`layers`), the three
+     * textures disposed with the bake, and the peak lights (`count`, `directions`, `powers`,
+     * `near`).
      */
     splitInputs() {
         if (!this.split) {
             const f = this.figures;
-            const exponents = layerExponents(f.exponents).slice(0, f.exponents.length + 1);
-            const table = lobeTable(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
-            const lobes = new THREE.DataTexture(table, f.view_rows, 2, THREE.RGBAFormat, THREE.FloatType);
+            const layers = this.textures.uFullLayers.image;
+            const exponents = effectiveExponents(layerExponents(f.exponents).slice(0, f.exponents.length + 1), texelSpread(layers.height));
+            const table = lobeMixture(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
+            const lobes = new THREE.DataTexture(table, f.view_rows, mixtureRows(exponents.length), THREE.RGBAFormat, THREE.FloatType);
             // Linear along the views (u = 1 - cos_o: the rows' centres at (r + 1/2) / rows), each
             // row of the texture read at its centre.
             lobes.minFilter = THREE.LinearFilter;
             lobes.magFilter = THREE.LinearFilter;
             lobes.needsUpdate = true;
-            // The layers again with the smooth part's level 0 as one more layer (splitLayers),
-            // filtered by the GPU (texelFetch, which the sampled estimators read uLayers with,
-            // ignores filtering): one bilinear read where env_bilinear makes four fetches, and no
+            // The peak lights' corrections per angle, azimuth and view, linear in all three.
+            const merl = this.textures.uMerl.image.data;
+            const kernels = mixtureKernels(table, f.view_rows, exponents);
+            const values = lightCorrections(merl, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, table, kernels);
+            const corrections = new THREE.Data3DTexture(values, KERNEL_STEPS, AZIMUTH_STEPS, f.view_rows);
+            corrections.format = THREE.RGBAFormat;
+            corrections.type = THREE.FloatType;
+            corrections.minFilter = THREE.LinearFilter;
+            corrections.magFilter = THREE.LinearFilter;
+            corrections.unpackAlignment = 4;
+            corrections.needsUpdate = true;
+            // The whole environment's layers with its level 0 as one more layer (splitLayers),
+            // filtered by the GPU: one bilinear read where env_bilinear makes four fetches, and no
             // branch between the layers and level 0. Float32 filtering is WebGL 2's
             // OES_texture_float_linear.
-            const layers = this.textures.uLayers.image;
             const environment = this.textures.uEnvironment.image;
             const [width, height] = [environment.width, environment.height];
             const extended = splitLayers(layers.data, layers.width, layers.height, layers.depth, environment.data, width, height);
@@ -237,10 +259,10 @@ export class Bake {
                 count: 0,
                 directions: new Float32Array(3 * MAX_PEAK_LIGHTS),
                 powers: new Float32Array(3 * MAX_PEAK_LIGHTS),
-                spreads: new Float32Array(MAX_PEAK_LIGHTS),
+                near: new Float32Array(2 * MAX_PEAK_LIGHTS),
             };
             const peaks = environment.data.subarray(4 * width * height, 8 * width * height);
-            this.split = { lobes, layers: linear, ...(f.peaks ? peakLights(peaks, width, height) : none) };
+            this.split = { lobes, corrections, layers: linear, ...(f.peaks ? peakLights(peaks, width, height) : none) };
         }
         return this.split;
     }
@@ -321,6 +343,7 @@ export class Bake {
     dispose() {
         Object.values(this.textures).forEach((t) => t.dispose());
         this.split?.lobes.dispose();
+        this.split?.corrections.dispose();
         this.split?.layers.dispose();
     }
 }

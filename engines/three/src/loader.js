@@ -185,7 +185,7 @@ export function checkFigures(f) {
  *   bounds nothing towards grazing angles or below the horizon, where a cell has no share
  *   (`merl::summary::cell_share`); the writer casts to f32 (`bake::stage::engine::run`) and
  *   refuses only what is then not finite (`prefilter::ktx::encode_data`). So up to FLT_MAX.
- * - `engine-environment`, `engine-layers`: radiance. The map's reader takes any finite
+ * - `engine-environment`, `engine-layers`, `engine-full-layers`: radiance. The map's reader takes any finite
  *   non-negative f32 (`envmap`'s `check_radiance`), the bake keeps texels above 65504 as single
  *   floats (`prefilter::ktx::Storage::Auto`) and the writer refuses only what is not finite. So
  *   up to FLT_MAX.
@@ -205,6 +205,7 @@ function roles(f) {
         'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [W, H, 2], range: [0, FLOAT32_MAX] },
         'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [Math.max(W, H) + 1, H + 1, 2], range: [0, 1] },
         'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, FLOAT32_MAX] },
+        'engine-full-layers': { uniform: 'uFullLayers', channels: 4, kind: 'array', shape: [Wl, Hl, f.exponents.length], range: [0, FLOAT32_MAX] },
     };
 }
 

@@ -229,7 +229,7 @@ ${COMMON}
 const uint MODE_REFERENCE = 0u;
 const uint MODE_PREFILTERED = 2u;
 // split.js's MAX_PEAK_LIGHTS.
-#define MAX_PEAK_LIGHTS 4
+#define MAX_PEAK_LIGHTS 2
 
 // engine-merl.ktx2: texel (phi_d, theta_d, theta_h) of the MERL grid, RGB in 1/sr, 0 without data.
 uniform sampler3D uMerl;
@@ -264,19 +264,23 @@ uniform bool uPeaks;
 // render::diffuse_split (the manifest's diffuse): the BRDF's diffuse part f_d, which the
 // prefiltered estimator reads from the cosine layer (the first) at the normal.
 uniform vec3 uDiffuse;
-// The split estimator's inputs (split.js), read where SPLIT is defined: the two lobes per view
-// (lobeTable; lobe_at says what each texel holds); the peaks as directional lights, their
-// directions in the environment's frame and their irradiance at normal incidence.
+#ifdef SPLIT
+// The split estimator's inputs (split.js). uLobes: lobeMixture's rows of texels per view (the
+// albedo and the layers' weights); uCorrections: what a peak light adds past the layers' share
+// of it, per view, angle from the mirror direction and azimuth about it (lightCorrections); uLayersLinear: engine-full-layers and, as
+// one more layer, level 0 at the layers' size (splitLayers), filtered linearly (u repeating, v
+// clamped): what env_bilinear computes, in one read. MIX_LAYERS, defined with SPLIT, is the
+// number of exponents (the layers and level 0). The peaks as directional lights: their
+// directions in the environment's frame, their irradiance at normal incidence, and the cosines
+// of their near cones (peakLights' near).
 uniform sampler2D uLobes;
-// engine-layers.ktx2 again and, as one more layer, the smooth part's level 0 at the layers' size
-// (split.js's splitLayers), filtered linearly (u repeating, v clamped): what env_bilinear
-// computes, in one read.
 uniform sampler2DArray uLayersLinear;
+uniform sampler3D uCorrections;
 uniform int uPeakCount;
 uniform vec3 uPeakDirections[MAX_PEAK_LIGHTS];
 uniform vec3 uPeakPowers[MAX_PEAK_LIGHTS];
-// Each peak light's spread: the mean 1 - cos between its directions and its own.
-uniform float uPeakSpreads[MAX_PEAK_LIGHTS];
+uniform vec2 uPeakNear[MAX_PEAK_LIGHTS];
+#endif
 // The frames this draw sums (first, count), and what the sum is divided by.
 uniform uint uFirstFrame;
 uniform uint uFrameCount;
@@ -758,14 +762,7 @@ vec3 estimate_sum(ShadingFrame frame, uint pixel, uint f, uint spp) {
     return sum;
 }
 
-// The lobes at the view (split.js's lobeTable), interpolated between the views' centres at
-// 1 - cos_o by the GPU, as view_layer_coordinate reads the view layers: row 0 the sharper lobe's
-// albedo (RGB) and exponent, row 1 the broader lobe's albedo over the sharper's (the two share
-// their colour), its exponent and the two lobes' layer coordinates.
-vec4 lobe_at(float cos_o, int row) {
-    return texture(uLobes, vec2(1.0 - cos_o, (float(row) + 0.5) / 2.0));
-}
-
+#ifdef SPLIT
 // env_uv with one inverse cosine for theta (the split estimator's: no twin to match to the bit).
 vec2 split_uv(vec3 w) {
     float u = merl_atan2(w.y, w.x) / (2.0 * PI);
@@ -791,55 +788,50 @@ vec3 split_brdf(vec3 wi, vec3 wo) {
     return texelFetch(uMerl, cell, 0).rgb;
 }
 
-// The layers at coordinate x (layers_bilinear's blend of layer k and k + 1, past the sharpest the
-// smooth part's level 0) read through uLayersLinear, without a branch.
-vec3 layers_linear(float x, vec2 uv) {
-    float last = float(textureSize(uLayersLinear, 0).z - 1);
-    float k = min(floor(x), last);
-    vec3 a = texture(uLayersLinear, vec3(uv, k)).rgb;
-    vec3 b = texture(uLayersLinear, vec3(uv, min(k + 1.0, last))).rgb;
-    return mix(a, b, x - k);
-}
+// The rows of uLobes (split.js's mixtureRows).
+#define MIX_ROWS (1 + (MIX_LAYERS + 2) / 4)
 
 // The split estimator (no twin; split.js says what it draws and where it is biased): the diffuse
-// part as estimate_sum reads it, the rest as the view's two Phong lobes around the mirror
-// direction, each read from the layer of its exponent, and each peak light through the diffuse
-// part and the widened lobes (the brightest through the table in place of the broader lobe).
+// part as estimate_sum reads it, the rest as the view's mixture of the layers in the mirror
+// direction, and each peak light away from its reflection through the table, in place of the
+// mixture's share of it.
 vec3 split_estimate(ShadingFrame frame) {
-    vec4 sharp = lobe_at(frame.cos_o, 0);
-    vec4 broad = lobe_at(frame.cos_o, 1);
+    // The view's albedo and weights, linear between the views' rows; past the last layer the
+    // texture array's layer clamps, and its weights are 0.
+    float u = 1.0 - frame.cos_o;
+    vec4 head = texture(uLobes, vec2(u, 0.5 / float(MIX_ROWS)));
     vec3 mirror = to_world(frame, vec3(-frame.wo_local.x, 0.0, frame.wo_local.z));
     vec2 uv = split_uv(mirror);
-    vec3 broad_albedo = sharp.rgb * broad.x;
-    vec3 sum = PI * uDiffuse * texture(uLayersLinear, vec3(split_uv(frame.n), 0.0)).rgb + sharp.rgb * layers_linear(broad.z, uv)
-        + broad_albedo * layers_linear(broad.w, uv);
-    // The brightest light through the table itself: the lobes fitted at each view place the
-    // BRDF's broader part around the mirror direction, where a measured table's need not lie (a
-    // metal's haze seen at grazing angles); its sharper lobe stays the fitted one, widened.
-    vec3 wl = to_local(frame, uPeakDirections[0]);
-    vec3 table = uPeakCount > 0 && wl.z > 0.0 ? split_brdf(wl, frame.wo_local) - uDiffuse : vec3(0.0);
-    // A light's spread widens the lobes that reflect it: small-angle spreads (the mean 1 - cos,
-    // 1 / (n + 2) for a Phong lobe of exponent n) add.
-    vec2 spread = 1.0 / (vec2(sharp.a, broad.y) + 2.0);
-    for (int i = 0; i < uPeakCount; i++) {
+    vec3 lobe = head.a * texture(uLayersLinear, vec3(uv, 0.0)).rgb;
+    for (int r = 1; r < MIX_ROWS; r++) {
+        vec4 t = texture(uLobes, vec2(u, (float(r) + 0.5) / float(MIX_ROWS)));
+        float k = float(4 * r - 3);
+        lobe += t.x * texture(uLayersLinear, vec3(uv, k)).rgb + t.y * texture(uLayersLinear, vec3(uv, k + 1.0)).rgb
+            + t.z * texture(uLayersLinear, vec3(uv, k + 2.0)).rgb + t.w * texture(uLayersLinear, vec3(uv, k + 3.0)).rgb;
+    }
+    vec3 sum = PI * uDiffuse * texture(uLayersLinear, vec3(split_uv(frame.n), 0.0)).rgb + head.rgb * lobe;
+    for (int i = 0; i < MAX_PEAK_LIGHTS; i++) {
+        if (i >= uPeakCount) {
+            break;
+        }
         vec3 d = uPeakDirections[i];
-        float cos_i = dot(frame.n, d);
-        // The part of the light above the horizon, its angular radius sqrt(2 spread).
-        float radius = sqrt(2.0 * uPeakSpreads[i]);
-        float above = clamp((cos_i + radius) / (2.0 * radius + 1e-6), 0.0, 1.0);
-        if (above > 0.0) {
-            float c = max(dot(mirror, d), 0.0);
-            vec2 n = max(1.0 / (spread + uPeakSpreads[i]) - 2.0, 0.0);
-            vec2 norm = (n + 1.0) / (2.0 * PI);
-            vec3 sharper = sharp.rgb * (norm.x * pow(c, n.x));
-            // The table less the sharper lobe unwidened, for the brightest; the broader lobe else.
-            vec3 rest = i == 0 ? max(table * max(cos_i, 0.0) - sharp.rgb * ((sharp.a + 1.0) / (2.0 * PI) * pow(c, sharp.a)), vec3(0.0))
-                               : broad_albedo * (norm.y * pow(c, n.y));
-            sum += uPeakPowers[i] * (uDiffuse * max(cos_i, 0.0) + (sharper + rest) * above);
+        float c = clamp(dot(mirror, d), -1.0, 1.0);
+        // 0 within the near cone, where the layers draw the light with its shape; 1 past twice it.
+        float away = 1.0 - smoothstep(uPeakNear[i].y, uPeakNear[i].x, c);
+        if (away > 0.0) {
+            // The light's angle from the mirror direction and azimuth about it (lightCorrections).
+            vec3 wl = to_local(frame, d);
+            float sin_a = sqrt(max(1.0 - c * c, 0.0));
+            vec3 e1 = vec3(frame.wo_local.z, 0.0, frame.wo_local.x);
+            float cos_b = sin_a > 1e-6 ? clamp(dot(wl, e1) / sin_a, -1.0, 1.0) : 1.0;
+            vec3 correction = texture(uCorrections, vec3(sqrt(acos(c) / PI), 0.5 + 0.5 * cos_b, u)).rgb;
+            sum += away * uPeakPowers[i] * correction;
         }
     }
-    return sum;
+    // The table's value less the mixture's may take more than the layers gave.
+    return max(sum, vec3(0.0));
 }
+#endif
 
 // shade_frame at pixel p (render::shade::shade_rows): the radiance (rows from the bottom), or
 // where the G-buffer has no triangle the environment behind.

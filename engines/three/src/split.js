@@ -1,30 +1,39 @@
-// The split estimator's inputs, derived at load time from the engine textures (as the peaks and
-// the smooth part are: data-schema/engine-textures.md): the BRDF's lobes per view from
-// engine-merl, the environment's peaks as a few directional lights from engine-environment, and
-// the layers with the smooth part's level 0 as one more, for the GPU's filtering.
+// The split estimator's inputs, derived at load time from the engine textures
+// (data-schema/engine-textures.md): the BRDF's lobe per view from engine-merl, as weights of the
+// Phong layers; the environment's peaks as a few directional lights from engine-environment; and
+// the whole environment's layers (engine-full-layers) with its level 0 as one more layer, for the
+// GPU's filtering.
 //
 // The split estimator (mode 'split', the live mode's first frame) draws a pixel without samples,
-// as three's own materials draw theirs: the diffuse part as the prefiltered estimator reads it
-// (pi f_d times the cosine layer at the normal); the rest of the BRDF at the view, `f - f_d`, as
-// two normalized Phong lobes around the mirror direction with the table's albedo and widths at
-// that view, each read from the Phong layer of its width in the mirror direction (the split of a
-// lobe into its albedo and a prefiltered lookup, with the table's own albedo where a split sum
-// has a fitted BRDF's); each peak light through the diffuse part and the lobes widened by the
-// light's spread, the brightest through the table itself in place of the broader lobe. It is
-// biased where the lobes are not Phong lobes around the mirror direction (off-specular peaks
-// towards grazing angles, Fresnel colour changing across a lobe) and where a peak is large or
-// not round; the live mode averages unbiased frames in after it.
+// as three's own materials draw theirs, from three parts:
+// - the diffuse part `f_d` as the prefiltered estimator reads it: pi f_d times the cosine layer at
+//   the normal, of the whole environment;
+// - the rest of the BRDF at the view, `f - f_d`, as a weighted sum of the Phong layers (and level
+//   0) read in the mirror direction: a lobe symmetric about the mirror direction, the table's own
+//   albedo at that view times a mixture of the layers' kernels whose encircled energy (the share
+//   of the lobe within each angle of the mirror direction) is the table's (lobeMixture). The layers
+//   hold the whole environment, so a lamp or the sun reflects with its own shape;
+// - each peak light (at most MAX_PEAK_LIGHTS, peakLights) through the table itself, away from its
+//   mirror reflection: the table's value at the light's centre less the mixture's, times its
+//   power. The mixture places the lobe's broad part around the mirror direction, where a measured
+//   table's need not lie (a metal's haze at grazing views, a felt's sheen); near the reflection
+//   (within NEAR_RADII of the light's radius, at least NEAR_MIN_DEGREES) the layers alone draw the
+//   light, with its shape, and the correction fades in over the next as far again.
+// It is biased where the table's lobe is not symmetric about the mirror direction and no peak
+// light corrects it (the smooth part of the map), where a light's centre does not stand for it
+// (a large lamp seen through a narrow lobe just past the near cone), and in colour across a lobe
+// (the mixture's weights are the luminance's); the live mode averages unbiased frames in after it.
 
 import { BakeError } from './loader.js';
 
-/** The most peak lights the split estimator reads (the shader's array size). */
-export const MAX_PEAK_LIGHTS = 4;
+/** The most peak lights the split estimator reads through the table (the shader's array size). */
+export const MAX_PEAK_LIGHTS = 2;
 
-/**
- * The grid over the map (columns, rows) whose cells a peak light stays within: a lamp larger than
- * a cell becomes a light per cell it covers, a few Gaussians closer to its shape than one.
- */
-export const PEAK_CELLS = [16, 8];
+/** The near cone of a peak light: this many times its radius... */
+export const NEAR_RADII = 2;
+
+/** ...and at least this wide, in degrees: the sharp lobes' and the layers' texels' extent. */
+export const NEAR_MIN_DEGREES = 2;
 
 // merl::half_diff (the shader's merl_half_diff): (theta_h, theta_d, phi_d) of a direction pair.
 function halfDiff(wi, wo) {
@@ -58,18 +67,44 @@ export function merlBrdf(data, size, phiDRange, wi, wo) {
 }
 
 /**
- * Per view `r` of `rows` (`1 - cos theta_o = (r + 1/2) / rows`, the view layers' rows): the BRDF
- * less its diffuse part `diffuse` as two normalized Phong lobes around the mirror direction
- * (twoLobes, on the directions weighted by that part's luminance times cos theta_i), its albedo
- * (RGB, `integral of (f - f_d) cos theta_i`) shared between them. Two rows of RGBA texels: row 0
- * texel `r` the sharper lobe's albedo (RGB) and exponent (from 0 to 1e6); row 1 texel `r` the
- * broader lobe's albedo over the sharper's (the two have the same colour), its exponent, and the
- * two exponents' layer coordinates among `exponents` (layerCoordinate). The integral runs over
- * half vectors: theta_h on MERL's square-root spacing (dense at the peak), `phiSteps` azimuths
- * over the half plane the view's symmetry leaves, `dw_i = 4 (wo . h) dw_h`.
+ * The spread (mean `1 - cos`) a bilinear read of a lat-long layer `height` texels high adds to
+ * its kernel: a tent one texel wide along each axis, `E[alpha^2] / 2 = 2 (pi / height)^2 / 6 / 2`.
  */
-export function lobeTable(merl, size, phiDRange, diffuse, rows, exponents, phiSteps = 64) {
-    const out = new Float32Array(8 * rows);
+export function texelSpread(height) {
+    return (Math.PI / height) ** 2 / 6;
+}
+
+/**
+ * The Phong exponents of the layers as read through the GPU's bilinear filtering: spreads add
+ * (`1 / (n + 2)`, a Phong lobe's mean `1 - cos`), so `1 / (n' + 2) = 1 / (n + 2) + spread`.
+ */
+export function effectiveExponents(exponents, spread) {
+    return Float32Array.from(exponents, (n) => 1 / (1 / (n + 2) + spread) - 2);
+}
+
+/** The angles (radians) at which lobeMixture matches encircled energy: 0.05 to 180 degrees, evenly in log. */
+const RADII = Array.from({ length: 48 }, (_, j) => ((0.05 * Math.PI) / 180) * 3600 ** (j / 47));
+
+/**
+ * Per view `r` of `rows` (`1 - cos theta_o = (r + 1/2) / rows`, the view layers' rows): the BRDF
+ * less its diffuse part `diffuse`, `f - f_d` (at least 0), as its albedo (RGB, the integral of
+ * `(f - f_d) cos theta_i`) times a mixture of normalized Phong kernels about the mirror direction
+ * of the `exponents` (the layers' and level 0's, as read: effectiveExponents), with weights at
+ * least 0 summing to 1, fitted to the lobe's encircled energy: for each angle of RADII, the
+ * share of the lobe's luminance within it of the mirror direction against the mixture's (for a
+ * Phong kernel `1 - cos^(n + 1)`), in least squares. The integral runs over half vectors:
+ * theta_h on MERL's square-root spacing (dense at the peak), `phiSteps` azimuths over the half
+ * plane the view's symmetry leaves, `dw_i = 4 (wo . h) dw_h`.
+ *
+ * Returns `1 + ceil((K - 1) / 4)` rows of `rows` RGBA texels for K exponents: row 0 texel `r`
+ * the albedo (RGB) and the first kernel's weight, row `1 + j` the weights of kernels `1 + 4 j`
+ * to `4 + 4 j` (0 past the last).
+ */
+export function lobeMixture(merl, size, phiDRange, diffuse, rows, exponents, phiSteps = 64) {
+    const k = exponents.length;
+    const textureRows = mixtureRows(k);
+    const out = new Float32Array(4 * rows * textureRows);
+    const kernels = Array.from(exponents, (n) => RADII.map((a) => (a >= Math.PI / 2 ? 1 : 1 - Math.cos(a) ** (n + 1))));
     const thetaSteps = size[2];
     for (let r = 0; r < rows; r++) {
         const cosO = 1 - (r + 0.5) / rows;
@@ -77,7 +112,8 @@ export function lobeTable(merl, size, phiDRange, diffuse, rows, exponents, phiSt
         const wo = [sinO, 0, cosO];
         const mirror = [-sinO, 0, cosO];
         const albedo = [0, 0, 0];
-        const spread = [];
+        // The lobe's luminance between consecutive radii (the last bin: past the widest).
+        const within = new Float64Array(RADII.length + 1);
         for (let i = 0; i < thetaSteps; i++) {
             // theta_h = (x / N)^2 pi / 2 at the cell's centre x = i + 1/2; d theta_h = pi x / N^2.
             const x = (i + 0.5) / thetaSteps;
@@ -97,155 +133,204 @@ export function lobeTable(merl, size, phiDRange, diffuse, rows, exponents, phiSt
                 const rest = f.map((v, c) => Math.max(v - diffuse[c], 0) * wi[2] * dw);
                 for (let c = 0; c < 3; c++) albedo[c] += rest[c];
                 const y = 0.2126 * rest[0] + 0.7152 * rest[1] + 0.0722 * rest[2];
-                if (y > 0) spread.push([wi[0] * mirror[0] + wi[2] * mirror[2], y]);
+                if (!(y > 0)) continue;
+                const alpha = Math.acos(Math.min(Math.max(wi[0] * mirror[0] + wi[2] * mirror[2], -1), 1));
+                let bin = 0;
+                while (bin < RADII.length && RADII[bin] < alpha) bin++;
+                within[bin] += y;
             }
         }
-        const [w, n1, n2] = twoLobes(spread);
-        // The sharper lobe's share at least 1e-6, so that the broader's over it stays finite.
-        const share = Math.max(w, 1e-6);
-        out.set([...albedo.map((v) => share * v), n1], 4 * r);
-        out.set([(1 - share) / share, n2, layerCoordinate(n1, exponents), layerCoordinate(n2, exponents)], 4 * (rows + r));
+        const total = within.reduce((a, b) => a + b, 0);
+        let sum = 0;
+        const encircled = RADII.map((_, j) => {
+            sum += within[j];
+            return total > 0 ? sum / total : 1;
+        });
+        const w = simplexLeastSquares(kernels, encircled);
+        out.set([...albedo, w[0]], 4 * r);
+        for (let q = 1; q < k; q++) out[4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4)] = w[q];
     }
     return out;
 }
 
+/** The angles from the mirror direction at which mixtureKernels tabulates the kernel. */
+export const KERNEL_STEPS = 64;
+
 /**
- * render::exponent_layer: the layer coordinate `k + t` of Phong exponent `n` among the layers'
- * `exponents` followed by the exponent past the sharpest (uLayerExponents), from 0 to the
- * number of layers.
+ * The mixture's kernel per view `r` of `rows` (lobeMixture's `table`, for the same
+ * `exponents`): `sum over k of w_k (n_k + 1) / (2 pi) cos^n_k alpha` (0 past 90 degrees) at
+ * `alpha = pi x^2`, `x = (j + 1/2) / KERNEL_STEPS` the centre of texel `j` (dense near the
+ * mirror direction): one row of KERNEL_STEPS values per view, what the shader reads for a peak
+ * light at angle alpha from the mirror direction in place of evaluating every kernel.
  */
-export function layerCoordinate(n, exponents) {
-    const layers = exponents.length - 1;
-    if (!(n > exponents[0])) return 0;
-    if (n >= exponents[layers]) return layers;
-    let k = 0;
-    while (k + 1 < layers && exponents[k + 1] <= n) k++;
-    const a = Math.log(exponents[k]);
-    return k + (Math.log(n) - a) / (Math.log(exponents[k + 1]) - a);
+export function mixtureKernels(table, rows, exponents) {
+    const out = new Float32Array(rows * KERNEL_STEPS);
+    for (let r = 0; r < rows; r++) {
+        const w = Array.from(exponents, (_, q) => (q === 0 ? table[4 * r + 3] : table[4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4)]));
+        for (let j = 0; j < KERNEL_STEPS; j++) {
+            const c = Math.cos(Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2);
+            out[r * KERNEL_STEPS + j] = c > 0 ? w.reduce((sum, wk, q) => sum + (wk * (exponents[q] + 1) * c ** exponents[q]) / (2 * Math.PI), 0) : 0;
+        }
+    }
+    return out;
 }
 
-// The density of a normalized Phong lobe of exponent n where ln cos alpha = log, per unit solid
-// angle.
-const phong = (n, log) => ((n + 1) / (2 * Math.PI)) * Math.exp(n * log);
+/** The azimuths about the mirror direction at which lightCorrections tabulates. */
+export const AZIMUTH_STEPS = 16;
 
 /**
- * A mixture of two normalized Phong lobes around the mirror direction that best explains the
- * weighted directions `spread` (`[cos alpha, weight]`): `[w, n1, n2]`, the first lobe's share and
- * the exponents, the sharper first. Maximum likelihood by expectation-maximization (given its
- * directions, a lobe's exponent is `n + 1 = -1 / E[ln cos alpha]`), from a sharp and a broad start
- * around the one-lobe estimate.
+ * What a peak light of unit power at a direction adds to the split estimate beyond what the
+ * layers gave of it, per view `r` of `rows`, angle `alpha` from the mirror direction (`pi x^2`,
+ * `x = (j + 1/2) / KERNEL_STEPS`) and azimuth `beta` about it (`cos beta = 2 (b + 1/2) /
+ * AZIMUTH_STEPS - 1`, 0 in the plane of the normal and the view towards the normal's side... by
+ * the table's symmetry one half of the azimuths): the table's `(f - f_d) cos theta_i` at that
+ * direction (0 below the horizon) less the mixture's kernel there times the view's albedo (the
+ * layers hold the light too, horizon or not). RGBA texels, `KERNEL_STEPS x AZIMUTH_STEPS x
+ * rows` (alpha fastest): the shader reads it once per light, filtered linearly, in place of the
+ * table and the kernels. `table` is lobeMixture's, `kernels` mixtureKernels'.
  */
-function twoLobes(spread) {
-    const points = spread.map(([c, y]) => {
-        const clamped = Math.min(Math.max(c, 1e-6), 1 - 1e-9);
-        return [clamped, y, Math.log(clamped)];
-    });
-    const total = points.reduce((sum, [, y]) => sum + y, 0);
-    if (!(total > 0)) return [1, 0, 0];
-    const meanLog = points.reduce((sum, [, y, log]) => sum + y * log, 0) / total;
-    const one = Math.min(-1 / meanLog - 1, 1e6);
-    let [w, n1, n2] = [0.5, Math.min(16 * one + 16, 1e6), Math.max(one / 4, 0)];
-    for (let step = 0; step < 32; step++) {
-        let [s1, l1, l2] = [0, 0, 0];
-        for (const [, y, log] of points) {
-            const p1 = w * phong(n1, log);
-            const p2 = (1 - w) * phong(n2, log);
-            const r = p1 + p2 > 0 ? p1 / (p1 + p2) : 0.5;
-            s1 += y * r;
-            l1 += y * r * log;
-            l2 += y * (1 - r) * log;
+export function lightCorrections(merl, size, phiDRange, diffuse, rows, table, kernels) {
+    const out = new Float32Array(4 * KERNEL_STEPS * AZIMUTH_STEPS * rows);
+    for (let r = 0; r < rows; r++) {
+        const cosO = 1 - (r + 0.5) / rows;
+        const sinO = Math.sqrt(Math.max(1 - cosO * cosO, 0));
+        const wo = [sinO, 0, cosO];
+        const mirror = [-sinO, 0, cosO];
+        // About the mirror direction: e1 in the plane of the normal and the view, e2 across it.
+        const e1 = [cosO, 0, sinO];
+        const albedo = [table[4 * r], table[4 * r + 1], table[4 * r + 2]];
+        for (let b = 0; b < AZIMUTH_STEPS; b++) {
+            const cosB = (2 * (b + 0.5)) / AZIMUTH_STEPS - 1;
+            const sinB = Math.sqrt(Math.max(1 - cosB * cosB, 0));
+            for (let j = 0; j < KERNEL_STEPS; j++) {
+                const alpha = Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2;
+                const [ca, sa] = [Math.cos(alpha), Math.sin(alpha)];
+                const wi = [0, 1, 2].map((c) => ca * mirror[c] + sa * cosB * e1[c] + (c === 1 ? sa * sinB : 0));
+                const f = wi[2] > 0 ? merlBrdf(merl, size, phiDRange, wi, wo) : [0, 0, 0];
+                const kernel = kernels[r * KERNEL_STEPS + j];
+                const at = 4 * ((r * AZIMUTH_STEPS + b) * KERNEL_STEPS + j);
+                for (let c = 0; c < 3; c++) out[at + c] = (wi[2] > 0 ? (f[c] - diffuse[c]) * wi[2] : 0) - albedo[c] * kernel;
+                out[at + 3] = 1;
+            }
         }
-        w = s1 / total;
-        n1 = l1 < 0 ? Math.min(Math.max(-s1 / l1 - 1, 0), 1e6) : 1e6;
-        n2 = l2 < 0 ? Math.min(Math.max(-(total - s1) / l2 - 1, 0), 1e6) : 1e6;
     }
-    return n1 >= n2 ? [w, n1, n2] : [1 - w, n2, n1];
+    return out;
+}
+
+/** The rows of lobeMixture's texture for `k` kernels. */
+export function mixtureRows(k) {
+    return 1 + Math.ceil((k - 1) / 4);
+}
+
+/**
+ * The weights `w` (at least 0, summing to 1) of the `columns` that best give `target` in least
+ * squares: projected coordinate descent on the normal equations, the sum held by a penalty row
+ * weighted as all of the target's rows together.
+ */
+function simplexLeastSquares(columns, target) {
+    const [k, m] = [columns.length, target.length];
+    const penalty = m;
+    const gram = columns.map((a) => columns.map((b) => penalty + a.reduce((s, v, j) => s + v * b[j], 0)));
+    const right = columns.map((a) => penalty + a.reduce((s, v, j) => s + v * target[j], 0));
+    const w = new Float64Array(k).fill(1 / k);
+    for (let step = 0; step < 500; step++) {
+        for (let p = 0; p < k; p++) {
+            let g = -right[p];
+            for (let q = 0; q < k; q++) g += gram[p][q] * w[q];
+            w[p] = Math.max(0, w[p] - g / gram[p][p]);
+        }
+    }
+    return w;
 }
 
 /**
  * The environment's peaks (`peaks`: engine-environment's layer 1, RGBA rows of `width x height`,
- * row 0 at the zenith) as at most MAX_PEAK_LIGHTS directional lights: the peak texels joined where
- * they touch (8 neighbours) within a cell of PEAK_CELLS, each group's irradiance at normal incidence (RGB, the
- * sum of radiance times solid angle) and its direction (the luminance-weighted mean, +z up); the
- * brightest groups kept, each other group added to the kept one nearest in direction; and each
- * light's spread, the mean of `1 - cos` between its texels' directions and its own (luminance
- * weighted). Returns `{ count, directions: Float32Array(3 MAX), powers: Float32Array(3 MAX),
- * spreads: Float32Array(MAX) }`.
+ * row 0 at the zenith) as at most MAX_PEAK_LIGHTS directional lights: the peak texels clustered
+ * about the lights' directions by luminance-weighted spherical k-means (the first centre the
+ * brightest texel, each next the texel with the most luminance times `1 - cos` to the centres
+ * so far among those more than 10 degrees from all of them, then 16 rounds of assigning each texel to its nearest centre and moving each centre to
+ * its texels' luminance-weighted mean direction), so that a sun keeps a light of its own beside
+ * the sky around it and a large lamp is one light. Each light's power is its texels' radiance
+ * times solid angle summed (RGB, its irradiance at normal incidence), brightest first; its
+ * `near` cone's cosines `[cos a, cos 2a]` with `a` NEAR_RADII times its radius
+ * (`sqrt(2 spread)`, `spread` the texels' mean `1 - cos` about its direction) and at least
+ * NEAR_MIN_DEGREES. Returns `{ count, directions: Float32Array(3 MAX), powers: Float32Array(3 MAX),
+ * near: Float32Array(2 MAX) }`.
  */
 export function peakLights(peaks, width, height) {
-    const label = new Int32Array(width * height).fill(-1);
-    const groups = [];
-    // The cell of PEAK_CELLS a texel lies in (columns from u = 0, rows from the zenith).
-    const cellOf = (k) =>
-        Math.floor(((k % width) * PEAK_CELLS[0]) / width) + PEAK_CELLS[0] * Math.floor((Math.floor(k / width) * PEAK_CELLS[1]) / height);
-    const lit = (k) => peaks[4 * k] > 0 || peaks[4 * k + 1] > 0 || peaks[4 * k + 2] > 0;
-    for (let start = 0; start < width * height; start++) {
-        if (label[start] >= 0 || !lit(start)) continue;
-        const g = { power: [0, 0, 0], dir: [0, 0, 0], weight: 0 };
-        label[start] = groups.length;
-        const stack = [start];
-        while (stack.length > 0) {
-            const k = stack.pop();
-            const [x, y] = [k % width, Math.floor(k / width)];
-            const v = (y + 0.5) / height;
+    const texels = [];
+    for (let y = 0; y < height; y++) {
+        const v = (y + 0.5) / height;
+        const s = Math.sin(Math.PI * v);
+        const solid = ((2 * Math.PI) / width) * (Math.PI / height) * s;
+        for (let x = 0; x < width; x++) {
+            const i = 4 * (y * width + x);
+            if (!(peaks[i] > 0 || peaks[i + 1] > 0 || peaks[i + 2] > 0)) continue;
             const u = (x + 0.5) / width;
-            const solid = ((2 * Math.PI) / width) * (Math.PI / height) * Math.sin(Math.PI * v);
-            const rgb = [peaks[4 * k], peaks[4 * k + 1], peaks[4 * k + 2]].map((c) => c * solid);
-            const lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-            const s = Math.sin(Math.PI * v);
+            const rgb = [peaks[i] * solid, peaks[i + 1] * solid, peaks[i + 2] * solid];
             const d = [s * Math.cos(2 * Math.PI * u), s * Math.sin(2 * Math.PI * u), Math.cos(Math.PI * v)];
+            texels.push({ d, rgb, lum: luminance(rgb) });
+        }
+    }
+    const centres = [];
+    if (texels.length > 0) centres.push(texels.reduce((a, b) => (b.lum > a.lum ? b : a)).d);
+    while (centres.length < MAX_PEAK_LIGHTS) {
+        let best;
+        let score = 0;
+        for (const t of texels) {
+            const near = Math.max(...centres.map((c) => dot(c, t.d)));
+            const s = t.lum * (1 - near);
+            if (near < SEPARATION_COS && s > score) [best, score] = [t, s];
+        }
+        if (!best) break;
+        centres.push(best.d);
+    }
+    let groups = [];
+    for (let round = 0; round < 16; round++) {
+        groups = centres.map(() => ({ power: [0, 0, 0], dir: [0, 0, 0], weight: 0 }));
+        for (const t of texels) {
+            let near = 0;
+            for (let c = 1; c < centres.length; c++) if (dot(centres[c], t.d) > dot(centres[near], t.d)) near = c;
+            const g = groups[near];
             for (let c = 0; c < 3; c++) {
-                g.power[c] += rgb[c];
-                g.dir[c] += lum * d[c];
+                g.power[c] += t.rgb[c];
+                g.dir[c] += t.lum * t.d[c];
             }
-            g.weight += lum;
-            for (let dy = -1; dy <= 1; dy++) {
-                const ny = y + dy;
-                if (ny < 0 || ny >= height) continue;
-                for (let dx = -1; dx <= 1; dx++) {
-                    const n = ny * width + ((x + dx + width) % width);
-                    if (label[n] < 0 && lit(n) && cellOf(n) === cellOf(start)) {
-                        label[n] = groups.length;
-                        stack.push(n);
-                    }
-                }
-            }
+            g.weight += t.lum;
         }
-        groups.push(g);
+        groups.forEach((g, c) => {
+            if (g.weight > 0) centres[c] = unit(g.dir);
+        });
     }
-    const lum = (p) => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-    const unit = (d) => {
-        const len = Math.hypot(...d);
-        return len > 0 ? d.map((c) => c / len) : [0, 0, 1];
-    };
-    groups.sort((a, b) => lum(b.power) - lum(a.power));
-    const kept = groups.slice(0, MAX_PEAK_LIGHTS);
-    const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    for (const g of groups.slice(MAX_PEAK_LIGHTS)) {
-        const d = unit(g.dir);
-        const near = kept.reduce((best, k) => (dot(unit(k.dir), d) > dot(unit(best.dir), d) ? k : best));
-        for (let c = 0; c < 3; c++) {
-            near.power[c] += g.power[c];
-            near.dir[c] += g.dir[c];
-        }
-        near.weight += g.weight;
-    }
+    groups = groups.filter((g) => g.weight > 0).sort((a, b) => luminance(b.power) - luminance(a.power));
+    if (!groups.every((g) => g.power.every(Number.isFinite))) throw new BakeError('error: the peaks sum to a value that is not finite');
     const directions = new Float32Array(3 * MAX_PEAK_LIGHTS);
     const powers = new Float32Array(3 * MAX_PEAK_LIGHTS);
-    const spreads = new Float32Array(MAX_PEAK_LIGHTS);
-    kept.forEach((k, i) => {
-        directions.set(unit(k.dir), 3 * i);
-        powers.set(k.power, 3 * i);
+    const near = new Float32Array(2 * MAX_PEAK_LIGHTS);
+    groups.forEach((g, i) => {
+        directions.set(unit(g.dir), 3 * i);
+        powers.set(g.power, 3 * i);
         // E[1 - cos] of the light's directions about their mean: 1 - |E[d]|.
-        spreads[i] = k.weight > 0 ? Math.min(Math.max(1 - Math.hypot(...k.dir) / k.weight, 0), 1) : 0;
+        const spread = Math.min(Math.max(1 - Math.hypot(...g.dir) / g.weight, 0), 1);
+        const a = Math.max(NEAR_RADII * Math.sqrt(2 * spread), (NEAR_MIN_DEGREES * Math.PI) / 180);
+        near.set([Math.cos(a), Math.cos(Math.min(2 * a, Math.PI))], 2 * i);
     });
-    if (!kept.every((k) => k.power.every(Number.isFinite))) throw new BakeError('error: the peaks sum to a value that is not finite');
-    return { count: kept.length, directions, powers, spreads };
+    return { count: groups.length, directions, powers, near };
 }
 
+// A texel within 10 degrees of a centre starts no other: one source stays one light.
+const SEPARATION_COS = Math.cos((10 * Math.PI) / 180);
+
+const luminance = (p) => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const unit = (d) => {
+    const len = Math.hypot(...d);
+    return len > 0 ? d.map((c) => c / len) : [0, 0, 1];
+};
+
 /**
- * engine-layers' `depth` layers (RGBA rows of `width x height`) and one more: the smooth part's
- * level 0 (engine-environment's level 0 less its peaks, `envWidth x envHeight`, at least 0: what
+ * engine-full-layers' `depth` layers (RGBA rows of `width x height`) and one more: the
+ * environment's level 0 (engine-environment's layer 0, `envWidth x envHeight`: what
  * layer_bilinear reads past the sharpest layer) averaged down to the layers' size, each layer
  * texel the mean of the level-0 texels whose centres it covers (the nearest one where none
  * does). The split estimator's uLayersLinear.
@@ -253,7 +338,6 @@ export function peakLights(peaks, width, height) {
 export function splitLayers(layers, width, height, depth, environment, envWidth, envHeight) {
     const out = new Float32Array(4 * width * height * (depth + 1));
     out.set(layers.subarray(0, 4 * width * height * depth));
-    const peaks = 4 * envWidth * envHeight;
     const base = 4 * width * height * depth;
     const sum = new Float64Array(4 * width * height);
     const count = new Uint32Array(width * height);
@@ -263,7 +347,7 @@ export function splitLayers(layers, width, height, depth, environment, envWidth,
             const lx = Math.min(Math.floor(((x + 0.5) / envWidth) * width), width - 1);
             const e = 4 * (y * envWidth + x);
             const l = ly * width + lx;
-            for (let c = 0; c < 3; c++) sum[4 * l + c] += Math.max(environment[e + c] - environment[peaks + e + c], 0);
+            for (let c = 0; c < 3; c++) sum[4 * l + c] += environment[e + c];
             count[l] += 1;
         }
     }
@@ -277,7 +361,7 @@ export function splitLayers(layers, width, height, depth, environment, envWidth,
             const ex = Math.min(Math.floor(((lx + 0.5) / width) * envWidth), envWidth - 1);
             const ey = Math.min(Math.floor(((ly + 0.5) / height) * envHeight), envHeight - 1);
             const e = 4 * (ey * envWidth + ex);
-            mean = [0, 1, 2].map((c) => Math.max(environment[e + c] - environment[peaks + e + c], 0));
+            mean = [environment[e], environment[e + 1], environment[e + 2]];
         }
         out.set([...mean, 1], base + 4 * l);
     }

@@ -54,6 +54,7 @@ const TEXTURES = {
     'engine-environment': { uniform: 'uEnvironment', channels: 4, kind: 'array', shape: [4, 2, 2], high: FLOAT32_MAX },
     'engine-light-tables': { uniform: 'uLightTables', channels: 1, kind: 'array', shape: [5, 3, 2], high: 1 },
     'engine-layers': { uniform: 'uLayers', channels: 4, kind: 'array', shape: [4, 2, 2], high: FLOAT32_MAX },
+    'engine-full-layers': { uniform: 'uFullLayers', channels: 4, kind: 'array', shape: [4, 2, 2], high: FLOAT32_MAX },
 };
 
 /** The synthetic bake's texture of `role`, 0.5 everywhere but where `value(i)` says otherwise. */
@@ -117,7 +118,7 @@ async function refused(promise, ...needles) {
 test('the synthetic bake loads', async () => {
     const bake = await load();
     assert.equal(bake.figures.slices, 2);
-    assert.equal(Object.keys(bake.textures).length, 6);
+    assert.equal(Object.keys(bake.textures).length, Object.keys(TEXTURES).length);
 });
 
 test('figures of the wrong type or out of range are refused, naming the figure', async () => {

@@ -1,12 +1,28 @@
 // The split estimator's inputs derived at load time (split.js; node --test), against analytic
-// answers: the lobe table's albedo of a Lambertian table (its albedo exactly) and of a Phong lobe
-// table (its albedo, its exponent), the layer coordinate of an exponent, the peak lights of a
-// peaks image (their power as the sum of radiance times solid angle), and the smooth part's
-// level 0 averaged down to the layers' size.
+// answers: the lobe mixture of a Lambertian table (its albedo exactly, nothing left once its
+// diffuse part is taken) and of a Phong lobe table (its albedo, its weight on the layer of its
+// exponent), the mixture's kernels, the peak lights' corrections (none where the mixture is the
+// table, the layers' share taken below the horizon), the peak lights of a peaks image (their
+// power as the sum of radiance times solid angle, a sun kept apart from a lamp, no power lost),
+// and level 0 averaged down to the layers' size.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { MAX_PEAK_LIGHTS, layerCoordinate, lobeTable, merlBrdf, peakLights, splitLayers } from '../src/split.js';
+import {
+    AZIMUTH_STEPS,
+    KERNEL_STEPS,
+    MAX_PEAK_LIGHTS,
+    NEAR_MIN_DEGREES,
+    effectiveExponents,
+    lightCorrections,
+    lobeMixture,
+    merlBrdf,
+    mixtureKernels,
+    mixtureRows,
+    peakLights,
+    splitLayers,
+    texelSpread,
+} from '../src/split.js';
 
 // MERL's 90 x 90 x 180 grid (phi_d over pi, reciprocity's fold), each cell the BRDF `f(wi, wo)`
 // at its centre: theta_h = ((h + 1/2) / 90)^2 pi / 2, theta_d and phi_d at their cells' middles,
@@ -48,49 +64,107 @@ test("a Lambertian table's albedo is its reflectance, and nothing is left once i
     const data = table(() => rho / Math.PI);
     const rows = 16;
     const exponents = [1, 4, 16, 64, 256];
-    const all = lobeTable(data, SIZE, Math.PI, [0, 0, 0], rows, exponents);
-    const rest = lobeTable(data, SIZE, Math.PI, [rho / Math.PI, rho / Math.PI, rho / Math.PI], rows, exponents);
+    const all = lobeMixture(data, SIZE, Math.PI, [0, 0, 0], rows, exponents);
+    const rest = lobeMixture(data, SIZE, Math.PI, [rho / Math.PI, rho / Math.PI, rho / Math.PI], rows, exponents);
     for (let r = 0; r < rows; r++) {
-        // The two lobes share the albedo (the broader's is the sharper's times row 1's first
-        // value); the quadrature over half vectors is within 1% of the hemisphere's integral of
-        // cos (pi) except at the most grazing views (2%).
-        const albedo = all[4 * r] * (1 + all[4 * (rows + r)]);
-        assert.ok(Math.abs(albedo - rho) < (r < rows - 2 ? 0.01 : 0.02) * rho, `row ${r}: ${albedo}`);
-        assert.ok(Math.abs(rest[4 * r] * (1 + rest[4 * (rows + r)])) < 1e-6, `row ${r}`);
+        // The quadrature over half vectors is within 1% of the hemisphere's integral of cos (pi)
+        // except at the most grazing views (2%).
+        assert.ok(Math.abs(all[4 * r] - rho) < (r < rows - 2 ? 0.01 : 0.02) * rho, `row ${r}: ${all[4 * r]}`);
+        assert.ok(Math.abs(rest[4 * r]) < 1e-6, `row ${r}`);
     }
 });
 
-test("a Phong lobe's albedo and exponent come back at a view where it lies above the horizon", () => {
-    // f cos theta_i = A (n + 1) / (2 pi) cos^n alpha around the mirror direction.
-    const [albedo, n] = [0.3, 50];
-    const data = table((wi, wo) => {
+// A table whose f cos theta_i is A (n + 1) / (2 pi) cos^n alpha about the mirror direction.
+function phongTable(albedo, n) {
+    return table((wi, wo) => {
         const cosAlpha = wi[0] * -wo[0] + wi[1] * -wo[1] + wi[2] * wo[2];
         return cosAlpha > 0 ? (albedo * (n + 1) * cosAlpha ** n) / (2 * Math.PI * wi[2]) : 0;
     });
-    const rows = 8;
-    const out = lobeTable(data, SIZE, Math.PI, [0, 0, 0], rows, [1, 4, 16, 64, 256, 1024]);
-    // Row 1: 1 - cos theta_o = 3/16, theta_o 36 degrees; the lobe (half width 14 degrees at
-    // half its height) lies above the horizon. The nearest-cell table misses a little of the peak.
-    const [w1, w2] = [out[4 * 1], out[4 * 1] * out[4 * (rows + 1)]];
-    assert.ok(Math.abs(w1 + w2 - albedo) < 0.03 * albedo, `${w1 + w2}`);
-    // Each lobe holding a tenth of the albedo or more has the exponent within 15%.
-    for (const [w, exponent] of [[w1, out[4 * 1 + 3]], [w2, out[4 * (rows + 1) + 1]]]) {
-        if (w > 0.1 * albedo) assert.ok(Math.abs(exponent - n) < 0.15 * n, `${exponent} holding ${w}`);
-    }
-    // The layer coordinates of the two lobes are their exponents' (row 1's last two values).
+}
+
+// Kernel q's weight in lobeMixture's output at view r.
+const weight = (out, rows, r, q) => (q === 0 ? out[4 * r + 3] : out[4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4)]);
+
+test("a Phong lobe's albedo comes back, its weight on the layer of its exponent", () => {
+    const [albedo, n] = [0.3, 64];
     const exponents = [1, 4, 16, 64, 256, 1024];
-    assert.ok(Math.abs(out[4 * (rows + 1) + 2] - layerCoordinate(out[4 * 1 + 3], exponents)) < 1e-6);
-    assert.ok(Math.abs(out[4 * (rows + 1) + 3] - layerCoordinate(out[4 * (rows + 1) + 1], exponents)) < 1e-6);
+    const rows = 8;
+    const out = lobeMixture(phongTable(albedo, n), SIZE, Math.PI, [0, 0, 0], rows, exponents);
+    assert.equal(out.length, 4 * rows * mixtureRows(exponents.length));
+    // Row 1: 1 - cos theta_o = 3/16, theta_o 36 degrees; the lobe (half width 8 degrees at half
+    // its height) lies above the horizon. The nearest-cell table misses a little of the peak.
+    assert.ok(Math.abs(out[4] - albedo) < 0.03 * albedo, `${out[4]}`);
+    const w = exponents.map((_, q) => weight(out, rows, 1, q));
+    assert.ok(w.every((v) => v >= 0), `${w}`);
+    assert.ok(Math.abs(w.reduce((a, b) => a + b, 0) - 1) < 0.01, `${w}`);
+    // The lobe's own layer holds nearly all of it (the penalty holding the sum and the table's
+    // cells leave a few percent to its neighbours).
+    assert.ok(w[3] > 0.85, `${w}`);
 });
 
-test('the layer coordinate of an exponent interpolates the layers logarithmically', () => {
-    const exponents = [1, 4, 16, 64, 256];
-    assert.equal(layerCoordinate(0.5, exponents), 0);
-    assert.equal(layerCoordinate(1, exponents), 0);
-    assert.equal(layerCoordinate(4, exponents), 1);
-    assert.ok(Math.abs(layerCoordinate(8, exponents) - 1.5) < 1e-12);
-    assert.equal(layerCoordinate(256, exponents), 4);
-    assert.equal(layerCoordinate(1e6, exponents), 4);
+test("the mixture's kernel is its weights' Phong kernels, and read through the bilinear texel", () => {
+    const exponents = [1, 4, 16];
+    const rows = 2;
+    const out = new Float32Array(4 * rows * mixtureRows(exponents.length));
+    // View 0: all on exponent 4; view 1: half on 1, half on 16.
+    out[4 * rows + 0] = 1;
+    out[4 * 1 + 3] = 0.5;
+    out[4 * rows + 4 + 1] = 0.5;
+    const kernels = mixtureKernels(out, rows, exponents);
+    for (const j of [0, 5, 20, 40]) {
+        const c = Math.cos(Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2);
+        const phong = (n) => (c > 0 ? ((n + 1) / (2 * Math.PI)) * c ** n : 0);
+        assert.ok(Math.abs(kernels[j] - phong(4)) < 1e-6, `view 0, texel ${j}`);
+        assert.ok(Math.abs(kernels[KERNEL_STEPS + j] - (phong(1) + phong(16)) / 2) < 1e-6, `view 1, texel ${j}`);
+    }
+    // A tent one texel wide along each axis adds the spread (pi / H)^2 / 6; an exponent past any
+    // texel's reach reads as the texel's own width.
+    assert.ok(Math.abs(texelSpread(256) - (Math.PI / 256) ** 2 / 6) < 1e-15);
+    const [sharp] = effectiveExponents([1e12], texelSpread(256));
+    assert.ok(Math.abs(sharp - (6 * (256 / Math.PI) ** 2 - 2)) < 1e-3 * sharp, `${sharp}`);
+    assert.ok(Math.abs(effectiveExponents([4], 0)[0] - 4) < 1e-5);
+});
+
+test("a peak light's correction is none where the mixture is the table, the layers' share below the horizon", () => {
+    const [albedo, n] = [0.3, 4];
+    const exponents = [1, 4, 16];
+    const rows = 4;
+    // The mixture of a broad Phong lobe: all on its own exponent (set by hand, the view's albedo).
+    const out = new Float32Array(4 * rows * mixtureRows(exponents.length));
+    for (let r = 0; r < rows; r++) {
+        out.set([albedo, albedo, albedo], 4 * r);
+        out[4 * rows + r * 4] = 1;
+    }
+    const kernels = mixtureKernels(out, rows, exponents);
+    const corrections = lightCorrections(phongTable(albedo, n), SIZE, Math.PI, [0, 0, 0], rows, out, kernels);
+    assert.equal(corrections.length, 4 * KERNEL_STEPS * AZIMUTH_STEPS * rows);
+    const peak = (albedo * (n + 1)) / (2 * Math.PI);
+    let [above, below, worst] = [0, 0, 0];
+    for (let r = 0; r < rows; r++) {
+        const cosO = 1 - (r + 0.5) / rows;
+        const sinO = Math.sqrt(1 - cosO * cosO);
+        for (let b = 0; b < AZIMUTH_STEPS; b++) {
+            const cosB = (2 * (b + 0.5)) / AZIMUTH_STEPS - 1;
+            for (let j = 0; j < KERNEL_STEPS; j++) {
+                const alpha = Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2;
+                // The light's height above the surface: its direction's z in the view's frame.
+                const z = Math.cos(alpha) * cosO + Math.sin(alpha) * cosB * sinO;
+                const v = corrections[4 * ((r * AZIMUTH_STEPS + b) * KERNEL_STEPS + j)];
+                if (z > 0.2) {
+                    worst = Math.max(worst, Math.abs(v) / peak);
+                    above++;
+                } else if (z < 0) {
+                    assert.ok(Math.abs(v + albedo * kernels[r * KERNEL_STEPS + j]) < 1e-6, `view ${r}, azimuth ${b}, texel ${j}`);
+                    below++;
+                }
+            }
+        }
+    }
+    // The table's nearest cell lies up to half a cell from the direction, and f = A (n + 1)
+    // cos^n alpha / (2 pi cos theta_i) changes fastest towards grazing: measured 4.4% of the
+    // lobe's peak above 0.2 of the light's height (21% just above the horizon).
+    assert.ok(worst < 0.05, `${worst} of the peak`);
+    assert.ok(above > 1000 && below > 1000, `${above} above, ${below} below`);
 });
 
 // A peaks image of 64 x 32 texels (row 0 at the zenith) lit at `texels` ([x, y, radiance]).
@@ -100,53 +174,54 @@ function peaksImage(texels) {
     return data;
 }
 const solidAngle = (y) => ((2 * Math.PI) / 64) * (Math.PI / 32) * Math.sin((Math.PI * (y + 0.5)) / 32);
+const direction = (u, v) => [Math.sin(Math.PI * v) * Math.cos(2 * Math.PI * u), Math.sin(Math.PI * v) * Math.sin(2 * Math.PI * u), Math.cos(Math.PI * v)];
 
-test('touching peak texels within a cell make one light, its power their radiance times solid angle', () => {
-    // A 2 x 2 block at rows 8-9 (one cell of 4 x 4 texels: 64 / 16 by 32 / 8), two touching texels
-    // in one cell at row 20, and two touching texels in two cells (x 7 and 8) at row 26.
-    const image = peaksImage([[10, 8, 100], [11, 8, 100], [10, 9, 100], [11, 9, 100], [5, 20, 50], [6, 20, 50], [7, 26, 30], [8, 26, 30]]);
+test('one source is one light: its power the radiance times solid angle, its direction the middle, its near cone', () => {
+    const image = peaksImage([[10, 8, 100], [11, 8, 100], [10, 9, 100], [11, 9, 100]]);
     const lights = peakLights(image, 64, 32);
-    assert.equal(lights.count, 4);
+    assert.equal(lights.count, 1);
     const block = 100 * (2 * solidAngle(8) + 2 * solidAngle(9));
-    const pair = 50 * 2 * solidAngle(20);
-    assert.ok(Math.abs(lights.powers[0] - block) < 1e-6 * block && Math.abs(lights.powers[1] - 2 * block) < 1e-5 * block);
-    assert.ok(Math.abs(lights.powers[3] - pair) < 1e-6 * pair);
-    for (const i of [2, 3]) assert.ok(Math.abs(lights.powers[3 * i] - 30 * solidAngle(26)) < 1e-6, `light ${i}`);
-    // The block's direction: between its texels' centres, at u = 11/64, v = 9/32.
-    const [u, v] = [11 / 64, 9 / 32];
-    const expected = [Math.sin(Math.PI * v) * Math.cos(2 * Math.PI * u), Math.sin(Math.PI * v) * Math.sin(2 * Math.PI * u), Math.cos(Math.PI * v)];
-    const cos = expected.reduce((s, e, i) => s + e * lights.directions[i], 0);
+    assert.ok(Math.abs(lights.powers[0] - block) < 1e-6 * block && Math.abs(lights.powers[2] - 3 * block) < 1e-5 * block);
+    const cos = direction(11 / 64, 9 / 32).reduce((s, e, i) => s + e * lights.directions[i], 0);
     assert.ok(cos > 0.9995, `${cos}`);
-    // The pair's light lies between its texels, at u = 6/64, theta that of row 20 (within 1e-3:
-    // the mean of two directions half a texel either side leans towards the pole); its spread is
-    // that of two texels 1/64 turn apart.
-    const [phi, theta] = [(2 * Math.PI * 6) / 64, (Math.PI * 20.5) / 32];
-    const toward = [Math.sin(theta) * Math.cos(phi), Math.sin(theta) * Math.sin(phi), Math.cos(theta)];
-    for (let c = 0; c < 3; c++) assert.ok(Math.abs(lights.directions[3 + c] - toward[c]) < 1e-3, `${lights.directions.slice(3, 6)}`);
-    assert.ok(lights.spreads[1] > 0 && lights.spreads[1] < 1 - Math.cos(Math.PI / 64), `${lights.spreads[1]}`);
+    // Four texels about 0.1 radians apart: a radius of a few hundredths, under the near cone's
+    // least width, so the cone is NEAR_MIN_DEGREES and twice it.
+    const least = (NEAR_MIN_DEGREES * Math.PI) / 180;
+    assert.ok(Math.abs(lights.near[0] - Math.cos(least)) < 1e-6 || lights.near[0] < Math.cos(least), `${lights.near[0]}`);
+    assert.ok(lights.near[1] < lights.near[0], `${lights.near}`);
+    assert.equal(lights.powers[3], 0);
 });
 
-test('past the most lights, each group joins the nearest kept one and no power is lost', () => {
-    // One texel in each of MAX + 3 cells (columns 4 texels wide; rows 16 and 28 in two rows of cells).
-    const texels = Array.from({ length: MAX_PEAK_LIGHTS + 3 }, (_, i) => [4 * (i % 16), i < 16 ? 16 : 28, 10 + i]);
-    const lights = peakLights(peaksImage(texels), 64, 32);
-    assert.equal(lights.count, MAX_PEAK_LIGHTS);
-    const total = texels.reduce((s, [, y, v]) => s + v * solidAngle(y), 0);
-    let kept = 0;
-    for (let i = 0; i < MAX_PEAK_LIGHTS; i++) kept += lights.powers[3 * i];
+test('a sun keeps its own light beside a larger dimmer source, and past the most lights no power is lost', () => {
+    // A bright texel (the sun) and a dim 3 x 3 lamp half the sky away, then a third source.
+    const lamp = [];
+    for (let dx = 0; dx < 3; dx++) for (let dy = 0; dy < 3; dy++) lamp.push([40 + dx, 14 + dy, 5]);
+    const two = peakLights(peaksImage([[8, 10, 1000], ...lamp]), 64, 32);
+    assert.equal(MAX_PEAK_LIGHTS, 2);
+    assert.equal(two.count, 2);
+    const sun = 1000 * solidAngle(10);
+    assert.ok(Math.abs(two.powers[0] - sun) < 1e-6 * sun, `${two.powers}`);
+    const lampPower = lamp.reduce((s, [, y, v]) => s + v * solidAngle(y), 0);
+    assert.ok(Math.abs(two.powers[3] - lampPower) < 1e-5 * lampPower, `${two.powers}`);
+    const cos = direction(8.5 / 64, 10.5 / 32).reduce((s, e, i) => s + e * two.directions[i], 0);
+    assert.ok(cos > 1 - 1e-9, `${cos}`);
+    const three = peakLights(peaksImage([[8, 10, 1000], ...lamp, [60, 25, 20]]), 64, 32);
+    assert.equal(three.count, MAX_PEAK_LIGHTS);
+    const total = sun + lampPower + 20 * solidAngle(25);
+    const kept = three.powers[0] + three.powers[3];
     assert.ok(Math.abs(kept - total) < 1e-5 * total, `${kept} of ${total}`);
 });
 
-test("the extra layer is the smooth part's level 0 averaged down to the layers' size", () => {
+test("the extra layer is level 0 averaged down to the layers' size", () => {
     const [w, h] = [4, 2];
     const layers = Float32Array.from({ length: 4 * w * h * 2 }, (_, i) => i);
     const env = new Float32Array(4 * 8 * 4 * 2);
     for (let i = 0; i < 8 * 4; i++) env.set([i, 1, 2, 1], 4 * i);
-    // A peak at texel (1, 0): level 0 less it is 0 there.
+    // A peak at texel (1, 0): the whole environment's level 0 keeps it.
     env.set([5, 0, 0, 0], 4 * (8 * 4 + 1));
     const out = splitLayers(layers, w, h, 2, env, 8, 4);
     assert.deepEqual(Array.from(out.subarray(0, layers.length)), Array.from(layers));
-    // Layer texel (0, 0) covers level-0 texels (0, 0), (1, 0), (0, 1), (1, 1): R 0, max(1 - 5, 0), 8, 9.
+    // Layer texel (0, 0) covers level-0 texels (0, 0), (1, 0), (0, 1), (1, 1): R 0, 1, 8, 9.
     const extra = out.subarray(layers.length);
-    assert.deepEqual(Array.from(extra.subarray(0, 4)), [(0 + 0 + 8 + 9) / 4, 1, 2, 1]);
+    assert.deepEqual(Array.from(extra.subarray(0, 4)), [(0 + 1 + 8 + 9) / 4, 1, 2, 1]);
 });

@@ -23,6 +23,8 @@ pub const ENVIRONMENT_KTX2: &str = "engine-environment.ktx2";
 pub const LIGHT_TABLES_KTX2: &str = "engine-light-tables.ktx2";
 /// The Phong layers of the smooth part.
 pub const LAYERS_KTX2: &str = "engine-layers.ktx2";
+/// The Phong layers of the whole environment, peaks included (the split estimator's).
+pub const FULL_LAYERS_KTX2: &str = "engine-full-layers.ktx2";
 
 /// The engine textures of `material` under `lighting` (both as `bake::load` makes them).
 pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Result<Staged, Error> {
@@ -121,6 +123,10 @@ pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Resul
     let layers_shape =
         DataShape { width: layer0.width(), height: layer0.height(), depth: 0, layers: layers.len(), channels: 4 };
     add(LAYERS_KTX2, "engine-layers", encode(LAYERS_KTX2, layers_shape, &layer_values)?);
+    // The bake's own layers, of the whole environment (the smooth part's plus the peaks'), in
+    // the same shape: what engines/three's split estimator reads its lobes from.
+    let full_values: Vec<f32> = lighting.layers.iter().flat_map(|l| rgba(l.rgb())).collect();
+    add(FULL_LAYERS_KTX2, "engine-full-layers", encode(FULL_LAYERS_KTX2, layers_shape, &full_values)?);
 
     let defaults = |mode: Estimator| {
         let s = Settings::previewer(mode, &material.samples, None, None, 0);
@@ -153,7 +159,7 @@ pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Resul
         format!(
             "engine textures: the MERL table as a {} x {} x {} rgba32f 3D texture, {} slices of half-vector tables \
              ({rows} rows x {sectors} sectors), {} view rows, level 0 of {w} x {h} with its peaks ({}), {} Phong \
-             layers of {} x {}: {megabytes:.1} MB",
+             layers of {} x {} of the smooth part and of the whole environment: {megabytes:.1} MB",
             dims.n_phi_d,
             dims.n_theta_d,
             dims.n_theta_h,

@@ -16,7 +16,7 @@ pub mod wavelet_brdf;
 /// ...; `data-schema/README.md` lists them by role): a rebake removes a file of the previous
 /// manifest only under such a name, so that no manifest can make it remove anything else.
 pub fn is_output_name(name: &str) -> bool {
-    const NAMES: [&str; 34] = [
+    const NAMES: [&str; 35] = [
         importance::ASSET,
         importance::PICTURE,
         bandwidth_atlas::ASSET,
@@ -47,6 +47,7 @@ pub fn is_output_name(name: &str) -> bool {
         engine::ENVIRONMENT_KTX2,
         engine::LIGHT_TABLES_KTX2,
         engine::LAYERS_KTX2,
+        engine::FULL_LAYERS_KTX2,
         fit::RECORD,
         fit::GLTF,
         fit::BIN,
