@@ -251,6 +251,42 @@ fn engine_textures_are_valid_ktx2_holding_the_bakes_numbers() {
     }
 }
 
+/// A bake whose engine-textures stage lists fewer files than the stage now writes (one made before
+/// it wrote `engine-full-layers.ktx2`) is not up to date: the rerun bakes it again, with the file.
+#[test]
+fn a_bake_missing_an_engine_texture_is_baked_again() {
+    let Some(shared) = shared_or_skip(&["data/env"]) else { return };
+    let tmp = crate::support::temp_dir();
+    let dir = tmp.path().join("bake");
+    let bake = || {
+        let mut cmd = tool("brdf-bake");
+        cmd.arg(crate::support::ggx_copper())
+            .arg("--env")
+            .arg(shared.join("data/env/quarry_01_1k.hdr"))
+            .arg("--out-dir")
+            .arg(&dir)
+            .args(["--engine-textures", "--analysis-size", "64", "--json"]);
+        let r = run(cmd, "");
+        assert!(matches!(r.code, Some(0 | 1)), "the bake failed\n{r}");
+        r.json_object()["up_to_date"].clone()
+    };
+    assert_eq!(bake(), serde_json::Value::Bool(false));
+    assert_eq!(bake(), serde_json::Value::Bool(true), "a rerun of the same bake is up to date");
+    // The manifest as an older brdf-bake wrote it: no engine-full-layers.
+    let path = dir.join("manifest.json");
+    let mut manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    for stage in manifest["stages"].as_array_mut().unwrap() {
+        if stage["name"] == "engine-textures" {
+            stage["outputs"].as_array_mut().unwrap().retain(|o| o["path"] != "engine-full-layers.ktx2");
+        }
+    }
+    std::fs::write(&path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    std::fs::remove_file(dir.join("engine-full-layers.ktx2")).unwrap();
+    assert_eq!(bake(), serde_json::Value::Bool(false), "the older bake was taken as up to date");
+    assert!(dir.join("engine-full-layers.ktx2").is_file());
+    crate::brdf_bake::check_complete(&dir);
+}
+
 /// The engine textures hold the lighting: without an environment the bake refuses to start.
 #[test]
 fn engine_textures_need_an_environment() {

@@ -584,12 +584,20 @@ fn source_file(source: &Source) -> SourceFile {
     }
 }
 
-/// Same tool and version, same inputs (by hash), same parameters.
+/// Same tool and version, same inputs (by hash), same parameters, and every engine texture the
+/// stage now writes where the bake has them.
 fn is_same_bake(previous: &BakeManifest, next: &BakeManifest) -> bool {
     let hashes =
         |m: &BakeManifest| (m.material.source_sha256.clone(), m.environment.as_ref().map(|e| e.source_sha256.clone()));
+    // An engine-textures stage from before the stage wrote every one of its files.
+    let engine_complete = previous
+        .stages
+        .iter()
+        .filter(|s| s.name == "engine-textures")
+        .all(|s| crate::stage::engine::FILES.iter().all(|name| s.outputs.iter().any(|o| o.path.as_str() == *name)));
     previous.manifest_version == next.manifest_version
         && previous.tool == next.tool
         && hashes(previous) == hashes(next)
         && previous.parameters == next.parameters
+        && engine_complete
 }

@@ -26,6 +26,11 @@ pub const LAYERS_KTX2: &str = "engine-layers.ktx2";
 /// The Phong layers of the whole environment, peaks included (the split estimator's).
 pub const FULL_LAYERS_KTX2: &str = "engine-full-layers.ktx2";
 
+/// Every file the stage writes, in order: a bake whose engine-textures stage lists fewer was made
+/// before the stage wrote them all, and is not up to date (`run::is_same_bake`).
+pub const FILES: [&str; 7] =
+    [MERL_KTX2, BRDF_TABLES_KTX2, VIEW_LAYERS_KTX2, ENVIRONMENT_KTX2, LIGHT_TABLES_KTX2, LAYERS_KTX2, FULL_LAYERS_KTX2];
+
 /// The engine textures of `material` under `lighting` (both as `bake::load` makes them).
 pub fn run(material: &Material, lighting: &Lighting, program: &Program) -> Result<Staged, Error> {
     let writer = format!("{} {}", program.name, program.version);
