@@ -78,7 +78,7 @@ export const SPLIT_WEIGHT = 4;
  * output, whose radiance is linear; the accumulator takes over its frames) drawing its next
  * frame, adds it to the running sum and shows the mean on the canvas through the renderer's tone
  * mapping and output colour space. A bake material's first frame is the split estimator's (no
- * samples: a picture without noise at 2.6 to 2.8 times the cost of a MeshStandardMaterial frame
+ * samples: a picture without noise at 2.2 to 2.8 times the cost of a MeshStandardMaterial frame
  * on SwiftShader, biased; split.js), counted as `splitWeight` frames; each frame after it draws the next frame of
  * the material's samples (frame `firstFrame + n - 1` of its spp, `n` the frames drawn so far), so
  * the split's bias fades as `splitWeight / (splitWeight + n - 1)` and the mean converges to the
