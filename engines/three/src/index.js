@@ -14,7 +14,7 @@ import * as THREE from 'three';
 
 import { floatTarget } from './live.js';
 import { BakeError, readBake } from './loader.js';
-import { AZIMUTH_STEPS, KERNEL_STEPS, MAX_PEAK_LIGHTS, effectiveExponents, lightCorrections, lobeMixture, mixtureKernels, mixtureRows, peakLights, splitLayers, texelSpread } from './split.js';
+import { AZIMUTH_STEPS, ANGLE_STEPS, MAX_PEAK_LIGHTS, effectiveExponents, lightCorrections, lobeMixture, mixtureKernels, mixtureRows, peakLights, splitLayers, texelSpread } from './split.js';
 
 import {
     BACKGROUND_FRAGMENT,
@@ -210,17 +210,18 @@ export class Bake {
     }
 
     /**
-     * The split estimator's inputs (split.js), derived once: the lobe mixture (`lobes`) and the
-     * peak lights' corrections (`corrections`), the whole environment's layers with level 0 (`layers`), the three
-     * textures disposed with the bake, and the peak lights (`count`, `directions`, `powers`,
-     * `near`).
+     * The split estimator's inputs (split.js), derived once: the lobe mixture (`lobes`), the peak
+     * lights' corrections (`corrections`) and the whole environment's layers with level 0
+     * (`layers`), the three textures disposed with the bake, and the peak lights (`count`,
+     * `directions`, `powers`, `near`).
      */
     splitInputs() {
         if (!this.split) {
             const f = this.figures;
             const layers = this.textures.uFullLayers.image;
             const exponents = effectiveExponents(layerExponents(f.exponents).slice(0, f.exponents.length + 1), texelSpread(layers.height));
-            const table = lobeMixture(this.textures.uMerl.image.data, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
+            const merl = this.textures.uMerl.image.data;
+            const table = lobeMixture(merl, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, exponents);
             const lobes = new THREE.DataTexture(table, f.view_rows, mixtureRows(exponents.length), THREE.RGBAFormat, THREE.FloatType);
             // Linear along the views (u = 1 - cos_o: the rows' centres at (r + 1/2) / rows), each
             // row of the texture read at its centre.
@@ -228,10 +229,9 @@ export class Bake {
             lobes.magFilter = THREE.LinearFilter;
             lobes.needsUpdate = true;
             // The peak lights' corrections per angle, azimuth and view, linear in all three.
-            const merl = this.textures.uMerl.image.data;
             const kernels = mixtureKernels(table, f.view_rows, exponents);
             const values = lightCorrections(merl, f.merl_size, f.phi_d_range, f.diffuse, f.view_rows, table, kernels);
-            const corrections = new THREE.Data3DTexture(values, KERNEL_STEPS, AZIMUTH_STEPS, f.view_rows);
+            const corrections = new THREE.Data3DTexture(values, ANGLE_STEPS, AZIMUTH_STEPS, f.view_rows);
             corrections.format = THREE.RGBAFormat;
             corrections.type = THREE.FloatType;
             corrections.minFilter = THREE.LinearFilter;

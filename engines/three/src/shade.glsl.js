@@ -769,25 +769,6 @@ vec2 split_uv(vec3 w) {
     return vec2(u < 0.0 ? u + 1.0 : u, acos(clamp(w.z, -1.0, 1.0)) / PI);
 }
 
-// material_brdf (the nearest cell) with the half and difference frames turned by the half
-// vector's own components rather than by its angles' sines and cosines.
-vec3 split_brdf(vec3 wi, vec3 wo) {
-    ivec3 dims = textureSize(uMerl, 0);
-    vec3 h = normalize(wi + wo);
-    float sin_h = length(h.xy);
-    vec2 phi = sin_h > 1e-7 ? h.xy / sin_h : vec2(1.0, 0.0);
-    vec3 a = vec3(wi.x * phi.x + wi.y * phi.y, wi.y * phi.x - wi.x * phi.y, wi.z);
-    vec3 d = vec3(a.x * h.z - a.z * sin_h, a.y, a.x * sin_h + a.z * h.z);
-    float phi_d = merl_atan2(d.y, d.x);
-    if (phi_d < 0.0) {
-        phi_d += uPhiDRange;
-    }
-    float x_h = sqrt(acos(clamp(h.z, -1.0, 1.0)) / HALF_PI) * float(dims.z);
-    float x_d = acos(clamp(d.z, -1.0, 1.0)) / HALF_PI * float(dims.y);
-    ivec3 cell = ivec3(merl_axis_index(phi_d / uPhiDRange * float(dims.x), dims.x), merl_axis_index(x_d, dims.y), merl_axis_index(x_h, dims.z));
-    return texelFetch(uMerl, cell, 0).rgb;
-}
-
 // The rows of uLobes (split.js's mixtureRows).
 #define MIX_ROWS (1 + (MIX_LAYERS + 2) / 4)
 

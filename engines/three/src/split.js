@@ -82,6 +82,20 @@ export function effectiveExponents(exponents, spread) {
     return Float32Array.from(exponents, (n) => 1 / (1 / (n + 2) + spread) - 2);
 }
 
+// View `r` of `rows` (`1 - cos theta_o = (r + 1/2) / rows`) in the xz plane: wo, its mirror
+// direction about the normal (+z), cos and sin theta_o.
+function viewOf(r, rows) {
+    const cosO = 1 - (r + 0.5) / rows;
+    const sinO = Math.sqrt(Math.max(1 - cosO * cosO, 0));
+    return { cosO, sinO, wo: [sinO, 0, cosO], mirror: [-sinO, 0, cosO] };
+}
+
+// Where lobeMixture's output holds kernel q's weight at view r: row 0's alpha for the first,
+// then four to a texel in the rows after it.
+function weightIndex(rows, r, q) {
+    return q === 0 ? 4 * r + 3 : 4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4);
+}
+
 /** The angles (radians) at which lobeMixture matches encircled energy: 0.05 to 180 degrees, evenly in log. */
 const RADII = Array.from({ length: 48 }, (_, j) => ((0.05 * Math.PI) / 180) * 3600 ** (j / 47));
 
@@ -107,10 +121,7 @@ export function lobeMixture(merl, size, phiDRange, diffuse, rows, exponents, phi
     const kernels = Array.from(exponents, (n) => RADII.map((a) => (a >= Math.PI / 2 ? 1 : 1 - Math.cos(a) ** (n + 1))));
     const thetaSteps = size[2];
     for (let r = 0; r < rows; r++) {
-        const cosO = 1 - (r + 0.5) / rows;
-        const sinO = Math.sqrt(Math.max(1 - cosO * cosO, 0));
-        const wo = [sinO, 0, cosO];
-        const mirror = [-sinO, 0, cosO];
+        const { wo, mirror } = viewOf(r, rows);
         const albedo = [0, 0, 0];
         // The lobe's luminance between consecutive radii (the last bin: past the widest).
         const within = new Float64Array(RADII.length + 1);
@@ -147,29 +158,31 @@ export function lobeMixture(merl, size, phiDRange, diffuse, rows, exponents, phi
             return total > 0 ? sum / total : 1;
         });
         const w = simplexLeastSquares(kernels, encircled);
-        out.set([...albedo, w[0]], 4 * r);
-        for (let q = 1; q < k; q++) out[4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4)] = w[q];
+        out.set(albedo, 4 * r);
+        w.forEach((v, q) => {
+            out[weightIndex(rows, r, q)] = v;
+        });
     }
     return out;
 }
 
-/** The angles from the mirror direction at which mixtureKernels tabulates the kernel. */
-export const KERNEL_STEPS = 64;
+/** The angles from the mirror direction at which mixtureKernels and lightCorrections tabulate. */
+export const ANGLE_STEPS = 64;
 
 /**
  * The mixture's kernel per view `r` of `rows` (lobeMixture's `table`, for the same
  * `exponents`): `sum over k of w_k (n_k + 1) / (2 pi) cos^n_k alpha` (0 past 90 degrees) at
- * `alpha = pi x^2`, `x = (j + 1/2) / KERNEL_STEPS` the centre of texel `j` (dense near the
- * mirror direction): one row of KERNEL_STEPS values per view, what the shader reads for a peak
- * light at angle alpha from the mirror direction in place of evaluating every kernel.
+ * `alpha = pi x^2`, `x = (j + 1/2) / ANGLE_STEPS` (dense near the mirror direction): one row of
+ * ANGLE_STEPS values per view, the layers' share of a peak light at angle alpha from the mirror
+ * direction that lightCorrections takes away.
  */
 export function mixtureKernels(table, rows, exponents) {
-    const out = new Float32Array(rows * KERNEL_STEPS);
+    const out = new Float32Array(rows * ANGLE_STEPS);
     for (let r = 0; r < rows; r++) {
-        const w = Array.from(exponents, (_, q) => (q === 0 ? table[4 * r + 3] : table[4 * (rows * (1 + Math.floor((q - 1) / 4)) + r) + ((q - 1) % 4)]));
-        for (let j = 0; j < KERNEL_STEPS; j++) {
-            const c = Math.cos(Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2);
-            out[r * KERNEL_STEPS + j] = c > 0 ? w.reduce((sum, wk, q) => sum + (wk * (exponents[q] + 1) * c ** exponents[q]) / (2 * Math.PI), 0) : 0;
+        const w = Array.from(exponents, (_, q) => table[weightIndex(rows, r, q)]);
+        for (let j = 0; j < ANGLE_STEPS; j++) {
+            const c = Math.cos(Math.PI * ((j + 0.5) / ANGLE_STEPS) ** 2);
+            out[r * ANGLE_STEPS + j] = c > 0 ? w.reduce((sum, wk, q) => sum + (wk * (exponents[q] + 1) * c ** exponents[q]) / (2 * Math.PI), 0) : 0;
         }
     }
     return out;
@@ -181,34 +194,31 @@ export const AZIMUTH_STEPS = 16;
 /**
  * What a peak light of unit power at a direction adds to the split estimate beyond what the
  * layers gave of it, per view `r` of `rows`, angle `alpha` from the mirror direction (`pi x^2`,
- * `x = (j + 1/2) / KERNEL_STEPS`) and azimuth `beta` about it (`cos beta = 2 (b + 1/2) /
- * AZIMUTH_STEPS - 1`, 0 in the plane of the normal and the view towards the normal's side... by
- * the table's symmetry one half of the azimuths): the table's `(f - f_d) cos theta_i` at that
+ * `x = (j + 1/2) / ANGLE_STEPS`) and azimuth `beta` about it (`cos beta = 2 (b + 1/2) /
+ * AZIMUTH_STEPS - 1`: 1 towards the normal in the plane of the normal and the view, -1 towards
+ * the horizon; the table's symmetry across that plane leaves `|beta|`): the table's `(f - f_d) cos theta_i` at that
  * direction (0 below the horizon) less the mixture's kernel there times the view's albedo (the
- * layers hold the light too, horizon or not). RGBA texels, `KERNEL_STEPS x AZIMUTH_STEPS x
+ * layers hold the light too, horizon or not). RGBA texels, `ANGLE_STEPS x AZIMUTH_STEPS x
  * rows` (alpha fastest): the shader reads it once per light, filtered linearly, in place of the
  * table and the kernels. `table` is lobeMixture's, `kernels` mixtureKernels'.
  */
 export function lightCorrections(merl, size, phiDRange, diffuse, rows, table, kernels) {
-    const out = new Float32Array(4 * KERNEL_STEPS * AZIMUTH_STEPS * rows);
+    const out = new Float32Array(4 * ANGLE_STEPS * AZIMUTH_STEPS * rows);
     for (let r = 0; r < rows; r++) {
-        const cosO = 1 - (r + 0.5) / rows;
-        const sinO = Math.sqrt(Math.max(1 - cosO * cosO, 0));
-        const wo = [sinO, 0, cosO];
-        const mirror = [-sinO, 0, cosO];
+        const { cosO, sinO, wo, mirror } = viewOf(r, rows);
         // About the mirror direction: e1 in the plane of the normal and the view, e2 across it.
         const e1 = [cosO, 0, sinO];
         const albedo = [table[4 * r], table[4 * r + 1], table[4 * r + 2]];
         for (let b = 0; b < AZIMUTH_STEPS; b++) {
             const cosB = (2 * (b + 0.5)) / AZIMUTH_STEPS - 1;
             const sinB = Math.sqrt(Math.max(1 - cosB * cosB, 0));
-            for (let j = 0; j < KERNEL_STEPS; j++) {
-                const alpha = Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2;
+            for (let j = 0; j < ANGLE_STEPS; j++) {
+                const alpha = Math.PI * ((j + 0.5) / ANGLE_STEPS) ** 2;
                 const [ca, sa] = [Math.cos(alpha), Math.sin(alpha)];
                 const wi = [0, 1, 2].map((c) => ca * mirror[c] + sa * cosB * e1[c] + (c === 1 ? sa * sinB : 0));
                 const f = wi[2] > 0 ? merlBrdf(merl, size, phiDRange, wi, wo) : [0, 0, 0];
-                const kernel = kernels[r * KERNEL_STEPS + j];
-                const at = 4 * ((r * AZIMUTH_STEPS + b) * KERNEL_STEPS + j);
+                const kernel = kernels[r * ANGLE_STEPS + j];
+                const at = 4 * ((r * AZIMUTH_STEPS + b) * ANGLE_STEPS + j);
                 for (let c = 0; c < 3; c++) out[at + c] = (wi[2] > 0 ? (f[c] - diffuse[c]) * wi[2] : 0) - albedo[c] * kernel;
                 out[at + 3] = 1;
             }

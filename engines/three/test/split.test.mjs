@@ -10,7 +10,7 @@ import { test } from 'node:test';
 
 import {
     AZIMUTH_STEPS,
-    KERNEL_STEPS,
+    ANGLE_STEPS,
     MAX_PEAK_LIGHTS,
     NEAR_MIN_DEGREES,
     effectiveExponents,
@@ -112,10 +112,10 @@ test("the mixture's kernel is its weights' Phong kernels, and read through the b
     out[4 * rows + 4 + 1] = 0.5;
     const kernels = mixtureKernels(out, rows, exponents);
     for (const j of [0, 5, 20, 40]) {
-        const c = Math.cos(Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2);
+        const c = Math.cos(Math.PI * ((j + 0.5) / ANGLE_STEPS) ** 2);
         const phong = (n) => (c > 0 ? ((n + 1) / (2 * Math.PI)) * c ** n : 0);
         assert.ok(Math.abs(kernels[j] - phong(4)) < 1e-6, `view 0, texel ${j}`);
-        assert.ok(Math.abs(kernels[KERNEL_STEPS + j] - (phong(1) + phong(16)) / 2) < 1e-6, `view 1, texel ${j}`);
+        assert.ok(Math.abs(kernels[ANGLE_STEPS + j] - (phong(1) + phong(16)) / 2) < 1e-6, `view 1, texel ${j}`);
     }
     // A tent one texel wide along each axis adds the spread (pi / H)^2 / 6; an exponent past any
     // texel's reach reads as the texel's own width.
@@ -137,7 +137,7 @@ test("a peak light's correction is none where the mixture is the table, the laye
     }
     const kernels = mixtureKernels(out, rows, exponents);
     const corrections = lightCorrections(phongTable(albedo, n), SIZE, Math.PI, [0, 0, 0], rows, out, kernels);
-    assert.equal(corrections.length, 4 * KERNEL_STEPS * AZIMUTH_STEPS * rows);
+    assert.equal(corrections.length, 4 * ANGLE_STEPS * AZIMUTH_STEPS * rows);
     const peak = (albedo * (n + 1)) / (2 * Math.PI);
     let [above, below, worst] = [0, 0, 0];
     for (let r = 0; r < rows; r++) {
@@ -145,16 +145,16 @@ test("a peak light's correction is none where the mixture is the table, the laye
         const sinO = Math.sqrt(1 - cosO * cosO);
         for (let b = 0; b < AZIMUTH_STEPS; b++) {
             const cosB = (2 * (b + 0.5)) / AZIMUTH_STEPS - 1;
-            for (let j = 0; j < KERNEL_STEPS; j++) {
-                const alpha = Math.PI * ((j + 0.5) / KERNEL_STEPS) ** 2;
+            for (let j = 0; j < ANGLE_STEPS; j++) {
+                const alpha = Math.PI * ((j + 0.5) / ANGLE_STEPS) ** 2;
                 // The light's height above the surface: its direction's z in the view's frame.
                 const z = Math.cos(alpha) * cosO + Math.sin(alpha) * cosB * sinO;
-                const v = corrections[4 * ((r * AZIMUTH_STEPS + b) * KERNEL_STEPS + j)];
+                const v = corrections[4 * ((r * AZIMUTH_STEPS + b) * ANGLE_STEPS + j)];
                 if (z > 0.2) {
                     worst = Math.max(worst, Math.abs(v) / peak);
                     above++;
                 } else if (z < 0) {
-                    assert.ok(Math.abs(v + albedo * kernels[r * KERNEL_STEPS + j]) < 1e-6, `view ${r}, azimuth ${b}, texel ${j}`);
+                    assert.ok(Math.abs(v + albedo * kernels[r * ANGLE_STEPS + j]) < 1e-6, `view ${r}, azimuth ${b}, texel ${j}`);
                     below++;
                 }
             }
